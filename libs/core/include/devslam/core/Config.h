@@ -1,0 +1,36 @@
+#pragma once
+/// INI helpers on top of MRPT's config classes: load a file with a clear error, and report
+/// keys that no loader knows (a typo in an INI must not be silently ignored).
+///
+/// Usage:
+///   auto cfg = devslam::core::loadIni("config_ini/tum_fr1.ini");
+///   opts.loadFromConfigFile(*cfg, "tracking");
+///   devslam::core::requireKnownKeys(*cfg, "tracking", {"n_features", "scale_factor"}, path);
+
+#include <mrpt/config/CConfigFileMemory.h>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace devslam::core {
+
+/// Reads an INI file into memory (never written back). Throws std::runtime_error naming
+/// the path when it is missing or unreadable.
+[[nodiscard]] std::unique_ptr<mrpt::config::CConfigFileMemory> loadIni(const std::string& path);
+
+/// Keys of `section` that are not in `known` (case-sensitive, MRPT keys are).
+[[nodiscard]] std::vector<std::string> unknownKeys(const mrpt::config::CConfigFileBase& cfg,
+                                                   const std::string& section,
+                                                   const std::vector<std::string>& known);
+
+/// Throws std::invalid_argument "<source> [section]: unknown key 'x' (known: a, b, c)"
+/// when the section holds a key that is not in `known`.
+void requireKnownKeys(const mrpt::config::CConfigFileBase& cfg, const std::string& section,
+                      const std::vector<std::string>& known, const std::string& source = "INI");
+
+/// Throws std::invalid_argument naming section and key when `ok` is false.
+void requireValue(bool ok, const std::string& section, const std::string& key,
+                  const std::string& what);
+
+}  // namespace devslam::core

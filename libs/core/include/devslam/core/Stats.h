@@ -1,0 +1,19 @@
+#pragma once
+/// Summary statistics as the TUM benchmark tools print them (numpy semantics:
+/// median of an even count = mean of the two middle values, std = population std).
+
+#include <vector>
+
+namespace devslam::core {
+
+struct Summary {
+    std::size_t count = 0;
+    double rmse = 0, mean = 0, median = 0, std = 0, min = 0, max = 0;
+};
+
+/// Summary of `v`; all zero for an empty vector.
+[[nodiscard]] Summary summarize(const std::vector<double>& v);
+/// Median (numpy.median); 0 for an empty vector.
+[[nodiscard]] double median(std::vector<double> v);
+
+}  // namespace devslam::core

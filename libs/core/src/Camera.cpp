@@ -1,0 +1,124 @@
+#include <devslam/core/Camera.h>
+#include <devslam/core/Config.h>
+
+#include <mrpt/config/CConfigFileBase.h>
+#include <mrpt/img/TCamera.h>
+
+#include <map>
+#include <stdexcept>
+
+namespace devslam::core {
+namespace {
+
+// Published calibrations of the TUM RGB-D benchmark
+// (https://cvg.cit.tum.de/data/datasets/rgbd-dataset/file_formats#intrinsic_camera_calibration_of_the_kinect).
+const std::map<std::string, CameraIntrinsics>& presets() {
+    static const std::map<std::string, CameraIntrinsics> kPresets = [] {
+        std::map<std::string, CameraIntrinsics> m;
+        CameraIntrinsics fr1;
+        fr1.fx = 517.3, fr1.fy = 516.5, fr1.cx = 318.6, fr1.cy = 255.3;
+        fr1.dist = {0.2624, -0.9531, -0.0054, 0.0026, 1.1633};
+        CameraIntrinsics fr2;
+        fr2.fx = 520.9, fr2.fy = 521.0, fr2.cx = 325.1, fr2.cy = 249.7;
+        fr2.dist = {0.2312, -0.7849, -0.0033, -0.0001, 0.9172};
+        CameraIntrinsics fr3;  // fr3 images are already undistorted
+        fr3.fx = 535.4, fr3.fy = 539.2, fr3.cx = 320.1, fr3.cy = 247.6;
+        CameraIntrinsics ros;  // ROS / OpenNI default
+        m["freiburg1"] = fr1;
+        m["freiburg2"] = fr2;
+        m["freiburg3"] = fr3;
+        m["ros_default"] = ros;
+        m["fr1"] = fr1;
+        m["fr2"] = fr2;
+        m["fr3"] = fr3;
+        return m;
+    }();
+    return kPresets;
+}
+
+}  // namespace
+
+std::vector<std::string> CameraIntrinsics::presetNames() {
+    std::vector<std::string> names;
+    for (const auto& [name, k] : presets()) names.push_back(name);
+    return names;
+}
+
+CameraIntrinsics CameraIntrinsics::fromPreset(const std::string& name) {
+    const auto it = presets().find(name);
+    if (it == presets().end()) {
+        std::string known;
+        for (const auto& n : presetNames()) known += (known.empty() ? "" : ", ") + n;
+        throw std::invalid_argument("unknown camera preset '" + name + "' (known: " + known + ")");
+    }
+    return it->second;
+}
+
+CameraIntrinsics CameraIntrinsics::fromConfig(const mrpt::config::CConfigFileBase& c,
+                                              const std::string& s) {
+    requireKnownKeys(c, s, {"preset", "fx", "fy", "cx", "cy", "width", "height", "dist"},
+                     "camera");
+    CameraIntrinsics K;
+    const std::string preset = c.read_string(s, "preset", "");
+    const bool has_preset = !preset.empty();
+    if (has_preset) K = fromPreset(preset);
+    K.fx = c.read_double(s, "fx", K.fx, !has_preset);
+    K.fy = c.read_double(s, "fy", K.fy, !has_preset);
+    K.cx = c.read_double(s, "cx", K.cx, !has_preset);
+    K.cy = c.read_double(s, "cy", K.cy, !has_preset);
+    K.width = c.read_int(s, "width", K.width);
+    K.height = c.read_int(s, "height", K.height);
+    std::vector<double> d(K.dist.begin(), K.dist.end());
+    c.read_vector(s, "dist", d, d);
+    requireValue(d.size() == 5, s, "dist", "must have 5 values k1 k2 p1 p2 k3");
+    std::copy(d.begin(), d.end(), K.dist.begin());
+    requireValue(K.fx > 0 && K.fy > 0, s, "fx/fy", "must be > 0");
+    requireValue(K.width > 0 && K.height > 0, s, "width/height", "must be > 0");
+    requireValue(K.cx >= 0 && K.cx < K.width && K.cy >= 0 && K.cy < K.height, s, "cx/cy",
+                 "must lie inside the image");
+    return K;
+}
+
+void CameraIntrinsics::saveToConfig(mrpt::config::CConfigFileBase& c, const std::string& s) const {
+    c.write(s, "fx", fx);
+    c.write(s, "fy", fy);
+    c.write(s, "cx", cx);
+    c.write(s, "cy", cy);
+    c.write(s, "width", width);
+    c.write(s, "height", height);
+    c.write(s, "dist", std::vector<double>(dist.begin(), dist.end()));
+}
+
+Eigen::Matrix3d CameraIntrinsics::matrix() const {
+    Eigen::Matrix3d M;
+    M << fx, 0, cx, 0, fy, cy, 0, 0, 1;
+    return M;
+}
+
+mrpt::img::TCamera CameraIntrinsics::toMrpt() const {
+    mrpt::img::TCamera cam;
+    cam.ncols = static_cast<uint32_t>(width);
+    cam.nrows = static_cast<uint32_t>(height);
+    cam.setIntrinsicParamsFromValues(fx, fy, cx, cy);
+    cam.setDistortionPlumbBob(dist[0], dist[1], dist[2], dist[3], dist[4]);
+    return cam;
+}
+
+CameraIntrinsics CameraIntrinsics::fromMrpt(const mrpt::img::TCamera& cam) {
+    CameraIntrinsics K;
+    K.fx = cam.fx();
+    K.fy = cam.fy();
+    K.cx = cam.cx();
+    K.cy = cam.cy();
+    K.width = static_cast<int>(cam.ncols);
+    K.height = static_cast<int>(cam.nrows);
+    K.dist = {cam.k1(), cam.k2(), cam.p1(), cam.p2(), cam.k3()};
+    return K;
+}
+
+bool CameraIntrinsics::operator==(const CameraIntrinsics& o) const {
+    return fx == o.fx && fy == o.fy && cx == o.cx && cy == o.cy && width == o.width &&
+           height == o.height && dist == o.dist;
+}
+
+}  // namespace devslam::core

@@ -1,0 +1,31 @@
+#include <devslam/core/Frame.h>
+
+#include <opencv2/core.hpp>
+
+#include <stdexcept>
+
+namespace devslam::core {
+
+cv::Mat Frame::rawDepth16() const {
+    cv::Mat raw;
+    // convertTo rounds to nearest and saturates, so a depth read from uint16 comes back exact.
+    depth.convertTo(raw, CV_16U, depth_scale);
+    return raw;
+}
+
+void validateFrame(const Frame& f, const std::string& what) {
+    auto fail = [&](const std::string& msg) { throw std::runtime_error(what + ": " + msg); };
+    if (f.bgr.empty()) fail("colour image is empty");
+    if (f.bgr.type() != CV_8UC3) fail("colour image must be 8-bit 3-channel (BGR)");
+    if (f.depth.empty()) fail("depth image is empty");
+    if (f.depth.type() != CV_32FC1) fail("depth must be float metres (CV_32FC1)");
+    if (f.depth.size() != f.bgr.size())
+        fail("depth is " + std::to_string(f.depth.cols) + "x" + std::to_string(f.depth.rows) +
+             " but colour is " + std::to_string(f.bgr.cols) + "x" + std::to_string(f.bgr.rows));
+    if (f.K.width != f.bgr.cols || f.K.height != f.bgr.rows)
+        fail("intrinsics are for " + std::to_string(f.K.width) + "x" + std::to_string(f.K.height) +
+             " but the image is " + std::to_string(f.bgr.cols) + "x" + std::to_string(f.bgr.rows));
+    if (!(f.depth_scale > 0)) fail("depth_scale must be > 0");
+}
+
+}  // namespace devslam::core

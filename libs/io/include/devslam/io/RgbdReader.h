@@ -1,0 +1,59 @@
+#pragma once
+/// One interface for every RGB-D source (TUM folders, MRPT rawlogs, rendered sequences).
+///
+/// Usage:
+///   auto reader = devslam::io::openRgbd("data/tum/fr1_xyz_first37", {});
+///   while (auto f = reader->next()) { process(*f); }
+///   if (auto gt = reader->groundTruth()) { ... }
+/// Not thread-safe.
+
+#include <devslam/core/Camera.h>
+#include <devslam/core/Frame.h>
+#include <devslam/core/Trajectory.h>
+
+#include <memory>
+#include <optional>
+#include <string>
+
+namespace mrpt::config {
+class CConfigFileBase;
+}
+
+namespace devslam::io {
+
+/// Options shared by the readers; `[dataset]` in an experiment INI.
+struct ReaderOptions {
+    /// Camera preset or "auto": for TUM folders "auto" picks freiburg1/2/3 from the folder
+    /// name ("rgbd_dataset_freiburg1_xyz", "fr1_xyz_first37"); for rawlogs it uses the
+    /// calibration stored in the observations.
+    std::string camera = "auto";
+    /// Used instead of `camera` when set (e.g. from an INI `[camera]` section).
+    std::optional<core::CameraIntrinsics> intrinsics;
+    double max_dt = 0.02;           ///< [s] rgb-depth association window (TUM associate.py)
+    double tum_depth_scale = 5000;  ///< [units/m] TUM depth PNG scale
+    std::string sensor_label;       ///< rawlog: only observations with this label ("" = all)
+
+    void loadFromConfig(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
+};
+
+class RgbdReader {
+public:
+    virtual ~RgbdReader() = default;
+    /// The next frame, or std::nullopt at the end. Throws std::runtime_error naming the file
+    /// (and line or observation index) when the data is damaged.
+    [[nodiscard]] virtual std::optional<core::Frame> next() = 0;
+    /// Number of frames if known up front (TUM: yes; rawlog: counted while opening).
+    [[nodiscard]] virtual std::optional<std::size_t> size() const = 0;
+    /// Ground truth if the source has it (TUM groundtruth.txt).
+    [[nodiscard]] virtual std::optional<core::Trajectory> groundTruth() const { return std::nullopt; }
+    /// Intrinsics the frames will carry.
+    [[nodiscard]] virtual core::CameraIntrinsics intrinsics() const = 0;
+    [[nodiscard]] virtual std::string describe() const = 0;
+};
+
+/// A TUM folder (has rgb.txt) or a `.rawlog` file, chosen by what `path` is. Throws
+/// std::runtime_error with the path when it is neither.
+[[nodiscard]] std::unique_ptr<RgbdReader> openRgbd(const std::string& path,
+                                                   const ReaderOptions& opts = {});
+
+}  // namespace devslam::io

@@ -1,0 +1,39 @@
+#pragma once
+/// Writes frames as a TUM RGB-D folder: rgb/<t>.png, depth/<t>.png (16-bit in the frame's
+/// own depth units, so a TUM source round-trips bit-exactly), rgb.txt, depth.txt, and
+/// optionally groundtruth.txt.
+///
+/// Usage:
+///   devslam::io::TumWriter out("out/seq");
+///   out.write(frame); ...; out.close();
+
+#include <devslam/core/Frame.h>
+#include <devslam/core/Trajectory.h>
+
+#include <cstdio>
+#include <memory>
+#include <string>
+
+namespace devslam::io {
+
+class TumWriter {
+public:
+    /// Creates the folder (and rgb/, depth/); throws if it cannot.
+    explicit TumWriter(std::string folder, const std::string& description = "devslam");
+    ~TumWriter();
+    TumWriter(const TumWriter&) = delete;
+    TumWriter& operator=(const TumWriter&) = delete;
+
+    /// Depth is written as round(depth * f.depth_scale); throws if a value exceeds 16 bits.
+    void write(const core::Frame& f);
+    void writeGroundTruth(const core::Trajectory& gt);
+    void close();
+    [[nodiscard]] std::size_t count() const { return count_; }
+
+private:
+    std::string folder_;
+    std::unique_ptr<std::FILE, int (*)(std::FILE*)> rgb_list_, depth_list_;
+    std::size_t count_ = 0;
+};
+
+}  // namespace devslam::io

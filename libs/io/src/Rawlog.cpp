@@ -1,0 +1,312 @@
+#include <devslam/io/Rawlog.h>
+
+#include <devslam/core/Pose.h>
+
+#include <mrpt/img/CImage.h>
+#include <mrpt/io/CFileGZInputStream.h>
+#include <mrpt/io/CFileGZOutputStream.h>
+#include <mrpt/obs/CActionCollection.h>
+#include <mrpt/obs/CActionRobotMovement2D.h>
+#include <mrpt/obs/CObservation3DRangeScan.h>
+#include <mrpt/obs/CSensoryFrame.h>
+#include <mrpt/serialization/CArchive.h>
+#include <mrpt/system/filesystem.h>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <stdexcept>
+
+namespace fs = std::filesystem;
+using mrpt::obs::CObservation3DRangeScan;
+
+namespace devslam::io {
+
+std::string rawlogImagesDir(const std::string& rawlog_path) {
+    const fs::path p(rawlog_path);
+    const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
+    return (dir / (p.stem().string() + "_Images")).string();
+}
+
+namespace {
+
+// Optical frame of MRPT's 3D-scan depth camera, seen from the observation frame (X forward,
+// Y left, Z up): the (0,0,0,-90deg,0,-90deg) rotation of CObservation3DRangeScan.
+const mrpt::poses::CPose3D& opticalInObs() {
+    static const mrpt::poses::CPose3D kPose(0, 0, 0, -M_PI / 2, 0, -M_PI / 2);
+    return kPose;
+}
+
+double roundedScale(float range_units) {
+    const double s = 1.0 / static_cast<double>(range_units);
+    return std::abs(s - std::round(s)) < 1e-3 * s ? std::round(s) : s;
+}
+
+// Depth image in metres in the depth camera (range_is_depth handled).
+cv::Mat depthInDepthCamera(const CObservation3DRangeScan& o) {
+    const int H = static_cast<int>(o.rangeImage.rows()), W = static_cast<int>(o.rangeImage.cols());
+    const cv::Mat raw(H, W, CV_16UC1, const_cast<uint16_t*>(o.rangeImage.data()));
+    cv::Mat m;
+    raw.convertTo(m, CV_32F, o.rangeUnits);
+    if (!o.range_is_depth) {  // Euclidean range along the pixel ray -> z
+        const auto& c = o.cameraParams;
+        for (int v = 0; v < H; ++v)
+            for (int u = 0; u < W; ++u) {
+                const double x = (u - c.cx()) / c.fx(), y = (v - c.cy()) / c.fy();
+                m.at<float>(v, u) /= static_cast<float>(std::sqrt(1 + x * x + y * y));
+            }
+    }
+    return m;
+}
+
+// Reprojects depth from the depth camera into the colour camera (z-buffered, nearest pixel).
+cv::Mat registerDepth(const CObservation3DRangeScan& o, const cv::Mat& depth, int W, int H) {
+    const auto& dc = o.cameraParams;
+    const auto& ic = o.cameraParamsIntensity;
+    // colour optical <- depth optical
+    const mrpt::poses::CPose3D T = (o.relativePoseIntensityWRTDepth - opticalInObs());
+    const Eigen::Isometry3d Tci = core::toIsometry(T).inverse();
+    cv::Mat out(H, W, CV_32F, cv::Scalar(0));
+    for (int v = 0; v < depth.rows; ++v)
+        for (int u = 0; u < depth.cols; ++u) {
+            const float z = depth.at<float>(v, u);
+            if (!(z > 0)) continue;
+            const Eigen::Vector3d p((u - dc.cx()) * z / dc.fx(), (v - dc.cy()) * z / dc.fy(), z);
+            const Eigen::Vector3d q = Tci * p;
+            if (q.z() <= 0) continue;
+            const int ui = static_cast<int>(std::lround(ic.fx() * q.x() / q.z() + ic.cx()));
+            const int vi = static_cast<int>(std::lround(ic.fy() * q.y() / q.z() + ic.cy()));
+            if (ui < 0 || vi < 0 || ui >= W || vi >= H) continue;
+            float& d = out.at<float>(vi, ui);
+            if (d == 0 || q.z() < d) d = static_cast<float>(q.z());
+        }
+    return out;
+}
+
+}  // namespace
+
+core::Frame frameFromObservation(const CObservation3DRangeScan& o, const std::string& what) {
+    if (!o.hasIntensityImage || o.intensityImage.isEmpty())
+        throw std::runtime_error(what + ": observation has no colour image");
+    if (!o.hasRangeImage || o.rangeImage.rows() == 0)
+        throw std::runtime_error(what + ": observation has no depth image");
+    core::Frame f;
+    f.timestamp = mrpt::Clock::toDouble(o.timestamp);
+    const cv::Mat& img = o.intensityImage.asCvMatRef();
+    if (img.channels() == 3) f.bgr = img.clone();  // CImage colour is BGR
+    else cv::cvtColor(img, f.bgr, cv::COLOR_GRAY2BGR);
+    if (f.bgr.depth() != CV_8U)
+        throw std::runtime_error(what + ": colour image must be 8 bits per channel");
+
+    // Values 1..13 with millimetre units are MRPT's rgbd_dataset2rawlog bug (metres truncated
+    // into uint16); refuse them instead of producing a wall 1 mm in front of the camera.
+    uint16_t max_raw = 0;
+    for (std::size_t k = 0; k < static_cast<std::size_t>(o.rangeImage.size()); ++k) max_raw = std::max(max_raw, o.rangeImage.data()[k]);
+    if (max_raw > 0 && max_raw < 20 && o.rangeUnits >= 0.0005f)
+        throw std::runtime_error(what + ": depth values are at most " + std::to_string(max_raw) +
+                                 " units of " + std::to_string(o.rangeUnits) +
+                                 " m: metres truncated to integers (MRPT rgbd_dataset2rawlog bug)?");
+    f.depth_scale = roundedScale(o.rangeUnits);
+    const cv::Mat depth = depthInDepthCamera(o);
+    const bool same_camera =
+        o.doDepthAndIntensityCamerasCoincide() &&
+        o.cameraParams.fx() == o.cameraParamsIntensity.fx() &&
+        o.cameraParams.fy() == o.cameraParamsIntensity.fy() &&
+        o.cameraParams.cx() == o.cameraParamsIntensity.cx() &&
+        o.cameraParams.cy() == o.cameraParamsIntensity.cy() && depth.size() == f.bgr.size();
+    f.depth = same_camera ? depth : registerDepth(o, depth, f.bgr.cols, f.bgr.rows);
+    f.K = core::CameraIntrinsics::fromMrpt(o.cameraParamsIntensity);
+    f.K.width = f.bgr.cols;
+    f.K.height = f.bgr.rows;
+    f.rgb_source = what;
+    f.depth_source = what;
+    return f;
+}
+
+// ---------------------------------------------------------------------------------------
+struct RawlogReader::Stream {
+    explicit Stream(const std::string& path) : file(path), arch(mrpt::serialization::archiveFrom(file)) {}
+    mrpt::io::CFileGZInputStream file;
+    mrpt::serialization::CArchiveStreamBase<mrpt::io::CFileGZInputStream> arch;
+    std::vector<CObservation3DRangeScan::Ptr> pending;  // from the current sensory frame
+    std::size_t objects = 0;
+
+    // Next 3D scan (optionally of one sensor label); nullptr at a clean end. Counts other
+    // observations in `skipped`. Throws on damage.
+    CObservation3DRangeScan::Ptr next(const std::string& label, std::size_t& skipped,
+                                      bool& saw_sf, bool& saw_obs) {
+        for (;;) {
+            while (!pending.empty()) {
+                auto o = pending.front();
+                pending.erase(pending.begin());
+                if (label.empty() || o->sensorLabel == label) return o;
+                ++skipped;
+            }
+            mrpt::serialization::CSerializable::Ptr obj;
+            const uint64_t pos = file.getPosition();
+            try {
+                obj = arch.ReadObject();
+            } catch (const mrpt::serialization::CExceptionEOF&) {
+                if (file.getPosition() == pos && file.checkEOF()) return nullptr;  // clean end
+                throw std::runtime_error("truncated object at byte " + std::to_string(pos));
+            } catch (const std::exception& e) {
+                throw std::runtime_error("cannot decode object at byte " + std::to_string(pos) +
+                                         ": " + std::string(e.what()).substr(0, 300));
+            }
+            ++objects;
+            if (auto sf = std::dynamic_pointer_cast<mrpt::obs::CSensoryFrame>(obj)) {
+                saw_sf = true;
+                for (const auto& o : *sf) {
+                    if (auto o3 = std::dynamic_pointer_cast<CObservation3DRangeScan>(o))
+                        pending.push_back(o3);
+                    else ++skipped;
+                }
+            } else if (auto o3 = std::dynamic_pointer_cast<CObservation3DRangeScan>(obj)) {
+                saw_obs = true;
+                pending.push_back(o3);
+            } else if (std::dynamic_pointer_cast<mrpt::obs::CActionCollection>(obj)) {
+                saw_sf = true;
+            } else {
+                if (std::dynamic_pointer_cast<mrpt::obs::CObservation>(obj)) saw_obs = true;
+                ++skipped;
+            }
+        }
+    }
+};
+
+RawlogReader::RawlogReader(std::string path, const ReaderOptions& opts, bool allow_truncated)
+    : path_(std::move(path)), opts_(opts) {
+    if (!fs::is_regular_file(path_)) throw std::runtime_error(path_ + ": rawlog file not found");
+    mrpt::img::CImage::setImagesPathBase(rawlogImagesDir(path_));
+    // Scan once: count frames, find damage, take the intrinsics of the first frame.
+    std::size_t skipped = 0;
+    bool saw_sf = false, saw_obs = false;
+    try {
+        Stream s(path_);
+        while (auto o = s.next(opts_.sensor_label, skipped, saw_sf, saw_obs)) {
+            if (n_frames_ == 0) {
+                o->load();
+                K_ = frameFromObservation(*o, path_ + " observation 0").K;
+                o->unload();
+            }
+            ++n_frames_;
+        }
+    } catch (const std::exception& e) {
+        damage_ = path_ + ": " + e.what() + " after " + std::to_string(n_frames_) +
+                  " RGB-D observations";
+        if (!allow_truncated || n_frames_ == 0) throw std::runtime_error(damage_);
+    }
+    n_skipped_ = skipped;
+    format_ = saw_sf ? "action/sensory-frame" : "observations-only";
+    if (n_frames_ == 0)
+        throw std::runtime_error(path_ + ": no CObservation3DRangeScan" +
+                                 (opts_.sensor_label.empty() ? std::string()
+                                                             : " with label '" + opts_.sensor_label + "'") +
+                                 " (" + std::to_string(skipped) + " other observations)");
+    if (opts_.intrinsics) K_ = *opts_.intrinsics;
+    stream_ = std::make_unique<Stream>(path_);
+}
+
+RawlogReader::~RawlogReader() = default;
+
+std::optional<core::Frame> RawlogReader::next() {
+    if (n_read_ >= n_frames_) return std::nullopt;
+    std::size_t skipped = 0;
+    bool sf = false, ob = false;
+    auto o = stream_->next(opts_.sensor_label, skipped, sf, ob);
+    if (!o) return std::nullopt;
+    const std::string what = path_ + " observation " + std::to_string(n_read_);
+    mrpt::img::CImage::setImagesPathBase(rawlogImagesDir(path_));
+    o->load();
+    core::Frame f = frameFromObservation(*o, what);
+    o->unload();
+    if (opts_.intrinsics) f.K = *opts_.intrinsics;
+    f.index = n_read_++;
+    return f;
+}
+
+std::string RawlogReader::describe() const {
+    return "rawlog " + path_ + " (" + format_ + ", " + std::to_string(n_frames_) +
+           " RGB-D observations" + (damage_.empty() ? "" : ", DAMAGED: " + damage_) + ")";
+}
+
+// ---------------------------------------------------------------------------------------
+struct RawlogWriter::Stream {
+    explicit Stream(const std::string& path, int level) {
+        if (!file.open(path, level))
+            throw std::runtime_error("cannot write rawlog '" + path + "'");
+    }
+    mrpt::io::CFileGZOutputStream file;
+};
+
+RawlogWriter::RawlogWriter(std::string path, const RawlogWriterOptions& opts)
+    : path_(std::move(path)), opts_(opts) {
+    if (opts_.compression < 0 || opts_.compression > 9)
+        throw std::invalid_argument("rawlog compression must be 0..9, got " +
+                                    std::to_string(opts_.compression));
+    stream_ = std::make_unique<Stream>(path_, opts_.compression);
+    if (opts_.external_images) {
+        images_dir_ = rawlogImagesDir(path_);
+        fs::create_directories(images_dir_);
+    }
+}
+
+RawlogWriter::~RawlogWriter() {
+    try {
+        close();
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "RawlogWriter: %s\n", e.what());
+    }
+}
+
+void RawlogWriter::write(const core::Frame& f) {
+    if (!stream_) throw std::logic_error("RawlogWriter::write after close: " + path_);
+    core::validateFrame(f, f.rgb_source.empty() ? "frame" : f.rgb_source);
+    auto obs = CObservation3DRangeScan::Create();
+    obs->sensorLabel = opts_.sensor_label;
+    obs->timestamp = mrpt::Clock::fromDouble(f.timestamp);
+    obs->range_is_depth = true;
+    obs->hasIntensityImage = true;
+    obs->intensityImage = mrpt::img::CImage(f.bgr, mrpt::img::DEEP_COPY);
+    obs->intensityImageChannel = CObservation3DRangeScan::CH_VISIBLE;
+    const cv::Mat raw = f.rawDepth16();
+    obs->rangeImage_setSize(raw.rows, raw.cols);
+    for (int r = 0; r < raw.rows; ++r) {
+        const auto* src = raw.ptr<uint16_t>(r);
+        for (int c = 0; c < raw.cols; ++c) obs->rangeImage(r, c) = src[c];
+    }
+    obs->hasRangeImage = true;
+    obs->rangeUnits = static_cast<float>(1.0 / f.depth_scale);
+    obs->maxRange = 65535.0f / static_cast<float>(f.depth_scale);
+    obs->cameraParams = f.K.toMrpt();
+    obs->cameraParamsIntensity = obs->cameraParams;  // registered
+    obs->relativePoseIntensityWRTDepth = opticalInObs();
+    if (opts_.external_images) {
+        const std::string base = "frame_" + std::to_string(count_);
+        mrpt::img::CImage::setImagesPathBase(images_dir_);
+        obs->intensityImage.saveToFile(images_dir_ + "/" + base + "_rgb.png");
+        obs->intensityImage.setExternalStorage(base + "_rgb.png");
+        obs->rangeImage_convertToExternalStorage(base + "_depth.bin", images_dir_ + "/");
+    }
+    auto arch = mrpt::serialization::archiveFrom(stream_->file);
+    if (opts_.sensory_frames) {
+        mrpt::obs::CActionCollection acts;  // no odometry: an empty action keeps the layout
+        mrpt::obs::CSensoryFrame sf;
+        sf.insert(obs);
+        arch << acts << sf;
+    } else {
+        arch << *obs;
+    }
+    ++count_;
+}
+
+void RawlogWriter::close() {
+    if (!stream_) return;
+    stream_->file.close();
+    stream_.reset();
+}
+
+}  // namespace devslam::io

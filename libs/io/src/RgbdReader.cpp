@@ -1,0 +1,37 @@
+#include <devslam/io/Rawlog.h>
+#include <devslam/io/RgbdReader.h>
+#include <devslam/io/TumReader.h>
+
+#include <devslam/core/Config.h>
+
+#include <mrpt/config/CConfigFileBase.h>
+
+#include <filesystem>
+#include <stdexcept>
+
+namespace fs = std::filesystem;
+
+namespace devslam::io {
+
+void ReaderOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, const std::string& s) {
+    core::requireKnownKeys(c, s, {"camera", "max_dt", "tum_depth_scale", "sensor_label"}, "dataset");
+    camera = c.read_string(s, "camera", camera);
+    max_dt = c.read_double(s, "max_dt", max_dt);
+    tum_depth_scale = c.read_double(s, "tum_depth_scale", tum_depth_scale);
+    sensor_label = c.read_string(s, "sensor_label", sensor_label);
+    core::requireValue(max_dt > 0, s, "max_dt", "must be > 0 s");
+    core::requireValue(tum_depth_scale > 0, s, "tum_depth_scale", "must be > 0");
+    if (camera != "auto") (void)core::CameraIntrinsics::fromPreset(camera);  // throws if unknown
+}
+
+std::unique_ptr<RgbdReader> openRgbd(const std::string& path, const ReaderOptions& opts) {
+    if (fs::is_directory(path)) {
+        if (!fs::exists(fs::path(path) / "rgb.txt"))
+            throw std::runtime_error(path + ": folder has no rgb.txt (not a TUM RGB-D folder)");
+        return std::make_unique<TumReader>(path, opts);
+    }
+    if (fs::is_regular_file(path)) return std::make_unique<RawlogReader>(path, opts);
+    throw std::runtime_error(path + ": no such TUM folder or rawlog file");
+}
+
+}  // namespace devslam::io

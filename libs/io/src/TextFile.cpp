@@ -1,0 +1,46 @@
+#include "TextFile.h"
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+namespace devslam::io::detail {
+
+void forEachDataLine(const std::string& path,
+                     const std::function<void(int, const std::vector<std::string>&)>& fn) {
+    std::ifstream in(path);
+    if (!in) throw std::runtime_error("cannot open '" + path + "'");
+    std::string line;
+    int n = 0;
+    while (std::getline(in, line)) {
+        ++n;
+        const auto hash = line.find('#');
+        if (hash != std::string::npos) line.resize(hash);
+        std::istringstream ss(line);
+        std::vector<std::string> tokens;
+        for (std::string t; ss >> t;) tokens.push_back(t);
+        if (!tokens.empty()) fn(n, tokens);
+    }
+    if (in.bad()) throw std::runtime_error("error reading '" + path + "'");
+}
+
+double parseNumber(const std::string& token, const std::string& path, int line,
+                   const std::string& what) {
+    std::size_t used = 0;
+    double v = 0;
+    try {
+        v = std::stod(token, &used);
+    } catch (const std::exception&) {
+        used = 0;
+    }
+    if (used != token.size() || !std::isfinite(v))
+        throw std::runtime_error(lineError(path, line, what + " '" + token + "' is not a number"));
+    return v;
+}
+
+std::string lineError(const std::string& path, int line, const std::string& msg) {
+    return path + " line " + std::to_string(line) + ": " + msg;
+}
+
+}  // namespace devslam::io::detail

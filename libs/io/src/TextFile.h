@@ -1,0 +1,23 @@
+#pragma once
+// Private helper: iterate over the data lines of a whitespace-separated text file with
+// '#' comments (the TUM list and trajectory formats).
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace devslam::io::detail {
+
+/// Calls fn(line_number, tokens) for each non-empty, non-comment line. Throws
+/// std::runtime_error "cannot open '<path>'" if the file cannot be read.
+void forEachDataLine(const std::string& path,
+                     const std::function<void(int, const std::vector<std::string>&)>& fn);
+
+/// Strict number parse (the whole token must be a finite number); throws
+/// std::runtime_error "<path> line N: <what> '<token>' is not a number".
+[[nodiscard]] double parseNumber(const std::string& token, const std::string& path, int line,
+                                 const std::string& what);
+
+[[nodiscard]] std::string lineError(const std::string& path, int line, const std::string& msg);
+
+}  // namespace devslam::io::detail

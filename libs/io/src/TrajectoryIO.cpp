@@ -1,0 +1,56 @@
+#include <devslam/io/TrajectoryIO.h>
+
+#include "TextFile.h"
+
+#include <devslam/core/Pose.h>
+
+#include <mrpt/math/CQuaternion.h>
+#include <mrpt/poses/CPose3DQuat.h>
+
+#include <cstdio>
+#include <memory>
+#include <stdexcept>
+
+namespace devslam::io {
+
+core::Trajectory readTumTrajectory(const std::string& path) {
+    core::Trajectory traj;
+    detail::forEachDataLine(path, [&](int line, const std::vector<std::string>& tok) {
+        if (tok.size() != 8)
+            throw std::runtime_error(detail::lineError(
+                path, line,
+                "expected 'timestamp tx ty tz qx qy qz qw' (8 values), got " +
+                    std::to_string(tok.size())));
+        double v[8];
+        static const char* kNames[8] = {"timestamp", "tx", "ty", "tz", "qx", "qy", "qz", "qw"};
+        for (int k = 0; k < 8; ++k) v[k] = detail::parseNumber(tok[k], path, line, kNames[k]);
+        if (!traj.empty() && v[0] <= traj.back().t)
+            throw std::runtime_error(detail::lineError(
+                path, line,
+                v[0] == traj.back().t ? "duplicate timestamp " + tok[0]
+                                      : "timestamp " + tok[0] + " is earlier than the previous"));
+        try {
+            traj.push_back({v[0], core::fromTum(v[1], v[2], v[3], v[4], v[5], v[6], v[7])});
+        } catch (const std::invalid_argument& e) {
+            throw std::runtime_error(detail::lineError(path, line, e.what()));
+        }
+    });
+    if (traj.empty()) throw std::runtime_error(path + ": no poses");
+    return traj;
+}
+
+void writeTumTrajectory(const std::string& path, const core::Trajectory& traj,
+                        const std::string& header_comment) {
+    std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(path.c_str(), "w"), &std::fclose);
+    if (!f) throw std::runtime_error("cannot write trajectory '" + path + "'");
+    if (!header_comment.empty()) std::fprintf(f.get(), "# %s\n", header_comment.c_str());
+    std::fprintf(f.get(), "# timestamp tx ty tz qx qy qz qw\n");
+    for (const auto& sp : traj) {
+        const mrpt::poses::CPose3DQuat q(sp.pose);
+        std::fprintf(f.get(), "%.6f %.9f %.9f %.9f %.9f %.9f %.9f %.9f\n", sp.t, q.x(), q.y(), q.z(),
+                     q.quat().x(), q.quat().y(), q.quat().z(), q.quat().r());
+    }
+    if (std::ferror(f.get())) throw std::runtime_error("error writing '" + path + "'");
+}
+
+}  // namespace devslam::io

@@ -1,0 +1,137 @@
+#include <devslam/io/TrajectoryIO.h>
+#include <devslam/io/TumReader.h>
+
+#include "TextFile.h"
+
+#include <devslam/core/Association.h>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <filesystem>
+#include <regex>
+#include <stdexcept>
+
+namespace fs = std::filesystem;
+
+namespace devslam::io {
+
+std::vector<TumListEntry> readTumList(const std::string& path) {
+    if (!fs::exists(path)) throw std::runtime_error(path + ": file not found");
+    std::vector<TumListEntry> out;
+    detail::forEachDataLine(path, [&](int line, const std::vector<std::string>& tok) {
+        if (tok.size() != 2)
+            throw std::runtime_error(detail::lineError(
+                path, line,
+                "expected 'timestamp filename', got " + std::to_string(tok.size()) + " fields"));
+        const double t = detail::parseNumber(tok[0], path, line, "timestamp");
+        if (!out.empty() && t <= out.back().t)
+            throw std::runtime_error(detail::lineError(
+                path, line,
+                (t == out.back().t ? "duplicate timestamp " : "unsorted timestamp ") + tok[0] +
+                    " (previous entry at line " + std::to_string(out.back().line) + ")"));
+        out.push_back({t, tok[1], line});
+    });
+    if (out.empty()) throw std::runtime_error(path + ": no entries");
+    return out;
+}
+
+std::optional<std::string> tumPresetFromName(const std::string& folder) {
+    static const std::regex kFr(R"((freiburg|fr)([123]))", std::regex::icase);
+    std::smatch m;
+    const std::string name = fs::path(folder).lexically_normal().filename().string().empty()
+                                 ? fs::path(folder).lexically_normal().parent_path().filename().string()
+                                 : fs::path(folder).lexically_normal().filename().string();
+    if (std::regex_search(name, m, kFr)) return "freiburg" + m[2].str();
+    return std::nullopt;
+}
+
+void loadTumImages(const std::string& rgb_path, const std::string& depth_path, double depth_scale,
+                   core::Frame& f) {
+    if (!fs::exists(rgb_path)) throw std::runtime_error(rgb_path + ": colour image not found");
+    if (!fs::exists(depth_path)) throw std::runtime_error(depth_path + ": depth image not found");
+    cv::Mat rgb = cv::imread(rgb_path, cv::IMREAD_UNCHANGED);
+    if (rgb.empty()) throw std::runtime_error(rgb_path + ": cannot decode colour image");
+    if (rgb.depth() != CV_8U)
+        throw std::runtime_error(rgb_path + ": colour image must be 8 bits per channel");
+    if (rgb.channels() == 1) cv::cvtColor(rgb, rgb, cv::COLOR_GRAY2BGR);
+    else if (rgb.channels() == 4) cv::cvtColor(rgb, rgb, cv::COLOR_BGRA2BGR);
+    cv::Mat raw = cv::imread(depth_path, cv::IMREAD_UNCHANGED);
+    if (raw.empty()) throw std::runtime_error(depth_path + ": cannot decode depth image");
+    if (raw.type() != CV_16UC1)
+        throw std::runtime_error(depth_path +
+                                 ": depth must be a 16-bit single-channel PNG (TUM format)");
+    if (raw.size() != rgb.size())
+        throw std::runtime_error(depth_path + ": depth is " + std::to_string(raw.cols) + "x" +
+                                 std::to_string(raw.rows) + " but " + rgb_path + " is " +
+                                 std::to_string(rgb.cols) + "x" + std::to_string(rgb.rows));
+    f.bgr = rgb;
+    raw.convertTo(f.depth, CV_32F, 1.0 / depth_scale);
+    f.depth_scale = depth_scale;
+    f.rgb_source = rgb_path;
+    f.depth_source = depth_path;
+}
+
+TumReader::TumReader(std::string folder, const ReaderOptions& opts)
+    : folder_(std::move(folder)), opts_(opts) {
+    if (!fs::is_directory(folder_))
+        throw std::runtime_error(folder_ + ": not a TUM RGB-D folder (not a directory)");
+    const auto rgb = readTumList(folder_ + "/rgb.txt");
+    const auto depth = readTumList(folder_ + "/depth.txt");
+    std::vector<double> ta, tb;
+    for (const auto& e : rgb) ta.push_back(e.t);
+    for (const auto& e : depth) tb.push_back(e.t);
+    for (const auto& [i, j] : core::associate(ta, tb, opts_.max_dt)) {
+        for (const auto* e : {&rgb[i], &depth[j]}) {
+            const std::string list = e == &rgb[i] ? "/rgb.txt" : "/depth.txt";
+            if (!fs::exists(folder_ + "/" + e->file))
+                throw std::runtime_error(detail::lineError(folder_ + list, e->line,
+                                                           "image '" + e->file + "' not found"));
+        }
+        pairs_.emplace_back(rgb[i], depth[j]);
+    }
+    if (pairs_.empty())
+        throw std::runtime_error(folder_ + ": no rgb/depth pair within " +
+                                 std::to_string(opts_.max_dt) + " s");
+
+    if (opts_.intrinsics) {
+        K_ = *opts_.intrinsics;
+    } else if (opts_.camera == "auto") {
+        K_ = core::CameraIntrinsics::fromPreset(tumPresetFromName(folder_).value_or("ros_default"));
+    } else {
+        K_ = core::CameraIntrinsics::fromPreset(opts_.camera);
+    }
+    const std::string gt = folder_ + "/groundtruth.txt";
+    if (fs::exists(gt)) gt_ = readTumTrajectory(gt);
+}
+
+core::Frame TumReader::read(std::size_t i) const {
+    if (i >= pairs_.size())
+        throw std::out_of_range(folder_ + ": frame " + std::to_string(i) + " of " +
+                                std::to_string(pairs_.size()));
+    const auto& [r, d] = pairs_[i];
+    core::Frame f;
+    f.index = i;
+    f.timestamp = r.t;
+    f.K = K_;
+    loadTumImages(folder_ + "/" + r.file, folder_ + "/" + d.file, opts_.tum_depth_scale, f);
+    if (f.K.width != f.bgr.cols || f.K.height != f.bgr.rows) {
+        // Presets are for 640x480; other sizes need explicit intrinsics.
+        throw std::runtime_error(f.rgb_source + ": image is " + std::to_string(f.bgr.cols) + "x" +
+                                 std::to_string(f.bgr.rows) + " but the camera intrinsics are for " +
+                                 std::to_string(f.K.width) + "x" + std::to_string(f.K.height));
+    }
+    return f;
+}
+
+std::optional<core::Frame> TumReader::next() {
+    if (cursor_ >= pairs_.size()) return std::nullopt;
+    return read(cursor_++);
+}
+
+std::string TumReader::describe() const {
+    return "TUM folder " + folder_ + " (" + std::to_string(pairs_.size()) + " rgb-depth pairs" +
+           (gt_ ? ", ground truth " + std::to_string(gt_->size()) + " poses" : "") + ")";
+}
+
+}  // namespace devslam::io

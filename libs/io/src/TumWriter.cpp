@@ -1,0 +1,73 @@
+#include <devslam/io/TrajectoryIO.h>
+#include <devslam/io/TumWriter.h>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <stdexcept>
+
+namespace fs = std::filesystem;
+
+namespace devslam::io {
+
+namespace {
+std::unique_ptr<std::FILE, int (*)(std::FILE*)> openList(const std::string& path,
+                                                         const std::string& kind,
+                                                         const std::string& description) {
+    std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(path.c_str(), "w"), &std::fclose);
+    if (!f) throw std::runtime_error("cannot write '" + path + "'");
+    std::fprintf(f.get(), "# %s images\n# %s\n# timestamp filename\n", kind.c_str(),
+                 description.c_str());
+    return f;
+}
+}  // namespace
+
+TumWriter::TumWriter(std::string folder, const std::string& description)
+    : folder_(std::move(folder)), rgb_list_(nullptr, &std::fclose), depth_list_(nullptr, &std::fclose) {
+    std::error_code ec;
+    fs::create_directories(folder_ + "/rgb", ec);
+    fs::create_directories(folder_ + "/depth", ec);
+    if (ec || !fs::is_directory(folder_ + "/depth"))
+        throw std::runtime_error("cannot create TUM folder '" + folder_ + "': " + ec.message());
+    rgb_list_ = openList(folder_ + "/rgb.txt", "color", description);
+    depth_list_ = openList(folder_ + "/depth.txt", "depth", description);
+}
+
+TumWriter::~TumWriter() = default;
+
+void TumWriter::write(const core::Frame& f) {
+    if (!rgb_list_) throw std::logic_error("TumWriter::write after close: " + folder_);
+    core::validateFrame(f, "frame " + std::to_string(f.index));
+    double max_depth = 0;
+    cv::minMaxLoc(f.depth, nullptr, &max_depth);
+    if (max_depth * f.depth_scale > 65535.5)
+        throw std::runtime_error("frame " + std::to_string(f.index) + ": depth " +
+                                 std::to_string(max_depth) + " m does not fit 16 bits at scale " +
+                                 std::to_string(f.depth_scale));
+    char stamp[32];
+    std::snprintf(stamp, sizeof stamp, "%.6f", f.timestamp);
+    const std::string rgb = std::string("rgb/") + stamp + ".png";
+    const std::string depth = std::string("depth/") + stamp + ".png";
+    if (!cv::imwrite(folder_ + "/" + rgb, f.bgr))
+        throw std::runtime_error("cannot write '" + folder_ + "/" + rgb + "'");
+    if (!cv::imwrite(folder_ + "/" + depth, f.rawDepth16()))
+        throw std::runtime_error("cannot write '" + folder_ + "/" + depth + "'");
+    std::fprintf(rgb_list_.get(), "%s %s\n", stamp, rgb.c_str());
+    std::fprintf(depth_list_.get(), "%s %s\n", stamp, depth.c_str());
+    ++count_;
+}
+
+void TumWriter::writeGroundTruth(const core::Trajectory& gt) {
+    writeTumTrajectory(folder_ + "/groundtruth.txt", gt, "ground truth");
+}
+
+void TumWriter::close() {
+    for (auto* f : {&rgb_list_, &depth_list_}) {
+        if (*f && std::fflush(f->get()) != 0)
+            throw std::runtime_error("error writing the lists of '" + folder_ + "'");
+        f->reset();
+    }
+}
+
+}  // namespace devslam::io

@@ -1,0 +1,114 @@
+#include <devslam/core/Association.h>
+#include <devslam/core/Camera.h>
+#include <devslam/core/Config.h>
+#include <devslam/core/Frame.h>
+#include <devslam/core/Pose.h>
+#include <devslam/core/Stats.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+using namespace devslam::core;
+
+TEST(Camera, PresetsMatchTumCalibration) {
+    const auto K = CameraIntrinsics::fromPreset("freiburg1");
+    EXPECT_DOUBLE_EQ(K.fx, 517.3);
+    EXPECT_DOUBLE_EQ(K.cy, 255.3);
+    EXPECT_DOUBLE_EQ(CameraIntrinsics::fromPreset("fr3").fx, 535.4);
+}
+
+TEST(Camera, UnknownPresetListsKnownOnes) {
+    try {
+        (void)CameraIntrinsics::fromPreset("kinect9");
+        FAIL() << "expected an exception";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("kinect9"), std::string::npos);
+        EXPECT_NE(std::string(e.what()).find("freiburg2"), std::string::npos);
+    }
+}
+
+TEST(Camera, BackprojectProjectRoundTrip) {
+    const auto K = CameraIntrinsics::fromPreset("freiburg3");
+    const Eigen::Vector3d p = backproject(100.25, 400.5, 2.5, K);
+    EXPECT_DOUBLE_EQ(p.z(), 2.5);
+    const auto uv = project(p, K);
+    ASSERT_TRUE(uv.has_value());
+    EXPECT_NEAR(uv->x(), 100.25, 1e-9);
+    EXPECT_NEAR(uv->y(), 400.5, 1e-9);
+    EXPECT_FALSE(project(Eigen::Vector3d(0, 0, -1), K).has_value());
+}
+
+TEST(Camera, ConfigRoundTripAndErrors) {
+    auto K = CameraIntrinsics::fromPreset("freiburg2");
+    mrpt::config::CConfigFileMemory mem;
+    K.saveToConfig(mem, "camera");
+    EXPECT_EQ(CameraIntrinsics::fromConfig(mem, "camera"), K);
+
+    mrpt::config::CConfigFileMemory typo("[camera]\npreset = freiburg1\nfxx = 3\n");
+    EXPECT_THROW((void)CameraIntrinsics::fromConfig(typo, "camera"), std::invalid_argument);
+    mrpt::config::CConfigFileMemory missing("[camera]\nfx = 500\nfy = 500\ncx = 320\n");
+    EXPECT_ANY_THROW((void)CameraIntrinsics::fromConfig(missing, "camera"));
+    mrpt::config::CConfigFileMemory bad("[camera]\npreset = fr1\ncx = 900\n");
+    EXPECT_THROW((void)CameraIntrinsics::fromConfig(bad, "camera"), std::invalid_argument);
+}
+
+TEST(Config, UnknownKeyIsNamed) {
+    mrpt::config::CConfigFileMemory mem("[a]\nx = 1\ny = 2\n");
+    EXPECT_EQ(unknownKeys(mem, "a", {"x"}), std::vector<std::string>{"y"});
+    try {
+        requireKnownKeys(mem, "a", {"x"}, "test.ini");
+        FAIL();
+    } catch (const std::invalid_argument& e) {
+        EXPECT_STREQ(e.what(), "test.ini [a]: unknown key 'y' (known: x)");
+    }
+    EXPECT_THROW((void)loadIni("/nonexistent/file.ini"), std::runtime_error);
+}
+
+TEST(Association, NearestPairsNeverReused) {
+    using P = std::pair<std::size_t, std::size_t>;
+    // Candidates (|dt| < 0.02): a1-b0 0.002, a0-b0 0.008, a1-b1 0.015. The closest pair
+    // wins, b0 is never reused, a0 stays unmatched (its only other option is 0.025 away).
+    EXPECT_EQ(associate({1.000, 1.010, 2.000}, {1.008, 1.025, 2.500}, 0.02),
+              (std::vector<P>{{1, 0}}));
+    // Greedy order as associate.py: a1-b0 (0.002) first, then a0 falls back to b1 (0.018).
+    EXPECT_EQ(associate({1.000, 1.010}, {1.008, 1.018}, 0.02), (std::vector<P>{{0, 1}, {1, 0}}));
+    // Unsorted input, offset applied to b.
+    EXPECT_EQ(associate({2.0, 1.0}, {0.5, 1.5}, 0.02, 0.5), (std::vector<P>{{1, 0}, {0, 1}}));
+    EXPECT_TRUE(associate({1.0}, {}, 0.02).empty());
+}
+
+TEST(Stats, MatchesNumpy) {
+    const auto s = summarize({1, 2, 3, 4});
+    EXPECT_DOUBLE_EQ(s.mean, 2.5);
+    EXPECT_DOUBLE_EQ(s.median, 2.5);
+    EXPECT_DOUBLE_EQ(s.rmse, std::sqrt(7.5));
+    EXPECT_DOUBLE_EQ(s.std, std::sqrt(1.25));
+    EXPECT_DOUBLE_EQ(s.min, 1);
+    EXPECT_DOUBLE_EQ(s.max, 4);
+    EXPECT_DOUBLE_EQ(median({5, 1, 3}), 3);
+    EXPECT_EQ(summarize({}).count, 0u);
+}
+
+TEST(Pose, TumQuaternionRoundTrip) {
+    const auto p = fromTum(1, 2, 3, 0.6132, 0.5962, -0.3311, -0.3986);
+    EXPECT_NEAR(p.x(), 1, 1e-12);
+    const auto T = toIsometry(p);
+    EXPECT_TRUE(toCPose3D(T).getHomogeneousMatrixVal<mrpt::math::CMatrixDouble44>().asEigen().isApprox(
+        T.matrix(), 1e-12));
+    EXPECT_THROW((void)fromTum(0, 0, 0, 0, 0, 0, 2), std::invalid_argument);
+    EXPECT_NEAR(rotationAngle(mrpt::poses::CPose3D(0, 0, 0, 0.3, 0, 0)), 0.3, 1e-12);
+    EXPECT_NEAR(wrapToPi(3 * M_PI / 2), -M_PI / 2, 1e-12);
+    EXPECT_NEAR(wrapToPi(M_PI), M_PI, 1e-12);
+}
+
+TEST(Frame, ValidateNamesTheProblem) {
+    Frame f;
+    f.bgr = cv::Mat(480, 640, CV_8UC3, cv::Scalar(0));
+    f.depth = cv::Mat(480, 640, CV_32FC1, cv::Scalar(1.0f));
+    EXPECT_NO_THROW(validateFrame(f, "x"));
+    f.depth = cv::Mat(240, 320, CV_32FC1, cv::Scalar(1.0f));
+    EXPECT_THROW(validateFrame(f, "x"), std::runtime_error);
+    f.depth = cv::Mat(480, 640, CV_16UC1);
+    EXPECT_THROW(validateFrame(f, "x"), std::runtime_error);
+}
