@@ -1,0 +1,24 @@
+#pragma once
+/// docs/RESULTS.md is assembled from sections, each owned by one command (the detector
+/// benchmark, the SLAM benchmark, the navigation benchmark...). A command regenerates only
+/// its own section, between `<!-- BEGIN name -->` and `<!-- END name -->` markers, so the
+/// file is never edited by hand and commands do not overwrite each other.
+///
+/// Usage:
+///   devslam::core::replaceResultsSection("docs/RESULTS.md", "detect", markdown);
+
+#include <string>
+
+namespace devslam::core {
+
+/// Replaces (or appends) the named section; creates the file with a title if missing.
+/// Throws std::runtime_error if the file cannot be written, or std::invalid_argument if
+/// `name` is empty or contains characters other than [a-z0-9_-].
+void replaceResultsSection(const std::string& path, const std::string& name,
+                           const std::string& markdown);
+
+/// The current UTC date-time and host facts ("2026-11-21 06:00 UTC, 2 cores, <cpu model>")
+/// for a "measured on" line under each table.
+[[nodiscard]] std::string measuredOnLine();
+
+}  // namespace devslam::core

@@ -1,0 +1,68 @@
+#pragma once
+/// Trajectory metrics exactly as the TUM RGB-D benchmark tools (evaluate_ate.py,
+/// evaluate_rpe.py) define them.
+///
+/// Usage:
+///   auto ate = devslam::eval::computeAte(gt, est);           // Horn alignment, no scale
+///   auto rpe = devslam::eval::computeRpe(gt, est, {});       // delta 1 s
+///   std::cout << devslam::eval::formatTable(ate, rpe);
+
+#include <devslam/core/Stats.h>
+#include <devslam/core/Trajectory.h>
+
+#include <Eigen/Geometry>
+
+#include <string>
+#include <vector>
+
+namespace devslam::eval {
+
+struct AteOptions {
+    double max_dt = 0.02;   ///< [s] association window (associate.py --max_difference)
+    double offset = 0.0;    ///< [s] added to the estimate's stamps (--offset)
+    double scale = 1.0;     ///< multiplies the estimate's translations (--scale)
+};
+
+struct AteResult {
+    core::Summary trans;                   ///< translational error after alignment [m]
+    Eigen::Isometry3d T_gt_est;            ///< alignment: p_gt ~= T_gt_est * p_est
+    std::vector<double> stamps;            ///< associated estimate stamps
+    std::vector<Eigen::Vector3d> gt_xyz;   ///< associated ground truth positions
+    std::vector<Eigen::Vector3d> est_xyz;  ///< aligned estimate positions
+    std::vector<double> errors;            ///< per pair [m]
+    std::size_t n_gt = 0, n_est = 0;       ///< poses in each input
+};
+
+/// Associates est to gt, aligns with Horn's closed-form rigid transform (no scale) and
+/// summarises the translational residuals. Throws std::invalid_argument when fewer than 3
+/// pairs associate.
+[[nodiscard]] AteResult computeAte(const core::Trajectory& gt, const core::Trajectory& est,
+                                   const AteOptions& opts = {});
+
+/// Horn (1987) closed-form rigid alignment of column-matched point sets: returns T with
+/// model ~= T * data minimising the sum of squared distances (no scale). Throws
+/// std::invalid_argument for fewer than 3 points or mismatched sizes.
+[[nodiscard]] Eigen::Isometry3d hornAlign(const std::vector<Eigen::Vector3d>& model,
+                                          const std::vector<Eigen::Vector3d>& data);
+
+struct RpeOptions {
+    double delta = 1.0;          ///< fixed interval
+    bool delta_in_frames = false;///< false: delta in seconds ("s"); true: in frames ("f")
+    double offset = 0.0;         ///< [s] added to the estimate's stamps
+};
+
+struct RpeResult {
+    core::Summary trans;  ///< [m]
+    core::Summary rot;    ///< [deg]
+    std::size_t n_pairs = 0;
+};
+
+/// E_i = (Q_i^-1 Q_j)^-1 (P_i^-1 P_j), j = the estimate index closest to "i + delta" (the
+/// paper's (2)-(3); evaluate_rpe.py --fixed_delta, which also skips j = last index): the
+/// translational norm and rotation angle of E_i. Q (ground truth) is the gt pose closest
+/// to each estimate stamp, and a pair is skipped when that is more than twice the median gt
+/// interval away, as evaluate_rpe.py does. Throws std::invalid_argument when no pair exists.
+[[nodiscard]] RpeResult computeRpe(const core::Trajectory& gt, const core::Trajectory& est,
+                                   const RpeOptions& opts = {});
+
+}  // namespace devslam::eval
