@@ -1,0 +1,150 @@
+#pragma once
+/// The dynamic-object filter (Algorithm 1 of the DEV-SLAM paper, with ego-motion
+/// compensation): which detected people are really moving, and the mask of image regions
+/// whose keypoints the SLAM front end must drop.
+///
+/// Usage:
+///   auto cfg = devslam::core::loadIni("config_ini/dynamic_filter.ini");
+///   auto filter = devslam::dynamic::makeFilterFromConfig(*cfg);
+///   auto out = filter->step(frame, T_prev_cur_prediction);   // in frame order
+///   orb->detect(gray, kps, out.mask.empty() ? cv::noArray() : ~out.mask);
+#include <devslam/core/Frame.h>
+#include <devslam/detect/PersonDetector.h>
+
+#include <Eigen/Geometry>
+#include <memory>
+#include <opencv2/core/mat.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace mrpt::config {
+class CConfigFileBase;
+}
+
+namespace devslam::dynamic {
+
+/// What is masked. INI: `mode = none | all_persons | dynamic`.
+enum class MaskMode {
+    None,        ///< nothing masked, detector never run (ORB-SLAM2-like)
+    AllPersons,  ///< every detected person masked (DynaSLAM-like)
+    Dynamic      ///< only people classified Moving (DEV-SLAM)
+};
+/// Parses "none", "all_persons", "dynamic"; throws std::invalid_argument with the known names.
+[[nodiscard]] MaskMode parseMaskMode(const std::string& name);
+[[nodiscard]] std::string toString(MaskMode mode);
+
+/// Motion state of a tracked box.
+enum class BoxState {
+    Unknown,  ///< too few tracked points to decide (yet)
+    Static,   ///< the object moves with the world (e.g. a seated person)
+    Moving    ///< the object moves in the world
+};
+[[nodiscard]] std::string toString(BoxState state);
+
+/// One person box tracked over frames.
+struct TrackedBox {
+    int id = -1;     ///< stable over frames (IoU association)
+    cv::Rect2f box;  ///< [px] in the current frame
+    BoxState state = BoxState::Unknown;
+    float score = 0.f;                 ///< detector score of the last detection
+    int n_points = 0;                  ///< flow points inside the box this step
+    int n_dynamic_points = 0;          ///< of which residual > threshold1
+    bool detected_this_frame = false;  ///< false: box carried by LK flow (or kept) this step
+};
+
+/// Result of one step.
+struct FilterOutput {
+    cv::Mat mask;  ///< CV_8UC1, frame size, 255 = masked (drop keypoints here), 0 = keep
+    std::vector<TrackedBox> boxes;
+    bool detector_ran = false;
+    double detect_ms = 0, filter_ms = 0;  ///< [ms] wall time of this step's stages
+    /// Ego-motion refined on background points (p_prev = T * p_cur), if computed.
+    std::optional<Eigen::Isometry3d> T_prev_cur_refined;
+
+    /// Diagnostics for overlays (previous-frame point, current-frame point, residual
+    /// [px] after ego-motion compensation, inside a person box, dynamic), empty in None.
+    struct FlowPoint {
+        cv::Point2f prev, cur;
+        float residual = 0.f;
+        bool in_box = false;
+        bool dynamic = false;
+    };
+    std::vector<FlowPoint> flow;
+};
+
+/// Dynamic-object filter. Not thread-safe; consumes frames in order.
+class DynamicObjectFilter {
+  public:
+    struct Options {
+        MaskMode mode = MaskMode::Dynamic;
+        int detect_every = 1;  ///< run the detector every k-th frame (1 = every frame)
+
+        // Flow points (Shi-Tomasi on the previous frame, pyramidal LK into the current one)
+        int max_corners = 400;             ///< corners in the whole image
+        int max_corners_per_box = 60;      ///< extra corners seeded inside each person box
+        double corner_quality = 0.01;      ///< Shi-Tomasi quality level (fraction of best)
+        double corner_min_distance = 7.0;  ///< [px] between corners
+        int lk_window = 21;                ///< [px] LK window side
+        int lk_levels = 3;                 ///< pyramid levels above the base
+        double fb_max_error = 1.0;         ///< [px] forward-backward check
+
+        // Ego-motion compensation
+        bool refine_ego_motion = true;     ///< refine the prior with PnP-RANSAC on background
+        int min_background_points = 12;    ///< fewer: keep the prior
+        double ransac_reprojection = 2.0;  ///< [px] PnP-RANSAC inlier threshold
+        double max_depth = 8.0;            ///< [m] depths beyond are not trusted
+
+        // Classification (Algorithm 1)
+        double threshold1 = 2.0;            ///< [px] residual flow that makes a point dynamic
+        int threshold2_count = 4;           ///< min dynamic points for a moving box
+        double threshold2_fraction = 0.25;  ///< and min fraction of the box's points
+        int min_points = 6;                 ///< fewer points in a box: no new evidence
+        double box_shrink = 0.1;            ///< fraction of w/h ignored at each box side
+
+        // Tracking and hysteresis
+        double iou_match = 0.3;         ///< min IoU to associate a detection with a track
+        int release_frames = 5;         ///< quiet frames before a Moving box becomes Static
+        int max_missed_detections = 2;  ///< detector runs without a match before a track is dropped
+
+        // Mask
+        int mask_margin = 10;  ///< [px] dilation of each masked box
+
+        /// Reads `[section]`; unknown keys throw std::invalid_argument naming them.
+        void loadFromConfig(const mrpt::config::CConfigFileBase& cfg,
+                            const std::string& section = "dynamic_filter");
+        void saveToConfig(mrpt::config::CConfigFileBase& cfg,
+                          const std::string& section = "dynamic_filter") const;
+    };
+
+    /// `detector` may be null only for MaskMode::None (std::invalid_argument otherwise).
+    DynamicObjectFilter(const Options& opts, std::unique_ptr<detect::PersonDetector> detector);
+    ~DynamicObjectFilter();
+    DynamicObjectFilter(const DynamicObjectFilter&) = delete;
+    DynamicObjectFilter& operator=(const DynamicObjectFilter&) = delete;
+
+    /// Processes the next frame. `T_prev_cur_prior`: pose of the current camera in the
+    /// previous camera's optical frame (p_prev = T * p_cur), e.g. the tracker's
+    /// constant-velocity prediction; nullopt = unknown (identity, refined on background).
+    /// Throws std::invalid_argument for a frame that is not CV_8UC3 + CV_32FC1 of equal size.
+    [[nodiscard]] FilterOutput step(const core::Frame& frame,
+                                    const std::optional<Eigen::Isometry3d>& T_prev_cur_prior);
+
+    [[nodiscard]] const Options& options() const { return opts_; }
+    /// Forgets all tracks and the previous frame (e.g. after tracking is lost).
+    void reset();
+
+  private:
+    struct Impl;
+    Options opts_;
+    std::unique_ptr<detect::PersonDetector> detector_;
+    std::unique_ptr<Impl> impl_;
+};
+
+/// Builds detector + filter from one INI (sections [detector] and [dynamic_filter]).
+/// `mode_override` replaces the INI's mode (e.g. from a command-line flag); in mode None
+/// no detector is built.
+[[nodiscard]] std::unique_ptr<DynamicObjectFilter> makeFilterFromConfig(
+    const mrpt::config::CConfigFileBase& cfg, std::optional<MaskMode> mode_override = {});
+
+}  // namespace devslam::dynamic
