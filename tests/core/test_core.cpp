@@ -94,8 +94,9 @@ TEST(Pose, TumQuaternionRoundTrip) {
     const auto p = fromTum(1, 2, 3, 0.6132, 0.5962, -0.3311, -0.3986);
     EXPECT_NEAR(p.x(), 1, 1e-12);
     const auto T = toIsometry(p);
-    EXPECT_TRUE(toCPose3D(T).getHomogeneousMatrixVal<mrpt::math::CMatrixDouble44>().asEigen().isApprox(
-        T.matrix(), 1e-12));
+    EXPECT_TRUE(
+        toCPose3D(T).getHomogeneousMatrixVal<mrpt::math::CMatrixDouble44>().asEigen().isApprox(
+            T.matrix(), 1e-12));
     EXPECT_THROW((void)fromTum(0, 0, 0, 0, 0, 0, 2), std::invalid_argument);
     EXPECT_NEAR(rotationAngle(mrpt::poses::CPose3D(0, 0, 0, 0.3, 0, 0)), 0.3, 1e-12);
     EXPECT_NEAR(wrapToPi(3 * M_PI / 2), -M_PI / 2, 1e-12);

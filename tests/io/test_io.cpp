@@ -1,3 +1,317 @@
+#include <devslam/core/Pose.h>
+#include <devslam/io/Rawlog.h>
+#include <devslam/io/RgbdReader.h>
+#include <devslam/io/TrajectoryIO.h>
 #include <devslam/io/TumReader.h>
+#include <devslam/io/TumWriter.h>
+
 #include <gtest/gtest.h>
-TEST(Placeholder, Builds) { SUCCEED(); }
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+
+namespace fs = std::filesystem;
+using namespace devslam;
+
+namespace {
+
+const std::string kTum = std::string(DEVSLAM_SOURCE_DIR) + "/data/tum/fr1_xyz_first37";
+const std::string kMrptRgbd = "/usr/share/mrpt/datasets/tests_rgbd.rawlog";  // mrpt-common
+
+// A fresh scratch folder per test, removed afterwards.
+class TempDir {
+  public:
+    TempDir() {
+        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+        path_ = fs::temp_directory_path() /
+                ("devslam_io_" + std::string(info->test_suite_name()) + "_" + info->name());
+        fs::remove_all(path_);
+        fs::create_directories(path_);
+    }
+    ~TempDir() { fs::remove_all(path_); }
+    [[nodiscard]] std::string str(const std::string& sub = {}) const {
+        return sub.empty() ? path_.string() : (path_ / sub).string();
+    }
+
+  private:
+    fs::path path_;
+};
+
+// Copies the first `n` associated frames of the shipped TUM folder into `dst`.
+void copyTumSubset(const std::string& dst, std::size_t n) {
+    io::TumReader in(kTum);
+    io::TumWriter out(dst, "test subset");
+    for (std::size_t i = 0; i < n; ++i) out.write(in.read(i));
+    out.close();
+}
+
+void writeText(const std::string& path, const std::string& text) {
+    std::ofstream(path) << text;
+}
+
+// Runs f, expects std::runtime_error whose message matches `pattern` (ECMAScript regex).
+template <class F>
+void expectError(F&& f, const std::string& pattern) {
+    try {
+        f();
+        ADD_FAILURE() << "expected an error matching '" << pattern << "'";
+    } catch (const std::runtime_error& e) {
+        EXPECT_TRUE(std::regex_search(e.what(), std::regex(pattern)))
+            << "message: " << e.what() << "\npattern: " << pattern;
+    }
+}
+
+void expectFramesEqual(const core::Frame& a, const core::Frame& b) {
+    EXPECT_NEAR(a.timestamp, b.timestamp, 1e-6);
+    ASSERT_EQ(a.bgr.size(), b.bgr.size());
+    EXPECT_EQ(cv::norm(a.bgr, b.bgr, cv::NORM_INF), 0.0) << "colour differs";
+    EXPECT_EQ(cv::norm(a.rawDepth16(), b.rawDepth16(), cv::NORM_INF), 0.0) << "raw depth differs";
+    EXPECT_EQ(a.K, b.K);
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------- TUM folders
+TEST(TumReader, ReadsShippedFramesLikeAssociatePy) {
+    io::TumReader r(kTum);
+    // 37 colour and 37 depth images; associate.py (max_difference 0.02) pairs 32 of them.
+    EXPECT_EQ(r.size(), 32u);
+    EXPECT_EQ(r.intrinsics(), core::CameraIntrinsics::fromPreset("freiburg1"));  // from the name
+    ASSERT_TRUE(r.groundTruth().has_value());
+    EXPECT_EQ(r.groundTruth()->size(), 3000u);
+    const core::Frame f = r.read(0);
+    EXPECT_NEAR(f.timestamp, 1305031102.175304, 1e-6);
+    EXPECT_EQ(f.bgr.type(), CV_8UC3);
+    EXPECT_EQ(f.depth.type(), CV_32FC1);
+    EXPECT_EQ(f.bgr.size(), cv::Size(640, 480));
+    // depth [m] == raw PNG value / 5000
+    const cv::Mat raw = cv::imread(f.depth_source, cv::IMREAD_UNCHANGED);
+    for (auto [u, v] : {std::pair{320, 240}, {100, 400}, {600, 50}})
+        EXPECT_FLOAT_EQ(f.depth.at<float>(v, u), raw.at<uint16_t>(v, u) / 5000.0f);
+    EXPECT_EQ(cv::countNonZero(raw == 0), cv::countNonZero(f.depth == 0.0f));  // 0 = missing
+    std::size_t n = 0;
+    while (auto g = r.next()) EXPECT_EQ(g->index, n++);
+    EXPECT_EQ(n, 32u);
+}
+
+TEST(TumReader, CameraSelection) {
+    EXPECT_EQ(io::tumPresetFromName("/x/rgbd_dataset_freiburg3_walking_xyz"), "freiburg3");
+    EXPECT_EQ(io::tumPresetFromName("fr2_desk/"), "freiburg2");
+    EXPECT_FALSE(io::tumPresetFromName("my_sequence").has_value());
+    io::ReaderOptions o;
+    o.camera = "freiburg3";
+    EXPECT_EQ(io::TumReader(kTum, o).intrinsics().fx, 535.4);
+    o.camera = "nonsense";
+    EXPECT_THROW(io::TumReader(kTum, o), std::invalid_argument);
+}
+
+TEST(TumReader, MalformedListsNameFileAndLine) {
+    TempDir d;
+    copyTumSubset(d.str("s"), 3);
+    const std::string rgb = d.str("s/rgb.txt");
+    std::ifstream in(rgb);
+    std::string header, l1, l2, l3, line;
+    for (int k = 0; k < 3; ++k) std::getline(in, line), header += line + "\n";
+    std::getline(in, l1), std::getline(in, l2), std::getline(in, l3);
+    in.close();
+
+    writeText(rgb, header + l1 + "\n" + "1305031102.2 rgb/a.png extra\n" + l3 + "\n");
+    expectError([&] { io::TumReader r(d.str("s")); },
+                "rgb\\.txt line 5: expected 'timestamp filename'");
+    writeText(rgb, header + l1 + "\nabc rgb/x.png\n");
+    expectError([&] { io::TumReader r(d.str("s")); },
+                "rgb\\.txt line 5: timestamp 'abc' is not a number");
+    writeText(rgb, header + l2 + "\n" + l1 + "\n");
+    expectError([&] { io::TumReader r(d.str("s")); }, "rgb\\.txt line 5: unsorted timestamp");
+    writeText(rgb, header + l1 + "\n" + l1 + "\n");
+    expectError([&] { io::TumReader r(d.str("s")); }, "rgb\\.txt line 5: duplicate timestamp");
+    writeText(rgb, header);
+    expectError([&] { io::TumReader r(d.str("s")); }, "rgb\\.txt: no entries");
+    fs::remove(rgb);
+    expectError([&] { (void)io::openRgbd(d.str("s")); }, "no rgb\\.txt");
+    expectError([&] { io::TumReader r(d.str("s")); }, "rgb\\.txt: file not found");
+    expectError([&] { (void)io::openRgbd(d.str("nothing_here")); }, "no such TUM folder or rawlog");
+}
+
+TEST(TumReader, BadImagesNameTheFile) {
+    TempDir d;
+    copyTumSubset(d.str("s"), 3);
+    io::TumReader ok(d.str("s"));
+    const core::Frame f0 = ok.read(0), f1 = ok.read(1), f2 = ok.read(2);
+
+    // A listed image that does not exist: caught when opening, with list file and line.
+    fs::remove(f2.rgb_source);
+    expectError([&] { io::TumReader r(d.str("s")); },
+                "rgb\\.txt line 6: image 'rgb/.*\\.png' not found");
+    // An image that does not decode.
+    writeText(f2.rgb_source, "this is not a png");
+    expectError([&] { (void)io::TumReader(d.str("s")).read(2); },
+                "\\.png: cannot decode colour image");
+    // Depth of the wrong type (8-bit) and of the wrong size.
+    cv::imwrite(f1.depth_source, cv::Mat(480, 640, CV_8UC1, cv::Scalar(7)));
+    expectError([&] { (void)io::TumReader(d.str("s")).read(1); }, "depth must be a 16-bit");
+    cv::imwrite(f0.depth_source, cv::Mat(240, 320, CV_16UC1, cv::Scalar(7)));
+    expectError([&] { (void)io::TumReader(d.str("s")).read(0); },
+                "depth is 320x240 but .* is 640x480");
+}
+
+// ---------------------------------------------------------------- trajectories
+TEST(TrajectoryIO, RoundTripAndErrors) {
+    TempDir d;
+    const auto gt = io::readTumTrajectory(kTum + "/groundtruth.txt");
+    ASSERT_EQ(gt.size(), 3000u);
+    EXPECT_NEAR(gt.front().t, 1305031098.6659, 1e-9);
+    EXPECT_NEAR(gt.front().pose.x(), 1.3563, 1e-12);
+    io::writeTumTrajectory(d.str("t.txt"), gt);
+    const auto back = io::readTumTrajectory(d.str("t.txt"));
+    ASSERT_EQ(back.size(), gt.size());
+    for (std::size_t i = 0; i < gt.size(); i += 97) {
+        EXPECT_NEAR(back[i].t, gt[i].t, 1e-6);
+        EXPECT_LT((back[i].pose - gt[i].pose).norm(), 1e-8);
+        EXPECT_LT(core::rotationAngle(back[i].pose - gt[i].pose), 1e-8);
+    }
+    writeText(d.str("bad.txt"), "# c\n1 0 0 0 0 0 0 1\n2 0 0 0 0 0 1\n");
+    expectError([&] { (void)io::readTumTrajectory(d.str("bad.txt")); },
+                "bad\\.txt line 3: expected .*got 7");
+    writeText(d.str("bad.txt"), "1 0 0 0 0 0 0 1\n1 0 0 0 0 0 0 1\n");
+    expectError([&] { (void)io::readTumTrajectory(d.str("bad.txt")); },
+                "line 2: duplicate timestamp");
+    writeText(d.str("bad.txt"), "1 0 0 0 0 0 0 3\n");
+    expectError([&] { (void)io::readTumTrajectory(d.str("bad.txt")); }, "line 1: quaternion norm");
+    writeText(d.str("bad.txt"), "# only comments\n");
+    expectError([&] { (void)io::readTumTrajectory(d.str("bad.txt")); }, "no poses");
+    expectError([&] { (void)io::readTumTrajectory(d.str("missing.txt")); }, "cannot open");
+}
+
+// ---------------------------------------------------------------- rawlogs
+class RawlogRoundTrip : public ::testing::TestWithParam<std::pair<bool, bool>> {};
+
+TEST_P(RawlogRoundTrip, AllRealFramesBitExact) {
+    const auto [sensory_frames, external] = GetParam();
+    TempDir d;
+    io::TumReader tum(kTum);
+    // Every real frame in the default layout; the other layouts on a few (saves CI time).
+    const std::size_t n = (sensory_frames || external) ? 4 : *tum.size();
+    io::RawlogWriterOptions wo;
+    wo.sensory_frames = sensory_frames;
+    wo.external_images = external;
+    const std::string path = d.str("seq.rawlog");
+    {
+        io::RawlogWriter w(path, wo);
+        for (std::size_t i = 0; i < n; ++i) w.write(tum.read(i));
+        w.close();
+        EXPECT_EQ(w.count(), n);
+    }
+    if (external) {
+        EXPECT_TRUE(fs::exists(d.str("seq_Images")));
+    }
+    io::RawlogReader r(path);
+    EXPECT_EQ(r.size(), n);
+    EXPECT_TRUE(r.damage().empty());
+    EXPECT_EQ(r.format(), sensory_frames ? "action/sensory-frame" : "observations-only");
+    std::size_t i = 0;
+    while (auto f = r.next()) expectFramesEqual(*f, tum.read(i++));
+    EXPECT_EQ(i, n);
+
+    // ... and back to a TUM folder: images identical to the originals, pixel for pixel.
+    {
+        io::RawlogReader again(path);
+        io::TumWriter out(d.str("back"));
+        while (auto f = again.next()) out.write(*f);
+        out.close();
+    }
+    io::TumReader back(d.str("back"));
+    ASSERT_EQ(back.size(), n);
+    EXPECT_NE(back.describe().find("camera.ini"), std::string::npos);
+    for (std::size_t k = 0; k < n; ++k) {
+        const auto a = tum.read(k), b = back.read(k);
+        expectFramesEqual(a, b);
+        const cv::Mat ra = cv::imread(a.depth_source, cv::IMREAD_UNCHANGED);
+        const cv::Mat rb = cv::imread(b.depth_source, cv::IMREAD_UNCHANGED);
+        EXPECT_EQ(cv::norm(ra, rb, cv::NORM_INF), 0.0);
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(Layouts, RawlogRoundTrip,
+                         ::testing::Values(std::pair{false, false}, std::pair{true, false},
+
+                                           std::pair{false, true}));
+
+TEST(Rawlog, MrptsRawlogEditReadsOurFiles) {
+    TempDir d;
+    copyTumSubset(d.str("s"), 5);
+    const std::string path = d.str("five.rawlog");
+    const std::string cmd = std::string(DEVSLAM_BIN_DIR) + "/devslam-convert " + d.str("s") + " " +
+                            path + " --sensory-frames > " + d.str("c.log") + " 2>&1";
+    ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+    const std::string info = d.str("info.txt");
+    ASSERT_EQ(std::system(("rawlog-edit --info -i " + path + " > " + info + " 2>&1").c_str()), 0)
+        << "rawlog-edit (Debian package mrpt-apps) must be installed and read the file";
+    std::ifstream in(info);
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_TRUE(std::regex_search(text, std::regex("RGBD\\s*/\\s*5\\s*/"))) << text;
+    EXPECT_TRUE(std::regex_search(text, std::regex("Actions/SensoryFrame format\\s*:\\s*Yes")))
+        << text;
+}
+
+TEST(Rawlog, TruncatedFileReportsWhatWasRead) {
+    TempDir d;
+    copyTumSubset(d.str("s"), 6);
+    const std::string path = d.str("six.rawlog");
+    {
+        io::RawlogWriter w(path, {});
+        io::TumReader tum(d.str("s"));
+        while (auto f = tum.next()) w.write(*f);
+    }
+    // Cut the file in the middle of the 4th observation (observations are similar in size).
+    const auto size = fs::file_size(path);
+    fs::resize_file(path, size * 7 / 12);
+    expectError([&] { io::RawlogReader r(path); }, "six\\.rawlog: .* after 3 RGB-D observations");
+    io::RawlogReader partial(path, {}, /*allow_truncated=*/true);
+    EXPECT_EQ(partial.size(), 3u);
+    EXPECT_FALSE(partial.damage().empty());
+    std::size_t n = 0;
+    while (partial.next()) ++n;
+    EXPECT_EQ(n, 3u);
+    // Cut inside the gzip header: nothing decodes, and the error says so.
+    fs::resize_file(path, 60);
+    expectError([&] { io::RawlogReader r(path); }, "truncated or corrupt gzip stream .* after 0");
+    writeText(path, "garbage");
+    expectError([&] { io::RawlogReader r(path); }, "cannot decode object 0 at byte 0");
+    expectError([&] { io::RawlogReader r(d.str("none.rawlog")); }, "rawlog file not found");
+}
+
+TEST(Rawlog, ReadsMrptsOwnOpenNiObservation) {
+    // One real OpenNI2 observation: depth in mm, not registered to colour.
+    ASSERT_TRUE(fs::exists(kMrptRgbd)) << "installed by Debian's mrpt-common";
+    io::RawlogReader r(kMrptRgbd);
+    EXPECT_EQ(r.size(), 1u);
+    const auto f = r.next();
+    ASSERT_TRUE(f.has_value());
+    EXPECT_NEAR(f->timestamp, 1462879443.617188, 1e-5);
+    EXPECT_EQ(f->depth_scale, 1000.0);
+    EXPECT_EQ(f->depth.size(), f->bgr.size());
+    EXPECT_NEAR(f->K.fx, 521.17923, 1e-4);  // the colour camera's intrinsics
+    double lo = 0, hi = 0;
+    cv::minMaxLoc(f->depth, &lo, &hi, nullptr, nullptr, f->depth > 0);
+    EXPECT_GT(lo, 1.5);  // the raw depth spans 1.624 .. 2.560 m along the depth camera's axis
+    EXPECT_LT(hi, 2.6);
+    EXPECT_GT(cv::countNonZero(f->depth > 0), 200000);  // of 273225 valid depth pixels
+    EXPECT_FALSE(r.next().has_value());
+}
+
+TEST(Rawlog, RejectsFramesThatCannotBeWritten) {
+    TempDir d;
+    io::RawlogWriter w(d.str("x.rawlog"), {});
+    core::Frame f;
+    f.bgr = cv::Mat(480, 640, CV_8UC3, cv::Scalar(1, 2, 3));
+    f.depth = cv::Mat(100, 100, CV_32FC1, cv::Scalar(1.0f));
+    EXPECT_THROW(w.write(f), std::runtime_error);
+    io::RawlogWriterOptions bad;
+    bad.compression = 11;
+    EXPECT_THROW(io::RawlogWriter(d.str("y.rawlog"), bad), std::invalid_argument);
+}

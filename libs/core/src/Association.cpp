@@ -8,8 +8,8 @@
 namespace devslam::core {
 
 std::vector<std::pair<std::size_t, std::size_t>> associate(const std::vector<double>& a,
-                                                            const std::vector<double>& b,
-                                                            double max_dt, double offset) {
+                                                           const std::vector<double>& b,
+                                                           double max_dt, double offset) {
     // associate.py builds all |a-b| pairs; a sorted window per `a` gives the same candidate
     // set in O(n log n + candidates).
     std::vector<std::size_t> order_b(b.size());

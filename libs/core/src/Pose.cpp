@@ -32,10 +32,10 @@ mrpt::poses::CPose3D fromTum(double tx, double ty, double tz, double qx, double 
 }
 
 double rotationAngle(const mrpt::poses::CPose3D& p) {
-    // TUM's compute_angle: arccos(min(1, max(-1, (trace(R) - 1) / 2))).
-    const auto R = p.getRotationMatrix();
-    const double c = (R(0, 0) + R(1, 1) + R(2, 2) - 1.0) / 2.0;
-    return std::acos(std::min(1.0, std::max(-1.0, c)));
+    // The same angle as TUM's compute_angle, arccos((trace(R) - 1) / 2), but evaluated as
+    // 2 atan2(|q_vec|, |q_w|): arccos loses half the digits near 0 (1e-8 rad noise).
+    const Eigen::Quaterniond q(p.getRotationMatrix().asEigen());
+    return 2.0 * std::atan2(q.vec().norm(), std::abs(q.w()));
 }
 
 double wrapToPi(double a) {

@@ -11,8 +11,8 @@ namespace devslam::core {
 
 void replaceResultsSection(const std::string& path, const std::string& name,
                            const std::string& markdown) {
-    if (name.empty() || name.find_first_not_of("abcdefghijklmnopqrstuvwxyz0123456789_-") !=
-                            std::string::npos)
+    if (name.empty() ||
+        name.find_first_not_of("abcdefghijklmnopqrstuvwxyz0123456789_-") != std::string::npos)
         throw std::invalid_argument("results section name '" + name + "' must match [a-z0-9_-]+");
     std::string text;
     {
@@ -28,7 +28,8 @@ void replaceResultsSection(const std::string& path, const std::string& name,
         }
     }
     const std::string begin = "<!-- BEGIN " + name + " -->", end = "<!-- END " + name + " -->";
-    const std::string block = begin + "\n" + markdown + (markdown.empty() || markdown.back() == '\n' ? "" : "\n") + end;
+    const std::string block =
+        begin + "\n" + markdown + (markdown.empty() || markdown.back() == '\n' ? "" : "\n") + end;
     const auto b = text.find(begin);
     const auto e = text.find(end);
     if (b != std::string::npos && e != std::string::npos && e > b) {

@@ -15,6 +15,8 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <zlib.h>
+
 #include <cmath>
 #include <filesystem>
 #include <limits>
@@ -86,6 +88,34 @@ cv::Mat registerDepth(const CObservation3DRangeScan& o, const cv::Mat& depth, in
     return out;
 }
 
+// A gzip stream cut short decodes cleanly up to the cut, and MRPT's stream reports a plain
+// end of file there; only zlib knows the trailer is missing. Returns the zlib error text,
+// or "" if the file is a complete gzip stream or not gzip at all (plain rawlogs).
+std::string gzipDamage(const std::string& path) {
+    gzFile f = gzopen(path.c_str(), "rb");
+    if (f == nullptr) return "cannot open";
+    std::vector<char> buf(1 << 20);
+    int n = 0;
+    while ((n = gzread(f, buf.data(), static_cast<unsigned>(buf.size()))) > 0) {
+    }
+    int err = Z_OK;
+    const char* msg = gzerror(f, &err);
+    const std::string out = (n < 0 || (err != Z_OK && err != Z_STREAM_END)) ? msg : "";
+    gzclose(f);
+    return out;
+}
+
+// MRPT nests exception texts several levels deep; keep the innermost "Message:" line.
+std::string innermostMessage(const std::string& what) {
+    std::string best = what.substr(0, what.find('\n'));
+    for (std::size_t p = what.find("Message:"); p != std::string::npos;
+         p = what.find("Message:", p + 1)) {
+        const std::size_t b = what.find_first_not_of(' ', p + 8);
+        best = what.substr(b, what.find('\n', b) - b);
+    }
+    return best;
+}
+
 }  // namespace
 
 core::Frame frameFromObservation(const CObservation3DRangeScan& o, const std::string& what) {
@@ -96,27 +126,31 @@ core::Frame frameFromObservation(const CObservation3DRangeScan& o, const std::st
     core::Frame f;
     f.timestamp = mrpt::Clock::toDouble(o.timestamp);
     const cv::Mat& img = o.intensityImage.asCvMatRef();
-    if (img.channels() == 3) f.bgr = img.clone();  // CImage colour is BGR
-    else cv::cvtColor(img, f.bgr, cv::COLOR_GRAY2BGR);
+    if (img.channels() == 3)
+        f.bgr = img.clone();  // CImage colour is BGR
+    else
+        cv::cvtColor(img, f.bgr, cv::COLOR_GRAY2BGR);
     if (f.bgr.depth() != CV_8U)
         throw std::runtime_error(what + ": colour image must be 8 bits per channel");
 
     // Values 1..13 with millimetre units are MRPT's rgbd_dataset2rawlog bug (metres truncated
     // into uint16); refuse them instead of producing a wall 1 mm in front of the camera.
     uint16_t max_raw = 0;
-    for (std::size_t k = 0; k < static_cast<std::size_t>(o.rangeImage.size()); ++k) max_raw = std::max(max_raw, o.rangeImage.data()[k]);
+    for (std::size_t k = 0; k < static_cast<std::size_t>(o.rangeImage.size()); ++k)
+        max_raw = std::max(max_raw, o.rangeImage.data()[k]);
     if (max_raw > 0 && max_raw < 20 && o.rangeUnits >= 0.0005f)
-        throw std::runtime_error(what + ": depth values are at most " + std::to_string(max_raw) +
-                                 " units of " + std::to_string(o.rangeUnits) +
-                                 " m: metres truncated to integers (MRPT rgbd_dataset2rawlog bug)?");
+        throw std::runtime_error(
+            what + ": depth values are at most " + std::to_string(max_raw) + " units of " +
+            std::to_string(o.rangeUnits) +
+            " m: metres truncated to integers (MRPT rgbd_dataset2rawlog bug)?");
     f.depth_scale = roundedScale(o.rangeUnits);
     const cv::Mat depth = depthInDepthCamera(o);
-    const bool same_camera =
-        o.doDepthAndIntensityCamerasCoincide() &&
-        o.cameraParams.fx() == o.cameraParamsIntensity.fx() &&
-        o.cameraParams.fy() == o.cameraParamsIntensity.fy() &&
-        o.cameraParams.cx() == o.cameraParamsIntensity.cx() &&
-        o.cameraParams.cy() == o.cameraParamsIntensity.cy() && depth.size() == f.bgr.size();
+    const bool same_camera = o.doDepthAndIntensityCamerasCoincide() &&
+                             o.cameraParams.fx() == o.cameraParamsIntensity.fx() &&
+                             o.cameraParams.fy() == o.cameraParamsIntensity.fy() &&
+                             o.cameraParams.cx() == o.cameraParamsIntensity.cx() &&
+                             o.cameraParams.cy() == o.cameraParamsIntensity.cy() &&
+                             depth.size() == f.bgr.size();
     f.depth = same_camera ? depth : registerDepth(o, depth, f.bgr.cols, f.bgr.rows);
     f.K = core::CameraIntrinsics::fromMrpt(o.cameraParamsIntensity);
     f.K.width = f.bgr.cols;
@@ -128,7 +162,8 @@ core::Frame frameFromObservation(const CObservation3DRangeScan& o, const std::st
 
 // ---------------------------------------------------------------------------------------
 struct RawlogReader::Stream {
-    explicit Stream(const std::string& path) : file(path), arch(mrpt::serialization::archiveFrom(file)) {}
+    explicit Stream(const std::string& path)
+        : file(path), arch(mrpt::serialization::archiveFrom(file)) {}
     mrpt::io::CFileGZInputStream file;
     mrpt::serialization::CArchiveStreamBase<mrpt::io::CFileGZInputStream> arch;
     std::vector<CObservation3DRangeScan::Ptr> pending;  // from the current sensory frame
@@ -136,8 +171,8 @@ struct RawlogReader::Stream {
 
     // Next 3D scan (optionally of one sensor label); nullptr at a clean end. Counts other
     // observations in `skipped`. Throws on damage.
-    CObservation3DRangeScan::Ptr next(const std::string& label, std::size_t& skipped,
-                                      bool& saw_sf, bool& saw_obs) {
+    CObservation3DRangeScan::Ptr next(const std::string& label, std::size_t& skipped, bool& saw_sf,
+                                      bool& saw_obs) {
         for (;;) {
             while (!pending.empty()) {
                 auto o = pending.front();
@@ -153,8 +188,10 @@ struct RawlogReader::Stream {
                 if (file.getPosition() == pos && file.checkEOF()) return nullptr;  // clean end
                 throw std::runtime_error("truncated object at byte " + std::to_string(pos));
             } catch (const std::exception& e) {
-                throw std::runtime_error("cannot decode object at byte " + std::to_string(pos) +
-                                         ": " + std::string(e.what()).substr(0, 300));
+                throw std::runtime_error("cannot decode object " + std::to_string(objects) +
+                                         " at byte " + std::to_string(pos) +
+                                         " of the uncompressed stream (" +
+                                         innermostMessage(e.what()) + ")");
             }
             ++objects;
             if (auto sf = std::dynamic_pointer_cast<mrpt::obs::CSensoryFrame>(obj)) {
@@ -162,7 +199,8 @@ struct RawlogReader::Stream {
                 for (const auto& o : *sf) {
                     if (auto o3 = std::dynamic_pointer_cast<CObservation3DRangeScan>(o))
                         pending.push_back(o3);
-                    else ++skipped;
+                    else
+                        ++skipped;
                 }
             } else if (auto o3 = std::dynamic_pointer_cast<CObservation3DRangeScan>(obj)) {
                 saw_obs = true;
@@ -194,17 +232,20 @@ RawlogReader::RawlogReader(std::string path, const ReaderOptions& opts, bool all
             }
             ++n_frames_;
         }
+        if (const std::string gz = gzipDamage(path_); !gz.empty())
+            throw std::runtime_error("truncated or corrupt gzip stream (" + gz + ")");
     } catch (const std::exception& e) {
-        damage_ = path_ + ": " + e.what() + " after " + std::to_string(n_frames_) +
-                  " RGB-D observations";
+        damage_ =
+            path_ + ": " + e.what() + " after " + std::to_string(n_frames_) + " RGB-D observations";
         if (!allow_truncated || n_frames_ == 0) throw std::runtime_error(damage_);
     }
     n_skipped_ = skipped;
     format_ = saw_sf ? "action/sensory-frame" : "observations-only";
     if (n_frames_ == 0)
         throw std::runtime_error(path_ + ": no CObservation3DRangeScan" +
-                                 (opts_.sensor_label.empty() ? std::string()
-                                                             : " with label '" + opts_.sensor_label + "'") +
+                                 (opts_.sensor_label.empty()
+                                      ? std::string()
+                                      : " with label '" + opts_.sensor_label + "'") +
                                  " (" + std::to_string(skipped) + " other observations)");
     if (opts_.intrinsics) K_ = *opts_.intrinsics;
     stream_ = std::make_unique<Stream>(path_);
@@ -236,8 +277,7 @@ std::string RawlogReader::describe() const {
 // ---------------------------------------------------------------------------------------
 struct RawlogWriter::Stream {
     explicit Stream(const std::string& path, int level) {
-        if (!file.open(path, level))
-            throw std::runtime_error("cannot write rawlog '" + path + "'");
+        if (!file.open(path, level)) throw std::runtime_error("cannot write rawlog '" + path + "'");
     }
     mrpt::io::CFileGZOutputStream file;
 };

@@ -14,7 +14,8 @@ namespace fs = std::filesystem;
 namespace devslam::io {
 
 void ReaderOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, const std::string& s) {
-    core::requireKnownKeys(c, s, {"camera", "max_dt", "tum_depth_scale", "sensor_label"}, "dataset");
+    core::requireKnownKeys(c, s, {"camera", "max_dt", "tum_depth_scale", "sensor_label"},
+                           "dataset");
     camera = c.read_string(s, "camera", camera);
     max_dt = c.read_double(s, "max_dt", max_dt);
     tum_depth_scale = c.read_double(s, "tum_depth_scale", tum_depth_scale);

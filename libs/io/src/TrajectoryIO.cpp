@@ -17,10 +17,10 @@ core::Trajectory readTumTrajectory(const std::string& path) {
     core::Trajectory traj;
     detail::forEachDataLine(path, [&](int line, const std::vector<std::string>& tok) {
         if (tok.size() != 8)
-            throw std::runtime_error(detail::lineError(
-                path, line,
-                "expected 'timestamp tx ty tz qx qy qz qw' (8 values), got " +
-                    std::to_string(tok.size())));
+            throw std::runtime_error(
+                detail::lineError(path, line,
+                                  "expected 'timestamp tx ty tz qx qy qz qw' (8 values), got " +
+                                      std::to_string(tok.size())));
         double v[8];
         static const char* kNames[8] = {"timestamp", "tx", "ty", "tz", "qx", "qy", "qz", "qw"};
         for (int k = 0; k < 8; ++k) v[k] = detail::parseNumber(tok[k], path, line, kNames[k]);
@@ -47,8 +47,8 @@ void writeTumTrajectory(const std::string& path, const core::Trajectory& traj,
     std::fprintf(f.get(), "# timestamp tx ty tz qx qy qz qw\n");
     for (const auto& sp : traj) {
         const mrpt::poses::CPose3DQuat q(sp.pose);
-        std::fprintf(f.get(), "%.6f %.9f %.9f %.9f %.9f %.9f %.9f %.9f\n", sp.t, q.x(), q.y(), q.z(),
-                     q.quat().x(), q.quat().y(), q.quat().z(), q.quat().r());
+        std::fprintf(f.get(), "%.6f %.9f %.9f %.9f %.9f %.9f %.9f %.9f\n", sp.t, q.x(), q.y(),
+                     q.z(), q.quat().x(), q.quat().y(), q.quat().z(), q.quat().r());
     }
     if (std::ferror(f.get())) throw std::runtime_error("error writing '" + path + "'");
 }

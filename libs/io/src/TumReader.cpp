@@ -4,6 +4,7 @@
 #include "TextFile.h"
 
 #include <devslam/core/Association.h>
+#include <devslam/core/Config.h>
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -39,9 +40,10 @@ std::vector<TumListEntry> readTumList(const std::string& path) {
 std::optional<std::string> tumPresetFromName(const std::string& folder) {
     static const std::regex kFr(R"((freiburg|fr)([123]))", std::regex::icase);
     std::smatch m;
-    const std::string name = fs::path(folder).lexically_normal().filename().string().empty()
-                                 ? fs::path(folder).lexically_normal().parent_path().filename().string()
-                                 : fs::path(folder).lexically_normal().filename().string();
+    const std::string name =
+        fs::path(folder).lexically_normal().filename().string().empty()
+            ? fs::path(folder).lexically_normal().parent_path().filename().string()
+            : fs::path(folder).lexically_normal().filename().string();
     if (std::regex_search(name, m, kFr)) return "freiburg" + m[2].str();
     return std::nullopt;
 }
@@ -54,8 +56,10 @@ void loadTumImages(const std::string& rgb_path, const std::string& depth_path, d
     if (rgb.empty()) throw std::runtime_error(rgb_path + ": cannot decode colour image");
     if (rgb.depth() != CV_8U)
         throw std::runtime_error(rgb_path + ": colour image must be 8 bits per channel");
-    if (rgb.channels() == 1) cv::cvtColor(rgb, rgb, cv::COLOR_GRAY2BGR);
-    else if (rgb.channels() == 4) cv::cvtColor(rgb, rgb, cv::COLOR_BGRA2BGR);
+    if (rgb.channels() == 1)
+        cv::cvtColor(rgb, rgb, cv::COLOR_GRAY2BGR);
+    else if (rgb.channels() == 4)
+        cv::cvtColor(rgb, rgb, cv::COLOR_BGRA2BGR);
     cv::Mat raw = cv::imread(depth_path, cv::IMREAD_UNCHANGED);
     if (raw.empty()) throw std::runtime_error(depth_path + ": cannot decode depth image");
     if (raw.type() != CV_16UC1)
@@ -94,12 +98,25 @@ TumReader::TumReader(std::string folder, const ReaderOptions& opts)
         throw std::runtime_error(folder_ + ": no rgb/depth pair within " +
                                  std::to_string(opts_.max_dt) + " s");
 
+    const std::string camera_ini = folder_ + "/camera.ini";
     if (opts_.intrinsics) {
         K_ = *opts_.intrinsics;
-    } else if (opts_.camera == "auto") {
-        K_ = core::CameraIntrinsics::fromPreset(tumPresetFromName(folder_).value_or("ros_default"));
-    } else {
+        camera_source_ = "given intrinsics";
+    } else if (opts_.camera != "auto") {
         K_ = core::CameraIntrinsics::fromPreset(opts_.camera);
+        camera_source_ = "preset " + opts_.camera;
+    } else if (fs::exists(camera_ini)) {
+        try {
+            K_ = core::CameraIntrinsics::fromConfig(*core::loadIni(camera_ini), "camera");
+        } catch (const std::exception& e) {
+            throw std::runtime_error(camera_ini + ": " + e.what());
+        }
+        camera_source_ = "camera.ini";
+    } else {
+        const auto preset = tumPresetFromName(folder_);
+        K_ = core::CameraIntrinsics::fromPreset(preset.value_or("ros_default"));
+        camera_source_ = preset ? "preset " + *preset + " (from the folder name)"
+                                : "preset ros_default (no camera.ini, folder name names no camera)";
     }
     const std::string gt = folder_ + "/groundtruth.txt";
     if (fs::exists(gt)) gt_ = readTumTrajectory(gt);
@@ -118,8 +135,9 @@ core::Frame TumReader::read(std::size_t i) const {
     if (f.K.width != f.bgr.cols || f.K.height != f.bgr.rows) {
         // Presets are for 640x480; other sizes need explicit intrinsics.
         throw std::runtime_error(f.rgb_source + ": image is " + std::to_string(f.bgr.cols) + "x" +
-                                 std::to_string(f.bgr.rows) + " but the camera intrinsics are for " +
-                                 std::to_string(f.K.width) + "x" + std::to_string(f.K.height));
+                                 std::to_string(f.bgr.rows) +
+                                 " but the camera intrinsics are for " + std::to_string(f.K.width) +
+                                 "x" + std::to_string(f.K.height));
     }
     return f;
 }
@@ -131,7 +149,8 @@ std::optional<core::Frame> TumReader::next() {
 
 std::string TumReader::describe() const {
     return "TUM folder " + folder_ + " (" + std::to_string(pairs_.size()) + " rgb-depth pairs" +
-           (gt_ ? ", ground truth " + std::to_string(gt_->size()) + " poses" : "") + ")";
+           (gt_ ? ", ground truth " + std::to_string(gt_->size()) + " poses" : "") + ", camera " +
+           camera_source_ + ")";
 }
 
 }  // namespace devslam::io

@@ -1,7 +1,11 @@
 #include <devslam/io/TrajectoryIO.h>
 #include <devslam/io/TumWriter.h>
 
+#include <mrpt/config/CConfigFileMemory.h>
+
 #include <opencv2/imgcodecs.hpp>
+
+#include <fstream>
 
 #include <cmath>
 #include <filesystem>
@@ -24,7 +28,9 @@ std::unique_ptr<std::FILE, int (*)(std::FILE*)> openList(const std::string& path
 }  // namespace
 
 TumWriter::TumWriter(std::string folder, const std::string& description)
-    : folder_(std::move(folder)), rgb_list_(nullptr, &std::fclose), depth_list_(nullptr, &std::fclose) {
+    : folder_(std::move(folder)),
+      rgb_list_(nullptr, &std::fclose),
+      depth_list_(nullptr, &std::fclose) {
     std::error_code ec;
     fs::create_directories(folder_ + "/rgb", ec);
     fs::create_directories(folder_ + "/depth", ec);
@@ -45,6 +51,15 @@ void TumWriter::write(const core::Frame& f) {
         throw std::runtime_error("frame " + std::to_string(f.index) + ": depth " +
                                  std::to_string(max_depth) + " m does not fit 16 bits at scale " +
                                  std::to_string(f.depth_scale));
+    if (count_ == 0) {
+        // Intrinsics travel with the folder (TumReader reads camera.ini before guessing).
+        mrpt::config::CConfigFileMemory cam;
+        f.K.saveToConfig(cam, "camera");
+        std::ofstream(folder_ + "/camera.ini")
+            << "# Camera intrinsics of this sequence (pinhole, depth registered to colour).\n"
+            << "# fx fy cx cy [px], width height [px], dist = k1 k2 p1 p2 k3 (OpenCV order)\n"
+            << cam.getContent();
+    }
     char stamp[32];
     std::snprintf(stamp, sizeof stamp, "%.6f", f.timestamp);
     const std::string rgb = std::string("rgb/") + stamp + ".png";

@@ -17,7 +17,8 @@ namespace devslam::core {
 /// or zero.
 [[nodiscard]] mrpt::poses::CPose3D fromTum(double tx, double ty, double tz, double qx, double qy,
                                            double qz, double qw);
-/// Rotation angle of a pose [rad] in [0, pi] (the TUM tools' `compute_angle`).
+/// Rotation angle of a pose [rad] in [0, pi] (the TUM tools' `compute_angle`, computed
+/// without its arccos round-off).
 [[nodiscard]] double rotationAngle(const mrpt::poses::CPose3D& p);
 /// Wraps an angle to (-pi, pi].
 [[nodiscard]] double wrapToPi(double a);

@@ -17,13 +17,13 @@
 namespace devslam::core {
 
 class ProgressBar {
-public:
+  public:
     ProgressBar(std::string label, std::size_t total, std::FILE* out = stderr,
                 double min_interval_s = 0.25);
     void update(std::size_t done, const std::string& extra = {});
     void finish(const std::string& extra = {});
 
-private:
+  private:
     void draw(std::size_t done, const std::string& extra, bool final_line);
     std::string label_;
     std::size_t total_;

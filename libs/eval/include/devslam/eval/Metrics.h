@@ -18,9 +18,9 @@
 namespace devslam::eval {
 
 struct AteOptions {
-    double max_dt = 0.02;   ///< [s] association window (associate.py --max_difference)
-    double offset = 0.0;    ///< [s] added to the estimate's stamps (--offset)
-    double scale = 1.0;     ///< multiplies the estimate's translations (--scale)
+    double max_dt = 0.02;  ///< [s] association window (associate.py --max_difference)
+    double offset = 0.0;   ///< [s] added to the estimate's stamps (--offset)
+    double scale = 1.0;    ///< multiplies the estimate's translations (--scale)
 };
 
 struct AteResult {
@@ -46,9 +46,9 @@ struct AteResult {
                                           const std::vector<Eigen::Vector3d>& data);
 
 struct RpeOptions {
-    double delta = 1.0;          ///< fixed interval
-    bool delta_in_frames = false;///< false: delta in seconds ("s"); true: in frames ("f")
-    double offset = 0.0;         ///< [s] added to the estimate's stamps
+    double delta = 1.0;            ///< fixed interval
+    bool delta_in_frames = false;  ///< false: delta in seconds ("s"); true: in frames ("f")
+    double offset = 0.0;           ///< [s] added to the estimate's stamps
 };
 
 struct RpeResult {

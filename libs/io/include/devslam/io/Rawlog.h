@@ -30,7 +30,7 @@ class CObservation3DRangeScan;
 namespace devslam::io {
 
 class RawlogReader final : public RgbdReader {
-public:
+  public:
     explicit RawlogReader(std::string path, const ReaderOptions& opts = {},
                           bool allow_truncated = false);
     ~RawlogReader() override;
@@ -46,7 +46,7 @@ public:
     /// Observations of other classes (odometry, lasers...) skipped while scanning.
     [[nodiscard]] std::size_t skippedObservations() const { return n_skipped_; }
 
-private:
+  private:
     struct Stream;
     std::string path_;
     ReaderOptions opts_;
@@ -68,12 +68,12 @@ struct RawlogWriterOptions {
     bool sensory_frames = false;
     /// true: a small .rawlog plus `<name>_Images/` with PNG colour and .bin depth.
     bool external_images = false;
-    int compression = 1;                 ///< gzip level 0..9
-    std::string sensor_label = "RGBD";   ///< CObservation::sensorLabel
+    int compression = 1;                ///< gzip level 0..9
+    std::string sensor_label = "RGBD";  ///< CObservation::sensorLabel
 };
 
 class RawlogWriter {
-public:
+  public:
     RawlogWriter(std::string path, const RawlogWriterOptions& opts);
     ~RawlogWriter();
     RawlogWriter(const RawlogWriter&) = delete;
@@ -83,7 +83,7 @@ public:
     void close();
     [[nodiscard]] std::size_t count() const { return count_; }
 
-private:
+  private:
     struct Stream;
     std::string path_, images_dir_;
     RawlogWriterOptions opts_;

@@ -37,7 +37,7 @@ struct ReaderOptions {
 };
 
 class RgbdReader {
-public:
+  public:
     virtual ~RgbdReader() = default;
     /// The next frame, or std::nullopt at the end. Throws std::runtime_error naming the file
     /// (and line or observation index) when the data is damaged.
@@ -45,7 +45,9 @@ public:
     /// Number of frames if known up front (TUM: yes; rawlog: counted while opening).
     [[nodiscard]] virtual std::optional<std::size_t> size() const = 0;
     /// Ground truth if the source has it (TUM groundtruth.txt).
-    [[nodiscard]] virtual std::optional<core::Trajectory> groundTruth() const { return std::nullopt; }
+    [[nodiscard]] virtual std::optional<core::Trajectory> groundTruth() const {
+        return std::nullopt;
+    }
     /// Intrinsics the frames will carry.
     [[nodiscard]] virtual core::CameraIntrinsics intrinsics() const = 0;
     [[nodiscard]] virtual std::string describe() const = 0;

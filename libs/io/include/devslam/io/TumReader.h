@@ -3,6 +3,11 @@
 /// Colour and depth are associated like TUM's associate.py (nearest within max_dt, each
 /// image used once); depth PNGs are 16-bit with 5000 units per metre, 0 = missing.
 ///
+/// Intrinsics, in order of precedence: ReaderOptions::intrinsics, a named preset
+/// (ReaderOptions::camera), the folder's own `camera.ini` (section [camera], written by
+/// TumWriter and the renderer), the preset the folder name implies ("freiburg1", "fr3"...),
+/// else the ROS default (describe() says which was used).
+///
 /// Every list is parsed and every referenced file checked for existence when the reader
 /// is constructed, so a damaged folder fails before any work starts, with file and line.
 ///
@@ -32,7 +37,7 @@ struct TumListEntry {
 [[nodiscard]] std::optional<std::string> tumPresetFromName(const std::string& folder);
 
 class TumReader final : public RgbdReader {
-public:
+  public:
     explicit TumReader(std::string folder, const ReaderOptions& opts = {});
     [[nodiscard]] std::optional<core::Frame> next() override;
     [[nodiscard]] std::optional<std::size_t> size() const override { return pairs_.size(); }
@@ -43,12 +48,13 @@ public:
     /// Random access to frame i (0-based) of the associated list.
     [[nodiscard]] core::Frame read(std::size_t i) const;
 
-private:
+  private:
     std::string folder_;
     ReaderOptions opts_;
     core::CameraIntrinsics K_;
     std::vector<std::pair<TumListEntry, TumListEntry>> pairs_;  // (rgb, depth)
     std::optional<core::Trajectory> gt_;
+    std::string camera_source_;
     std::size_t cursor_ = 0;
 };
 

@@ -17,7 +17,7 @@
 namespace devslam::io {
 
 class TumWriter {
-public:
+  public:
     /// Creates the folder (and rgb/, depth/); throws if it cannot.
     explicit TumWriter(std::string folder, const std::string& description = "devslam");
     ~TumWriter();
@@ -30,7 +30,7 @@ public:
     void close();
     [[nodiscard]] std::size_t count() const { return count_; }
 
-private:
+  private:
     std::string folder_;
     std::unique_ptr<std::FILE, int (*)(std::FILE*)> rgb_list_, depth_list_;
     std::size_t count_ = 0;

@@ -1,0 +1,106 @@
+// devslam-eval: ATE and RPE of an estimated trajectory against ground truth, computed as
+// the TUM RGB-D benchmark tools do (evaluate_ate.py, evaluate_rpe.py --fixed_delta).
+#include <devslam/eval/Metrics.h>
+#include <devslam/eval/Report.h>
+#include <devslam/io/TrajectoryIO.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <iostream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace {
+
+const char* kUsage = R"(usage: devslam-eval GROUNDTRUTH ESTIMATE [options]
+  Both files in TUM format: 'timestamp tx ty tz qx qy qz qw' per line, '#' comments.
+options:
+  --max-dt S        association window [s] (default 0.02, as associate.py)
+  --offset S        time offset added to the estimate [s] (default 0)
+  --scale K         scale applied to the estimate's translations (default 1)
+  --delta D         RPE interval (default 1)
+  --delta-unit U    s (seconds, default) or f (frames)
+  --json FILE       also write the figures as JSON
+  --plot FILE.png   also write a plot (top view coloured by error, x/y/z over time)
+  --title TEXT      plot title (default: the estimate's file name)
+  --no-rpe          ATE only
+)";
+
+double number(const std::string& opt, const char* v) {
+    char* end = nullptr;
+    const double x = std::strtod(v, &end);
+    if (end == v || *end != '\0')
+        throw std::invalid_argument(opt + ": '" + v + "' is not a number");
+    return x;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    try {
+        std::vector<std::string> pos;
+        devslam::eval::AteOptions ao;
+        devslam::eval::RpeOptions ro;
+        std::string json, plot, title;
+        bool rpe = true;
+        for (int i = 1; i < argc; ++i) {
+            const std::string a = argv[i];
+            auto value = [&]() -> const char* {
+                if (i + 1 >= argc) throw std::invalid_argument(a + " needs a value");
+                return argv[++i];
+            };
+            if (a == "-h" || a == "--help") {
+                std::cout << kUsage;
+                return 0;
+            } else if (a == "--max-dt")
+                ao.max_dt = number(a, value());
+            else if (a == "--offset")
+                ao.offset = ro.offset = number(a, value());
+            else if (a == "--scale")
+                ao.scale = number(a, value());
+            else if (a == "--delta")
+                ro.delta = number(a, value());
+            else if (a == "--delta-unit") {
+                const std::string u = value();
+                if (u != "s" && u != "f")
+                    throw std::invalid_argument("--delta-unit: 's' or 'f', got '" + u + "'");
+                ro.delta_in_frames = (u == "f");
+            } else if (a == "--json")
+                json = value();
+            else if (a == "--plot")
+                plot = value();
+            else if (a == "--title")
+                title = value();
+            else if (a == "--no-rpe")
+                rpe = false;
+            else if (!a.empty() && a[0] == '-')
+                throw std::invalid_argument("unknown option " + a);
+            else
+                pos.push_back(a);
+        }
+        if (pos.size() != 2) {
+            std::cerr << kUsage;
+            return 2;
+        }
+        const auto gt = devslam::io::readTumTrajectory(pos[0]);
+        auto est = devslam::io::readTumTrajectory(pos[1]);
+        const auto ate = devslam::eval::computeAte(gt, est, ao);
+        std::optional<devslam::eval::RpeResult> r;
+        if (rpe) {
+            if (ao.scale != 1.0)
+                for (auto& p : est)
+                    p.pose.setFromValues(ao.scale * p.pose.x(), ao.scale * p.pose.y(),
+                                         ao.scale * p.pose.z(), p.pose.yaw(), p.pose.pitch(),
+                                         p.pose.roll());
+            r = devslam::eval::computeRpe(gt, est, ro);
+        }
+        std::cout << devslam::eval::formatTable(&ate, r ? &*r : nullptr, &ro);
+        if (!json.empty()) devslam::eval::writeJson(json, &ate, r ? &*r : nullptr, &ro);
+        if (!plot.empty()) devslam::eval::plotAte(plot, ate, title.empty() ? pos[1] : title);
+        return 0;
+    } catch (const std::exception& e) {
+        std::cerr << "devslam-eval: " << e.what() << "\n";
+        return 1;
+    }
+}

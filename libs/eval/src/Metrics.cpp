@@ -1,0 +1,132 @@
+#include <devslam/eval/Metrics.h>
+
+#include <devslam/core/Association.h>
+#include <devslam/core/Pose.h>
+
+#include <Eigen/Geometry>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace devslam::eval {
+
+Eigen::Isometry3d hornAlign(const std::vector<Eigen::Vector3d>& model,
+                            const std::vector<Eigen::Vector3d>& data) {
+    if (model.size() != data.size())
+        throw std::invalid_argument("hornAlign: " + std::to_string(model.size()) + " model vs " +
+                                    std::to_string(data.size()) + " data points");
+    if (model.size() < 3)
+        throw std::invalid_argument("hornAlign: need at least 3 point pairs, got " +
+                                    std::to_string(model.size()));
+    Eigen::Matrix3Xd src(3, data.size()), dst(3, model.size());
+    for (std::size_t i = 0; i < data.size(); ++i) src.col(i) = data[i], dst.col(i) = model[i];
+    // Eigen's Umeyama without scale is the same least-squares optimum as Horn's closed form
+    // used by evaluate_ate.py (SVD of the cross-covariance with the reflection fix).
+    Eigen::Isometry3d T;
+    T.matrix() = Eigen::umeyama(src, dst, false);
+    return T;
+}
+
+AteResult computeAte(const core::Trajectory& gt, const core::Trajectory& est,
+                     const AteOptions& opts) {
+    std::vector<double> tg, te;
+    for (const auto& p : gt) tg.push_back(p.t);
+    for (const auto& p : est) te.push_back(p.t);
+    // evaluate_ate.py: associate(gt, est, offset, max_difference) with the offset on est.
+    const auto pairs = core::associate(tg, te, opts.max_dt, opts.offset);
+    if (pairs.size() < 3)
+        throw std::invalid_argument(
+            "ATE: only " + std::to_string(pairs.size()) + " of " + std::to_string(est.size()) +
+            " estimated poses associate with the ground truth within " +
+            std::to_string(opts.max_dt) + " s (wrong files, or timestamps in other units?)");
+    AteResult r;
+    r.n_gt = gt.size();
+    r.n_est = est.size();
+    std::vector<Eigen::Vector3d> model, data;
+    for (const auto& [i, j] : pairs) {
+        const auto& g = gt[i].pose;
+        const auto& e = est[j].pose;
+        model.emplace_back(g.x(), g.y(), g.z());
+        data.emplace_back(opts.scale * e.x(), opts.scale * e.y(), opts.scale * e.z());
+        r.stamps.push_back(est[j].t);
+    }
+    r.T_gt_est = hornAlign(model, data);
+    for (std::size_t k = 0; k < model.size(); ++k) {
+        const Eigen::Vector3d aligned = r.T_gt_est * data[k];
+        r.errors.push_back((aligned - model[k]).norm());
+        r.est_xyz.push_back(aligned);
+    }
+    r.gt_xyz = std::move(model);
+    r.trans = core::summarize(r.errors);
+    return r;
+}
+
+namespace {
+
+// evaluate_rpe.py's find_closest_index, reproduced step by step (a bisection that keeps the
+// best |L[m] - t| seen on the way; ties keep the earlier-visited index).
+std::size_t findClosestIndex(const std::vector<double>& L, double t) {
+    std::size_t begin = 0, end = L.size(), best = 0;
+    double diff = std::abs(L[0] - t);
+    while (begin < end) {
+        const std::size_t mid = (begin + end) / 2;
+        if (std::abs(L[mid] - t) < diff) {
+            diff = std::abs(L[mid] - t);
+            best = mid;
+        }
+        if (t == L[mid]) return mid;
+        if (L[mid] > t)
+            end = mid;
+        else
+            begin = mid + 1;
+    }
+    return best;
+}
+
+}  // namespace
+
+RpeResult computeRpe(const core::Trajectory& gt, const core::Trajectory& est,
+                     const RpeOptions& opts) {
+    if (gt.size() < 2 || est.size() < 2)
+        throw std::invalid_argument("RPE: need at least 2 poses in each trajectory");
+    if (!(opts.delta > 0)) throw std::invalid_argument("RPE: delta must be > 0");
+    std::vector<double> sg, se;
+    for (const auto& p : gt) sg.push_back(p.t);
+    for (const auto& p : est) se.push_back(p.t);
+    // Trajectories are sorted by construction (readers reject unsorted files).
+    std::vector<double> index(se.size());
+    for (std::size_t i = 0; i < se.size(); ++i)
+        index[i] = opts.delta_in_frames ? static_cast<double>(i) : se[i];
+
+    std::vector<double> intervals;
+    for (std::size_t i = 1; i < sg.size(); ++i) intervals.push_back(sg[i] - sg[i - 1]);
+    const double gt_max_dt = 2.0 * core::median(intervals);
+
+    std::vector<double> trans, rot;
+    for (std::size_t i = 0; i < se.size(); ++i) {
+        const std::size_t j = findClosestIndex(index, index[i] + opts.delta);
+        if (j == se.size() - 1) continue;  // evaluate_rpe.py drops pairs ending at the last pose
+        const std::size_t g0 = findClosestIndex(sg, se[i] + opts.offset);
+        const std::size_t g1 = findClosestIndex(sg, se[j] + opts.offset);
+        if (std::abs(sg[g0] - (se[i] + opts.offset)) > gt_max_dt ||
+            std::abs(sg[g1] - (se[j] + opts.offset)) > gt_max_dt)
+            continue;
+        const mrpt::poses::CPose3D rel_est = est[j].pose - est[i].pose;  // P_i^-1 P_j
+        const mrpt::poses::CPose3D rel_gt = gt[g1].pose - gt[g0].pose;   // Q_i^-1 Q_j
+        const mrpt::poses::CPose3D err = rel_gt - rel_est;               // (P rel)^-1 (Q rel)
+        trans.push_back(err.norm());
+        rot.push_back(core::rotationAngle(err) * 180.0 / M_PI);
+    }
+    if (trans.empty())
+        throw std::invalid_argument("RPE: no pose pair " + std::to_string(opts.delta) +
+                                    (opts.delta_in_frames ? " frames" : " s") +
+                                    " apart has ground truth (sequence too short?)");
+    RpeResult r;
+    r.trans = core::summarize(trans);
+    r.rot = core::summarize(rot);
+    r.n_pairs = trans.size();
+    return r;
+}
+
+}  // namespace devslam::eval

@@ -1,0 +1,139 @@
+#include <devslam/eval/Plot.h>
+#include <devslam/eval/Report.h>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+namespace devslam::eval {
+
+namespace {
+
+std::string fmt(const char* f, double v) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, f, v);
+    return buf;
+}
+
+std::string summaryJson(const core::Summary& s) {
+    std::ostringstream o;
+    o.precision(9);
+    o << "{\"count\": " << s.count << ", \"rmse\": " << s.rmse << ", \"mean\": " << s.mean
+      << ", \"median\": " << s.median << ", \"std\": " << s.std << ", \"min\": " << s.min
+      << ", \"max\": " << s.max << "}";
+    return o.str();
+}
+
+std::string deltaText(const RpeOptions* o) {
+    if (!o) return "";
+    return fmt("%g", o->delta) + (o->delta_in_frames ? " frames" : " s");
+}
+
+}  // namespace
+
+std::string formatTable(const AteResult* ate, const RpeResult* rpe, const RpeOptions* ro) {
+    std::ostringstream o;
+    auto row = [&](const std::string& name, const core::Summary& s, const char* unit, double k) {
+        char buf[200];
+        std::snprintf(buf, sizeof buf, "%-22s %10.6f %10.6f %10.6f %10.6f %10.6f %10.6f  %s\n",
+                      name.c_str(), k * s.rmse, k * s.mean, k * s.median, k * s.std, k * s.min,
+                      k * s.max, unit);
+        o << buf;
+    };
+    char head[200];
+    std::snprintf(head, sizeof head, "%-22s %10s %10s %10s %10s %10s %10s\n", "metric", "rmse",
+                  "mean", "median", "std", "min", "max");
+    o << head;
+    if (ate) {
+        row("ATE translation", ate->trans, "m", 1.0);
+        o << "  (" << ate->trans.count << " pairs of " << ate->n_est << " estimated and "
+          << ate->n_gt << " ground-truth poses)\n";
+    }
+    if (rpe) {
+        const std::string d = ro ? " (" + deltaText(ro) + ")" : "";
+        row("RPE translation" + d, rpe->trans, "m", 1.0);
+        row("RPE rotation" + d, rpe->rot, "deg", 1.0);
+        o << "  (" << rpe->n_pairs << " pose pairs)\n";
+    }
+    return o.str();
+}
+
+std::string toJson(const AteResult* ate, const RpeResult* rpe, const RpeOptions* ro) {
+    std::ostringstream o;
+    o << "{";
+    if (ate) {
+        o << "\"ate\": {\"translation_m\": " << summaryJson(ate->trans)
+          << ", \"n_est\": " << ate->n_est << ", \"n_gt\": " << ate->n_gt << "}";
+    }
+    if (rpe) {
+        if (ate) o << ", ";
+        o << "\"rpe\": {";
+        if (ro)
+            o << "\"delta\": " << ro->delta << ", \"delta_unit\": \""
+              << (ro->delta_in_frames ? "f" : "s") << "\", ";
+        o << "\"translation_m\": " << summaryJson(rpe->trans)
+          << ", \"rotation_deg\": " << summaryJson(rpe->rot) << ", \"pairs\": " << rpe->n_pairs
+          << "}";
+    }
+    o << "}\n";
+    return o.str();
+}
+
+void writeJson(const std::string& path, const AteResult* ate, const RpeResult* rpe,
+               const RpeOptions* ro) {
+    std::ofstream out(path);
+    out << toJson(ate, rpe, ro);
+    if (!out) throw std::runtime_error("cannot write '" + path + "'");
+}
+
+void plotAte(const std::string& path, const AteResult& ate, const std::string& title) {
+    cv::Mat canvas(900, 1200, CV_8UC3, cv::Scalar(255, 255, 255));
+    std::vector<double> gx, gy, ex, ey, t;
+    for (std::size_t i = 0; i < ate.gt_xyz.size(); ++i) {
+        gx.push_back(ate.gt_xyz[i].x()), gy.push_back(ate.gt_xyz[i].y());
+        ex.push_back(ate.est_xyz[i].x()), ey.push_back(ate.est_xyz[i].y());
+        t.push_back(ate.stamps[i] - ate.stamps.front());
+    }
+    const double emax = std::max(ate.trans.max, 1e-9);
+    std::vector<cv::Scalar> colours;
+    for (double e : ate.errors) colours.push_back(heatColour(e / emax));
+
+    Plot top(cv::Rect(0, 0, 600, 900),
+             title + ": top view, ATE RMSE " + fmt("%.4f", ate.trans.rmse) + " m", "x [m]",
+             "y [m]");
+    top.fit(gx, gy);
+    top.fit(ex, ey);
+    top.equalAspect();
+    top.axes(canvas);
+    top.line(canvas, gx, gy, cv::Scalar(0, 0, 0), 2);
+    for (std::size_t i = 0; i < gx.size(); ++i)  // error segments gt -> estimate
+        cv::line(canvas, top.toPixel(gx[i], gy[i]), top.toPixel(ex[i], ey[i]), colours[i], 1,
+                 cv::LINE_AA);
+    top.points(canvas, ex, ey, colours, 3);
+    top.legend(canvas, {{"ground truth", cv::Scalar(0, 0, 0)},
+                        {"estimate (blue 0 -> red " + fmt("%.4f", emax) + " m)", heatColour(1.0)}});
+
+    const char* names[3] = {"x", "y", "z"};
+    for (int a = 0; a < 3; ++a) {
+        std::vector<double> g, e;
+        for (std::size_t i = 0; i < ate.gt_xyz.size(); ++i)
+            g.push_back(ate.gt_xyz[i][a]), e.push_back(ate.est_xyz[i][a]);
+        Plot p(cv::Rect(600, 300 * a, 600, 300), std::string(names[a]) + " over time", "t [s]",
+               std::string(names[a]) + " [m]");
+        p.fit(t, g);
+        p.fit(t, e);
+        p.axes(canvas);
+        p.line(canvas, t, g, cv::Scalar(0, 0, 0), 2);
+        p.line(canvas, t, e, cv::Scalar(30, 120, 255), 1);
+        if (a == 0)
+            p.legend(canvas, {{"ground truth", cv::Scalar(0, 0, 0)},
+                              {"estimate", cv::Scalar(30, 120, 255)}});
+    }
+    if (!cv::imwrite(path, canvas)) throw std::runtime_error("cannot write plot '" + path + "'");
+}
+
+}  // namespace devslam::eval
