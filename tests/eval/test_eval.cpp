@@ -1,0 +1,215 @@
+#include <devslam/core/Pose.h>
+#include <devslam/eval/Metrics.h>
+#include <devslam/eval/Report.h>
+#include <devslam/io/TrajectoryIO.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+using namespace devslam;
+using mrpt::poses::CPose3D;
+
+namespace {
+
+const std::string kGt = std::string(DEVSLAM_SOURCE_DIR) + "/data/tum/fr1_xyz_first37/groundtruth.txt";
+
+// A smooth synthetic trajectory at `hz` (helix with changing orientation).
+core::Trajectory helix(std::size_t n, double hz) {
+    core::Trajectory t;
+    for (std::size_t i = 0; i < n; ++i) {
+        const double s = static_cast<double>(i) / hz;
+        t.push_back({100.0 + s, CPose3D(std::cos(s), std::sin(s), 0.1 * s, 0.3 * s, 0.1 * std::sin(s), 0.05)});
+    }
+    return t;
+}
+
+core::Trajectory transformed(const core::Trajectory& in, const CPose3D& T) {
+    core::Trajectory out = in;
+    for (auto& p : out) p.pose = T + p.pose;
+    return out;
+}
+
+// Adds a world-frame translation offset to pose i (rotation unchanged).
+CPose3D shifted(const CPose3D& p, const Eigen::Vector3d& d) {
+    CPose3D q = p;
+    q.x_incr(d.x());
+    q.y_incr(d.y());
+    q.z_incr(d.z());
+    return q;
+}
+
+}  // namespace
+
+TEST(Horn, RecoversAKnownRigidTransform) {
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> u(-2, 2);
+    std::vector<Eigen::Vector3d> data, model;
+    const CPose3D T(0.4, -1.2, 2.0, 0.7, -0.3, 1.1);
+    const Eigen::Isometry3d Ti = core::toIsometry(T);
+    for (int i = 0; i < 20; ++i) {
+        data.emplace_back(u(rng), u(rng), u(rng));
+        model.push_back(Ti * data.back());
+    }
+    EXPECT_TRUE(eval::hornAlign(model, data).matrix().isApprox(Ti.matrix(), 1e-10));
+    EXPECT_THROW((void)eval::hornAlign({model[0], model[1]}, {data[0], data[1]}), std::invalid_argument);
+}
+
+TEST(Ate, RigidlyMovedTrajectoryHasZeroError) {
+    const auto gt = helix(300, 30);
+    const CPose3D T(3, -2, 1, 1.0, 0.2, -0.4);
+    const auto r = eval::computeAte(gt, transformed(gt, T));
+    EXPECT_EQ(r.trans.count, 300u);
+    EXPECT_LT(r.trans.rmse, 1e-9);
+    EXPECT_LT(r.trans.max, 1e-9);
+    // the alignment is the inverse of the motion applied
+    EXPECT_TRUE(r.T_gt_est.matrix().isApprox(core::toIsometry(-T).matrix(), 1e-9));
+}
+
+TEST(Ate, GaussianNoiseGivesExpectedRmse) {
+    const auto gt = helix(3000, 30);
+    auto est = gt;
+    std::mt19937 rng(42);
+    constexpr double kSigma = 0.01;  // [m] per axis
+    std::normal_distribution<double> n(0, kSigma);
+    for (auto& p : est) p.pose = shifted(p.pose, {n(rng), n(rng), n(rng)});
+    const auto r = eval::computeAte(gt, est);
+    // E|e|^2 = 3 sigma^2 -> RMSE = sqrt(3) sigma; the mean of a chi(3) is 2 sqrt(2/pi) sigma.
+    EXPECT_NEAR(r.trans.rmse, std::sqrt(3.0) * kSigma, 0.03 * std::sqrt(3.0) * kSigma);
+    EXPECT_NEAR(r.trans.mean, 2 * std::sqrt(2 / M_PI) * kSigma, 0.03 * 1.6 * kSigma);
+}
+
+TEST(Ate, AssociationWindowIsHonoured) {
+    const auto gt = helix(100, 10);  // 0.1 s apart
+    auto est = gt;
+    for (std::size_t i = 0; i < est.size(); ++i) est[i].t += (i % 2 ? 0.015 : 0.025);
+    // Only the odd poses are within 0.02 s of their ground truth.
+    EXPECT_EQ(eval::computeAte(gt, est).trans.count, 50u);
+    eval::AteOptions wide;
+    wide.max_dt = 0.03;
+    EXPECT_EQ(eval::computeAte(gt, est, wide).trans.count, 100u);
+    eval::AteOptions off;
+    off.offset = -0.025;  // undoes the even poses' shift exactly
+    EXPECT_GE(eval::computeAte(gt, est, off).trans.count, 50u);
+    auto far = gt;
+    for (auto& p : far) p.t += 1000;
+    EXPECT_THROW((void)eval::computeAte(gt, far), std::invalid_argument);
+}
+
+TEST(Rpe, ConstantDriftGivesExpectedError) {
+    // World-frame drift d per frame: E_i has translation -(j-i) R_j^T d, norm (j-i)|d|,
+    // and no rotation, whatever the ground truth's orientation.
+    const auto gt = helix(300, 30);
+    auto est = gt;
+    const Eigen::Vector3d d(0.001, -0.0005, 0.0002);
+    for (std::size_t i = 0; i < est.size(); ++i) est[i].pose = shifted(gt[i].pose, d * double(i));
+    eval::RpeOptions frames;
+    frames.delta = 10;
+    frames.delta_in_frames = true;
+    const auto r = eval::computeRpe(gt, est, frames);
+    EXPECT_NEAR(r.trans.rmse, 10 * d.norm(), 1e-9);
+    EXPECT_NEAR(r.trans.std, 0, 1e-9);
+    EXPECT_LT(r.rot.max, 1e-6);
+    // delta 1 s at 30 Hz = 30 frames; pairs ending at the last pose are dropped (as in
+    // evaluate_rpe.py) -> 300 - 30 - 1 pairs.
+    const auto s = eval::computeRpe(gt, est, {});
+    EXPECT_NEAR(s.trans.median, 30 * d.norm(), 1e-9);
+    EXPECT_EQ(s.n_pairs, 269u);
+}
+
+TEST(Rpe, ReproducesEvaluateRpeQuirks) {
+    const auto gt = helix(5, 1);
+    eval::RpeOptions o;
+    o.delta = 1;
+    o.delta_in_frames = true;
+    // pairs (0,1) (1,2) (2,3); (3,4) ends at the last index and (4,4) too: dropped.
+    EXPECT_EQ(eval::computeRpe(gt, gt, o).n_pairs, 3u);
+    // A constant rotation error about z on every pose of a pure translation gives 0 RPE.
+    core::Trajectory line, rotated;
+    for (int i = 0; i < 50; ++i) {
+        line.push_back({double(i), CPose3D(0.1 * i, 0, 0, 0, 0, 0)});
+        rotated.push_back({double(i), CPose3D(0.1 * i, 0, 0, 0, 0, 0) + CPose3D(0, 0, 0, 0.2, 0, 0)});
+    }
+    o.delta = 5;
+    const auto r = eval::computeRpe(line, rotated, o);
+    EXPECT_NEAR(r.rot.max, 0, 1e-9);
+    EXPECT_NEAR(r.trans.max, 0.5 * std::hypot(1 - std::cos(0.2), std::sin(0.2)), 1e-9);
+}
+
+// The real fr1_xyz ground truth (100 Hz motion capture), subsampled and perturbed by known
+// amounts: the figures must be those the TUM definitions give in closed form.
+TEST(RealGroundTruth, KnownPerturbationsGiveKnownFigures) {
+    const auto gt = io::readTumTrajectory(kGt);
+    core::Trajectory est;
+    for (std::size_t i = 0; i < gt.size(); i += 3) est.push_back(gt[i]);  // ~33 Hz
+    for (auto& p : est) p.t += 0.002;  // still nearest to its own gt pose (gt is 100 Hz)
+    const CPose3D T(-0.5, 0.3, 1.2, 2.0, -0.1, 0.3);
+    {  // rigid motion only: ATE = RPE = 0
+        const auto moved = transformed(est, T);
+        const auto a = eval::computeAte(gt, moved);
+        EXPECT_EQ(a.trans.count, est.size());
+        EXPECT_LT(a.trans.rmse, 1e-7);
+        EXPECT_LT(eval::computeRpe(gt, moved, {}).trans.rmse, 1e-7);
+    }
+    {  // +-1 cm along x, alternating: the alignment cannot absorb it -> RMSE 1 cm, std ~0
+        auto e = est;
+        for (std::size_t i = 0; i < e.size(); ++i)
+            e[i].pose = shifted(e[i].pose, {i % 2 ? 0.01 : -0.01, 0, 0});
+        const auto a = eval::computeAte(gt, transformed(e, T));
+        EXPECT_NEAR(a.trans.rmse, 0.01, 1e-4);
+        EXPECT_NEAR(a.trans.median, 0.01, 2e-4);
+        EXPECT_LT(a.trans.std, 2e-4);
+    }
+    {  // 1 mm of world drift per estimate: RPE over 10 frames = 1 cm for every pair
+        auto e = est;
+        for (std::size_t i = 0; i < e.size(); ++i)
+            e[i].pose = shifted(e[i].pose, {0.001 * double(i), 0, 0});
+        eval::RpeOptions o;
+        o.delta = 10;
+        o.delta_in_frames = true;
+        const auto r = eval::computeRpe(gt, transformed(e, T), o);
+        EXPECT_NEAR(r.trans.min, 0.01, 1e-7);
+        EXPECT_NEAR(r.trans.max, 0.01, 1e-7);
+        EXPECT_LT(r.rot.max, 1e-5);
+        EXPECT_EQ(r.n_pairs, est.size() - 11);
+    }
+}
+
+TEST(Report, TableJsonPlotAndApp) {
+    const auto gt = helix(100, 30);
+    auto est = gt;
+    for (std::size_t i = 0; i < est.size(); ++i) est[i].pose = shifted(est[i].pose, {0.002 * (i % 3), 0, 0});
+    const auto a = eval::computeAte(gt, est);
+    const auto r = eval::computeRpe(gt, est, {});
+    const std::string table = eval::formatTable(&a, &r);
+    EXPECT_NE(table.find("ATE translation"), std::string::npos);
+    EXPECT_NE(table.find("RPE rotation"), std::string::npos);
+    const std::string json = eval::toJson(&a, &r);
+    EXPECT_NE(json.find("\"rmse\": " + std::to_string(a.trans.rmse).substr(0, 6)), std::string::npos) << json;
+
+    const auto dir = std::filesystem::temp_directory_path() / "devslam_eval_report";
+    std::filesystem::create_directories(dir);
+    io::writeTumTrajectory((dir / "gt.txt").string(), gt);
+    io::writeTumTrajectory((dir / "est.txt").string(), est);
+    const std::string cmd = std::string(DEVSLAM_BIN_DIR) + "/devslam-eval " + (dir / "gt.txt").string() +
+                            " " + (dir / "est.txt").string() + " --json " + (dir / "e.json").string() +
+                            " --plot " + (dir / "e.png").string() + " > " + (dir / "out.txt").string();
+    ASSERT_EQ(std::system(cmd.c_str()), 0);
+    EXPECT_GT(std::filesystem::file_size(dir / "e.png"), 10000u);
+    std::ifstream in(dir / "e.json");
+    const std::string app_json((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_NE(app_json.find("\"translation_m\""), std::string::npos);
+    // bad input: a clear error and a non-zero exit status
+    std::ofstream(dir / "bad.txt") << "1 2 3\n";
+    const std::string bad = std::string(DEVSLAM_BIN_DIR) + "/devslam-eval " + (dir / "gt.txt").string() +
+                            " " + (dir / "bad.txt").string() + " 2> " + (dir / "err.txt").string();
+    EXPECT_NE(std::system(bad.c_str()), 0);
+    std::ifstream err(dir / "err.txt");
+    const std::string msg((std::istreambuf_iterator<char>(err)), std::istreambuf_iterator<char>());
+    EXPECT_NE(msg.find("bad.txt line 1: expected"), std::string::npos) << msg;
+    std::filesystem::remove_all(dir);
+}
