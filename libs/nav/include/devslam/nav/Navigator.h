@@ -1,0 +1,100 @@
+#pragma once
+/// Global + local navigation glue: A* on the map, waypoints within the PTG reference
+/// distance handed to MRPT's CReactiveNavigationSystem (whose holonomic method is chosen by
+/// name, e.g. CHolonomicVFHPlus), and replanning when the path is blocked or VFH+ keeps
+/// seeing a dense sector toward its target.
+///
+///   robot (CRobot2NavInterface) <── CReactiveNavigationSystem <── waypoints <── GridPlanner
+///                 │ senseObstacles()                                    ▲ replan (ReplanTrigger)
+///                 └──────────────────────────────────────────────────────┘
+///
+/// Usage:
+///   devslam::nav::Navigator nav(robot, navIni, NavigatorOptions::fromConfig(navIni));
+///   nav.start(map, startPose, goal, 0.3);          // throws PlanningError on a bad start/goal
+///   while (...) { nav.step(t); simulate(dt); }    // step at options.nav_period (simulated time)
+/// Not thread-safe. Time comes from mrpt::Clock (set it to Simulated in a simulator).
+#include <devslam/nav/GridPlanner.h>
+#include <devslam/nav/Replan.h>
+
+#include <mrpt/config/CConfigFileMemory.h>
+#include <mrpt/math/TPose2D.h>
+#include <mrpt/nav/reactive/CRobot2NavInterface.h>
+
+#include <memory>
+#include <optional>
+#include <string>
+
+namespace mrpt::nav {
+class CReactiveNavigationSystem;
+}
+
+namespace devslam::nav {
+
+/// INI section [navigator] plus the planner ([global_planner]) and replanning ([replan]).
+struct NavigatorOptions {
+    double nav_period = 0.1;                 ///< [s] period of navigationStep()
+    double waypoint_allowed_distance = 0.5;  ///< [m] intermediate waypoint reached radius
+    std::string holonomic_method = "CHolonomicVFHPlus";  ///< overrides the INI's choice
+    double robot_radius = 0.25;  ///< [m] circle used for the PTG robot polygon (16 sides)
+    bool log_file = false;       ///< write an MRPT .reactivenavlog
+    std::string log_directory = "reactivenav.logs";
+    std::string ptg_cache_directory = "";  ///< "" = a folder in the system temp dir
+    GridPlannerOptions planner;
+    ReplanOptions replan;
+
+    /// Reads [navigator], [global_planner] and [replan] from `cfg` (unknown keys rejected).
+    [[nodiscard]] static NavigatorOptions fromConfig(const mrpt::config::CConfigFileBase& cfg,
+                                                     const std::string& source = "INI");
+};
+
+/// Outcome of one step.
+enum class NavState { Idle, Navigating, GoalReached, Error };
+[[nodiscard]] const char* toString(NavState s);
+
+class Navigator {
+  public:
+    /// `nav_ini` holds MRPT's reactive sections ([CAbstractPTGBasedReactive], PTGs, the
+    /// holonomic methods); robot shape, ref distance and method are set from `opts`.
+    Navigator(mrpt::nav::CRobot2NavInterface& robot, const mrpt::config::CConfigFileBase& nav_ini,
+              NavigatorOptions opts);
+    ~Navigator();
+    Navigator(const Navigator&) = delete;
+    Navigator& operator=(const Navigator&) = delete;
+
+    /// Plans on `map` and starts the reactive navigator. Throws PlanningError for a bad
+    /// start/goal; returns false (and stays Idle) when no path exists.
+    [[nodiscard]] bool start(const mrpt::maps::COccupancyGridMap2D& map,
+                             const mrpt::math::TPose2D& start, const mrpt::math::TPoint2D& goal,
+                             double goal_tolerance);
+    /// One navigation step at time t [s]; call every nav_period.
+    NavState step(double t);
+
+    [[nodiscard]] const GridPath& globalPath() const { return first_path_; }
+    [[nodiscard]] const std::vector<mrpt::math::TPoint2D>& waypoints() const { return waypoints_; }
+    [[nodiscard]] int replanCount() const { return replans_; }
+    [[nodiscard]] double lastStepSeconds() const { return last_step_s_; }  ///< wall time
+    [[nodiscard]] std::string lastError() const { return last_error_; }
+    [[nodiscard]] double refDistance() const { return ref_distance_; }
+    [[nodiscard]] mrpt::nav::CReactiveNavigationSystem& reactive();
+
+  private:
+    bool replan(const mrpt::math::TPose2D& pose, const std::vector<mrpt::math::TPoint2D>& sensed);
+    void sendWaypoints();
+    mrpt::nav::CRobot2NavInterface& robot_;
+    NavigatorOptions opts_;
+    std::unique_ptr<mrpt::nav::CReactiveNavigationSystem> nav_;
+    GridPlanner planner_;
+    mrpt::maps::COccupancyGridMap2D static_map_;
+    ReplanTrigger trigger_;
+    GridPath first_path_, path_;
+    std::vector<mrpt::math::TPoint2D> waypoints_;
+    mrpt::math::TPoint2D goal_;
+    double goal_tolerance_ = 0.3;
+    double ref_distance_ = 2.0;
+    int replans_ = 0;
+    double last_step_s_ = 0;
+    bool active_ = false;
+    std::string last_error_;
+};
+
+}  // namespace devslam::nav

@@ -1,0 +1,64 @@
+#pragma once
+/// When should the global planner intervene? Two triggers (paper section 3.2):
+///  - the remaining global path is blocked by a sensed obstacle (a person stepping in,
+///    an obstacle missing from the map),
+///  - VFH+ reports a high obstacle density toward its target for some time.
+/// A minimum interval between replans prevents thrashing.
+///
+/// Usage:
+///   ReplanTrigger trigger(opts);
+///   if (auto r = trigger.update({t, blocked, density}); r != ReplanReason::None) replan();
+#include <mrpt/config/CConfigFileBase.h>
+#include <mrpt/math/TPoint2D.h>
+
+#include <string>
+#include <vector>
+
+namespace devslam::nav {
+
+/// INI section [replan].
+struct ReplanOptions {
+    double density_threshold = 0.6;    ///< [-] VFH+ primary density toward the target
+    double density_time = 3.0;         ///< [s] the density must stay above for this long
+    double min_interval = 2.0;         ///< [s] minimum time between two replans
+    double blocked_lookahead = 2.0;    ///< [m] path length ahead checked for blockage
+    double blocked_margin = 0.05;      ///< [m] added to the robot radius for the blocked check
+    double obstacle_inflation = 0.30;  ///< [m] radius stamped around sensed points when replanning
+    double sensed_range = 3.0;         ///< [m] sensed points farther than this are not stamped
+
+    void loadFromConfigFile(const mrpt::config::CConfigFileBase& c, const std::string& s,
+                            const std::string& source = "INI");
+    void saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const;
+};
+
+enum class ReplanReason { None, PathBlocked, HighDensity };
+[[nodiscard]] const char* toString(ReplanReason r);
+
+struct ReplanInput {
+    double t = 0;               ///< [s] current time
+    bool path_blocked = false;  ///< from pathBlocked()
+    double goal_density = 0;    ///< [-] VFH+ target_density (0 if unknown)
+};
+
+/// Small state machine over ReplanInput; not thread-safe.
+class ReplanTrigger {
+  public:
+    explicit ReplanTrigger(ReplanOptions o = {}) : opts_(o) {}
+    /// Returns the reason to replan now, or None. Records the replan time when not None.
+    [[nodiscard]] ReplanReason update(const ReplanInput& in);
+    void reset(double t);
+
+  private:
+    ReplanOptions opts_;
+    double last_replan_ = -1e9;
+    double dense_since_ = -1;  ///< time the density went above threshold, -1 if below
+};
+
+/// True when a point of `obstacles` (world frame) lies within `radius` [m] of the path
+/// polyline, looking ahead `lookahead` [m] from the path point closest to `robot`.
+[[nodiscard]] bool pathBlocked(const std::vector<mrpt::math::TPoint2D>& path,
+                               const mrpt::math::TPoint2D& robot,
+                               const std::vector<mrpt::math::TPoint2D>& obstacles, double radius,
+                               double lookahead);
+
+}  // namespace devslam::nav

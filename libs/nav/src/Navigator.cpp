@@ -1,0 +1,258 @@
+#include <devslam/core/Config.h>
+#include <devslam/nav/CHolonomicVFHPlus.h>
+#include <devslam/nav/Navigator.h>
+
+#include <mrpt/maps/CSimplePointsMap.h>
+#include <mrpt/nav/reactive/CReactiveNavigationSystem.h>
+#include <mrpt/poses/CPose2D.h>
+#include <mrpt/system/filesystem.h>
+
+#include <chrono>
+#include <cmath>
+#include <functional>
+#include <sstream>
+
+namespace devslam::nav {
+
+namespace {
+/// Exposes the per-PTG holonomic objects and silences MRPT's timing table.
+class ReactiveNav : public mrpt::nav::CReactiveNavigationSystem {
+  public:
+    ReactiveNav(mrpt::nav::CRobot2NavInterface& r, bool log, const std::string& dir)
+        : CReactiveNavigationSystem(r, false, log, dir) {
+        m_timlog_delays.enable(false);
+    }
+    /// Lowest VFH+ target density over the PTGs (-1 if no VFH+ instance).
+    double vfhTargetDensity() const {
+        double d = -1;
+        for (const auto& h : m_holonomicMethod)
+            if (const auto* v = dynamic_cast<const CHolonomicVFHPlus*>(h.get()))
+                if (!v->lastOutput().primary.empty())
+                    d = d < 0 ? v->lastOutput().target_density
+                              : std::min(d, v->lastOutput().target_density);
+        return d;
+    }
+};
+
+void copyConfig(const mrpt::config::CConfigFileBase& from, mrpt::config::CConfigFileMemory& to) {
+    std::vector<std::string> sections;
+    from.getAllSections(sections);
+    for (const auto& s : sections) {
+        std::vector<std::string> keys;
+        from.getAllKeys(s, keys);
+        for (const auto& k : keys) to.write(s, k, from.read_string(s, k, "", false));
+    }
+}
+}  // namespace
+
+NavigatorOptions NavigatorOptions::fromConfig(const mrpt::config::CConfigFileBase& c,
+                                              const std::string& source) {
+    NavigatorOptions o;
+    const std::string s = "navigator";
+    core::requireKnownKeys(c, s,
+                           {"nav_period", "waypoint_allowed_distance", "holonomic_method",
+                            "robot_radius", "log_file", "log_directory"},
+                           source);
+    o.nav_period = c.read_double(s, "nav_period", o.nav_period);
+    o.waypoint_allowed_distance =
+        c.read_double(s, "waypoint_allowed_distance", o.waypoint_allowed_distance);
+    o.holonomic_method = c.read_string(s, "holonomic_method", o.holonomic_method);
+    o.robot_radius = c.read_double(s, "robot_radius", o.robot_radius);
+    o.log_file = c.read_bool(s, "log_file", o.log_file);
+    o.log_directory = c.read_string(s, "log_directory", o.log_directory);
+    core::requireValue(o.nav_period > 0, s, "nav_period", "must be > 0 s");
+    core::requireValue(o.robot_radius > 0, s, "robot_radius", "must be > 0 m");
+    o.planner.loadFromConfigFile(c, "global_planner", source);
+    o.replan.loadFromConfigFile(c, "replan", source);
+    return o;
+}
+
+const char* toString(NavState s) {
+    switch (s) {
+        case NavState::Idle:
+            return "idle";
+        case NavState::Navigating:
+            return "navigating";
+        case NavState::GoalReached:
+            return "goal reached";
+        case NavState::Error:
+            return "error";
+    }
+    return "?";
+}
+
+Navigator::Navigator(mrpt::nav::CRobot2NavInterface& robot,
+                     const mrpt::config::CConfigFileBase& nav_ini, NavigatorOptions opts)
+    : robot_(robot), opts_(std::move(opts)), planner_(opts_.planner), trigger_(opts_.replan) {
+    registerNavClasses();
+    mrpt::config::CConfigFileMemory cfg;
+    copyConfig(nav_ini, cfg);
+    const std::string sec_ptg = "CAbstractPTGBasedReactive";
+    const std::string sec_rns = "CReactiveNavigationSystem";
+    if (!cfg.sectionExists(sec_ptg) || !cfg.sectionExists(sec_rns))
+        throw std::invalid_argument("Navigator: the navigation INI lacks [" + sec_ptg + "] or [" +
+                                    sec_rns + "]");
+    cfg.write(sec_ptg, "holonomic_method", opts_.holonomic_method);
+    ref_distance_ = cfg.read_double(sec_ptg, "ref_distance", 0.0, true);
+    // robot polygon: 16-gon circumscribing the robot circle
+    std::vector<double> xs, ys;
+    const int nv = 16;
+    const double rv = opts_.robot_radius / std::cos(M_PI / nv);
+    for (int i = 0; i < nv; i++) {
+        xs.push_back(rv * std::cos(2 * M_PI * i / nv));
+        ys.push_back(rv * std::sin(2 * M_PI * i / nv));
+    }
+    cfg.write(sec_rns, "RobotModel_shape2D_xs", xs);
+    cfg.write(sec_rns, "RobotModel_shape2D_ys", ys);
+
+    nav_ = std::make_unique<ReactiveNav>(robot_, opts_.log_file, opts_.log_directory);
+    nav_->setMinLoggingLevel(mrpt::system::LVL_ERROR);
+    std::string cache = opts_.ptg_cache_directory;
+    if (cache.empty()) {
+        // PTG collision grids depend on the PTG section and the robot shape only.
+        std::vector<std::string> keys;
+        cfg.getAllKeys(sec_rns, keys);
+        std::ostringstream os;
+        for (const auto& k : keys) os << k << "=" << cfg.read_string(sec_rns, k, "") << ";";
+        os << cfg.read_string(sec_ptg, "ref_distance", "");
+        cache = mrpt::system::getTempFileName();
+        cache = mrpt::system::extractFileDirectory(cache) + "/devslam_ptg_cache_" +
+                std::to_string(std::hash<std::string>{}(os.str()));
+    }
+    mrpt::system::createDirectory(cache);
+    nav_->params_abstract_ptg_navigator.ptg_cache_files_directory = cache;
+    nav_->loadConfigFile(cfg);
+    nav_->initialize();
+}
+
+Navigator::~Navigator() = default;
+
+mrpt::nav::CReactiveNavigationSystem& Navigator::reactive() {
+    return *nav_;
+}
+
+bool Navigator::start(const mrpt::maps::COccupancyGridMap2D& map, const mrpt::math::TPose2D& start,
+                      const mrpt::math::TPoint2D& goal, double goal_tolerance) {
+    static_map_ = map;
+    goal_ = goal;
+    goal_tolerance_ = goal_tolerance;
+    planner_.setMap(map);
+    auto p = planner_.plan({start.x, start.y}, goal);  // throws PlanningError
+    if (!p) {
+        last_error_ = "no path from start to goal";
+        return false;
+    }
+    first_path_ = *p;
+    path_ = *p;
+    replans_ = 0;
+    trigger_.reset(0.0);
+    sendWaypoints();
+    active_ = true;
+    return true;
+}
+
+void Navigator::sendWaypoints() {
+    const double spacing = std::min(opts_.planner.waypoint_spacing, 0.9 * ref_distance_);
+    waypoints_ = decimateWaypoints(planner_, path_, spacing);
+    mrpt::nav::TWaypointSequence seq;
+    for (size_t i = 0; i < waypoints_.size(); i++) {
+        const bool last = i + 1 == waypoints_.size();
+        seq.waypoints.emplace_back(waypoints_[i].x, waypoints_[i].y,
+                                   last ? goal_tolerance_ : opts_.waypoint_allowed_distance, !last);
+    }
+    nav_->navigateWaypoints(seq);
+}
+
+bool Navigator::replan(const mrpt::math::TPose2D& pose,
+                       const std::vector<mrpt::math::TPoint2D>& sensed) {
+    // static map + sensed obstacles (people, unmapped objects) stamped as discs
+    mrpt::maps::COccupancyGridMap2D m = static_map_;
+    const double keep_out = opts_.planner.robot_radius + opts_.replan.obstacle_inflation + 0.05;
+    const double r = opts_.replan.obstacle_inflation;
+    const double res = m.getResolution();
+    for (const auto& o : sensed) {
+        const double d = std::hypot(o.x - pose.x, o.y - pose.y);
+        if (d > opts_.replan.sensed_range || d < keep_out) continue;
+        if (std::hypot(o.x - goal_.x, o.y - goal_.y) < opts_.planner.robot_radius + r) continue;
+        for (double dy = -r; dy <= r; dy += res)
+            for (double dx = -r; dx <= r; dx += res)
+                if (dx * dx + dy * dy <= r * r) {
+                    const int cx = m.x2idx(o.x + dx), cy = m.y2idx(o.y + dy);
+                    if (cx >= 0 && cy >= 0 && cx < int(m.getSizeX()) && cy < int(m.getSizeY()))
+                        m.setCell(cx, cy, 0.0f);
+                }
+    }
+    std::optional<GridPath> p;
+    for (const auto* mp : {&m, &static_map_}) {
+        planner_.setMap(*mp);
+        try {
+            p = planner_.plan({pose.x, pose.y}, goal_);
+        } catch (const PlanningError& e) {
+            last_error_ = e.what();
+            p.reset();
+        }
+        if (p) break;
+    }
+    planner_.setMap(static_map_);
+    if (!p) return false;
+    path_ = *p;
+    replans_++;
+    sendWaypoints();
+    return true;
+}
+
+NavState Navigator::step(double t) {
+    if (!active_) return NavState::Idle;
+    mrpt::math::TPose2D pose, odo;
+    mrpt::math::TTwist2D vel;
+    mrpt::system::TTimeStamp ts;
+    std::string frame;
+    if (!robot_.getCurrentPoseAndSpeeds(pose, vel, ts, odo, frame)) {
+        last_error_ = "robot did not report its pose";
+        return NavState::Error;
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    nav_->navigationStep();
+    last_step_s_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+    const double goal_dist = std::hypot(pose.x - goal_.x, pose.y - goal_.y);
+    const auto st = nav_->getCurrentState();
+    if (st == mrpt::nav::CAbstractNavigator::IDLE && goal_dist <= goal_tolerance_ + 0.05) {
+        active_ = false;
+        return NavState::GoalReached;
+    }
+
+    // sensed obstacles in the world frame (for the blocked-path check and replanning)
+    mrpt::maps::CSimplePointsMap local;
+    std::vector<mrpt::math::TPoint2D> sensed;
+    if (robot_.senseObstacles(local, ts)) {
+        const mrpt::poses::CPose2D P(pose);
+        const auto& xs = local.getPointsBufferRef_x();
+        const auto& ys = local.getPointsBufferRef_y();
+        for (size_t i = 0; i < xs.size(); i++) {
+            double gx, gy;
+            P.composePoint(xs[i], ys[i], gx, gy);
+            sensed.emplace_back(gx, gy);
+        }
+    }
+    if (st == mrpt::nav::CAbstractNavigator::NAV_ERROR ||
+        st == mrpt::nav::CAbstractNavigator::IDLE) {
+        // MRPT gave up ("not approaching target") or ended short of the goal: replan
+        if (st == mrpt::nav::CAbstractNavigator::NAV_ERROR) nav_->resetNavError();
+        trigger_.reset(t);
+        if (!replan(pose, sensed)) {
+            // keep trying with the previous path
+            sendWaypoints();
+        }
+        return NavState::Navigating;
+    }
+    const double radius = opts_.planner.robot_radius + opts_.replan.blocked_margin;
+    const bool blocked =
+        pathBlocked(path_.points, {pose.x, pose.y}, sensed, radius, opts_.replan.blocked_lookahead);
+    const double density = static_cast<const ReactiveNav&>(*nav_).vfhTargetDensity();
+    const ReplanReason why = trigger_.update({t, blocked, std::max(0.0, density)});
+    if (why != ReplanReason::None) (void)replan(pose, sensed);
+    return NavState::Navigating;
+}
+
+}  // namespace devslam::nav

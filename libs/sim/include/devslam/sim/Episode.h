@@ -1,0 +1,59 @@
+#pragma once
+/// One closed-loop navigation run in the Bullet world: A* on the rasterized world, MRPT's
+/// reactive navigator with the chosen holonomic method driving SimRobot, mrpt::Clock in
+/// simulated time (so MRPT's timeouts follow simulated seconds), fixed physics step, and
+/// the measures of the run. Also draws the run as a PNG (map, A* path, driven trajectory,
+/// pedestrians' tracks), like Fig. 6 of the paper.
+///
+/// Usage:
+///   auto world = devslam::sim::loadWorld("sim_worlds/paper_fig6.ini");
+///   auto ini = devslam::core::loadIni("config_ini/nav_reactive.ini");
+///   auto res = devslam::sim::runEpisode(world, *ini, navOpts, {});
+///   devslam::sim::writeEpisodePng(world, res, "run.png", "VFH+");
+#include <devslam/nav/GridPlanner.h>
+#include <devslam/nav/Navigator.h>
+#include <devslam/sim/World.h>
+
+#include <string>
+#include <vector>
+
+namespace devslam::sim {
+
+struct EpisodeOptions {
+    std::string holonomic_method = "CHolonomicVFHPlus";  ///< MRPT class name
+    bool log_file = false;                               ///< write an MRPT navlog
+    std::string log_directory = "reactivenav.logs";
+    double record_period = 0.1;  ///< [s] trajectory / tracks sampling
+};
+
+enum class Outcome { Success, Collision, Timeout, NoPath };
+[[nodiscard]] const char* toString(Outcome o);
+
+struct EpisodeResult {
+    Outcome outcome = Outcome::Timeout;
+    std::string reason;                 ///< human-readable detail
+    double time = 0;                    ///< [s] simulated time at the end
+    double path_length = 0;             ///< [m] driven distance
+    double astar_length = 0;            ///< [m] first global path
+    double min_clearance_static = 1e9;  ///< [m] robot edge to nearest static obstacle
+    double min_clearance_people = 1e9;  ///< [m] robot edge to nearest person edge
+    int static_collisions = 0;          ///< contact events with walls/boxes
+    int person_collisions = 0;          ///< contact events with people
+    int replans = 0;
+    std::vector<double> step_seconds;  ///< wall time of each navigationStep()
+    std::vector<mrpt::math::TPose2D> trajectory;
+    std::vector<std::vector<mrpt::math::TPoint2D>> pedestrian_tracks;
+    nav::GridPath global_path;
+    std::vector<mrpt::math::TPoint2D> waypoints;
+};
+
+/// Runs one episode. Throws nav::PlanningError if start/goal are invalid for the planner.
+[[nodiscard]] EpisodeResult runEpisode(const WorldSpec& world,
+                                       const mrpt::config::CConfigFileBase& nav_ini,
+                                       nav::NavigatorOptions nav_opts, const EpisodeOptions& opts);
+
+/// Draws the world and the run; throws std::runtime_error if the file cannot be written.
+void writeEpisodePng(const WorldSpec& world, const EpisodeResult& r, const std::string& path,
+                     const std::string& title);
+
+}  // namespace devslam::sim

@@ -1,0 +1,53 @@
+#pragma once
+/// MRPT's CRobot2NavInterface on top of the Bullet Simulator, so MRPT's reactive navigator
+/// drives the simulated robot exactly as it would drive a real one: pose and speeds from
+/// the rigid body, (v, w) commands through CVehicleVelCmd_DiffDriven, obstacles from the
+/// latest laser scan in the robot frame, time from the simulation clock.
+///
+/// Usage:
+///   devslam::sim::SimRobot robot(sim);
+///   mrpt::nav::CReactiveNavigationSystem nav(robot);
+/// Not thread-safe.
+#include <devslam/sim/Simulator.h>
+
+#include <mrpt/nav/reactive/CRobot2NavInterface.h>
+
+namespace devslam::sim {
+
+class SimRobot : public mrpt::nav::CRobot2NavInterface {
+  public:
+    explicit SimRobot(Simulator& sim) : sim_(sim) { setMinLoggingLevel(mrpt::system::LVL_WARN); }
+
+    bool getCurrentPoseAndSpeeds(mrpt::math::TPose2D& pose, mrpt::math::TTwist2D& vel_global,
+                                 mrpt::system::TTimeStamp& timestamp, mrpt::math::TPose2D& odometry,
+                                 std::string& frame_id) override;
+    bool changeSpeeds(const mrpt::kinematics::CVehicleVelCmd& cmd) override;
+    bool changeSpeedsNOP() override { return true; }
+    bool stop(bool is_emergency_stop = true) override;
+    mrpt::kinematics::CVehicleVelCmd::Ptr getEmergencyStopCmd() override;
+    mrpt::kinematics::CVehicleVelCmd::Ptr getStopCmd() override;
+    bool senseObstacles(mrpt::maps::CSimplePointsMap& obstacles,
+                        mrpt::system::TTimeStamp& timestamp) override;
+    double getNavigationTime() override { return sim_.time() - nav_t0_; }
+    void resetNavigationTimer() override { nav_t0_ = sim_.time(); }
+
+    void sendNavigationEndEvent() override { end_events_++; }
+    void sendNavigationEndDueToErrorEvent() override { error_events_++; }
+    void sendWaySeemsBlockedEvent() override { blocked_events_++; }
+    void sendApparentCollisionEvent() override {}
+    void sendNavigationStartEvent() override {}
+    void sendWaypointReachedEvent(int, bool) override {}
+    void sendNewWaypointTargetEvent(int) override {}
+    void sendCannotGetCloserToBlockedTargetEvent() override {}
+
+    [[nodiscard]] int endEvents() const { return end_events_; }
+    [[nodiscard]] int errorEvents() const { return error_events_; }
+    [[nodiscard]] int blockedEvents() const { return blocked_events_; }
+
+  private:
+    Simulator& sim_;
+    double nav_t0_ = 0;
+    int end_events_ = 0, error_events_ = 0, blocked_events_ = 0;
+};
+
+}  // namespace devslam::sim

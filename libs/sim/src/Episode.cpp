@@ -1,0 +1,212 @@
+#include <devslam/sim/Episode.h>
+#include <devslam/sim/SimRobot.h>
+#include <devslam/sim/Simulator.h>
+
+#include <mrpt/core/Clock.h>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <cmath>
+#include <sstream>
+
+namespace devslam::sim {
+
+namespace {
+constexpr double kClockEpoch = 1.7e9;  // [s] simulated clock origin (0 is INVALID_TIMESTAMP)
+
+/// Switches mrpt::Clock to simulated time for its lifetime.
+class SimulatedClock {
+  public:
+    SimulatedClock() : previous_(mrpt::Clock::getActiveClock()) {
+        mrpt::Clock::setSimulatedTime(mrpt::Clock::fromDouble(kClockEpoch));
+        mrpt::Clock::setActiveClock(mrpt::Clock::Simulated);
+    }
+    ~SimulatedClock() { mrpt::Clock::setActiveClock(previous_); }
+    void set(double t) { mrpt::Clock::setSimulatedTime(mrpt::Clock::fromDouble(kClockEpoch + t)); }
+    SimulatedClock(const SimulatedClock&) = delete;
+    SimulatedClock& operator=(const SimulatedClock&) = delete;
+
+  private:
+    mrpt::Clock::Source previous_;
+};
+}  // namespace
+
+const char* toString(Outcome o) {
+    switch (o) {
+        case Outcome::Success:
+            return "success";
+        case Outcome::Collision:
+            return "collision";
+        case Outcome::Timeout:
+            return "timeout";
+        case Outcome::NoPath:
+            return "no_path";
+    }
+    return "?";
+}
+
+EpisodeResult runEpisode(const WorldSpec& world, const mrpt::config::CConfigFileBase& nav_ini,
+                         nav::NavigatorOptions nav_opts, const EpisodeOptions& opts) {
+    SimulatedClock clock;
+    EpisodeResult res;
+    nav_opts.robot_radius = world.robot.radius;
+    nav_opts.planner.robot_radius = world.robot.radius;
+    nav_opts.holonomic_method = opts.holonomic_method;
+    nav_opts.log_file = opts.log_file;
+    nav_opts.log_directory = opts.log_directory;
+
+    Simulator sim(world);
+    SimRobot robot(sim);
+    const auto grid = rasterize(world);
+    const auto statics = staticObstacles(world);
+    nav::Navigator navigator(robot, nav_ini, nav_opts);
+    if (!navigator.start(grid, world.robot.start, world.goal, world.goal_tolerance)) {
+        res.outcome = Outcome::NoPath;
+        res.reason = navigator.lastError();
+        return res;
+    }
+    res.global_path = navigator.globalPath();
+    res.astar_length = res.global_path.length;
+    res.waypoints = navigator.waypoints();
+    res.pedestrian_tracks.resize(world.pedestrians.size());
+
+    double next_nav = 0, next_rec = 0;
+    auto prev = sim.robotPose();
+    const double r = world.robot.radius;
+    while (true) {
+        const double t = sim.time();
+        const auto p = sim.robotPose();
+        res.path_length += std::hypot(p.x - prev.x, p.y - prev.y);
+        prev = p;
+        for (const auto& o : statics)
+            res.min_clearance_static =
+                std::min(res.min_clearance_static, distanceToObstacle(o, {p.x, p.y}) - r);
+        const auto peds = sim.pedestrianPositions();
+        for (size_t i = 0; i < peds.size(); i++)
+            res.min_clearance_people =
+                std::min(res.min_clearance_people, std::hypot(peds[i].x - p.x, peds[i].y - p.y) -
+                                                       r - world.pedestrians[i].radius);
+        if (t + 1e-9 >= next_rec) {
+            res.trajectory.push_back(p);
+            for (size_t i = 0; i < peds.size(); i++) res.pedestrian_tracks[i].push_back(peds[i]);
+            next_rec += opts.record_period;
+        }
+        const auto& col = sim.collisions();
+        if (col.static_events > 0 || col.person_events > 0) {
+            res.outcome = Outcome::Collision;
+            res.reason = col.static_events > 0 ? "touched a static obstacle" : "touched a person";
+            break;
+        }
+        if (std::hypot(p.x - world.goal.x, p.y - world.goal.y) <= world.goal_tolerance) {
+            res.outcome = Outcome::Success;
+            break;
+        }
+        if (t >= world.timeout) {
+            res.outcome = Outcome::Timeout;
+            res.reason = "not at the goal after " + std::to_string(world.timeout) + " s";
+            break;
+        }
+        if (t + 1e-9 >= next_nav) {
+            clock.set(t);
+            const auto st = navigator.step(t);
+            res.step_seconds.push_back(navigator.lastStepSeconds());
+            next_nav += nav_opts.nav_period;
+            if (st == nav::NavState::Error) {
+                res.outcome = Outcome::Timeout;
+                res.reason = "navigator error: " + navigator.lastError();
+                break;
+            }
+        }
+        sim.step();
+        clock.set(sim.time());
+    }
+    res.time = sim.time();
+    res.static_collisions = sim.collisions().static_events;
+    res.person_collisions = sim.collisions().person_events;
+    res.replans = navigator.replanCount();
+    res.trajectory.push_back(sim.robotPose());
+    return res;
+}
+
+void writeEpisodePng(const WorldSpec& w, const EpisodeResult& r, const std::string& path,
+                     const std::string& title) {
+    const double ppm =
+        std::clamp(1000.0 / std::max(w.x_max - w.x_min, w.y_max - w.y_min), 20.0, 100.0);
+    const int margin_top = 40;
+    const int W = static_cast<int>(std::ceil((w.x_max - w.x_min) * ppm));
+    const int H = static_cast<int>(std::ceil((w.y_max - w.y_min) * ppm)) + margin_top;
+    cv::Mat img(H, W, CV_8UC3, cv::Scalar(255, 255, 255));
+    auto px = [&](double x, double y) {
+        return cv::Point(static_cast<int>(std::lround((x - w.x_min) * ppm)),
+                         H - 1 - static_cast<int>(std::lround((y - w.y_min) * ppm)));
+    };
+    // grid lines every metre
+    for (double x = std::ceil(w.x_min); x <= w.x_max; x += 1.0)
+        cv::line(img, px(x, w.y_min), px(x, w.y_max), cv::Scalar(235, 235, 235), 1);
+    for (double y = std::ceil(w.y_min); y <= w.y_max; y += 1.0)
+        cv::line(img, px(w.x_min, y), px(w.x_max, y), cv::Scalar(235, 235, 235), 1);
+    for (const auto& o : staticObstacles(w)) {
+        cv::Scalar colour = o.kind == "block"  ? cv::Scalar(60, 120, 180)  // wood (BGR)
+                            : o.kind == "wall" ? cv::Scalar(70, 70, 70)
+                                               : cv::Scalar(110, 110, 140);
+        if (o.shape == Obstacle::Shape::Cylinder) {
+            cv::circle(img, px(o.cx, o.cy), static_cast<int>(o.radius * ppm), colour, cv::FILLED,
+                       cv::LINE_AA);
+            continue;
+        }
+        std::vector<cv::Point> poly;
+        const double c = std::cos(o.yaw), s = std::sin(o.yaw);
+        for (auto [u, v] : {std::pair{-1, -1}, {1, -1}, {1, 1}, {-1, 1}}) {
+            const double lx = u * o.sx / 2, ly = v * o.sy / 2;
+            poly.push_back(px(o.cx + c * lx - s * ly, o.cy + s * lx + c * ly));
+        }
+        cv::fillConvexPoly(img, poly, colour, cv::LINE_AA);
+    }
+    auto polyline = [&](const std::vector<cv::Point>& pts, const cv::Scalar& col, int th) {
+        if (pts.size() >= 2) cv::polylines(img, pts, false, col, th, cv::LINE_AA);
+    };
+    // pedestrians' tracks (orange) with their final position
+    for (size_t i = 0; i < r.pedestrian_tracks.size(); i++) {
+        std::vector<cv::Point> pts;
+        for (const auto& q : r.pedestrian_tracks[i]) pts.push_back(px(q.x, q.y));
+        polyline(pts, cv::Scalar(0, 140, 255), 2);
+        if (!pts.empty())
+            cv::circle(img, pts.back(), static_cast<int>(w.pedestrians[i].radius * ppm),
+                       cv::Scalar(0, 140, 255), 2, cv::LINE_AA);
+    }
+    // A* path (blue, dashed look by waypoints)
+    std::vector<cv::Point> ap;
+    for (const auto& q : r.global_path.points) ap.push_back(px(q.x, q.y));
+    polyline(ap, cv::Scalar(220, 120, 0), 2);
+    for (const auto& q : r.waypoints)
+        cv::circle(img, px(q.x, q.y), 4, cv::Scalar(220, 120, 0), cv::FILLED, cv::LINE_AA);
+    // driven trajectory (red) and robot footprints every 2 s
+    std::vector<cv::Point> tp;
+    for (const auto& q : r.trajectory) tp.push_back(px(q.x, q.y));
+    polyline(tp, cv::Scalar(30, 30, 220), 2);
+    for (size_t i = 0; i < r.trajectory.size(); i += 20)
+        cv::circle(img, tp[i], static_cast<int>(w.robot.radius * ppm), cv::Scalar(120, 120, 230), 1,
+                   cv::LINE_AA);
+    // start and goal
+    const auto& s0 = w.robot.start;
+    cv::drawMarker(img, px(s0.x, s0.y), cv::Scalar(0, 160, 0), cv::MARKER_SQUARE, 16, 3);
+    cv::drawMarker(img, px(w.goal.x, w.goal.y), cv::Scalar(0, 0, 200), cv::MARKER_STAR, 18, 2);
+    cv::circle(img, px(w.goal.x, w.goal.y), static_cast<int>(w.goal_tolerance * ppm),
+               cv::Scalar(0, 0, 200), 1, cv::LINE_AA);
+    // title and legend
+    cv::rectangle(img, cv::Point(0, 0), cv::Point(W, margin_top - 1), cv::Scalar(250, 250, 250),
+                  cv::FILLED);
+    std::ostringstream os;
+    os.precision(3);
+    os << title << ": " << toString(r.outcome) << ", " << r.time << " s, path " << r.path_length
+       << " m (A* " << r.astar_length << " m)";
+    cv::putText(img, os.str(), cv::Point(8, 16), cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(0, 0, 0),
+                1, cv::LINE_AA);
+    cv::putText(
+        img, "blue: A* + waypoints   red: robot   orange: people   green: start   star: goal",
+        cv::Point(8, 33), cv::FONT_HERSHEY_SIMPLEX, 0.42, cv::Scalar(60, 60, 60), 1, cv::LINE_AA);
+    if (!cv::imwrite(path, img)) throw std::runtime_error("writeEpisodePng: cannot write " + path);
+}
+
+}  // namespace devslam::sim

@@ -1,0 +1,277 @@
+#include <devslam/core/Config.h>
+#include <devslam/sim/World.h>
+
+#include <mrpt/config/CConfigFileBase.h>
+#include <mrpt/core/bits_math.h>
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+namespace devslam::sim {
+
+namespace {
+[[noreturn]] void fail(const std::string& source, const std::string& section,
+                       const std::string& key, const std::string& what) {
+    throw std::invalid_argument(source + " [" + section + "]" + (key.empty() ? "" : " " + key) +
+                                ": " + what);
+}
+
+std::vector<std::string> splitWords(const std::string& s) {
+    std::istringstream is(s);
+    std::vector<std::string> out;
+    std::string w;
+    while (is >> w) out.push_back(w);
+    return out;
+}
+
+std::vector<double> parseNumbers(const std::vector<std::string>& words, size_t from,
+                                 const std::string& source, const std::string& section,
+                                 const std::string& key) {
+    std::vector<double> v;
+    for (size_t i = from; i < words.size(); i++) {
+        try {
+            size_t used = 0;
+            v.push_back(std::stod(words[i], &used));
+            if (used != words[i].size()) throw std::invalid_argument("trailing characters");
+        } catch (const std::exception&) {
+            fail(source, section, key, "'" + words[i] + "' is not a number");
+        }
+    }
+    return v;
+}
+
+double readRequired(const mrpt::config::CConfigFileBase& c, const std::string& source,
+                    const std::string& s, const std::string& k) {
+    if (!c.keyExists(s, k)) fail(source, s, k, "required key is missing");
+    return c.read_double(s, k, 0.0);
+}
+}  // namespace
+
+WorldSpec loadWorld(const std::string& path) {
+    auto cfg = core::loadIni(path);
+    return parseWorld(*cfg, path);
+}
+
+WorldSpec parseWorld(const mrpt::config::CConfigFileBase& c, const std::string& source) {
+    WorldSpec w;
+    w.source = source;
+    for (const char* s : {"world", "robot", "goal"})
+        if (!c.sectionExists(s)) fail(source, s, "", "required section is missing");
+
+    std::string s = "world";
+    core::requireKnownKeys(c, s,
+                           {"name", "x_min", "x_max", "y_min", "y_max", "boundary_walls",
+                            "grid_resolution", "time_step", "timeout", "seed", "pedestrians_yield"},
+                           source);
+    w.name = c.read_string(s, "name", w.name);
+    w.x_min = readRequired(c, source, s, "x_min");
+    w.x_max = readRequired(c, source, s, "x_max");
+    w.y_min = readRequired(c, source, s, "y_min");
+    w.y_max = readRequired(c, source, s, "y_max");
+    w.boundary_walls = c.read_bool(s, "boundary_walls", w.boundary_walls);
+    w.grid_resolution = c.read_double(s, "grid_resolution", w.grid_resolution);
+    w.time_step = c.read_double(s, "time_step", w.time_step);
+    w.timeout = c.read_double(s, "timeout", w.timeout);
+    w.seed = static_cast<uint32_t>(c.read_uint64_t(s, "seed", w.seed));
+    w.pedestrians_yield = c.read_bool(s, "pedestrians_yield", w.pedestrians_yield);
+
+    s = "robot";
+    core::requireKnownKeys(c, s,
+                           {"start_x", "start_y", "start_yaw_deg", "radius", "max_v", "max_w_deg",
+                            "max_acc", "max_ang_acc_deg"},
+                           source);
+    w.robot.start.x = readRequired(c, source, s, "start_x");
+    w.robot.start.y = readRequired(c, source, s, "start_y");
+    w.robot.start.phi = mrpt::DEG2RAD(c.read_double(s, "start_yaw_deg", 0.0));
+    w.robot.radius = c.read_double(s, "radius", w.robot.radius);
+    w.robot.max_v = c.read_double(s, "max_v", w.robot.max_v);
+    w.robot.max_w = mrpt::DEG2RAD(c.read_double(s, "max_w_deg", mrpt::RAD2DEG(w.robot.max_w)));
+    w.robot.max_acc = c.read_double(s, "max_acc", w.robot.max_acc);
+    w.robot.max_ang_acc =
+        mrpt::DEG2RAD(c.read_double(s, "max_ang_acc_deg", mrpt::RAD2DEG(w.robot.max_ang_acc)));
+
+    s = "goal";
+    core::requireKnownKeys(c, s, {"x", "y", "tolerance"}, source);
+    w.goal.x = readRequired(c, source, s, "x");
+    w.goal.y = readRequired(c, source, s, "y");
+    w.goal_tolerance = c.read_double(s, "tolerance", w.goal_tolerance);
+
+    s = "laser";
+    core::requireKnownKeys(
+        c, s, {"range", "rays", "fov_deg", "noise_std", "rate_hz", "height", "detect_people"},
+        source);
+    w.laser.range = c.read_double(s, "range", w.laser.range);
+    w.laser.rays = c.read_int(s, "rays", w.laser.rays);
+    w.laser.fov = mrpt::DEG2RAD(c.read_double(s, "fov_deg", mrpt::RAD2DEG(w.laser.fov)));
+    w.laser.noise_std = c.read_double(s, "noise_std", w.laser.noise_std);
+    w.laser.rate = c.read_double(s, "rate_hz", w.laser.rate);
+    w.laser.height = c.read_double(s, "height", w.laser.height);
+    w.laser.detect_people = c.read_bool(s, "detect_people", w.laser.detect_people);
+
+    std::vector<std::string> keys;
+    s = "obstacles";
+    c.getAllKeys(s, keys);
+    for (const auto& k : keys) {
+        const auto words = splitWords(c.read_string(s, k, ""));
+        if (words.empty()) fail(source, s, k, "empty obstacle");
+        const auto v = parseNumbers(words, 1, source, s, k);
+        Obstacle o;
+        o.name = k;
+        o.kind = words[0];
+        if (o.kind == "box" || o.kind == "block" || o.kind == "wall") {
+            if (v.size() != 4 && v.size() != 5)
+                fail(source, s, k, "expected '" + o.kind + " cx cy size_x size_y [yaw_deg]'");
+            o.shape = Obstacle::Shape::Box;
+            o.cx = v[0];
+            o.cy = v[1];
+            o.sx = v[2];
+            o.sy = v[3];
+            o.yaw = v.size() == 5 ? mrpt::DEG2RAD(v[4]) : 0.0;
+            if (o.sx <= 0 || o.sy <= 0) fail(source, s, k, "sizes must be > 0 m");
+            o.height = o.kind == "block" ? 0.4 : 1.0;
+        } else if (o.kind == "cylinder") {
+            if (v.size() != 3) fail(source, s, k, "expected 'cylinder cx cy radius'");
+            o.shape = Obstacle::Shape::Cylinder;
+            o.cx = v[0];
+            o.cy = v[1];
+            o.radius = v[2];
+            if (o.radius <= 0) fail(source, s, k, "radius must be > 0 m");
+        } else {
+            fail(source, s, k,
+                 "unknown obstacle kind '" + o.kind + "' (known: box, block, wall, cylinder)");
+        }
+        w.obstacles.push_back(o);
+    }
+
+    s = "pedestrians";
+    keys.clear();
+    c.getAllKeys(s, keys);
+    for (const auto& k : keys) {
+        const auto words = splitWords(c.read_string(s, k, ""));
+        if (words.empty()) fail(source, s, k, "empty pedestrian");
+        Pedestrian p;
+        p.name = k;
+        const auto v = parseNumbers(words, 1, source, s, k);
+        if (words[0] == "scripted") {
+            // scripted speed radius delay x1 y1 x2 y2 ...
+            if (v.size() < 7 || (v.size() - 3) % 2 != 0)
+                fail(source, s, k,
+                     "expected 'scripted speed radius delay x1 y1 x2 y2 [...]' (>= 2 points)");
+            p.mode = Pedestrian::Mode::Scripted;
+        } else if (words[0] == "random") {
+            if (v.size() != 5) fail(source, s, k, "expected 'random speed radius delay x y'");
+            p.mode = Pedestrian::Mode::RandomWalk;
+        } else {
+            fail(source, s, k,
+                 "unknown pedestrian mode '" + words[0] + "' (known: scripted, random)");
+        }
+        p.speed = v[0];
+        p.radius = v[1];
+        p.start_delay = v[2];
+        for (size_t i = 3; i + 1 < v.size(); i += 2) p.path.emplace_back(v[i], v[i + 1]);
+        if (p.speed < 0 || p.radius <= 0 || p.start_delay < 0)
+            fail(source, s, k, "speed and delay must be >= 0, radius > 0");
+        w.pedestrians.push_back(p);
+    }
+    validateWorld(w);
+    return w;
+}
+
+void validateWorld(const WorldSpec& w) {
+    const auto& src = w.source;
+    if (!(w.x_max > w.x_min) || !(w.y_max > w.y_min))
+        fail(src, "world", "x_min", "bounds must satisfy x_min < x_max and y_min < y_max");
+    if (w.grid_resolution <= 0 || w.grid_resolution > 0.5)
+        fail(src, "world", "grid_resolution", "must be in (0, 0.5] m");
+    if (w.time_step <= 0 || w.time_step > 0.1)
+        fail(src, "world", "time_step", "must be in (0, 0.1] s");
+    if (w.timeout <= 0) fail(src, "world", "timeout", "must be > 0 s");
+    if (w.robot.radius <= 0) fail(src, "robot", "radius", "must be > 0 m");
+    if (w.robot.max_v <= 0 || w.robot.max_w <= 0 || w.robot.max_acc <= 0 ||
+        w.robot.max_ang_acc <= 0)
+        fail(src, "robot", "max_v", "speed and acceleration limits must be > 0");
+    if (w.laser.range <= 0 || w.laser.rays < 2 || w.laser.rate <= 0 || w.laser.noise_std < 0 ||
+        w.laser.fov <= 0 || w.laser.fov > 2 * M_PI + 1e-9)
+        fail(src, "laser", "",
+             "range > 0, rays >= 2, rate_hz > 0, noise_std >= 0, 0 < fov_deg <= 360");
+    if (w.goal_tolerance <= 0) fail(src, "goal", "tolerance", "must be > 0 m");
+    auto inside = [&](const mrpt::math::TPoint2D& p) {
+        return p.x > w.x_min && p.x < w.x_max && p.y > w.y_min && p.y < w.y_max;
+    };
+    if (!inside({w.robot.start.x, w.robot.start.y}))
+        fail(src, "robot", "start_x", "start is outside the world bounds");
+    if (!inside(w.goal)) fail(src, "goal", "x", "goal is outside the world bounds");
+    for (const auto& o : staticObstacles(w)) {
+        const double dg = distanceToObstacle(o, w.goal);
+        if (dg <= 0) fail(src, "goal", "x", "the goal lies inside obstacle '" + o.name + "'");
+        if (dg < w.robot.radius)
+            fail(src, "goal", "x",
+                 "the goal is " + std::to_string(dg) + " m from obstacle '" + o.name +
+                     "', closer than the robot radius " + std::to_string(w.robot.radius) +
+                     " m: the robot cannot stand on it");
+        if (distanceToObstacle(o, {w.robot.start.x, w.robot.start.y}) < w.robot.radius)
+            fail(src, "robot", "start_x",
+                 "the robot starts inside or touching obstacle '" + o.name + "'");
+    }
+    for (const auto& p : w.pedestrians) {
+        if (p.path.empty()) fail(src, "pedestrians", p.name, "no position given");
+        for (const auto& q : p.path)
+            if (!inside(q)) fail(src, "pedestrians", p.name, "a point is outside the world bounds");
+    }
+}
+
+std::vector<Obstacle> staticObstacles(const WorldSpec& w) {
+    std::vector<Obstacle> out = w.obstacles;
+    if (w.boundary_walls) {
+        const double t = 0.1, cx = 0.5 * (w.x_min + w.x_max), cy = 0.5 * (w.y_min + w.y_max);
+        const double lx = w.x_max - w.x_min, ly = w.y_max - w.y_min;
+        auto wall = [&](const char* n, double x, double y, double sx, double sy) {
+            Obstacle o;
+            o.name = n;
+            o.kind = "wall";
+            o.cx = x;
+            o.cy = y;
+            o.sx = sx;
+            o.sy = sy;
+            out.push_back(o);
+        };
+        wall("boundary_south", cx, w.y_min + t / 2, lx, t);
+        wall("boundary_north", cx, w.y_max - t / 2, lx, t);
+        wall("boundary_west", w.x_min + t / 2, cy, t, ly);
+        wall("boundary_east", w.x_max - t / 2, cy, t, ly);
+    }
+    return out;
+}
+
+double distanceToObstacle(const Obstacle& o, const mrpt::math::TPoint2D& p) {
+    const double dx = p.x - o.cx, dy = p.y - o.cy;
+    if (o.shape == Obstacle::Shape::Cylinder) return std::hypot(dx, dy) - o.radius;
+    const double c = std::cos(o.yaw), s = std::sin(o.yaw);
+    const double lx = c * dx + s * dy, ly = -s * dx + c * dy;  // box frame
+    const double qx = std::abs(lx) - o.sx / 2, qy = std::abs(ly) - o.sy / 2;
+    const double outside = std::hypot(std::max(qx, 0.0), std::max(qy, 0.0));
+    return outside + std::min(std::max(qx, qy), 0.0);
+}
+
+mrpt::maps::COccupancyGridMap2D rasterize(const WorldSpec& w) {
+    mrpt::maps::COccupancyGridMap2D g;
+    g.setSize(w.x_min, w.x_max, w.y_min, w.y_max, static_cast<float>(w.grid_resolution), 1.0f);
+    const double half = 0.5 * w.grid_resolution;
+    for (const auto& o : staticObstacles(w)) {
+        const double r =
+            o.shape == Obstacle::Shape::Cylinder ? o.radius : 0.5 * std::hypot(o.sx, o.sy);
+        const int x0 = std::max(0, g.x2idx(o.cx - r - half)),
+                  x1 = std::min(int(g.getSizeX()) - 1, g.x2idx(o.cx + r + half));
+        const int y0 = std::max(0, g.y2idx(o.cy - r - half)),
+                  y1 = std::min(int(g.getSizeY()) - 1, g.y2idx(o.cy + r + half));
+        for (int y = y0; y <= y1; y++)
+            for (int x = x0; x <= x1; x++)
+                if (distanceToObstacle(o, {g.idx2x(x), g.idx2y(y)}) <= half * 0.999)
+                    g.setCell(x, y, 0.0f);
+    }
+    return g;
+}
+
+}  // namespace devslam::sim
