@@ -20,7 +20,7 @@ Summary summarize(const std::vector<double>& v) {
     Summary s;
     s.count = v.size();
     if (v.empty()) return s;
-    const double n = static_cast<double>(v.size());
+    const auto n = static_cast<double>(v.size());
     double sum = 0, sum_sq = 0;
     for (double x : v) sum += x, sum_sq += x * x;
     s.mean = sum / n;

@@ -82,7 +82,7 @@ cv::Mat registerDepth(const CObservation3DRangeScan& o, const cv::Mat& depth, in
             const int ui = static_cast<int>(std::lround(ic.fx() * q.x() / q.z() + ic.cx()));
             const int vi = static_cast<int>(std::lround(ic.fy() * q.y() / q.z() + ic.cy()));
             if (ui < 0 || vi < 0 || ui >= W || vi >= H) continue;
-            float& d = out.at<float>(vi, ui);
+            auto& d = out.at<float>(vi, ui);
             if (d == 0 || q.z() < d) d = static_cast<float>(q.z());
         }
     return out;
@@ -100,7 +100,7 @@ std::string gzipDamage(const std::string& path) {
     }
     int err = Z_OK;
     const char* msg = gzerror(f, &err);
-    const std::string out = (n < 0 || (err != Z_OK && err != Z_STREAM_END)) ? msg : "";
+    std::string out = (n < 0 || (err != Z_OK && err != Z_STREAM_END)) ? msg : "";
     gzclose(f);
     return out;
 }
@@ -215,8 +215,8 @@ struct RawlogReader::Stream {
     }
 };
 
-RawlogReader::RawlogReader(std::string path, const ReaderOptions& opts, bool allow_truncated)
-    : path_(std::move(path)), opts_(opts) {
+RawlogReader::RawlogReader(std::string path, ReaderOptions opts, bool allow_truncated)
+    : path_(std::move(path)), opts_(std::move(opts)) {
     if (!fs::is_regular_file(path_)) throw std::runtime_error(path_ + ": rawlog file not found");
     mrpt::img::CImage::setImagesPathBase(rawlogImagesDir(path_));
     // Scan once: count frames, find damage, take the intrinsics of the first frame.
@@ -282,8 +282,8 @@ struct RawlogWriter::Stream {
     mrpt::io::CFileGZOutputStream file;
 };
 
-RawlogWriter::RawlogWriter(std::string path, const RawlogWriterOptions& opts)
-    : path_(std::move(path)), opts_(opts) {
+RawlogWriter::RawlogWriter(std::string path, RawlogWriterOptions opts)
+    : path_(std::move(path)), opts_(std::move(opts)) {
     if (opts_.compression < 0 || opts_.compression > 9)
         throw std::invalid_argument("rawlog compression must be 0..9, got " +
                                     std::to_string(opts_.compression));

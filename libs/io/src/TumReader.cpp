@@ -76,8 +76,8 @@ void loadTumImages(const std::string& rgb_path, const std::string& depth_path, d
     f.depth_source = depth_path;
 }
 
-TumReader::TumReader(std::string folder, const ReaderOptions& opts)
-    : folder_(std::move(folder)), opts_(opts) {
+TumReader::TumReader(std::string folder, ReaderOptions opts)
+    : folder_(std::move(folder)), opts_(std::move(opts)) {
     if (!fs::is_directory(folder_))
         throw std::runtime_error(folder_ + ": not a TUM RGB-D folder (not a directory)");
     const auto rgb = readTumList(folder_ + "/rgb.txt");

@@ -31,8 +31,7 @@ namespace devslam::io {
 
 class RawlogReader final : public RgbdReader {
   public:
-    explicit RawlogReader(std::string path, const ReaderOptions& opts = {},
-                          bool allow_truncated = false);
+    explicit RawlogReader(std::string path, ReaderOptions opts = {}, bool allow_truncated = false);
     ~RawlogReader() override;
     [[nodiscard]] std::optional<core::Frame> next() override;
     [[nodiscard]] std::optional<std::size_t> size() const override { return n_frames_; }
@@ -74,7 +73,7 @@ struct RawlogWriterOptions {
 
 class RawlogWriter {
   public:
-    RawlogWriter(std::string path, const RawlogWriterOptions& opts);
+    RawlogWriter(std::string path, RawlogWriterOptions opts);
     ~RawlogWriter();
     RawlogWriter(const RawlogWriter&) = delete;
     RawlogWriter& operator=(const RawlogWriter&) = delete;

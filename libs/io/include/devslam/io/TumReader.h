@@ -38,7 +38,7 @@ struct TumListEntry {
 
 class TumReader final : public RgbdReader {
   public:
-    explicit TumReader(std::string folder, const ReaderOptions& opts = {});
+    explicit TumReader(std::string folder, ReaderOptions opts = {});
     [[nodiscard]] std::optional<core::Frame> next() override;
     [[nodiscard]] std::optional<std::size_t> size() const override { return pairs_.size(); }
     [[nodiscard]] std::optional<core::Trajectory> groundTruth() const override { return gt_; }
