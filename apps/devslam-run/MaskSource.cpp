@@ -1,0 +1,68 @@
+#include "MaskSource.h"
+
+#include <stdexcept>
+
+#ifdef DEVSLAM_HAVE_DYNAMIC
+#include <devslam/dynamic/DynamicObjectFilter.h>
+#endif
+
+namespace devslam::run {
+
+namespace {
+#ifndef DEVSLAM_HAVE_DYNAMIC
+class NoMask final : public MaskSource {
+  public:
+    MaskStep step(const core::Frame&, const std::optional<Eigen::Isometry3d>&) override {
+        return {};
+    }
+    void reset() override {}
+    std::string describe() const override { return "none (no detector)"; }
+};
+#endif
+
+#ifdef DEVSLAM_HAVE_DYNAMIC
+class FilterMask final : public MaskSource {
+  public:
+    explicit FilterMask(std::unique_ptr<dynamic::DynamicObjectFilter> f) : filter_(std::move(f)) {}
+    MaskStep step(const core::Frame& frame,
+                  const std::optional<Eigen::Isometry3d>& prior) override {
+        auto out = filter_->step(frame, prior);
+        MaskStep s;
+        s.mask = std::move(out.mask);
+        s.detect_ms = out.detect_ms;
+        s.filter_ms = out.filter_ms;
+        s.detector_ran = out.detector_ran;
+        s.n_boxes = static_cast<int>(out.boxes.size());
+        for (const auto& b : out.boxes) s.n_moving += b.state == dynamic::BoxState::Moving ? 1 : 0;
+        s.T_prev_cur_refined = out.T_prev_cur_refined;
+        return s;
+    }
+    void reset() override { filter_->reset(); }
+    std::string describe() const override {
+        return "dynamic filter, mode " + dynamic::toString(filter_->options().mode);
+    }
+
+  private:
+    std::unique_ptr<dynamic::DynamicObjectFilter> filter_;
+};
+#endif
+}  // namespace
+
+std::unique_ptr<MaskSource> makeMaskSource(const std::string& mode,
+                                           const mrpt::config::CConfigFileBase& cfg) {
+    if (mode != "none" && mode != "all_persons" && mode != "dynamic")
+        throw std::invalid_argument("unknown mode '" + mode +
+                                    "' (known: none, all_persons, dynamic)");
+#ifdef DEVSLAM_HAVE_DYNAMIC
+    auto filter = dynamic::makeFilterFromConfig(cfg, dynamic::parseMaskMode(mode));
+    return std::make_unique<FilterMask>(std::move(filter));
+#else
+    (void)cfg;
+    if (mode != "none")
+        throw std::runtime_error("mode '" + mode +
+                                 "' needs devslam::dynamic, which this build does not have");
+    return std::make_unique<NoMask>();
+#endif
+}
+
+}  // namespace devslam::run

@@ -1,0 +1,38 @@
+#pragma once
+/// The dynamic mask for each frame: engineer A's DynamicObjectFilter when the build has
+/// devslam::dynamic (DEVSLAM_HAVE_DYNAMIC), otherwise an empty mask (MaskMode::None
+/// behaviour) and an error for the other modes.
+#include <devslam/core/Frame.h>
+
+#include <mrpt/config/CConfigFileBase.h>
+#include <Eigen/Geometry>
+#include <opencv2/core/mat.hpp>
+
+#include <memory>
+#include <optional>
+#include <string>
+
+namespace devslam::run {
+
+struct MaskStep {
+    cv::Mat mask;  ///< empty or CV_8UC1, 255 = dynamic
+    double detect_ms = 0, filter_ms = 0;
+    bool detector_ran = false;
+    int n_boxes = 0, n_moving = 0;
+    std::optional<Eigen::Isometry3d> T_prev_cur_refined;
+};
+
+class MaskSource {
+  public:
+    virtual ~MaskSource() = default;
+    [[nodiscard]] virtual MaskStep step(const core::Frame& frame,
+                                        const std::optional<Eigen::Isometry3d>& prior) = 0;
+    virtual void reset() = 0;
+    [[nodiscard]] virtual std::string describe() const = 0;
+};
+
+/// mode: "none" | "all_persons" | "dynamic". `cfg` holds [detector] and [dynamic_filter].
+[[nodiscard]] std::unique_ptr<MaskSource> makeMaskSource(const std::string& mode,
+                                                         const mrpt::config::CConfigFileBase& cfg);
+
+}  // namespace devslam::run

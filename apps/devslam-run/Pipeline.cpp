@@ -1,0 +1,322 @@
+#include "Pipeline.h"
+
+#include "MaskSource.h"
+
+#include <devslam/core/Config.h>
+#include <devslam/core/Pose.h>
+#include <devslam/core/Progress.h>
+#include <devslam/core/Stats.h>
+#include <devslam/eval/Report.h>
+#include <devslam/io/TrajectoryIO.h>
+#include <devslam/slam/MapExporter.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace devslam::run {
+
+namespace {
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+std::string num(double v, int prec = 6) {
+    char b[64];
+    std::snprintf(b, sizeof b, "%.*f", prec, v);
+    return b;
+}
+
+std::string summaryJson(const core::Summary& s) {
+    return "{\"count\": " + std::to_string(s.count) + ", \"rmse\": " + num(s.rmse) +
+           ", \"mean\": " + num(s.mean) + ", \"median\": " + num(s.median) +
+           ", \"std\": " + num(s.std) + ", \"min\": " + num(s.min) + ", \"max\": " + num(s.max) +
+           "}";
+}
+
+std::string timingJson(const FrameTiming& t) {
+    return "{\"detect\": " + num(t.detect, 3) + ", \"filter\": " + num(t.filter, 3) +
+           ", \"features\": " + num(t.features, 3) + ", \"tracking\": " + num(t.tracking, 3) +
+           ", \"mapping\": " + num(t.mapping, 3) + ", \"backend\": " + num(t.backend, 3) +
+           ", \"total\": " + num(t.total(), 3) + "}";
+}
+}  // namespace
+
+double peakRssMb() {
+    std::ifstream in("/proc/self/status");
+    std::string line;
+    while (std::getline(in, line))
+        if (line.rfind("VmHWM:", 0) == 0) return std::stod(line.substr(6)) / 1024.0;
+    return 0.0;
+}
+
+RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
+                      const mrpt::config::CConfigFileBase& cfg,
+                      const mrpt::config::CConfigFileBase& filter_cfg) {
+    const auto slam_opts = slam::SlamOptions::fromConfig(cfg);
+    slam::GridMapOptions grid_opts;
+    grid_opts.loadFromConfig(cfg, "grid_map");
+    auto masks = makeMaskSource(rc.mode, filter_cfg);
+    slam::Slam slam(slam_opts);
+
+    RunReport rep;
+    rep.input = rc.input;
+    rep.mode = rc.mode;
+    rep.mask_source = masks->describe();
+    const auto K = reader.intrinsics();
+    rep.camera = "fx=" + num(K.fx, 1) + " fy=" + num(K.fy, 1) + " cx=" + num(K.cx, 1) +
+                 " cy=" + num(K.cy, 1) + " " + std::to_string(K.width) + "x" +
+                 std::to_string(K.height);
+    const std::size_t total = rc.max_frames ? std::min(rc.max_frames, reader.size().value_or(0))
+                                            : reader.size().value_or(0);
+    std::optional<core::ProgressBar> bar;
+    if (rc.progress) bar.emplace("devslam-run " + rc.mode, total);
+    std::size_t n = 0;
+    double elapsed_ms = 0;
+    while (auto frame = reader.next()) {
+        if (rc.max_frames && n >= rc.max_frames) break;
+        frame->index = n;
+        FrameLog fl;
+        fl.index = n;
+        fl.t = frame->timestamp;
+        const auto prior = slam.predictPrevCur(frame->timestamp);
+        const MaskStep ms = masks->step(*frame, prior);
+        fl.ms.detect = ms.detect_ms;
+        fl.ms.filter = ms.filter_ms;
+        fl.n_boxes = ms.n_boxes;
+        fl.n_moving = ms.n_moving;
+        auto t0 = Clock::now();
+        auto feats = slam.extract(*frame, ms.mask);
+        fl.ms.features = msSince(t0);
+        fl.n_features = static_cast<int>(feats.size());
+        fl.n_masked = feats.n_masked;
+        t0 = Clock::now();
+        const auto tr = slam.track(*frame, feats, std::nullopt);
+        fl.ms.tracking = msSince(t0);
+        t0 = Clock::now();
+        const auto mr = slam.mapStep(*frame, std::move(feats), tr);
+        fl.ms.mapping = msSince(t0);
+        t0 = Clock::now();
+        const auto br = slam.backendStep(mr, frame->K);
+        fl.ms.backend = msSince(t0);
+        fl.state = slam::toString(tr.state);
+        fl.n_inliers = tr.n_inliers;
+        fl.keyframe = mr.keyframe_inserted;
+        fl.loop = br.loop_closed;
+        if (tr.state == slam::TrackingState::Lost) masks->reset();
+        elapsed_ms += fl.ms.total();
+        rep.log.push_back(fl);
+        ++n;
+        if (bar) {
+            const double fps = elapsed_ms > 0 ? 1000.0 * n / elapsed_ms : 0.0;
+            bar->update(n, num(fps, 1) + " fps, " + fl.state);
+        }
+    }
+    if (bar) bar->finish();
+
+    rep.frames = n;
+    rep.keyframes = slam.map().keyframes().size();
+    rep.landmarks = slam.map().landmarks().size();
+    rep.loops = static_cast<std::size_t>(slam.loopsClosed());
+    rep.lost = slam.lostFrames();
+    rep.trajectory = slam.trajectory();
+    rep.keyframe_trajectory = slam.keyframeTrajectory();
+    std::vector<double> fps, total_ms;
+    std::vector<double> st[6];
+    for (const auto& l : rep.log) {
+        const double t = l.ms.total();
+        total_ms.push_back(t);
+        fps.push_back(t > 0 ? 1000.0 / t : 0.0);
+        const double v[6] = {l.ms.detect,   l.ms.filter,  l.ms.features,
+                             l.ms.tracking, l.ms.mapping, l.ms.backend};
+        for (int k = 0; k < 6; ++k) st[k].push_back(v[k]);
+    }
+    rep.median_fps = core::median(fps);
+    rep.median_ms = core::median(total_ms);
+    rep.mean_fps = elapsed_ms > 0 ? 1000.0 * n / elapsed_ms : 0.0;
+    double* mean_fields[6] = {&rep.stage_mean_ms.detect,   &rep.stage_mean_ms.filter,
+                              &rep.stage_mean_ms.features, &rep.stage_mean_ms.tracking,
+                              &rep.stage_mean_ms.mapping,  &rep.stage_mean_ms.backend};
+    double* med_fields[6] = {&rep.stage_median_ms.detect,   &rep.stage_median_ms.filter,
+                             &rep.stage_median_ms.features, &rep.stage_median_ms.tracking,
+                             &rep.stage_median_ms.mapping,  &rep.stage_median_ms.backend};
+    for (int k = 0; k < 6; ++k) {
+        *mean_fields[k] = core::summarize(st[k]).mean;
+        *med_fields[k] = core::median(st[k]);
+    }
+    rep.map_mb = static_cast<double>(slam.map().approxBytes()) / (1024.0 * 1024.0);
+    rep.bytes_per_keyframe =
+        rep.keyframes ? static_cast<double>(slam.map().approxBytes()) / rep.keyframes : 0.0;
+
+    rep.ground_truth = reader.groundTruth();
+    if (rep.ground_truth && rep.trajectory.size() >= 3) {
+        try {
+            rep.ate = eval::computeAte(*rep.ground_truth, rep.trajectory);
+            eval::RpeOptions one_s;
+            rep.rpe_1s = eval::computeRpe(*rep.ground_truth, rep.trajectory, one_s);
+        } catch (const std::invalid_argument&) {
+            // Too short for a 1 s delta (or no association): reported as absent.
+        }
+        try {
+            eval::RpeOptions per_frame;
+            per_frame.delta = 1;
+            per_frame.delta_in_frames = true;
+            rep.rpe_frame = eval::computeRpe(*rep.ground_truth, rep.trajectory, per_frame);
+        } catch (const std::invalid_argument&) {
+        }
+    }
+
+    if (!rc.out_dir.empty()) {
+        namespace fs = std::filesystem;
+        fs::create_directories(rc.out_dir);
+        auto out = [&](const std::string& name) {
+            const std::string p = (fs::path(rc.out_dir) / name).string();
+            rep.outputs.push_back(p);
+            return p;
+        };
+        std::string lost_note =
+            "lost frames (motion-model pose): " + std::to_string(rep.lost.size());
+        io::writeTumTrajectory(out("trajectory.txt"), rep.trajectory,
+                               "DEV-SLAM per-frame trajectory, mode " + rc.mode + "; " + lost_note);
+        io::writeTumTrajectory(out("keyframes.txt"), rep.keyframe_trajectory,
+                               "DEV-SLAM keyframe trajectory, mode " + rc.mode);
+        {
+            std::ofstream lf(out("lost_frames.txt"));
+            lf << "# index timestamp (frames without a tracked pose)\n";
+            for (std::size_t i : rep.lost) lf << i << " " << num(rep.trajectory[i].t, 6) << "\n";
+        }
+        slam::writePly(out("map.ply"), slam.map());
+        std::optional<core::Trajectory> gt_in_est;
+        if (rep.ate && rep.ground_truth) {
+            // Ground truth brought into the SLAM frame for the 3D view.
+            const Eigen::Isometry3d T_est_gt = rep.ate->T_gt_est.inverse();
+            core::Trajectory g;
+            for (const auto& sp : *rep.ground_truth) {
+                if (sp.t < rep.trajectory.front().t - 0.05 || sp.t > rep.trajectory.back().t + 0.05)
+                    continue;
+                g.push_back({sp.t, core::toCPose3D(T_est_gt * core::toIsometry(sp.pose))});
+            }
+            gt_in_est = g;
+        }
+        slam::write3DScene(out("map.3Dscene"), slam.map(), rep.trajectory, gt_in_est);
+        if (auto grid = slam::buildOccupancyGrid(slam.map(), grid_opts)) {
+            const std::string stem = (fs::path(rc.out_dir) / "map_grid").string();
+            slam::saveGrid(*grid, stem);
+            rep.outputs.push_back(stem + ".png");
+            rep.outputs.push_back(stem + ".gridmap");
+        }
+        if (rep.ate)
+            eval::plotAte(out("trajectory.png"), *rep.ate,
+                          fs::path(rc.input).filename().string() + ", mode " + rc.mode);
+        rep.peak_rss_mb = peakRssMb();
+        std::ofstream js(out("run.json"));
+        js << toJson(rep);
+    }
+    rep.peak_rss_mb = peakRssMb();
+    return rep;
+}
+
+std::string formatSummary(const RunReport& r) {
+    std::ostringstream o;
+    o << "input      : " << r.input << "\n"
+      << "mode       : " << r.mode << " (" << r.mask_source << ")\n"
+      << "camera     : " << r.camera << "\n"
+      << "frames     : " << r.frames << "   keyframes: " << r.keyframes
+      << "   landmarks: " << r.landmarks << "   loops closed: " << r.loops << "\n"
+      << "lost frames: " << r.lost.size();
+    if (!r.lost.empty()) {
+        o << " (indices:";
+        for (std::size_t i = 0; i < r.lost.size() && i < 20; ++i) o << " " << r.lost[i];
+        if (r.lost.size() > 20) o << " ...";
+        o << ")";
+    }
+    o << "\n"
+      << "speed      : median " << num(r.median_fps, 1) << " FPS (" << num(r.median_ms, 1)
+      << " ms/frame), mean " << num(r.mean_fps, 1) << " FPS\n"
+      << "stages [ms]: median / mean\n";
+    const char* names[6] = {"detect", "filter", "features", "tracking", "mapping", "backend"};
+    const double med[6] = {r.stage_median_ms.detect,   r.stage_median_ms.filter,
+                           r.stage_median_ms.features, r.stage_median_ms.tracking,
+                           r.stage_median_ms.mapping,  r.stage_median_ms.backend};
+    const double mean[6] = {r.stage_mean_ms.detect,   r.stage_mean_ms.filter,
+                            r.stage_mean_ms.features, r.stage_mean_ms.tracking,
+                            r.stage_mean_ms.mapping,  r.stage_mean_ms.backend};
+    for (int k = 0; k < 6; ++k) {
+        char line[96];
+        std::snprintf(line, sizeof line, "  %-9s %8.2f / %8.2f\n", names[k], med[k], mean[k]);
+        o << line;
+    }
+    o << "memory     : peak RSS " << num(r.peak_rss_mb, 1) << " MB, map " << num(r.map_mb, 2)
+      << " MB (" << num(r.bytes_per_keyframe / 1024.0, 1) << " KiB per keyframe)\n";
+    if (r.ate) {
+        o << "ATE        : RMSE " << num(r.ate->trans.rmse, 4) << " m, mean "
+          << num(r.ate->trans.mean, 4) << " m, median " << num(r.ate->trans.median, 4) << " m, max "
+          << num(r.ate->trans.max, 4) << " m (" << r.ate->trans.count
+          << " poses, lost frames included)\n";
+    } else if (r.ground_truth) {
+        o << "ATE        : not computed (too few associated poses)\n";
+    } else {
+        o << "ATE        : no ground truth\n";
+    }
+    if (r.rpe_1s)
+        o << "RPE (1 s)  : trans RMSE " << num(r.rpe_1s->trans.rmse, 4) << " m, rot RMSE "
+          << num(r.rpe_1s->rot.rmse, 3) << " deg (" << r.rpe_1s->n_pairs << " pairs)\n";
+    if (r.rpe_frame)
+        o << "RPE (1 f)  : trans RMSE " << num(r.rpe_frame->trans.rmse, 4) << " m, rot RMSE "
+          << num(r.rpe_frame->rot.rmse, 3) << " deg (" << r.rpe_frame->n_pairs << " pairs)\n";
+    if (!r.outputs.empty()) {
+        o << "outputs    :";
+        for (const auto& p : r.outputs) o << "\n  " << p;
+        o << "\n";
+    }
+    return o.str();
+}
+
+std::string toJson(const RunReport& r) {
+    std::ostringstream o;
+    auto esc = [](const std::string& s) {
+        std::string e;
+        for (char c : s) {
+            if (c == '"' || c == '\\') e += '\\';
+            e += c;
+        }
+        return e;
+    };
+    o << "{\n  \"input\": \"" << esc(r.input) << "\",\n  \"mode\": \"" << r.mode
+      << "\",\n  \"mask_source\": \"" << esc(r.mask_source) << "\",\n  \"frames\": " << r.frames
+      << ",\n  \"keyframes\": " << r.keyframes << ",\n  \"landmarks\": " << r.landmarks
+      << ",\n  \"loops_closed\": " << r.loops << ",\n  \"lost_frames\": " << r.lost.size()
+      << ",\n  \"lost_frame_indices\": [";
+    for (std::size_t i = 0; i < r.lost.size(); ++i) o << (i ? ", " : "") << r.lost[i];
+    o << "],\n  \"median_fps\": " << num(r.median_fps, 2)
+      << ",\n  \"mean_fps\": " << num(r.mean_fps, 2)
+      << ",\n  \"stage_median_ms\": " << timingJson(r.stage_median_ms)
+      << ",\n  \"stage_mean_ms\": " << timingJson(r.stage_mean_ms)
+      << ",\n  \"peak_rss_mb\": " << num(r.peak_rss_mb, 1)
+      << ",\n  \"map_mb\": " << num(r.map_mb, 3)
+      << ",\n  \"bytes_per_keyframe\": " << num(r.bytes_per_keyframe, 0);
+    if (r.ate) o << ",\n  \"ate\": " << summaryJson(r.ate->trans);
+    if (r.rpe_1s)
+        o << ",\n  \"rpe_1s\": {\"trans\": " << summaryJson(r.rpe_1s->trans)
+          << ", \"rot_deg\": " << summaryJson(r.rpe_1s->rot) << "}";
+    if (r.rpe_frame)
+        o << ",\n  \"rpe_1frame\": {\"trans\": " << summaryJson(r.rpe_frame->trans)
+          << ", \"rot_deg\": " << summaryJson(r.rpe_frame->rot) << "}";
+    o << ",\n  \"per_frame\": [";
+    for (std::size_t i = 0; i < r.log.size(); ++i) {
+        const auto& l = r.log[i];
+        o << (i ? ",\n    " : "\n    ") << "{\"index\": " << l.index << ", \"t\": " << num(l.t, 6)
+          << ", \"state\": \"" << l.state << "\", \"features\": " << l.n_features
+          << ", \"masked\": " << l.n_masked << ", \"inliers\": " << l.n_inliers
+          << ", \"boxes\": " << l.n_boxes << ", \"moving\": " << l.n_moving
+          << ", \"keyframe\": " << (l.keyframe ? "true" : "false")
+          << ", \"ms\": " << timingJson(l.ms) << "}";
+    }
+    o << "\n  ]\n}\n";
+    return o.str();
+}
+
+}  // namespace devslam::run

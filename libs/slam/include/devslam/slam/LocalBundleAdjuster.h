@@ -1,0 +1,53 @@
+#pragma once
+/// Local bundle adjustment: the poses of the newest keyframes and every landmark they see
+/// are refined together (keyframes outside the window that see those landmarks are held
+/// fixed), minimising the same reprojection + virtual-right-coordinate residuals as the
+/// tracker, with a Huber kernel. Own Levenberg-Marquardt on Eigen with the Schur
+/// complement on the 3x3 landmark blocks (dense reduced camera system, window <= ~20).
+///
+/// Usage:
+///   auto r = devslam::slam::localBundleAdjust(map, newest_kf, K, opts);
+/// Not thread-safe (modifies `map`).
+#include <devslam/core/Camera.h>
+#include <devslam/slam/Map.h>
+
+#include <string>
+
+namespace mrpt::config {
+class CConfigFileBase;
+}
+
+namespace devslam::slam {
+
+struct LocalBaOptions {
+    bool enabled = true;
+    int window = 5;              ///< keyframes optimised (newest ones)
+    int iterations = 8;          ///< LM iterations
+    double bf = 40.0;            ///< [px*m] virtual baseline * fx (as the tracker)
+    double chi2_mono = 5.991;    ///< outlier test for 2-dof residuals (Huber width too)
+    double chi2_stereo = 7.815;  ///< for 3-dof residuals
+    double scale_factor = 1.2;   ///< ORB pyramid scale (level sigmas)
+
+    void loadFromConfig(const mrpt::config::CConfigFileBase& cfg,
+                        const std::string& section = "local_ba");
+    void saveToConfig(mrpt::config::CConfigFileBase& cfg,
+                      const std::string& section = "local_ba") const;
+};
+
+struct LocalBaResult {
+    int n_keyframes = 0;        ///< optimised
+    int n_fixed_keyframes = 0;  ///< seen, held fixed
+    int n_landmarks = 0;
+    int n_observations = 0;
+    int iterations = 0;
+    double initial_cost = 0.0;  ///< robust cost (sum of Huber-weighted chi2)
+    double final_cost = 0.0;
+    int n_outliers_removed = 0;  ///< observations removed after the optimisation
+};
+
+/// Optimises the window ending at `newest`. Keyframe 0 (the gauge) is never moved.
+[[nodiscard]] LocalBaResult localBundleAdjust(Map& map, KeyframeId newest,
+                                              const core::CameraIntrinsics& K,
+                                              const LocalBaOptions& opts);
+
+}  // namespace devslam::slam

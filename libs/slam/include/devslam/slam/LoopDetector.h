@@ -1,0 +1,51 @@
+#pragma once
+/// Loop detection: descriptor matching of a new keyframe against older keyframes near
+/// its current pose estimate, geometric verification by PnP-RANSAC + refinement on the
+/// old keyframe's landmarks. Pure function.
+///
+/// Usage:
+///   if (auto loop = devslam::slam::detectLoop(map, kf_id, K, opts)) edges.push_back(...);
+#include <devslam/core/Camera.h>
+#include <devslam/slam/Map.h>
+#include <devslam/slam/PoseSolver.h>
+
+#include <optional>
+#include <string>
+
+namespace mrpt::config {
+class CConfigFileBase;
+}
+
+namespace devslam::slam {
+
+struct LoopOptions {
+    bool enabled = true;
+    int min_keyframe_gap = 20;  ///< candidates are at least this many keyframes older
+    double max_distance = 1.0;  ///< [m] candidate keyframes within this of the current pose
+    int max_candidates = 3;     ///< nearest candidates verified
+    int max_hamming = 50;       ///< descriptor threshold
+    double ratio = 0.8;         ///< ratio test
+    int min_inliers = 40;       ///< verified inliers for a loop
+    double sigma_t = 0.02;      ///< [m] loop-edge translation std (pose-graph information)
+    double sigma_r_deg = 1.0;   ///< [deg] loop-edge rotation std
+
+    void loadFromConfig(const mrpt::config::CConfigFileBase& cfg,
+                        const std::string& section = "loop_closure");
+    void saveToConfig(mrpt::config::CConfigFileBase& cfg,
+                      const std::string& section = "loop_closure") const;
+};
+
+struct LoopConstraint {
+    KeyframeId old_kf = kNoId, new_kf = kNoId;
+    Eigen::Isometry3d T_old_new;  ///< measured pose of the new keyframe in the old one
+    int n_inliers = 0;
+};
+
+/// Looks for a loop between `current` and older keyframes (see LoopOptions).
+[[nodiscard]] std::optional<LoopConstraint> detectLoop(const Map& map, KeyframeId current,
+                                                       const core::CameraIntrinsics& K,
+                                                       const LoopOptions& opts,
+                                                       const PoseRefineOptions& refine = {},
+                                                       unsigned long long seed = 777);
+
+}  // namespace devslam::slam

@@ -1,0 +1,62 @@
+#pragma once
+/// ORB features (OpenCV) spread over the image with a grid, keypoints inside the dynamic
+/// mask dropped, depth looked up and back-projected.
+///
+/// Usage:
+///   devslam::slam::OrbExtractor orb(opts);
+///   FrameFeatures f = orb.extract(frame, filter_out.mask);   // mask may be empty
+/// Not thread-safe (owns the cv::ORB object).
+#include <devslam/core/Frame.h>
+#include <devslam/slam/Types.h>
+
+#include <opencv2/features2d.hpp>
+
+#include <string>
+
+namespace mrpt::config {
+class CConfigFileBase;
+}
+
+namespace devslam::slam {
+
+class OrbExtractor {
+  public:
+    struct Options {
+        int n_features = 1250;       ///< features kept per frame (the paper: 1250)
+        double scale_factor = 1.2;   ///< pyramid scale between levels
+        int n_levels = 8;            ///< pyramid levels
+        int fast_threshold = 20;     ///< FAST threshold (intensity units)
+        int min_fast_threshold = 7;  ///< retried with this when a frame yields too few corners
+        double oversample = 1.6;     ///< ORB asked for oversample*n_features, then spread
+        int grid_cols = 8;           ///< spreading grid (cells over the image width)
+        int grid_rows = 6;           ///< spreading grid (cells over the image height)
+        double min_depth = 0.1;      ///< [m] nearer depth is treated as missing
+        double max_depth = 6.0;      ///< [m] farther depth is treated as missing
+
+        void loadFromConfig(const mrpt::config::CConfigFileBase& cfg,
+                            const std::string& section = "orb");
+        void saveToConfig(mrpt::config::CConfigFileBase& cfg,
+                          const std::string& section = "orb") const;
+    };
+
+    explicit OrbExtractor(const Options& opts);
+
+    /// Features of `frame`. `mask`: empty, or CV_8UC1 of the frame size with 255 = dynamic
+    /// (keypoints there are dropped and counted in n_masked). Throws std::invalid_argument
+    /// for a mask of the wrong size/type.
+    [[nodiscard]] FrameFeatures extract(const core::Frame& frame, const cv::Mat& mask) const;
+
+    [[nodiscard]] const Options& options() const { return opts_; }
+
+  private:
+    Options opts_;
+    cv::Ptr<cv::ORB> orb_, orb_low_;
+};
+
+/// Keeps at most `n` keypoints spread over a cols x rows grid: each cell first keeps its
+/// strongest n/(cols*rows) responses, the rest of the budget goes to the strongest left.
+/// Returns indices into `kps`, sorted ascending. Deterministic (ties by index).
+[[nodiscard]] std::vector<int> spreadOverGrid(const std::vector<cv::KeyPoint>& kps, cv::Size image,
+                                              int cols, int rows, int n);
+
+}  // namespace devslam::slam

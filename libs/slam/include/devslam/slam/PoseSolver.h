@@ -1,0 +1,74 @@
+#pragma once
+/// Camera pose from 2D-3D correspondences: PnP-RANSAC (cv::solvePnPRansac) for a robust
+/// initial pose, then a motion-only Gauss-Newton refinement with a Huber kernel on the
+/// reprojection error plus, where depth is measured, the error of a virtual right-camera
+/// coordinate u_r = u - bf/z (the RGB-D residual of ORB-SLAM2). Pure functions.
+#include <devslam/core/Camera.h>
+
+#include <Eigen/Geometry>
+
+#include <optional>
+#include <vector>
+
+namespace devslam::slam {
+
+/// One correspondence: world point and its measurement in the image.
+struct PoseObservation {
+    Eigen::Vector3d p_w;    ///< [m]
+    Eigen::Vector2d uv;     ///< [px] measured keypoint
+    double depth = 0.0;     ///< [m] measured depth at the keypoint, 0 = none
+    double inv_sigma2 = 1;  ///< 1/sigma^2 of the keypoint's pyramid level
+};
+
+struct PnpRansacOptions {
+    int iterations = 100;             ///< RANSAC iterations
+    double reprojection_px = 4.0;     ///< [px] inlier threshold
+    double confidence = 0.99;         ///< RANSAC confidence
+    int min_inliers = 12;             ///< fewer: no pose
+    unsigned long long seed = 12345;  ///< cv::theRNG() state before the call (determinism)
+};
+
+struct PnpResult {
+    Eigen::Isometry3d T_wc;
+    std::vector<int> inliers;  ///< indices into the observations
+};
+
+/// RANSAC PnP (EPnP hypotheses). `guess_T_wc` (optional) seeds the final iterative fit.
+/// std::nullopt with fewer than max(6, min_inliers) observations or inliers.
+[[nodiscard]] std::optional<PnpResult> solvePnpRansac(
+    const std::vector<PoseObservation>& obs, const core::CameraIntrinsics& K,
+    const PnpRansacOptions& opts, const std::optional<Eigen::Isometry3d>& guess_T_wc = {});
+
+struct PoseRefineOptions {
+    double bf = 40.0;            ///< [px*m] virtual stereo baseline times fx (ORB-SLAM2 TUM: 40)
+    int rounds = 4;              ///< outlier classification rounds
+    int iterations = 10;         ///< Gauss-Newton iterations per round
+    double chi2_mono = 5.991;    ///< chi-square 95% for 2 dof (pixels^2 / sigma^2)
+    double chi2_stereo = 7.815;  ///< chi-square 95% for 3 dof
+};
+
+struct PoseRefineResult {
+    Eigen::Isometry3d T_wc;
+    std::vector<char> inlier;  ///< per observation
+    int n_inliers = 0;
+    double rms_px = 0.0;  ///< RMS reprojection error of the inliers [px]
+};
+
+/// Motion-only refinement from `T_wc_init` (all observations start as inliers; each
+/// round re-classifies them by chi-square, the last rounds without the robust kernel).
+[[nodiscard]] PoseRefineResult refinePose(const std::vector<PoseObservation>& obs,
+                                          const Eigen::Isometry3d& T_wc_init,
+                                          const core::CameraIntrinsics& K,
+                                          const PoseRefineOptions& opts);
+
+/// Residual and Jacobian of one observation w.r.t. a left perturbation [v, w] of T_cw and
+/// w.r.t. the world point: r = predicted - measured (2 or 3 rows). false when behind the camera.
+bool observationJacobians(const Eigen::Isometry3d& T_cw, const Eigen::Vector3d& p_w,
+                          const Eigen::Vector2d& uv, double depth, const core::CameraIntrinsics& K,
+                          double bf, Eigen::Vector3d& r, Eigen::Matrix<double, 3, 6>& J_pose,
+                          Eigen::Matrix3d& J_point, int& rows);
+
+/// exp of a twist [v, w] as used by the optimizers (rotation by the angle-axis w).
+[[nodiscard]] Eigen::Isometry3d expTwist(const Eigen::Matrix<double, 6, 1>& xi);
+
+}  // namespace devslam::slam

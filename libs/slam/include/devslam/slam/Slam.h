@@ -1,0 +1,145 @@
+#pragma once
+/// The RGB-D SLAM system: ORB extraction (dynamic mask applied), tracking, keyframe
+/// insertion with local mapping (landmark creation, culling, local BA), and the back end
+/// (loop detection, MRPT pose graph). Stages are separate calls so that the caller can time
+/// them; process() runs them all.
+///
+///   Frame + mask ─► extract ─► track ─► mapStep (keyframe? new landmarks, cull, local BA)
+///                                              └─► backendStep (loop? pose graph, correct map)
+///
+/// Usage:
+///   devslam::slam::Slam slam(devslam::slam::SlamOptions::fromConfig(*cfg));
+///   while (auto f = reader->next()) { auto r = slam.process(*f, mask); }
+///   auto traj = slam.trajectory();           // every frame, lost ones flagged
+/// Not thread-safe; deterministic (RANSAC seeded from the frame index).
+#include <devslam/core/Frame.h>
+#include <devslam/core/Trajectory.h>
+#include <devslam/slam/KeyframeSelector.h>
+#include <devslam/slam/LocalBundleAdjuster.h>
+#include <devslam/slam/LoopDetector.h>
+#include <devslam/slam/Map.h>
+#include <devslam/slam/OrbExtractor.h>
+#include <devslam/slam/PoseGraph.h>
+#include <devslam/slam/Tracker.h>
+
+#include <optional>
+#include <string>
+
+namespace mrpt::config {
+class CConfigFileBase;
+}
+
+namespace devslam::slam {
+
+/// Local-mapping rules besides keyframe selection and BA.
+struct MappingOptions {
+    int min_init_points = 100;  ///< keypoints with depth needed to start the map
+    double cull_min_found_ratio =
+        0.25;                   ///< found/visible below this (after cull_min_visible) -> removed
+    int cull_min_visible = 6;   ///< visible count before the ratio test applies
+    int cull_keyframe_age = 3;  ///< landmarks this many keyframes old need >= 2 observations
+    double odometry_sigma_t = 0.01;     ///< [m] consecutive-keyframe edge std in the pose graph
+    double odometry_sigma_r_deg = 0.5;  ///< [deg]
+
+    void loadFromConfig(const mrpt::config::CConfigFileBase& cfg,
+                        const std::string& section = "mapping");
+    void saveToConfig(mrpt::config::CConfigFileBase& cfg,
+                      const std::string& section = "mapping") const;
+};
+
+struct SlamOptions {
+    OrbExtractor::Options orb;
+    TrackerOptions tracker;
+    KeyframeSelectorOptions keyframes;
+    MappingOptions mapping;
+    LocalBaOptions local_ba;
+    LoopOptions loop;
+    PoseGraphOptions pose_graph;
+    unsigned long long seed = 12345;  ///< base RANSAC seed (per frame: seed + frame index)
+
+    /// Sections [orb] [tracker] [keyframes] [mapping] [local_ba] [loop_closure]
+    /// [pose_graph] (all optional; unknown keys throw naming section and key).
+    [[nodiscard]] static SlamOptions fromConfig(const mrpt::config::CConfigFileBase& cfg);
+    void saveToConfig(mrpt::config::CConfigFileBase& cfg) const;
+};
+
+struct MappingResult {
+    bool keyframe_inserted = false;
+    KeyframeReason reason = KeyframeReason::None;
+    KeyframeId keyframe = kNoId;
+    int new_landmarks = 0;
+    int culled_landmarks = 0;
+    LocalBaResult ba;
+};
+
+struct BackendResult {
+    bool loop_closed = false;
+    std::optional<LoopConstraint> loop;
+    PoseGraphResult graph;  ///< filled when a loop was closed
+};
+
+/// Everything about one processed frame.
+struct FrameResult {
+    std::size_t index = 0;
+    double timestamp = 0.0;
+    TrackResult track;
+    MappingResult mapping;
+    BackendResult backend;
+    int n_features = 0;
+    int n_masked = 0;
+};
+
+class Slam {
+  public:
+    explicit Slam(const SlamOptions& opts);
+
+    [[nodiscard]] FrameFeatures extract(const core::Frame& frame, const cv::Mat& mask) const;
+    /// Tracks (or, first, initializes on) the frame; records its trajectory entry.
+    [[nodiscard]] TrackResult track(const core::Frame& frame, const FrameFeatures& features,
+                                    const std::optional<Eigen::Isometry3d>& T_prev_cur_prior = {});
+    /// Keyframe decision and local mapping for the frame just tracked.
+    [[nodiscard]] MappingResult mapStep(const core::Frame& frame, FrameFeatures features,
+                                        const TrackResult& track);
+    /// Loop detection and pose-graph optimisation after a keyframe insertion.
+    [[nodiscard]] BackendResult backendStep(const MappingResult& mapping,
+                                            const core::CameraIntrinsics& K);
+    /// All stages for one frame.
+    [[nodiscard]] FrameResult process(
+        const core::Frame& frame, const cv::Mat& mask,
+        const std::optional<Eigen::Isometry3d>& T_prev_cur_prior = {});
+
+    /// Prediction for the dynamic filter (see Tracker::predictPrevCur).
+    [[nodiscard]] std::optional<Eigen::Isometry3d> predictPrevCur(double timestamp) const {
+        return tracker_.predictPrevCur(timestamp);
+    }
+    /// Pose of every frame so far (relative to its reference keyframe, so later keyframe
+    /// corrections carry over). Lost frames hold their motion-model prediction.
+    [[nodiscard]] core::Trajectory trajectory() const;
+    /// Indices (0-based, in processing order) of frames without a tracked pose.
+    [[nodiscard]] std::vector<std::size_t> lostFrames() const;
+    [[nodiscard]] core::Trajectory keyframeTrajectory() const;
+    [[nodiscard]] const Map& map() const { return map_; }
+    [[nodiscard]] int loopsClosed() const { return static_cast<int>(loop_edges_.size()); }
+    [[nodiscard]] const SlamOptions& options() const { return opts_; }
+
+  private:
+    struct FrameRecord {
+        double t = 0.0;
+        KeyframeId ref_kf = kNoId;  ///< kNoId: pose is absolute (before the first keyframe)
+        Eigen::Isometry3d T_ref_c = Eigen::Isometry3d::Identity();
+        bool valid = false;
+    };
+    void applyCorrections(const std::map<std::int64_t, Eigen::Isometry3d>& new_poses);
+
+    SlamOptions opts_;
+    OrbExtractor orb_;
+    Tracker tracker_;
+    Map map_;
+    std::vector<FrameRecord> records_;
+    std::vector<PoseGraphEdge> loop_edges_;
+    int frames_since_kf_ = 0;
+    int tracked_at_last_kf_ = 0;
+    bool pending_init_ = false;
+};
+
+}  // namespace devslam::slam

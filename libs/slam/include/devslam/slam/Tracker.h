@@ -1,0 +1,109 @@
+#pragma once
+/// Frame-to-map tracking: constant-velocity prediction, projection matching against the
+/// local map, cv::solvePnPRansac, motion-only refinement, a second finer projection pass,
+/// and relocalization against keyframes when tracking is lost.
+///
+/// States:  NotInitialized --(first keyframe)--> Ok <--> Lost
+///          (Ok after Lost is reported once as Relocalized)
+///
+/// Usage:
+///   Tracker tracker(opts);
+///   tracker.initialize(T_wc0, t0);                       // after the first keyframe
+///   auto r = tracker.track({&features, t, prior}, map, K, seed);
+/// Not thread-safe.
+#include <devslam/core/Camera.h>
+#include <devslam/slam/Map.h>
+#include <devslam/slam/Matching.h>
+#include <devslam/slam/PoseSolver.h>
+
+#include <optional>
+#include <string>
+
+namespace mrpt::config {
+class CConfigFileBase;
+}
+
+namespace devslam::slam {
+
+enum class TrackingState { NotInitialized, Ok, Relocalized, Lost };
+[[nodiscard]] std::string toString(TrackingState s);
+
+struct TrackerOptions {
+    ProjectionMatchOptions projection;  ///< first pass (radius around the prediction)
+    double fine_radius = 4.0;           ///< [px] second pass around the refined pose
+    double wide_radius_factor = 3.0;    ///< first pass retried with radius * this when too few
+    PnpRansacOptions pnp;
+    PoseRefineOptions refine;
+    int min_matches = 20;         ///< fewer projection matches: wide search, then relocalize
+    int min_inliers = 20;         ///< fewer inliers after refinement: tracking failed
+    int local_keyframes = 10;     ///< the local map = landmarks of the last N keyframes
+    double max_motion_dt = 0.25;  ///< [s] larger frame gaps: no velocity extrapolation
+    int reloc_keyframes = 10;     ///< keyframes tried when relocalizing (newest, nearest)
+    int reloc_min_inliers = 25;   ///< PnP inliers needed to relocalize
+    int reloc_max_hamming = 64;   ///< brute-force matching threshold
+    double reloc_ratio = 0.8;     ///< brute-force ratio test
+
+    void loadFromConfig(const mrpt::config::CConfigFileBase& cfg,
+                        const std::string& section = "tracker");
+    void saveToConfig(mrpt::config::CConfigFileBase& cfg,
+                      const std::string& section = "tracker") const;
+};
+
+struct TrackInput {
+    const FrameFeatures* features = nullptr;
+    double timestamp = 0.0;  ///< [s]
+    /// Pose of this camera in the previous one (p_prev = T * p_cur) from elsewhere (e.g. the
+    /// dynamic filter's refined ego-motion); replaces the velocity model when set.
+    std::optional<Eigen::Isometry3d> T_prev_cur_prior;
+};
+
+struct TrackResult {
+    TrackingState state = TrackingState::NotInitialized;
+    Eigen::Isometry3d T_wc = Eigen::Isometry3d::Identity();  ///< estimate, or prediction if Lost
+    bool pose_valid = false;                 ///< false: T_wc is only the motion-model prediction
+    int n_matches = 0;                       ///< correspondences given to the refinement
+    int n_inliers = 0;                       ///< inliers after refinement
+    int n_in_view = 0;                       ///< local-map landmarks projecting into the image
+    double rms_px = 0.0;                     ///< inlier reprojection RMS [px]
+    std::vector<LandmarkId> landmark_of_kp;  ///< per keypoint: inlier landmark or kNoId
+    std::string reason;                      ///< why tracking failed (empty when Ok)
+};
+
+class Tracker {
+  public:
+    explicit Tracker(const TrackerOptions& opts) : opts_(opts) {}
+
+    /// Starts tracking at a pose (the first keyframe's).
+    void initialize(const Eigen::Isometry3d& T_wc, double timestamp);
+    /// Tracks one frame against `map`; updates the landmarks' visible/found counters.
+    /// `seed` makes RANSAC deterministic.
+    [[nodiscard]] TrackResult track(const TrackInput& in, Map& map, const core::CameraIntrinsics& K,
+                                    unsigned long long seed);
+    /// Constant-velocity prediction of the next camera in the last one (p_prev = T * p_cur)
+    /// for a frame at `timestamp`; nullopt when unknown (not initialized, lost, big gap).
+    [[nodiscard]] std::optional<Eigen::Isometry3d> predictPrevCur(double timestamp) const;
+    /// Moves the tracker's last pose by a world correction (after loop closure).
+    void applyCorrection(const Eigen::Isometry3d& T_new_old);
+    [[nodiscard]] TrackingState state() const { return state_; }
+    [[nodiscard]] const Eigen::Isometry3d& lastPose() const { return last_T_wc_; }
+
+  private:
+    std::optional<PoseRefineResult> trackWithMap(const FrameFeatures& f, Map& map,
+                                                 const core::CameraIntrinsics& K,
+                                                 const Eigen::Isometry3d& pred,
+                                                 const std::vector<LandmarkId>& local,
+                                                 unsigned long long seed, TrackResult& res) const;
+    std::optional<Eigen::Isometry3d> relocalize(const FrameFeatures& f, const Map& map,
+                                                const core::CameraIntrinsics& K,
+                                                unsigned long long seed) const;
+
+    TrackerOptions opts_;
+    TrackingState state_ = TrackingState::NotInitialized;
+    Eigen::Isometry3d last_T_wc_ = Eigen::Isometry3d::Identity();
+    Eigen::Isometry3d velocity_ = Eigen::Isometry3d::Identity();  ///< T_prev_cur of the last step
+    bool has_velocity_ = false;
+    double last_t_ = 0.0;
+    double velocity_dt_ = 0.0;
+};
+
+}  // namespace devslam::slam

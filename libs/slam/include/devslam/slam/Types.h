@@ -1,0 +1,51 @@
+#pragma once
+/// Plain data shared by the SLAM stages: ids, extracted frame features, keyframes and
+/// landmarks. Poses are T_wc (camera optical frame -> world, p_w = T_wc * p_c); the world
+/// frame is the optical frame of the first keyframe (x right, y down, z forward).
+#include <Eigen/Geometry>
+#include <opencv2/core/mat.hpp>
+#include <opencv2/core/types.hpp>
+
+#include <cstdint>
+#include <vector>
+
+namespace devslam::slam {
+
+using KeyframeId = std::int64_t;  ///< strong-ish id, never reused; -1 = none
+using LandmarkId = std::int64_t;  ///< never reused; -1 = none
+constexpr std::int64_t kNoId = -1;
+
+/// ORB features of one frame with their depth (see OrbExtractor).
+struct FrameFeatures {
+    std::vector<cv::KeyPoint> keypoints;    ///< [px], octave = pyramid level
+    cv::Mat descriptors;                    ///< CV_8U, one 32-byte row per keypoint
+    std::vector<float> depth;               ///< [m] per keypoint, 0 = none (missing/out of range)
+    std::vector<Eigen::Vector3d> points_c;  ///< back-projected point [m] (valid iff depth > 0)
+    std::vector<cv::Vec3b> colors;          ///< BGR at the keypoint
+    int n_masked = 0;  ///< keypoints dropped because they fell in the dynamic mask
+    [[nodiscard]] std::size_t size() const { return keypoints.size(); }
+};
+
+/// A keyframe: a frame kept in the map, with the landmark each keypoint observes.
+struct Keyframe {
+    KeyframeId id = kNoId;
+    std::size_t frame_index = 0;  ///< index of the source frame
+    double timestamp = 0.0;       ///< [s]
+    Eigen::Isometry3d T_wc = Eigen::Isometry3d::Identity();
+    FrameFeatures features;
+    std::vector<LandmarkId> landmark_of_kp;  ///< per keypoint, kNoId = none
+};
+
+/// A 3D point of the map.
+struct Landmark {
+    LandmarkId id = kNoId;
+    Eigen::Vector3d p_w = Eigen::Vector3d::Zero();  ///< [m] world
+    cv::Mat descriptor;                             ///< 1x32 CV_8U (of the reference observation)
+    cv::Vec3b color{0, 0, 0};                       ///< BGR
+    KeyframeId ref_kf = kNoId;                      ///< keyframe that created it
+    int n_visible = 0;                              ///< times it projected inside a tracked frame
+    int n_found = 0;  ///< times it was matched (inlier) in a tracked frame
+    std::vector<std::pair<KeyframeId, int>> observations;  ///< (keyframe, keypoint index)
+};
+
+}  // namespace devslam::slam

@@ -1,0 +1,94 @@
+#include <devslam/core/Config.h>
+#include <devslam/slam/LoopDetector.h>
+#include <devslam/slam/Matching.h>
+
+#include <mrpt/config/CConfigFileBase.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace devslam::slam {
+
+void LoopOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, const std::string& s) {
+    core::requireKnownKeys(c, s,
+                           {"enabled", "min_keyframe_gap", "max_distance", "max_candidates",
+                            "max_hamming", "ratio", "min_inliers", "sigma_t", "sigma_r_deg"});
+    enabled = c.read_bool(s, "enabled", enabled);
+    min_keyframe_gap = c.read_int(s, "min_keyframe_gap", min_keyframe_gap);
+    max_distance = c.read_double(s, "max_distance", max_distance);
+    max_candidates = c.read_int(s, "max_candidates", max_candidates);
+    max_hamming = c.read_int(s, "max_hamming", max_hamming);
+    ratio = c.read_double(s, "ratio", ratio);
+    min_inliers = c.read_int(s, "min_inliers", min_inliers);
+    sigma_t = c.read_double(s, "sigma_t", sigma_t);
+    sigma_r_deg = c.read_double(s, "sigma_r_deg", sigma_r_deg);
+    core::requireValue(min_keyframe_gap >= 1, s, "min_keyframe_gap", "must be >= 1");
+    core::requireValue(max_distance > 0, s, "max_distance", "must be > 0");
+    core::requireValue(min_inliers >= 6, s, "min_inliers", "must be >= 6");
+    core::requireValue(sigma_t > 0 && sigma_r_deg > 0, s, "sigma_t/sigma_r_deg", "must be > 0");
+}
+
+void LoopOptions::saveToConfig(mrpt::config::CConfigFileBase& c, const std::string& s) const {
+    c.write(s, "enabled", enabled);
+    c.write(s, "min_keyframe_gap", min_keyframe_gap);
+    c.write(s, "max_distance", max_distance);
+    c.write(s, "max_candidates", max_candidates);
+    c.write(s, "max_hamming", max_hamming);
+    c.write(s, "ratio", ratio);
+    c.write(s, "min_inliers", min_inliers);
+    c.write(s, "sigma_t", sigma_t);
+    c.write(s, "sigma_r_deg", sigma_r_deg);
+}
+
+std::optional<LoopConstraint> detectLoop(const Map& map, KeyframeId current,
+                                         const core::CameraIntrinsics& K, const LoopOptions& opts,
+                                         const PoseRefineOptions& refine, unsigned long long seed) {
+    if (!opts.enabled) return std::nullopt;
+    const Keyframe& cur = map.keyframe(current);
+    std::vector<std::pair<double, KeyframeId>> cands;
+    for (const auto& [id, kf] : map.keyframes()) {
+        if (id > current - opts.min_keyframe_gap) break;  // std::map: ascending ids
+        const double d = (kf.T_wc.translation() - cur.T_wc.translation()).norm();
+        if (d <= opts.max_distance) cands.emplace_back(d, id);
+    }
+    std::sort(cands.begin(), cands.end());
+    if (static_cast<int>(cands.size()) > opts.max_candidates) cands.resize(opts.max_candidates);
+    std::optional<LoopConstraint> best;
+    for (const auto& [d, id] : cands) {
+        const Keyframe& old = map.keyframe(id);
+        std::vector<int> rows;
+        for (int i = 0; i < static_cast<int>(old.landmark_of_kp.size()); ++i)
+            if (old.landmark_of_kp[i] != kNoId) rows.push_back(i);
+        if (static_cast<int>(rows.size()) < opts.min_inliers) continue;
+        cv::Mat train(static_cast<int>(rows.size()), 32, CV_8U);
+        for (std::size_t r = 0; r < rows.size(); ++r)
+            old.features.descriptors.row(rows[r]).copyTo(train.row(static_cast<int>(r)));
+        const auto pairs =
+            matchBruteForce(cur.features.descriptors, train, opts.max_hamming, opts.ratio);
+        if (static_cast<int>(pairs.size()) < opts.min_inliers) continue;
+        // Points in the OLD camera frame: the verified pose is relative, free of drift.
+        const Eigen::Isometry3d T_cw_old = old.T_wc.inverse();
+        std::vector<PoseObservation> obs;
+        for (const auto& [q, t] : pairs) {
+            const auto& kp = cur.features.keypoints[q];
+            const double s = std::pow(1.2, kp.octave);
+            obs.push_back({T_cw_old * map.landmark(old.landmark_of_kp[rows[t]])->p_w,
+                           {kp.pt.x, kp.pt.y},
+                           cur.features.depth[q],
+                           1.0 / (s * s)});
+        }
+        PnpRansacOptions pnp;
+        pnp.iterations = 300;
+        pnp.min_inliers = opts.min_inliers;
+        pnp.seed = seed;
+        const auto sol = solvePnpRansac(obs, K, pnp);
+        if (!sol) continue;
+        const auto ref = refinePose(obs, sol->T_wc, K, refine);
+        if (ref.n_inliers < opts.min_inliers) continue;
+        if (!best || ref.n_inliers > best->n_inliers)
+            best = LoopConstraint{id, current, ref.T_wc, ref.n_inliers};
+    }
+    return best;
+}
+
+}  // namespace devslam::slam

@@ -1,0 +1,147 @@
+#include <devslam/core/Config.h>
+#include <devslam/slam/OrbExtractor.h>
+
+#include <mrpt/config/CConfigFileBase.h>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <numeric>
+#include <stdexcept>
+
+namespace devslam::slam {
+
+void OrbExtractor::Options::loadFromConfig(const mrpt::config::CConfigFileBase& c,
+                                           const std::string& s) {
+    core::requireKnownKeys(
+        c, s,
+        {"n_features", "scale_factor", "n_levels", "fast_threshold", "min_fast_threshold",
+         "oversample", "grid_cols", "grid_rows", "min_depth", "max_depth"});
+    n_features = c.read_int(s, "n_features", n_features);
+    scale_factor = c.read_double(s, "scale_factor", scale_factor);
+    n_levels = c.read_int(s, "n_levels", n_levels);
+    fast_threshold = c.read_int(s, "fast_threshold", fast_threshold);
+    min_fast_threshold = c.read_int(s, "min_fast_threshold", min_fast_threshold);
+    oversample = c.read_double(s, "oversample", oversample);
+    grid_cols = c.read_int(s, "grid_cols", grid_cols);
+    grid_rows = c.read_int(s, "grid_rows", grid_rows);
+    min_depth = c.read_double(s, "min_depth", min_depth);
+    max_depth = c.read_double(s, "max_depth", max_depth);
+    core::requireValue(n_features > 0, s, "n_features", "must be > 0");
+    core::requireValue(scale_factor > 1.0, s, "scale_factor", "must be > 1");
+    core::requireValue(n_levels >= 1, s, "n_levels", "must be >= 1");
+    core::requireValue(oversample >= 1.0, s, "oversample", "must be >= 1");
+    core::requireValue(grid_cols >= 1 && grid_rows >= 1, s, "grid_cols/grid_rows", "must be >= 1");
+    core::requireValue(max_depth > min_depth && min_depth >= 0, s, "min_depth/max_depth",
+                       "need 0 <= min_depth < max_depth");
+}
+
+void OrbExtractor::Options::saveToConfig(mrpt::config::CConfigFileBase& c,
+                                         const std::string& s) const {
+    c.write(s, "n_features", n_features);
+    c.write(s, "scale_factor", scale_factor);
+    c.write(s, "n_levels", n_levels);
+    c.write(s, "fast_threshold", fast_threshold);
+    c.write(s, "min_fast_threshold", min_fast_threshold);
+    c.write(s, "oversample", oversample);
+    c.write(s, "grid_cols", grid_cols);
+    c.write(s, "grid_rows", grid_rows);
+    c.write(s, "min_depth", min_depth);
+    c.write(s, "max_depth", max_depth);
+}
+
+OrbExtractor::OrbExtractor(const Options& opts) : opts_(opts) {
+    const int n = static_cast<int>(opts_.n_features * opts_.oversample);
+    orb_ = cv::ORB::create(n, static_cast<float>(opts_.scale_factor), opts_.n_levels, 19, 0, 2,
+                           cv::ORB::HARRIS_SCORE, 31, opts_.fast_threshold);
+    orb_low_ = cv::ORB::create(n, static_cast<float>(opts_.scale_factor), opts_.n_levels, 19, 0, 2,
+                               cv::ORB::HARRIS_SCORE, 31, opts_.min_fast_threshold);
+}
+
+std::vector<int> spreadOverGrid(const std::vector<cv::KeyPoint>& kps, cv::Size image, int cols,
+                                int rows, int n) {
+    std::vector<int> order(kps.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::stable_sort(order.begin(), order.end(),
+                     [&](int a, int b) { return kps[a].response > kps[b].response; });
+    if (static_cast<int>(kps.size()) <= n) {
+        std::sort(order.begin(), order.end());
+        return order;
+    }
+    const int per_cell = std::max(1, n / (cols * rows));
+    std::vector<int> count(static_cast<std::size_t>(cols * rows), 0);
+    std::vector<char> taken(kps.size(), 0);
+    std::vector<int> out;
+    out.reserve(n);
+    for (int i : order) {
+        const int cx = std::clamp(static_cast<int>(kps[i].pt.x * cols / image.width), 0, cols - 1);
+        const int cy = std::clamp(static_cast<int>(kps[i].pt.y * rows / image.height), 0, rows - 1);
+        int& c = count[cy * cols + cx];
+        if (c < per_cell && static_cast<int>(out.size()) < n) {
+            ++c;
+            taken[i] = 1;
+            out.push_back(i);
+        }
+    }
+    for (int i : order) {
+        if (static_cast<int>(out.size()) >= n) break;
+        if (!taken[i]) out.push_back(i);
+    }
+    std::sort(out.begin(), out.end());
+    return out;
+}
+
+FrameFeatures OrbExtractor::extract(const core::Frame& frame, const cv::Mat& mask) const {
+    if (!mask.empty() && (mask.type() != CV_8UC1 || mask.size() != frame.bgr.size()))
+        throw std::invalid_argument("orb extractor: mask must be CV_8UC1 of the frame size");
+    FrameFeatures f;
+    if (frame.bgr.empty()) return f;
+    cv::Mat gray;
+    cv::cvtColor(frame.bgr, gray, cv::COLOR_BGR2GRAY);
+    std::vector<cv::KeyPoint> kps;
+    cv::Mat desc;
+    orb_->detectAndCompute(gray, cv::noArray(), kps, desc);
+    if (static_cast<int>(kps.size()) < opts_.n_features / 2) {
+        kps.clear();
+        orb_low_->detectAndCompute(gray, cv::noArray(), kps, desc);
+    }
+    // Drop keypoints in the dynamic mask (after detection, so the count is reported).
+    std::vector<int> keep_idx;
+    keep_idx.reserve(kps.size());
+    std::vector<cv::KeyPoint> unmasked;
+    unmasked.reserve(kps.size());
+    for (int i = 0; i < static_cast<int>(kps.size()); ++i) {
+        const int u = std::clamp(static_cast<int>(kps[i].pt.x + 0.5f), 0, gray.cols - 1);
+        const int v = std::clamp(static_cast<int>(kps[i].pt.y + 0.5f), 0, gray.rows - 1);
+        if (!mask.empty() && mask.at<uchar>(v, u) != 0) {
+            ++f.n_masked;
+            continue;
+        }
+        keep_idx.push_back(i);
+        unmasked.push_back(kps[i]);
+    }
+    const auto sel =
+        spreadOverGrid(unmasked, gray.size(), opts_.grid_cols, opts_.grid_rows, opts_.n_features);
+    f.keypoints.reserve(sel.size());
+    f.descriptors.create(static_cast<int>(sel.size()), 32, CV_8U);
+    f.depth.reserve(sel.size());
+    f.points_c.reserve(sel.size());
+    f.colors.reserve(sel.size());
+    const bool has_depth = !frame.depth.empty() && frame.depth.size() == frame.bgr.size();
+    for (std::size_t r = 0; r < sel.size(); ++r) {
+        const int i = keep_idx[sel[r]];
+        const cv::KeyPoint& kp = kps[i];
+        f.keypoints.push_back(kp);
+        desc.row(i).copyTo(f.descriptors.row(static_cast<int>(r)));
+        const int u = std::clamp(static_cast<int>(kp.pt.x + 0.5f), 0, gray.cols - 1);
+        const int v = std::clamp(static_cast<int>(kp.pt.y + 0.5f), 0, gray.rows - 1);
+        float z = has_depth ? frame.depth.at<float>(v, u) : 0.f;
+        if (!(z >= opts_.min_depth && z <= opts_.max_depth)) z = 0.f;  // also rejects NaN
+        f.depth.push_back(z);
+        f.points_c.push_back(z > 0 ? core::backproject(kp.pt.x, kp.pt.y, z, frame.K)
+                                   : Eigen::Vector3d::Zero());
+        f.colors.push_back(frame.bgr.at<cv::Vec3b>(v, u));
+    }
+    return f;
+}
+
+}  // namespace devslam::slam

@@ -1,0 +1,266 @@
+#include <devslam/core/Config.h>
+#include <devslam/core/Pose.h>
+#include <devslam/slam/Slam.h>
+
+#include <mrpt/config/CConfigFileBase.h>
+
+#include <cmath>
+
+namespace devslam::slam {
+
+void MappingOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, const std::string& s) {
+    core::requireKnownKeys(c, s,
+                           {"min_init_points", "cull_min_found_ratio", "cull_min_visible",
+                            "cull_keyframe_age", "odometry_sigma_t", "odometry_sigma_r_deg"});
+    min_init_points = c.read_int(s, "min_init_points", min_init_points);
+    cull_min_found_ratio = c.read_double(s, "cull_min_found_ratio", cull_min_found_ratio);
+    cull_min_visible = c.read_int(s, "cull_min_visible", cull_min_visible);
+    cull_keyframe_age = c.read_int(s, "cull_keyframe_age", cull_keyframe_age);
+    odometry_sigma_t = c.read_double(s, "odometry_sigma_t", odometry_sigma_t);
+    odometry_sigma_r_deg = c.read_double(s, "odometry_sigma_r_deg", odometry_sigma_r_deg);
+    core::requireValue(min_init_points >= 10, s, "min_init_points", "must be >= 10");
+    core::requireValue(cull_min_found_ratio >= 0 && cull_min_found_ratio < 1, s,
+                       "cull_min_found_ratio", "must be in [0, 1)");
+    core::requireValue(odometry_sigma_t > 0 && odometry_sigma_r_deg > 0, s,
+                       "odometry_sigma_t/odometry_sigma_r_deg", "must be > 0");
+}
+
+void MappingOptions::saveToConfig(mrpt::config::CConfigFileBase& c, const std::string& s) const {
+    c.write(s, "min_init_points", min_init_points);
+    c.write(s, "cull_min_found_ratio", cull_min_found_ratio);
+    c.write(s, "cull_min_visible", cull_min_visible);
+    c.write(s, "cull_keyframe_age", cull_keyframe_age);
+    c.write(s, "odometry_sigma_t", odometry_sigma_t);
+    c.write(s, "odometry_sigma_r_deg", odometry_sigma_r_deg);
+}
+
+SlamOptions SlamOptions::fromConfig(const mrpt::config::CConfigFileBase& cfg) {
+    SlamOptions o;
+    o.orb.loadFromConfig(cfg, "orb");
+    o.tracker.loadFromConfig(cfg, "tracker");
+    o.keyframes.loadFromConfig(cfg, "keyframes");
+    o.mapping.loadFromConfig(cfg, "mapping");
+    o.local_ba.loadFromConfig(cfg, "local_ba");
+    o.loop.loadFromConfig(cfg, "loop_closure");
+    core::requireKnownKeys(cfg, "pose_graph", {"max_iterations", "seed"});
+    o.pose_graph.max_iterations = cfg.read_int("pose_graph", "max_iterations", 100);
+    o.seed = static_cast<unsigned long long>(cfg.read_uint64_t("pose_graph", "seed", o.seed));
+    core::requireValue(o.pose_graph.max_iterations > 0, "pose_graph", "max_iterations",
+                       "must be > 0");
+    // The level sigmas of tracking and BA follow the ORB pyramid.
+    o.local_ba.scale_factor = o.orb.scale_factor;
+    return o;
+}
+
+void SlamOptions::saveToConfig(mrpt::config::CConfigFileBase& cfg) const {
+    orb.saveToConfig(cfg, "orb");
+    tracker.saveToConfig(cfg, "tracker");
+    keyframes.saveToConfig(cfg, "keyframes");
+    mapping.saveToConfig(cfg, "mapping");
+    local_ba.saveToConfig(cfg, "local_ba");
+    loop.saveToConfig(cfg, "loop_closure");
+    cfg.write("pose_graph", "max_iterations", pose_graph.max_iterations);
+    cfg.write("pose_graph", "seed", static_cast<uint64_t>(seed));
+}
+
+Slam::Slam(const SlamOptions& opts) : opts_(opts), orb_(opts.orb), tracker_(opts.tracker) {}
+
+FrameFeatures Slam::extract(const core::Frame& frame, const cv::Mat& mask) const {
+    return orb_.extract(frame, mask);
+}
+
+TrackResult Slam::track(const core::Frame& frame, const FrameFeatures& features,
+                        const std::optional<Eigen::Isometry3d>& prior) {
+    TrackResult res;
+    FrameRecord rec;
+    rec.t = frame.timestamp;
+    if (tracker_.state() == TrackingState::NotInitialized) {
+        int n_depth = 0;
+        for (float z : features.depth) n_depth += z > 0 ? 1 : 0;
+        res.landmark_of_kp.assign(features.size(), kNoId);
+        if (n_depth >= opts_.mapping.min_init_points) {
+            // The first keyframe defines the world frame.
+            res.state = TrackingState::Ok;
+            res.pose_valid = true;
+            res.T_wc = Eigen::Isometry3d::Identity();
+            pending_init_ = true;
+            tracker_.initialize(res.T_wc, frame.timestamp);
+            rec.valid = true;
+        } else {
+            res.state = TrackingState::NotInitialized;
+            res.reason = "not initialized: " + std::to_string(n_depth) + " keypoints with depth";
+        }
+        records_.push_back(rec);
+        return res;
+    }
+    const TrackInput in{&features, frame.timestamp, prior};
+    res = tracker_.track(in, map_, frame.K, opts_.seed + frame.index);
+    rec.valid = res.pose_valid;
+    const auto last = map_.lastKeyframes(1);
+    if (!last.empty()) {
+        rec.ref_kf = last.front();
+        rec.T_ref_c = map_.keyframe(rec.ref_kf).T_wc.inverse() * res.T_wc;
+    } else {
+        rec.T_ref_c = res.T_wc;
+    }
+    records_.push_back(rec);
+    return res;
+}
+
+MappingResult Slam::mapStep(const core::Frame& frame, FrameFeatures features,
+                            const TrackResult& track) {
+    MappingResult out;
+    if (!track.pose_valid) return out;
+    ++frames_since_kf_;
+    int n_close_tracked = 0, n_close_untracked = 0;
+    for (std::size_t i = 0; i < features.size(); ++i) {
+        if (features.depth[i] <= 0) continue;
+        if (track.landmark_of_kp[i] != kNoId)
+            ++n_close_tracked;
+        else
+            ++n_close_untracked;
+    }
+    if (!pending_init_) {
+        KeyframeSelectorInput in;
+        in.frames_since_last_kf = frames_since_kf_;
+        in.n_tracked = track.n_inliers;
+        in.n_tracked_at_last_kf = tracked_at_last_kf_;
+        in.n_close_tracked = n_close_tracked;
+        in.n_close_untracked = n_close_untracked;
+        const auto& last = map_.keyframe(map_.lastKeyframes(1).front());
+        const Eigen::Isometry3d d = last.T_wc.inverse() * track.T_wc;
+        in.translation = d.translation().norm();
+        in.rotation_deg = Eigen::AngleAxisd(d.linear()).angle() * 180.0 / M_PI;
+        const auto dec = decideKeyframe(in, opts_.keyframes);
+        out.reason = dec.reason;
+        if (!dec.insert) return out;
+    }
+    pending_init_ = false;
+    Keyframe kf;
+    kf.frame_index = frame.index;
+    kf.timestamp = frame.timestamp;
+    kf.T_wc = track.T_wc;
+    kf.features = std::move(features);
+    const KeyframeId id = map_.addKeyframe(std::move(kf));
+    Keyframe& k = map_.keyframe(id);
+    for (std::size_t i = 0; i < k.features.size(); ++i) {
+        const LandmarkId lm = track.landmark_of_kp[i];
+        if (lm != kNoId && map_.landmark(lm)) {
+            map_.addObservation(lm, id, static_cast<int>(i));
+        } else if (k.features.depth[i] > 0) {
+            map_.addLandmark(k.T_wc * k.features.points_c[i],
+                             k.features.descriptors.row(static_cast<int>(i)), k.features.colors[i],
+                             id, static_cast<int>(i));
+            ++out.new_landmarks;
+        }
+    }
+    out.keyframe_inserted = true;
+    out.keyframe = id;
+    frames_since_kf_ = 0;
+    tracked_at_last_kf_ = std::max(track.n_inliers, n_close_tracked + n_close_untracked);
+    if (!records_.empty()) {
+        records_.back().ref_kf = id;
+        records_.back().T_ref_c = Eigen::Isometry3d::Identity();
+    }
+    // Cull landmarks that are rarely found where they should be seen, or that no later
+    // keyframe confirmed.
+    std::vector<LandmarkId> cull;
+    for (const auto& [lid, lm] : map_.landmarks()) {
+        if (lm.n_visible >= opts_.mapping.cull_min_visible &&
+            lm.n_found < opts_.mapping.cull_min_found_ratio * lm.n_visible)
+            cull.push_back(lid);
+        else if (lm.ref_kf == id - opts_.mapping.cull_keyframe_age && lm.observations.size() < 2)
+            cull.push_back(lid);
+    }
+    for (LandmarkId lid : cull) map_.removeLandmark(lid);
+    out.culled_landmarks = static_cast<int>(cull.size());
+    if (opts_.local_ba.enabled) out.ba = localBundleAdjust(map_, id, frame.K, opts_.local_ba);
+    // The tracker continues from the (possibly adjusted) keyframe pose.
+    tracker_.applyCorrection(map_.keyframe(id).T_wc * track.T_wc.inverse());
+    return out;
+}
+
+BackendResult Slam::backendStep(const MappingResult& mapping, const core::CameraIntrinsics& K) {
+    BackendResult out;
+    if (!mapping.keyframe_inserted || !opts_.loop.enabled) return out;
+    out.loop = detectLoop(map_, mapping.keyframe, K, opts_.loop, opts_.tracker.refine,
+                          opts_.seed + static_cast<unsigned long long>(mapping.keyframe));
+    if (!out.loop) return out;
+    PoseGraphEdge e;
+    e.from = out.loop->old_kf;
+    e.to = out.loop->new_kf;
+    e.T_from_to = out.loop->T_old_new;
+    e.information = diagonalInformation(opts_.loop.sigma_t, opts_.loop.sigma_r_deg * M_PI / 180.0);
+    loop_edges_.push_back(e);
+    // Odometry edges from the current estimates (consistent), plus every loop edge.
+    std::map<std::int64_t, Eigen::Isometry3d> poses;
+    for (const auto& [id, kf] : map_.keyframes()) poses[id] = kf.T_wc;
+    std::vector<PoseGraphEdge> edges;
+    const auto odo_info = diagonalInformation(opts_.mapping.odometry_sigma_t,
+                                              opts_.mapping.odometry_sigma_r_deg * M_PI / 180.0);
+    for (auto it = poses.begin(); std::next(it) != poses.end(); ++it) {
+        auto nx = std::next(it);
+        edges.push_back({it->first, nx->first, it->second.inverse() * nx->second, odo_info});
+    }
+    edges.insert(edges.end(), loop_edges_.begin(), loop_edges_.end());
+    out.graph = optimizePoseGraph(poses, edges, poses.begin()->first, opts_.pose_graph);
+    applyCorrections(out.graph.poses);
+    out.loop_closed = true;
+    return out;
+}
+
+void Slam::applyCorrections(const std::map<std::int64_t, Eigen::Isometry3d>& new_poses) {
+    std::map<KeyframeId, Eigen::Isometry3d> delta;
+    for (auto& [id, kf] : map_.keyframes()) {
+        auto it = new_poses.find(id);
+        if (it == new_poses.end()) continue;
+        delta[id] = it->second * kf.T_wc.inverse();
+        kf.T_wc = it->second;
+    }
+    for (auto& [lid, lm] : map_.landmarks()) {
+        auto it = delta.find(lm.ref_kf);
+        if (it != delta.end()) lm.p_w = it->second * lm.p_w;
+    }
+    if (!delta.empty()) tracker_.applyCorrection(delta.rbegin()->second);
+}
+
+FrameResult Slam::process(const core::Frame& frame, const cv::Mat& mask,
+                          const std::optional<Eigen::Isometry3d>& prior) {
+    FrameResult r;
+    r.index = frame.index;
+    r.timestamp = frame.timestamp;
+    FrameFeatures f = extract(frame, mask);
+    r.n_features = static_cast<int>(f.size());
+    r.n_masked = f.n_masked;
+    r.track = track(frame, f, prior);
+    r.mapping = mapStep(frame, std::move(f), r.track);
+    r.backend = backendStep(r.mapping, frame.K);
+    return r;
+}
+
+core::Trajectory Slam::trajectory() const {
+    core::Trajectory out;
+    out.reserve(records_.size());
+    for (const auto& r : records_) {
+        Eigen::Isometry3d T = r.T_ref_c;
+        if (r.ref_kf != kNoId) T = map_.keyframe(r.ref_kf).T_wc * r.T_ref_c;
+        out.push_back({r.t, core::toCPose3D(T)});
+    }
+    return out;
+}
+
+std::vector<std::size_t> Slam::lostFrames() const {
+    std::vector<std::size_t> out;
+    for (std::size_t i = 0; i < records_.size(); ++i)
+        if (!records_[i].valid) out.push_back(i);
+    return out;
+}
+
+core::Trajectory Slam::keyframeTrajectory() const {
+    core::Trajectory out;
+    for (const auto& [id, kf] : map_.keyframes())
+        out.push_back({kf.timestamp, core::toCPose3D(kf.T_wc)});
+    return out;
+}
+
+}  // namespace devslam::slam

@@ -1,0 +1,299 @@
+#include <devslam/core/Config.h>
+#include <devslam/slam/Tracker.h>
+
+#include <mrpt/config/CConfigFileBase.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace devslam::slam {
+
+std::string toString(TrackingState s) {
+    switch (s) {
+        case TrackingState::NotInitialized:
+            return "not_initialized";
+        case TrackingState::Ok:
+            return "ok";
+        case TrackingState::Relocalized:
+            return "relocalized";
+        case TrackingState::Lost:
+            return "lost";
+    }
+    return "?";
+}
+
+void TrackerOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, const std::string& s) {
+    core::requireKnownKeys(c, s, {"search_radius",      "fine_radius",
+                                  "wide_radius_factor", "max_hamming",
+                                  "match_ratio",        "max_depth",
+                                  "pnp_iterations",     "pnp_reprojection_px",
+                                  "pnp_confidence",     "bf",
+                                  "refine_rounds",      "refine_iterations",
+                                  "min_matches",        "min_inliers",
+                                  "local_keyframes",    "max_motion_dt",
+                                  "reloc_keyframes",    "reloc_min_inliers",
+                                  "reloc_max_hamming",  "reloc_ratio"});
+    projection.radius = c.read_double(s, "search_radius", projection.radius);
+    fine_radius = c.read_double(s, "fine_radius", fine_radius);
+    wide_radius_factor = c.read_double(s, "wide_radius_factor", wide_radius_factor);
+    projection.max_hamming = c.read_int(s, "max_hamming", projection.max_hamming);
+    projection.ratio = c.read_double(s, "match_ratio", projection.ratio);
+    projection.max_depth = c.read_double(s, "max_depth", projection.max_depth);
+    pnp.iterations = c.read_int(s, "pnp_iterations", pnp.iterations);
+    pnp.reprojection_px = c.read_double(s, "pnp_reprojection_px", pnp.reprojection_px);
+    pnp.confidence = c.read_double(s, "pnp_confidence", pnp.confidence);
+    refine.bf = c.read_double(s, "bf", refine.bf);
+    refine.rounds = c.read_int(s, "refine_rounds", refine.rounds);
+    refine.iterations = c.read_int(s, "refine_iterations", refine.iterations);
+    min_matches = c.read_int(s, "min_matches", min_matches);
+    min_inliers = c.read_int(s, "min_inliers", min_inliers);
+    local_keyframes = c.read_int(s, "local_keyframes", local_keyframes);
+    max_motion_dt = c.read_double(s, "max_motion_dt", max_motion_dt);
+    reloc_keyframes = c.read_int(s, "reloc_keyframes", reloc_keyframes);
+    reloc_min_inliers = c.read_int(s, "reloc_min_inliers", reloc_min_inliers);
+    reloc_max_hamming = c.read_int(s, "reloc_max_hamming", reloc_max_hamming);
+    reloc_ratio = c.read_double(s, "reloc_ratio", reloc_ratio);
+    core::requireValue(projection.radius > 0 && fine_radius > 0, s, "search_radius/fine_radius",
+                       "must be > 0");
+    core::requireValue(projection.max_hamming > 0 && projection.max_hamming <= 256, s,
+                       "max_hamming", "must be in (0, 256]");
+    core::requireValue(projection.ratio > 0 && projection.ratio <= 1, s, "match_ratio",
+                       "must be in (0, 1]");
+    core::requireValue(pnp.iterations > 0, s, "pnp_iterations", "must be > 0");
+    core::requireValue(pnp.reprojection_px > 0, s, "pnp_reprojection_px", "must be > 0");
+    core::requireValue(refine.bf > 0, s, "bf", "must be > 0");
+    core::requireValue(min_inliers >= 6, s, "min_inliers", "must be >= 6");
+    core::requireValue(local_keyframes >= 1, s, "local_keyframes", "must be >= 1");
+    core::requireValue(reloc_keyframes >= 1, s, "reloc_keyframes", "must be >= 1");
+}
+
+void TrackerOptions::saveToConfig(mrpt::config::CConfigFileBase& c, const std::string& s) const {
+    c.write(s, "search_radius", projection.radius);
+    c.write(s, "fine_radius", fine_radius);
+    c.write(s, "wide_radius_factor", wide_radius_factor);
+    c.write(s, "max_hamming", projection.max_hamming);
+    c.write(s, "match_ratio", projection.ratio);
+    c.write(s, "max_depth", projection.max_depth);
+    c.write(s, "pnp_iterations", pnp.iterations);
+    c.write(s, "pnp_reprojection_px", pnp.reprojection_px);
+    c.write(s, "pnp_confidence", pnp.confidence);
+    c.write(s, "bf", refine.bf);
+    c.write(s, "refine_rounds", refine.rounds);
+    c.write(s, "refine_iterations", refine.iterations);
+    c.write(s, "min_matches", min_matches);
+    c.write(s, "min_inliers", min_inliers);
+    c.write(s, "local_keyframes", local_keyframes);
+    c.write(s, "max_motion_dt", max_motion_dt);
+    c.write(s, "reloc_keyframes", reloc_keyframes);
+    c.write(s, "reloc_min_inliers", reloc_min_inliers);
+    c.write(s, "reloc_max_hamming", reloc_max_hamming);
+    c.write(s, "reloc_ratio", reloc_ratio);
+}
+
+void Tracker::initialize(const Eigen::Isometry3d& T_wc, double timestamp) {
+    state_ = TrackingState::Ok;
+    last_T_wc_ = T_wc;
+    last_t_ = timestamp;
+    has_velocity_ = false;
+    velocity_ = Eigen::Isometry3d::Identity();
+}
+
+std::optional<Eigen::Isometry3d> Tracker::predictPrevCur(double timestamp) const {
+    if (state_ == TrackingState::NotInitialized || state_ == TrackingState::Lost)
+        return std::nullopt;
+    const double dt = timestamp - last_t_;
+    if (!has_velocity_ || dt <= 0 || dt > opts_.max_motion_dt || velocity_dt_ <= 0)
+        return Eigen::Isometry3d::Identity();
+    // Scale the last inter-frame motion to this frame's interval.
+    const double s = dt / velocity_dt_;
+    const Eigen::AngleAxisd aa(velocity_.linear());
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear() = Eigen::AngleAxisd(aa.angle() * s, aa.axis()).toRotationMatrix();
+    T.translation() = velocity_.translation() * s;
+    return T;
+}
+
+void Tracker::applyCorrection(const Eigen::Isometry3d& T_new_old) {
+    last_T_wc_ = T_new_old * last_T_wc_;
+}
+
+namespace {
+std::vector<PoseObservation> observationsOf(const Map& map, const FrameFeatures& f,
+                                            const std::vector<Match>& matches,
+                                            double scale_factor) {
+    std::vector<PoseObservation> obs;
+    obs.reserve(matches.size());
+    for (const auto& m : matches) {
+        const auto& kp = f.keypoints[m.kp];
+        const double s = std::pow(scale_factor, kp.octave);
+        obs.push_back(
+            {map.landmark(m.landmark)->p_w, {kp.pt.x, kp.pt.y}, f.depth[m.kp], 1.0 / (s * s)});
+    }
+    return obs;
+}
+constexpr double kScaleFactor = 1.2;  // pyramid scale for the level sigmas (OrbExtractor default)
+}  // namespace
+
+std::optional<PoseRefineResult> Tracker::trackWithMap(const FrameFeatures& f, Map& map,
+                                                      const core::CameraIntrinsics& K,
+                                                      const Eigen::Isometry3d& pred,
+                                                      const std::vector<LandmarkId>& local,
+                                                      unsigned long long seed,
+                                                      TrackResult& res) const {
+    const KeypointGrid grid(f.keypoints, cv::Size(K.width, K.height));
+    auto matches = matchByProjection(map, local, f, grid, pred, K, opts_.projection);
+    if (static_cast<int>(matches.size()) < opts_.min_matches) {
+        auto wide = opts_.projection;
+        wide.radius *= opts_.wide_radius_factor;
+        matches = matchByProjection(map, local, f, grid, pred, K, wide);
+    }
+    if (static_cast<int>(matches.size()) < opts_.min_matches) {
+        res.reason = "too few projection matches (" + std::to_string(matches.size()) + ")";
+        return std::nullopt;
+    }
+    auto obs = observationsOf(map, f, matches, kScaleFactor);
+    auto pnp_opts = opts_.pnp;
+    pnp_opts.seed = seed;
+    const auto pnp = solvePnpRansac(obs, K, pnp_opts, pred);
+    Eigen::Isometry3d T0 = pred;
+    if (pnp) T0 = pnp->T_wc;
+    auto refined = refinePose(obs, T0, K, opts_.refine);
+    if (refined.n_inliers < opts_.min_inliers) {
+        res.reason = "too few inliers after refinement (" + std::to_string(refined.n_inliers) + ")";
+        return std::nullopt;
+    }
+    // Second pass: every local landmark again around the refined pose, tighter window.
+    auto fine = opts_.projection;
+    fine.radius = opts_.fine_radius;
+    std::vector<LandmarkId> in_view;
+    matches =
+        matchByProjection(map, local, f, grid, refined.T_wc, K, fine, &res.n_in_view, &in_view);
+    obs = observationsOf(map, f, matches, kScaleFactor);
+    auto refined2 = refinePose(obs, refined.T_wc, K, opts_.refine);
+    if (refined2.n_inliers < opts_.min_inliers) {
+        res.reason =
+            "too few inliers in the fine pass (" + std::to_string(refined2.n_inliers) + ")";
+        return std::nullopt;
+    }
+    res.n_matches = static_cast<int>(matches.size());
+    res.landmark_of_kp.assign(f.size(), kNoId);
+    for (LandmarkId id : in_view) ++map.landmark(id)->n_visible;
+    for (std::size_t i = 0; i < matches.size(); ++i) {
+        if (!refined2.inlier[i]) continue;
+        res.landmark_of_kp[matches[i].kp] = matches[i].landmark;
+        ++map.landmark(matches[i].landmark)->n_found;
+    }
+    return refined2;
+}
+
+std::optional<Eigen::Isometry3d> Tracker::relocalize(const FrameFeatures& f, const Map& map,
+                                                     const core::CameraIntrinsics& K,
+                                                     unsigned long long seed) const {
+    // Candidates: the newest keyframes and the ones nearest to the last pose.
+    std::vector<std::pair<double, KeyframeId>> by_dist;
+    for (const auto& [id, kf] : map.keyframes())
+        by_dist.emplace_back((kf.T_wc.translation() - last_T_wc_.translation()).norm(), id);
+    std::sort(by_dist.begin(), by_dist.end());
+    std::vector<KeyframeId> cands = map.lastKeyframes(opts_.reloc_keyframes / 2 + 1);
+    for (const auto& [d, id] : by_dist) {
+        if (static_cast<int>(cands.size()) >= opts_.reloc_keyframes) break;
+        if (std::find(cands.begin(), cands.end(), id) == cands.end()) cands.push_back(id);
+    }
+    std::optional<Eigen::Isometry3d> best;
+    int best_inliers = 0;
+    for (KeyframeId id : cands) {
+        const Keyframe& kf = map.keyframe(id);
+        std::vector<int> rows;
+        for (int i = 0; i < static_cast<int>(kf.landmark_of_kp.size()); ++i)
+            if (kf.landmark_of_kp[i] != kNoId) rows.push_back(i);
+        if (static_cast<int>(rows.size()) < opts_.reloc_min_inliers) continue;
+        cv::Mat train(static_cast<int>(rows.size()), 32, CV_8U);
+        for (std::size_t r = 0; r < rows.size(); ++r)
+            kf.features.descriptors.row(rows[r]).copyTo(train.row(static_cast<int>(r)));
+        const auto pairs =
+            matchBruteForce(f.descriptors, train, opts_.reloc_max_hamming, opts_.reloc_ratio);
+        if (static_cast<int>(pairs.size()) < opts_.reloc_min_inliers) continue;
+        std::vector<PoseObservation> obs;
+        for (const auto& [q, t] : pairs) {
+            const auto& kp = f.keypoints[q];
+            const double s = std::pow(kScaleFactor, kp.octave);
+            obs.push_back({map.landmark(kf.landmark_of_kp[rows[t]])->p_w,
+                           {kp.pt.x, kp.pt.y},
+                           f.depth[q],
+                           1.0 / (s * s)});
+        }
+        auto pnp_opts = opts_.pnp;
+        pnp_opts.seed = seed;
+        pnp_opts.iterations = std::max(pnp_opts.iterations, 300);
+        pnp_opts.min_inliers = opts_.reloc_min_inliers;
+        const auto pnp = solvePnpRansac(obs, K, pnp_opts);
+        if (!pnp) continue;
+        const auto refined = refinePose(obs, pnp->T_wc, K, opts_.refine);
+        if (refined.n_inliers >= opts_.reloc_min_inliers && refined.n_inliers > best_inliers) {
+            best_inliers = refined.n_inliers;
+            best = refined.T_wc;
+        }
+    }
+    return best;
+}
+
+TrackResult Tracker::track(const TrackInput& in, Map& map, const core::CameraIntrinsics& K,
+                           unsigned long long seed) {
+    TrackResult res;
+    const FrameFeatures& f = *in.features;
+    res.landmark_of_kp.assign(f.size(), kNoId);
+    if (state_ == TrackingState::NotInitialized) {
+        res.state = state_;
+        res.reason = "not initialized";
+        return res;
+    }
+    const auto prev_cur = in.T_prev_cur_prior ? in.T_prev_cur_prior : predictPrevCur(in.timestamp);
+    const Eigen::Isometry3d pred = last_T_wc_ * prev_cur.value_or(Eigen::Isometry3d::Identity());
+    res.T_wc = pred;
+    const auto local = map.landmarksOf(map.lastKeyframes(opts_.local_keyframes));
+
+    std::optional<PoseRefineResult> ok;
+    const bool was_lost = state_ == TrackingState::Lost;
+    if (!was_lost && f.size() > 0) ok = trackWithMap(f, map, K, pred, local, seed, res);
+    if (!ok && f.size() > 0) {
+        // Relocalize against keyframes, then track the local map from that pose.
+        TrackResult reloc_res;
+        if (const auto T = relocalize(f, map, K, seed)) {
+            auto near = map.landmarksOf(map.lastKeyframes(opts_.local_keyframes));
+            ok = trackWithMap(f, map, K, *T, near, seed + 1, reloc_res);
+            if (ok) {
+                const std::string why = res.reason;
+                res = reloc_res;
+                res.reason = was_lost ? "" : "relocalized after: " + why;
+            }
+        }
+        if (!ok && res.reason.empty()) res.reason = "relocalization failed";
+    }
+    if (f.size() == 0) res.reason = "no features";
+    if (!ok) {
+        state_ = TrackingState::Lost;
+        has_velocity_ = false;
+        res.state = state_;
+        res.T_wc = pred;
+        res.pose_valid = false;
+        res.landmark_of_kp.assign(f.size(), kNoId);
+        // Keep last_T_wc_: the next frame predicts from the last good pose.
+        return res;
+    }
+    const double dt = in.timestamp - last_t_;
+    velocity_ = last_T_wc_.inverse() * ok->T_wc;
+    velocity_dt_ = dt;
+    has_velocity_ = !was_lost && dt > 0 && dt <= opts_.max_motion_dt;
+    last_T_wc_ = ok->T_wc;
+    last_t_ = in.timestamp;
+    state_ = (was_lost || !res.reason.empty()) ? TrackingState::Relocalized : TrackingState::Ok;
+    res.state = state_;
+    if (state_ == TrackingState::Relocalized) state_ = TrackingState::Ok;
+    res.T_wc = ok->T_wc;
+    res.pose_valid = true;
+    res.n_inliers = ok->n_inliers;
+    res.rms_px = ok->rms_px;
+    return res;
+}
+
+}  // namespace devslam::slam
