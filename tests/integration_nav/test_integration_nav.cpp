@@ -1,0 +1,144 @@
+// Closed-loop navigation: A* + VFH+ through MRPT's reactive navigator, first on MRPT's own
+// kinematic simulator (laser simulated on the grid), then in a small Bullet world; and a
+// smoke test of both apps.
+#include <devslam/core/Config.h>
+#include <devslam/nav/CHolonomicVFHPlus.h>
+#include <devslam/nav/Navigator.h>
+#include <devslam/sim/Episode.h>
+#include <devslam/sim/World.h>
+
+#include <gtest/gtest.h>
+#include <mrpt/core/Clock.h>
+#include <mrpt/kinematics/CVehicleSimul_DiffDriven.h>
+#include <mrpt/maps/CSimplePointsMap.h>
+#include <mrpt/nav/reactive/CRobot2NavInterfaceForSimulator.h>
+#include <mrpt/obs/CObservation2DRangeScan.h>
+#include <mrpt/system/CDirectoryExplorer.h>
+#include <mrpt/system/filesystem.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+
+namespace {
+const std::string kSrc = DEVSLAM_SOURCE_DIR;
+const std::string kIni = kSrc + "/config_ini/nav_reactive.ini";
+
+/// MRPT's kinematic diff-drive simulator + a laser simulated on the occupancy grid.
+class KinematicRobot : public mrpt::nav::CRobot2NavInterfaceForSimulator_DiffDriven {
+  public:
+    KinematicRobot(mrpt::kinematics::CVehicleSimul_DiffDriven& sim,
+                   const mrpt::maps::COccupancyGridMap2D& grid)
+        : CRobot2NavInterfaceForSimulator_DiffDriven(sim), sim_(sim), grid_(grid) {
+        setMinLoggingLevel(mrpt::system::LVL_ERROR);
+    }
+    bool senseObstacles(mrpt::maps::CSimplePointsMap& obstacles,
+                        mrpt::system::TTimeStamp& ts) override {
+        mrpt::obs::CObservation2DRangeScan scan;
+        scan.aperture = 2 * M_PI;
+        scan.maxRange = 6.0;
+        scan.rightToLeft = true;
+        grid_.laserScanSimulator(scan, mrpt::poses::CPose2D(sim_.getCurrentGTPose()), 0.5f, 181,
+                                 0.0f);
+        obstacles.clear();
+        obstacles.insertObservation(scan);
+        ts = mrpt::Clock::now();
+        return true;
+    }
+
+  private:
+    mrpt::kinematics::CVehicleSimul_DiffDriven& sim_;
+    const mrpt::maps::COccupancyGridMap2D& grid_;
+};
+}  // namespace
+
+TEST(IntegrationNav, AStarPlusVfhOnMrptKinematicSimulator) {
+    devslam::nav::registerNavClasses();
+    // 12 x 8 m hall, a wall with a gap between start and goal
+    mrpt::maps::COccupancyGridMap2D grid;
+    grid.setSize(0, 12, 0, 8, 0.05f, 1.0f);
+    auto fill = [&](double x0, double y0, double x1, double y1) {
+        for (double y = y0; y <= y1; y += 0.025)
+            for (double x = x0; x <= x1; x += 0.025) grid.setPos(x, y, 0.0f);
+    };
+    fill(0, 0, 12, 0.1);
+    fill(0, 7.9, 12, 8);
+    fill(0, 0, 0.1, 8);
+    fill(11.9, 0, 12, 8);
+    fill(6.0, 0.1, 6.2, 5.0);  // wall, gap y in [5.0, 7.9]
+    mrpt::kinematics::CVehicleSimul_DiffDriven sim;
+    sim.setCurrentGTPose({1.5, 2.0, 0.0});
+    KinematicRobot robot(sim, grid);
+
+    mrpt::Clock::setSimulatedTime(mrpt::Clock::fromDouble(1.7e9));
+    const auto prev_clock = mrpt::Clock::getActiveClock();
+    mrpt::Clock::setActiveClock(mrpt::Clock::Simulated);
+    const auto ini = devslam::core::loadIni(kIni);
+    auto opts = devslam::nav::NavigatorOptions::fromConfig(*ini, kIni);
+    opts.robot_radius = 0.25;
+    opts.planner.robot_radius = 0.25;
+    devslam::nav::Navigator nav(robot, *ini, opts);
+    ASSERT_TRUE(nav.start(grid, {1.5, 2.0, 0.0}, {10.5, 2.0}, 0.3));
+    EXPECT_GT(nav.globalPath().length, 10.5);  // straight line 9 m: must detour via the gap
+    double min_wall = 1e9;
+    bool reached = false;
+    for (double t = 0; t < 80.0; t += 0.1) {
+        mrpt::Clock::setSimulatedTime(mrpt::Clock::fromDouble(1.7e9 + sim.getTime()));
+        if (nav.step(sim.getTime()) == devslam::nav::NavState::GoalReached) {
+            reached = true;
+            break;
+        }
+        for (int k = 0; k < 10; k++) sim.simulateOneTimeStep(0.01);
+        const auto p = sim.getCurrentGTPose();
+        // distance from robot centre to the wall box [6.0, 6.2] x [0.1, 5.0]
+        const double dx = std::max({6.0 - p.x, 0.0, p.x - 6.2});
+        const double dy = std::max({0.1 - p.y, 0.0, p.y - 5.0});
+        min_wall = std::min(min_wall, std::hypot(dx, dy));
+    }
+    mrpt::Clock::setActiveClock(prev_clock);
+    const auto p = sim.getCurrentGTPose();
+    EXPECT_TRUE(reached) << "final pose " << p.x << ", " << p.y;
+    EXPECT_LT(std::hypot(p.x - 10.5, p.y - 2.0), 0.35);
+    EXPECT_GT(min_wall, 0.25);  // never touched the wall (robot radius 0.25)
+}
+
+TEST(IntegrationNav, AStarPlusVfhInBulletWorld) {
+    devslam::nav::registerNavClasses();
+    const auto world = devslam::sim::loadWorld(kSrc + "/sim_worlds/obstacle_near_goal.ini");
+    const auto ini = devslam::core::loadIni(kIni);
+    const auto opts = devslam::nav::NavigatorOptions::fromConfig(*ini, kIni);
+    const auto r = devslam::sim::runEpisode(world, *ini, opts, {});
+    EXPECT_EQ(r.outcome, devslam::sim::Outcome::Success) << r.reason;
+    EXPECT_EQ(r.static_collisions, 0);
+    EXPECT_GT(r.min_clearance_static, 0.0);
+    EXPECT_LT(r.time, 40.0);
+    EXPECT_GT(r.path_length, 6.5);  // straight-line distance is 7.0 m (minus the tolerance)
+}
+
+TEST(IntegrationNav, AppsSmokeTest) {
+    const std::string bin = DEVSLAM_BIN_DIR;
+    const std::string out = mrpt::system::getTempFileName() + "_navsmoke";
+    ASSERT_TRUE(mrpt::system::createDirectory(out));
+    const std::string png = out + "/fig6.png";
+    const std::string cmd = bin + "/devslam-nav " + kSrc + "/sim_worlds/paper_fig6.ini --png " +
+                            png + " --navlog " + out + "/navlog > " + out + "/nav.txt 2>&1";
+    EXPECT_EQ(std::system(cmd.c_str()), 0) << cmd;
+    EXPECT_TRUE(mrpt::system::fileExists(png));
+    EXPECT_GT(mrpt::system::getFileSize(png), 10000u);
+    std::vector<std::string> logs;
+    mrpt::system::CDirectoryExplorer::TFileInfoList files;
+    mrpt::system::CDirectoryExplorer::explore(out + "/navlog", FILE_ATTRIB_ARCHIVE, files);
+    EXPECT_FALSE(files.empty()) << "no navlog written";
+    // bad world: clear error, exit code 2
+    const std::string bad = bin + "/devslam-nav " + kSrc +
+                            "/tests/sim/data/obstacle_on_goal.ini > " + out + "/bad.txt 2>&1";
+    EXPECT_EQ(WEXITSTATUS(std::system(bad.c_str())), 2);
+    // bench smoke test: one method, one world per category, RESULTS.md untouched
+    const std::string bench =
+        bin + "/devslam-nav-bench --per-category 1 --methods CHolonomicVFHPlus --png-dir " + out +
+        " > " + out + "/bench.md 2> " + out + "/bench.err";
+    EXPECT_EQ(std::system(bench.c_str()), 0) << bench;
+    EXPECT_TRUE(mrpt::system::fileExists(out + "/nav_bench_success.png"));
+    const std::string md = mrpt::system::getFileSize(out + "/bench.md") > 0 ? "ok" : "";
+    EXPECT_EQ(md, "ok");
+}

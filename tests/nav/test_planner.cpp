@@ -1,0 +1,185 @@
+// Grid A* with known answers, endpoint validation, waypoints and replanning triggers.
+#include <devslam/core/Config.h>
+#include <devslam/nav/GridPlanner.h>
+#include <devslam/nav/Navigator.h>
+#include <devslam/nav/Replan.h>
+#include <devslam/nav/VfhPlus.h>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+using namespace devslam::nav;
+using mrpt::math::TPoint2D;
+
+namespace {
+mrpt::maps::COccupancyGridMap2D emptyGrid(double w, double h, double res = 0.1) {
+    mrpt::maps::COccupancyGridMap2D g;
+    g.setSize(0, w, 0, h, static_cast<float>(res), 1.0f);
+    return g;
+}
+void fillRect(mrpt::maps::COccupancyGridMap2D& g, double x0, double y0, double x1, double y1) {
+    for (int y = 0; y < int(g.getSizeY()); y++)
+        for (int x = 0; x < int(g.getSizeX()); x++) {
+            const double cx = g.idx2x(x), cy = g.idx2y(y);
+            if (cx >= x0 && cx <= x1 && cy >= y0 && cy <= y1) g.setCell(x, y, 0.0f);
+        }
+}
+GridPlannerOptions plain() {
+    GridPlannerOptions o;
+    o.robot_radius = 0.05;
+    o.inflation_margin = 0.0;
+    o.clearance_weight = 0.0;
+    return o;
+}
+}  // namespace
+
+TEST(GridPlanner, StraightLineInFreeSpace) {
+    GridPlanner p(plain());
+    p.setMap(emptyGrid(10, 10));
+    const auto path = p.plan({1.05, 5.05}, {8.05, 5.05});
+    ASSERT_TRUE(path);
+    EXPECT_NEAR(path->length, 7.0, 1e-9);
+}
+
+TEST(GridPlanner, OctileDiagonal) {
+    GridPlanner p(plain());
+    p.setMap(emptyGrid(10, 10));
+    const auto path = p.plan({1.05, 1.05}, {4.05, 6.05});  // 3 diagonal + 2 straight metres
+    ASSERT_TRUE(path);
+    EXPECT_NEAR(path->cost, 3.0 * std::sqrt(2.0) + 2.0, 1e-6);
+}
+
+TEST(GridPlanner, WallWithGapKnownLength) {
+    // 10x10 m, wall at x in [4.95, 5.05] except a gap around y = 8; path must go through it
+    auto g = emptyGrid(10, 10);
+    fillRect(g, 4.9, 0.0, 5.1, 7.5);
+    fillRect(g, 4.9, 8.5, 5.1, 10.0);
+    GridPlanner p(plain());
+    p.setMap(g);
+    const TPoint2D s(2.05, 2.05), t(8.05, 2.05);
+    const auto path = p.plan(s, t);
+    ASSERT_TRUE(path);
+    // optimal on the cell graph: (2.05,2.05) -> (4.85,7.55) [lowest free gap row, wall cells
+    // at x = 4.95 and 5.05] -> straight 0.3 m through the gap -> (5.15,7.55) -> (8.05,2.05)
+    const double expected = (2.8 * std::sqrt(2.0) + 2.7) + 0.3 + (2.9 * std::sqrt(2.0) + 2.6);
+    EXPECT_NEAR(path->cost, expected, 1e-6);
+    bool through_gap = false;
+    for (const auto& q : path->points)
+        if (std::abs(q.x - 5.0) < 0.1 && q.y > 7.5 && q.y < 8.5) through_gap = true;
+    EXPECT_TRUE(through_gap);
+}
+
+TEST(GridPlanner, NoPathIsNullopt) {
+    auto g = emptyGrid(10, 10);
+    fillRect(g, 4.9, 0.0, 5.1, 10.0);  // wall across the map
+    GridPlanner p(plain());
+    p.setMap(g);
+    EXPECT_FALSE(p.plan({2, 5}, {8, 5}).has_value());
+}
+
+TEST(GridPlanner, InvalidEndpointsThrowClearErrors) {
+    auto g = emptyGrid(10, 10);
+    fillRect(g, 6.0, 4.0, 7.0, 6.0);
+    GridPlannerOptions o;
+    o.robot_radius = 0.3;
+    GridPlanner p(o);
+    p.setMap(g);
+    try {
+        (void)p.plan({-1, 5}, {2, 2});
+        FAIL();
+    } catch (const PlanningError& e) {
+        EXPECT_EQ(e.status(), EndpointStatus::OutsideMap);
+        EXPECT_NE(std::string(e.what()).find("start"), std::string::npos);
+    }
+    try {
+        (void)p.plan({1, 1}, {6.5, 5.0});
+        FAIL();
+    } catch (const PlanningError& e) {
+        EXPECT_EQ(e.status(), EndpointStatus::InsideObstacle);
+        EXPECT_NE(std::string(e.what()).find("goal"), std::string::npos);
+    }
+    EXPECT_EQ(p.checkEndpoint({5.85, 5.0}), EndpointStatus::TooCloseToObstacle);
+    // a goal 0.35 m from the box (inside the inflation margin, outside the radius) is reachable
+    const auto near = p.plan({1, 1}, {5.65, 5.0});
+    ASSERT_TRUE(near);
+}
+
+TEST(GridPlanner, InflationAndClearanceKeepAwayFromWalls) {
+    auto g = emptyGrid(10, 6, 0.05);
+    fillRect(g, 0, 2.9, 6.0, 3.1);  // a wall just above a straight line
+    GridPlannerOptions o;
+    o.robot_radius = 0.25;
+    GridPlanner p(o);
+    p.setMap(g);
+    const auto path = p.plan({1.0, 2.0}, {9.0, 2.0});
+    ASSERT_TRUE(path);
+    double min_c = 1e9;
+    for (const auto& q : path->points) min_c = std::min(min_c, p.clearance(q));
+    EXPECT_GE(min_c, o.robot_radius + o.inflation_margin - 1e-6);
+}
+
+TEST(GridPlanner, WaypointsWithinSpacingAndClear) {
+    auto g = emptyGrid(20, 10, 0.05);
+    fillRect(g, 9.9, 0.0, 10.1, 6.0);
+    GridPlanner p;
+    p.setMap(g);
+    const auto path = p.plan({2, 2}, {18, 2});
+    ASSERT_TRUE(path);
+    const auto wps = decimateWaypoints(p, *path, 1.5);
+    ASSERT_GE(wps.size(), 2u);
+    EXPECT_LT(wps.size(), path->points.size() / 5);
+    EXPECT_NEAR(wps.back().x, 18.0, 1e-9);
+    TPoint2D prev(2, 2);
+    for (const auto& w : wps) {
+        EXPECT_LE(std::hypot(w.x - prev.x, w.y - prev.y), 1.5 + 1e-9);
+        EXPECT_TRUE(p.segmentClear(prev, w, p.options().robot_radius));
+        prev = w;
+    }
+}
+
+TEST(Replan, TriggersOnBlockedPathAndSustainedDensity) {
+    ReplanOptions o;
+    o.min_interval = 2.0;
+    o.density_time = 3.0;
+    o.density_threshold = 0.6;
+    ReplanTrigger t(o);
+    t.reset(0.0);
+    EXPECT_EQ(t.update({1.0, true, 0.0}), ReplanReason::None);  // too soon after the last replan
+    EXPECT_EQ(t.update({2.5, true, 0.0}), ReplanReason::PathBlocked);
+    EXPECT_EQ(t.update({3.0, false, 0.9}), ReplanReason::None);  // dense since 3.0
+    EXPECT_EQ(t.update({5.0, false, 0.9}), ReplanReason::None);  // only 2 s
+    EXPECT_EQ(t.update({6.1, false, 0.9}), ReplanReason::HighDensity);
+    EXPECT_EQ(t.update({9.0, false, 0.2}), ReplanReason::None);
+}
+
+TEST(Replan, PathBlockedLooksAheadOnly) {
+    const std::vector<TPoint2D> path{{0, 0}, {2, 0}, {4, 0}, {6, 0}};
+    EXPECT_TRUE(pathBlocked(path, {0.5, 0}, {{1.5, 0.1}}, 0.3, 2.0));
+    EXPECT_FALSE(pathBlocked(path, {0.5, 0}, {{1.5, 0.5}}, 0.3, 2.0));  // beside the path
+    EXPECT_FALSE(pathBlocked(path, {0.5, 0}, {{5.5, 0.0}}, 0.3, 2.0));  // beyond lookahead
+    EXPECT_FALSE(pathBlocked(path, {4.5, 0}, {{1.0, 0.0}}, 0.3, 2.0));  // behind the robot
+}
+
+TEST(NavConfig, EveryNavIniLoads) {
+    const std::string path = std::string(DEVSLAM_SOURCE_DIR) + "/config_ini/nav_reactive.ini";
+    const auto cfg = devslam::core::loadIni(path);
+    const auto o = NavigatorOptions::fromConfig(*cfg, path);
+    EXPECT_EQ(o.holonomic_method, "CHolonomicVFHPlus");
+    EXPECT_DOUBLE_EQ(o.nav_period, 0.1);
+    EXPECT_DOUBLE_EQ(o.planner.waypoint_spacing, 1.5);
+    VfhPlusOptions v;
+    v.loadFromConfigFile(*cfg, "CHolonomicVFHPlus", path);
+    EXPECT_GT(v.mu1, v.mu2 + v.mu3);
+}
+
+TEST(NavConfig, UnknownKeyIsReported) {
+    mrpt::config::CConfigFileMemory c;
+    c.write("navigator", "nav_perod", 0.1);
+    try {
+        (void)NavigatorOptions::fromConfig(c, "x.ini");
+        FAIL();
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("nav_perod"), std::string::npos);
+    }
+}

@@ -1,0 +1,213 @@
+// World files, the Bullet simulator (laser, drive limits, contacts, determinism) and the
+// CRobot2NavInterface adapter, with known answers.
+#include <devslam/sim/RandomWorlds.h>
+#include <devslam/sim/SimRobot.h>
+#include <devslam/sim/Simulator.h>
+#include <devslam/sim/World.h>
+
+#include <gtest/gtest.h>
+#include <mrpt/config/CConfigFileMemory.h>
+#include <mrpt/kinematics/CVehicleVelCmd_DiffDriven.h>
+#include <mrpt/maps/CSimplePointsMap.h>
+
+#include <cmath>
+
+using namespace devslam::sim;
+
+namespace {
+const std::string kWorlds = std::string(DEVSLAM_SOURCE_DIR) + "/sim_worlds/";
+
+/// An empty 10 x 6 m room, robot at (2, 3) facing +x, no noise.
+WorldSpec room() {
+    WorldSpec w;
+    w.name = "room";
+    w.x_min = 0;
+    w.x_max = 10;
+    w.y_min = 0;
+    w.y_max = 6;
+    w.robot.start = {2, 3, 0};
+    w.goal = {8, 3};
+    w.laser.noise_std = 0;
+    w.laser.rays = 360;
+    return w;
+}
+}  // namespace
+
+TEST(World, EveryShippedWorldLoads) {
+    for (const char* name : {"paper_fig6", "corridor_people", "office", "obstacle_near_goal"}) {
+        const auto w = loadWorld(kWorlds + name + ".ini");
+        EXPECT_EQ(w.name, name);
+        EXPECT_FALSE(w.obstacles.empty()) << name;
+        const auto g = rasterize(w);
+        EXPECT_GT(g.getSizeX(), 100u);
+    }
+    const auto c = loadWorld(kWorlds + "corridor_people.ini");
+    EXPECT_EQ(c.pedestrians.size(), 4u);
+    EXPECT_EQ(c.pedestrians[0].mode, Pedestrian::Mode::Scripted);
+    const auto f = loadWorld(kWorlds + "paper_fig6.ini");
+    EXPECT_NEAR(f.robot.max_w, M_PI / 2, 1e-9);  // 90 deg/s
+    EXPECT_DOUBLE_EQ(f.goal.x, 11.0);
+}
+
+TEST(World, ObstacleOnGoalIsAClearError) {
+    const std::string path =
+        std::string(DEVSLAM_SOURCE_DIR) + "/tests/sim/data/obstacle_on_goal.ini";
+    try {
+        (void)loadWorld(path);
+        FAIL() << "a world with a box on the goal was accepted";
+    } catch (const std::invalid_argument& e) {
+        const std::string m = e.what();
+        EXPECT_NE(m.find("obstacle_on_goal.ini"), std::string::npos) << m;
+        EXPECT_NE(m.find("[goal]"), std::string::npos) << m;
+        EXPECT_NE(m.find("box_5"), std::string::npos) << m;
+    }
+}
+
+TEST(World, BadEntriesNameTheKey) {
+    mrpt::config::CConfigFileMemory c(
+        "[world]\nx_min=0\nx_max=5\ny_min=0\ny_max=5\n[robot]\nstart_x=1\nstart_y=1\n"
+        "[goal]\nx=4\ny=4\n[obstacles]\nthing = pyramid 1 2 3\n");
+    try {
+        (void)parseWorld(c, "w.ini");
+        FAIL();
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("thing"), std::string::npos);
+        EXPECT_NE(std::string(e.what()).find("pyramid"), std::string::npos);
+    }
+    c.setContent(
+        "[world]\nx_min=0\nx_max=5\ny_min=0\ny_max=5\nspeed=3\n[robot]\nstart_x=1\n"
+        "start_y=1\n[goal]\nx=4\ny=4\n");
+    EXPECT_THROW((void)parseWorld(c, "w.ini"), std::invalid_argument);  // unknown key 'speed'
+}
+
+TEST(World, DistanceToRotatedBox) {
+    Obstacle o;
+    o.cx = 1;
+    o.cy = 1;
+    o.sx = 2;
+    o.sy = 1;
+    o.yaw = M_PI / 2;  // now 1 wide along x, 2 along y
+    EXPECT_NEAR(distanceToObstacle(o, {2.5, 1}), 1.0, 1e-9);
+    EXPECT_NEAR(distanceToObstacle(o, {1, 3}), 1.0, 1e-9);
+    EXPECT_NEAR(distanceToObstacle(o, {1, 1}), -0.5, 1e-9);
+}
+
+TEST(Simulator, LaserMeasuresKnownRanges) {
+    auto w = room();  // boundary walls 0.1 thick: inner faces at x=0.1, 9.9, y=0.1, 5.9
+    Obstacle box;
+    box.name = "b";
+    box.cx = 5;
+    box.cy = 3;
+    box.sx = 1;
+    box.sy = 1;
+    w.obstacles.push_back(box);
+    Simulator sim(w);
+    const auto& s = sim.scan();
+    auto rangeAt = [&](double a) {
+        size_t best = 0;
+        for (size_t i = 0; i < s.angles.size(); i++)
+            if (std::abs(s.angles[i] - a) < std::abs(s.angles[best] - a)) best = i;
+        return s.ranges[best];
+    };
+    EXPECT_NEAR(rangeAt(0.0), 2.5, 0.01);          // box face at x = 4.5
+    EXPECT_NEAR(rangeAt(M_PI / 2), 2.9, 0.01);     // north wall
+    EXPECT_NEAR(rangeAt(-M_PI / 2), 2.9, 0.01);    // south wall
+    EXPECT_NEAR(rangeAt(M_PI - 1e-3), 1.9, 0.02);  // west wall
+}
+
+TEST(Simulator, AccelerationLimitsAndDriving) {
+    auto w = room();
+    w.robot.max_acc = 0.5;
+    Simulator sim(w);
+    sim.setCommand(0.6, 0.0);
+    for (int i = 0; i < 50; i++) sim.step();  // 0.5 s
+    EXPECT_NEAR(sim.linearVelocity(), 0.25, 1e-6);
+    for (int i = 0; i < 250; i++) sim.step();  // until 3 s: at 0.6 after 1.2 s
+    EXPECT_NEAR(sim.linearVelocity(), 0.6, 1e-9);
+    // distance: ramp 1.2 s (0.36 m) + 1.8 s at 0.6 (1.08 m)
+    EXPECT_NEAR(sim.robotPose().x - 2.0, 1.44, 0.02);
+    EXPECT_NEAR(sim.robotPose().y, 3.0, 1e-3);
+    EXPECT_NEAR(sim.time(), 3.0, 1e-9);
+    sim.setCommand(0.0, 10.0);  // clamped to max_w
+    for (int i = 0; i < 200; i++) sim.step();
+    EXPECT_NEAR(sim.angularVelocity(), w.robot.max_w, 1e-9);
+}
+
+TEST(Simulator, CollisionWithWallIsCountedOnce) {
+    auto w = room();
+    Simulator sim(w);
+    sim.setCommand(0.6, 0);
+    for (int i = 0; i < 2000; i++) sim.step();  // 20 s toward the east wall at x = 9.9
+    EXPECT_EQ(sim.collisions().static_events, 1);
+    EXPECT_TRUE(sim.collisions().static_contact);
+    EXPECT_NEAR(sim.robotPose().x, 9.9 - w.robot.radius, 0.03);  // stopped by the wall
+}
+
+TEST(Simulator, PedestrianWalksScriptAndIsSeenAndTouched) {
+    auto w = room();
+    w.pedestrians_yield = false;
+    Pedestrian p;
+    p.name = "p";
+    p.speed = 1.0;
+    p.path = {{6, 3}, {0.6, 3}};  // walks straight through the robot
+    w.pedestrians.push_back(p);
+    Simulator sim(w);
+    EXPECT_NEAR(sim.scan().ranges[180], 3.75, 0.02);  // ray 180 of 360 points at angle 0
+    for (int i = 0; i < 400; i++) sim.step();         // contact from t = 3.5 s (x = 2.5)
+    EXPECT_GE(sim.collisions().person_events, 1);
+    EXPECT_EQ(sim.collisions().static_events, 0);
+}
+
+TEST(Simulator, DeterministicForASeed) {
+    auto run = [](uint32_t seed) {
+        auto w = randomWorld(Category::CorridorPeople, 3);
+        w.seed = seed;
+        Simulator sim(w);
+        sim.setCommand(0.4, 0.1);
+        for (int i = 0; i < 500; i++) sim.step();
+        return std::make_pair(sim.pedestrianPositions(), sim.scan().ranges);
+    };
+    const auto a = run(7), b = run(7), c = run(8);
+    ASSERT_EQ(a.first.size(), b.first.size());
+    for (size_t i = 0; i < a.first.size(); i++) {
+        EXPECT_DOUBLE_EQ(a.first[i].x, b.first[i].x);
+        EXPECT_DOUBLE_EQ(a.first[i].y, b.first[i].y);
+    }
+    EXPECT_EQ(a.second, b.second);
+    EXPECT_NE(a.second, c.second);  // laser noise depends on the seed
+}
+
+TEST(SimRobot, AdapterImplementsTheNavInterface) {
+    auto w = room();
+    w.laser.range = 15.0;  // reaches every corner of the room
+    Simulator sim(w);
+    SimRobot robot(sim);
+    mrpt::kinematics::CVehicleVelCmd_DiffDriven cmd;
+    cmd.lin_vel = 0.3;
+    cmd.ang_vel = 0.0;
+    EXPECT_TRUE(robot.changeSpeeds(cmd));
+    for (int i = 0; i < 200; i++) sim.step();
+    mrpt::math::TPose2D pose, odo;
+    mrpt::math::TTwist2D vel;
+    mrpt::system::TTimeStamp ts;
+    std::string frame;
+    ASSERT_TRUE(robot.getCurrentPoseAndSpeeds(pose, vel, ts, odo, frame));
+    EXPECT_GT(pose.x, 2.4);
+    EXPECT_NEAR(vel.vx, 0.3, 1e-6);
+    mrpt::maps::CSimplePointsMap pts;
+    ASSERT_TRUE(robot.senseObstacles(pts, ts));
+    EXPECT_EQ(pts.size(), 360u);  // closed room: every ray hits
+    EXPECT_TRUE(robot.stop());
+    auto stop = robot.getStopCmd();
+    EXPECT_TRUE(stop->isStopCmd());
+}
+
+TEST(RandomWorlds, SameSeedSameWorldAndAlwaysSolvable) {
+    for (auto c : allCategories())
+        for (uint32_t s = 1; s <= 3; s++) {
+            const auto a = randomWorld(c, s), b = randomWorld(c, s);
+            ASSERT_EQ(a.obstacles.size(), b.obstacles.size());
+            EXPECT_DOUBLE_EQ(a.goal.x, b.goal.x);
+            EXPECT_NO_THROW(validateWorld(a));
+        }
+}
