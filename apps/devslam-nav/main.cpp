@@ -18,7 +18,8 @@ void usage() {
                  "  --method NAME   holonomic method: CHolonomicVFHPlus (default), CHolonomicND,\n"
                  "                  CHolonomicVFF, CHolonomicFullEval\n"
                  "  --png FILE      picture of the run (default nav_<world>.png)\n"
-                 "  --navlog DIR    also write MRPT's navlog into DIR\n";
+                 "  --navlog DIR    also write MRPT's navlog into DIR\n"
+                 "  --verbose       MRPT navigator messages (DEBUG level)\n";
 }
 }  // namespace
 
@@ -26,6 +27,7 @@ int main(int argc, char** argv) {
     std::string world_path, png, navlog;
     std::string config = std::string(DEVSLAM_SOURCE_DIR) + "/config_ini/nav_reactive.ini";
     std::string method = "CHolonomicVFHPlus";
+    bool verbose = false;
     for (int i = 1; i < argc; i++) {
         const std::string a = argv[i];
         auto next = [&]() -> std::string {
@@ -41,6 +43,8 @@ int main(int argc, char** argv) {
                 png = next();
             else if (a == "--navlog")
                 navlog = next();
+            else if (a == "--verbose")
+                verbose = true;
             else if (a == "-h" || a == "--help") {
                 usage();
                 return 0;
@@ -65,6 +69,7 @@ int main(int argc, char** argv) {
         const auto world = devslam::sim::loadWorld(world_path);
         const auto ini = devslam::core::loadIni(config);
         auto nav_opts = devslam::nav::NavigatorOptions::fromConfig(*ini, config);
+        nav_opts.verbose = verbose;
         devslam::sim::EpisodeOptions eo;
         eo.holonomic_method = method;
         if (!navlog.empty()) {

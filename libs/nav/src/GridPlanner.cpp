@@ -96,6 +96,7 @@ void GridPlanner::setMap(const mrpt::maps::COccupancyGridMap2D& grid) {
             any_obstacle |= occ;
         }
     clearance_.assign(static_cast<size_t>(w_) * h_, kNoObstacle);
+    mult_.assign(clearance_.size(), 1.0f);
     if (!any_obstacle) return;
     cv::Mat dist;
     cv::distanceTransform(free_mask, dist, cv::DIST_L2, cv::DIST_MASK_PRECISE);
@@ -106,6 +107,8 @@ void GridPlanner::setMap(const mrpt::maps::COccupancyGridMap2D& grid) {
             // distance between cell centres minus half a cell = distance to the cell edge
             clearance_[x + y * w_] = d <= 0 ? 0.f : std::max(0.f, (d - 0.5f) * res);
         }
+    for (size_t i = 0; i < clearance_.size(); i++)
+        mult_[i] = static_cast<float>(stepMultiplier(static_cast<int>(i)));
 }
 
 double GridPlanner::clearance(const mrpt::math::TPoint2D& p) const {
@@ -188,14 +191,13 @@ std::optional<GridPath> GridPlanner::plan(const mrpt::math::TPoint2D& start,
                 if (nx < 0 || ny < 0 || nx >= w_ || ny >= h_) continue;
                 const int ni = nx + ny * w_;
                 if (closed[ni]) continue;
-                const double mult = stepMultiplier(ni);
+                const double mult = mult_[ni];
                 if (mult < 0) continue;
                 // no corner cutting: both orthogonal neighbours must be traversable
-                if (dx != 0 && dy != 0 &&
-                    (stepMultiplier(cx + dx + cy * w_) < 0 || stepMultiplier(cx + ny * w_) < 0))
+                if (dx != 0 && dy != 0 && (mult_[cx + dx + cy * w_] < 0 || mult_[cx + ny * w_] < 0))
                     continue;
                 const double step = res * ((dx != 0 && dy != 0) ? kSqrt2 : 1.0);
-                const double ng = g[cur] + step * 0.5 * (mult + std::max(1.0, stepMultiplier(cur)));
+                const double ng = g[cur] + step * 0.5 * (mult + std::max(1.0f, mult_[cur]));
                 if (ng < g[ni]) {
                     g[ni] = ng;
                     parent[ni] = cur;

@@ -106,7 +106,7 @@ Navigator::Navigator(mrpt::nav::CRobot2NavInterface& robot,
     cfg.write(sec_rns, "RobotModel_shape2D_ys", ys);
 
     nav_ = std::make_unique<ReactiveNav>(robot_, opts_.log_file, opts_.log_directory);
-    nav_->setMinLoggingLevel(mrpt::system::LVL_ERROR);
+    nav_->setMinLoggingLevel(opts_.verbose ? mrpt::system::LVL_DEBUG : mrpt::system::LVL_ERROR);
     std::string cache = opts_.ptg_cache_directory;
     if (cache.empty()) {
         // PTG collision grids depend on the PTG section and the robot shape only.

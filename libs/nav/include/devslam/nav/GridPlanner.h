@@ -93,6 +93,7 @@ class GridPlanner {
     GridPlannerOptions opts_;
     mrpt::maps::COccupancyGridMap2D grid_;
     std::vector<float> clearance_;  ///< [m] per cell, row-major (x + y*W)
+    std::vector<float> mult_;       ///< step cost multiplier per cell, < 0 = lethal
     int w_ = 0, h_ = 0;
 };
 

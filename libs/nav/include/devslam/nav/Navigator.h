@@ -39,6 +39,7 @@ struct NavigatorOptions {
     bool log_file = false;       ///< write an MRPT .reactivenavlog
     std::string log_directory = "reactivenav.logs";
     std::string ptg_cache_directory = "";  ///< "" = a folder in the system temp dir
+    bool verbose = false;  ///< MRPT navigator log level INFO instead of ERROR (not in INI)
     GridPlannerOptions planner;
     ReplanOptions replan;
 
