@@ -4,6 +4,7 @@
 #include <devslam/core/Config.h>
 #include <devslam/nav/CHolonomicVFHPlus.h>
 #include <devslam/sim/Episode.h>
+#include <devslam/sim/RandomWorlds.h>
 
 #include <mrpt/system/filesystem.h>
 
@@ -12,8 +13,21 @@
 #include <string>
 
 namespace {
+/// A world file, or "random:CATEGORY:SEED" for one of the benchmark's generated worlds.
+devslam::sim::WorldSpec loadOrGenerate(const std::string& spec) {
+    const std::string prefix = "random:";
+    if (spec.rfind(prefix, 0) != 0) return devslam::sim::loadWorld(spec);
+    const auto colon = spec.rfind(':');
+    const std::string cat = spec.substr(prefix.size(), colon - prefix.size());
+    for (auto c : devslam::sim::allCategories())
+        if (cat == devslam::sim::toString(c))
+            return devslam::sim::randomWorld(c, static_cast<uint32_t>(std::stoul(spec.substr(colon + 1))));
+    throw std::invalid_argument("unknown random world category '" + cat +
+                                "' (known: open_clutter, corridor_people, office, obstacle_near_goal)");
+}
+
 void usage() {
-    std::cerr << "usage: devslam-nav WORLD.ini [options]\n"
+    std::cerr << "usage: devslam-nav WORLD.ini|random:CATEGORY:SEED [options]\n"
                  "  --config FILE   navigation INI (default config_ini/nav_reactive.ini)\n"
                  "  --method NAME   holonomic method: CHolonomicVFHPlus (default), CHolonomicND,\n"
                  "                  CHolonomicVFF, CHolonomicFullEval\n"
@@ -66,7 +80,7 @@ int main(int argc, char** argv) {
     }
     try {
         devslam::nav::registerNavClasses();
-        const auto world = devslam::sim::loadWorld(world_path);
+        const auto world = loadOrGenerate(world_path);
         const auto ini = devslam::core::loadIni(config);
         auto nav_opts = devslam::nav::NavigatorOptions::fromConfig(*ini, config);
         nav_opts.verbose = verbose;

@@ -1,5 +1,6 @@
 #include <devslam/sim/RandomWorlds.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <stdexcept>
@@ -135,10 +136,12 @@ WorldSpec corridorPeople(Rng& g) {
             p.path = {{uni(g, 5.0, 12.0), y}};
         } else {
             p.mode = Pedestrian::Mode::Scripted;
-            p.path = towards ? std::vector<mrpt::math::TPoint2D>{{xa, y}, {1.5, uni(g, 0.6, 2.6)}}
+            // turn-around points stay 1.5 m clear of the start and the goal: a person who
+            // parks on the goal would make the world unsolvable for every method
+            p.path = towards ? std::vector<mrpt::math::TPoint2D>{{xa, y}, {2.5, uni(g, 0.6, 2.6)}}
                              : std::vector<mrpt::math::TPoint2D>{{xa - 2.0, y},
-                                                                 {15.0, uni(g, 0.6, 2.6)}};
-            if (p.path[0].x < 3.0) p.path[0].x = 3.0;
+                                                                 {13.5, uni(g, 0.6, 2.6)}};
+            p.path[0].x = std::clamp(p.path[0].x, 3.0, 13.5);
         }
         w.pedestrians.push_back(p);
     }
