@@ -105,6 +105,7 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
         fl.state = slam::toString(tr.state);
         fl.n_inliers = tr.n_inliers;
         fl.keyframe = mr.keyframe_inserted;
+        fl.keyframe_reason = slam::toString(mr.reason);
         fl.loop = br.loop_closed;
         if (tr.state == slam::TrackingState::Lost) masks->reset();
         elapsed_ms += fl.ms.total();
@@ -312,7 +313,8 @@ std::string toJson(const RunReport& r) {
           << ", \"state\": \"" << l.state << "\", \"features\": " << l.n_features
           << ", \"masked\": " << l.n_masked << ", \"inliers\": " << l.n_inliers
           << ", \"boxes\": " << l.n_boxes << ", \"moving\": " << l.n_moving
-          << ", \"keyframe\": " << (l.keyframe ? "true" : "false")
+          << ", \"keyframe\": " << (l.keyframe ? "true" : "false") << ", \"keyframe_reason\": \""
+          << l.keyframe_reason << "\""
           << ", \"ms\": " << timingJson(l.ms) << "}";
     }
     o << "\n  ]\n}\n";

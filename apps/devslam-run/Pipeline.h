@@ -34,7 +34,7 @@ struct FrameTiming {
 struct FrameLog {
     std::size_t index = 0;
     double t = 0;
-    std::string state;
+    std::string state, keyframe_reason;
     int n_features = 0, n_masked = 0, n_inliers = 0, n_boxes = 0, n_moving = 0;
     bool keyframe = false, loop = false;
     FrameTiming ms;

@@ -12,16 +12,14 @@
 namespace devslam::slam {
 
 void LocalBaOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, const std::string& s) {
-    core::requireKnownKeys(
-        c, s,
-        {"enabled", "window", "iterations", "bf", "chi2_mono", "chi2_stereo", "scale_factor"});
+    core::requireKnownKeys(c, s,
+                           {"enabled", "window", "iterations", "bf", "chi2_mono", "chi2_stereo"});
     enabled = c.read_bool(s, "enabled", enabled);
     window = c.read_int(s, "window", window);
     iterations = c.read_int(s, "iterations", iterations);
     bf = c.read_double(s, "bf", bf);
     chi2_mono = c.read_double(s, "chi2_mono", chi2_mono);
     chi2_stereo = c.read_double(s, "chi2_stereo", chi2_stereo);
-    scale_factor = c.read_double(s, "scale_factor", scale_factor);
     core::requireValue(window >= 1 && window <= 30, s, "window", "must be in [1, 30]");
     core::requireValue(iterations >= 0, s, "iterations", "must be >= 0");
     core::requireValue(bf > 0, s, "bf", "must be > 0");
@@ -34,7 +32,6 @@ void LocalBaOptions::saveToConfig(mrpt::config::CConfigFileBase& c, const std::s
     c.write(s, "bf", bf);
     c.write(s, "chi2_mono", chi2_mono);
     c.write(s, "chi2_stereo", chi2_stereo);
-    c.write(s, "scale_factor", scale_factor);
 }
 
 namespace {

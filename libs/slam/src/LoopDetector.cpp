@@ -71,7 +71,7 @@ std::optional<LoopConstraint> detectLoop(const Map& map, KeyframeId current,
         std::vector<PoseObservation> obs;
         for (const auto& [q, t] : pairs) {
             const auto& kp = cur.features.keypoints[q];
-            const double s = std::pow(1.2, kp.octave);
+            const double s = std::pow(opts.scale_factor, kp.octave);
             obs.push_back({T_cw_old * map.landmark(old.landmark_of_kp[rows[t]])->p_w,
                            {kp.pt.x, kp.pt.y},
                            cur.features.depth[q],

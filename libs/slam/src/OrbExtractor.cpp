@@ -2,6 +2,7 @@
 #include <devslam/slam/OrbExtractor.h>
 
 #include <mrpt/config/CConfigFileBase.h>
+#include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
@@ -90,6 +91,21 @@ std::vector<int> spreadOverGrid(const std::vector<cv::KeyPoint>& kps, cv::Size i
     return out;
 }
 
+void undistortKeypoints(FrameFeatures& f, const core::CameraIntrinsics& K) {
+    const bool distorted =
+        std::any_of(K.dist.begin(), K.dist.end(), [](double d) { return d != 0.0; });
+    if (!distorted || f.keypoints.empty()) return;
+    std::vector<cv::Point2f> in(f.keypoints.size()), out;
+    for (std::size_t i = 0; i < in.size(); ++i) in[i] = f.keypoints[i].pt;
+    const cv::Mat Kc = (cv::Mat_<double>(3, 3) << K.fx, 0, K.cx, 0, K.fy, K.cy, 0, 0, 1);
+    const cv::Mat D(1, 5, CV_64F, const_cast<double*>(K.dist.data()));
+    cv::undistortPoints(in, out, Kc, D, cv::noArray(), Kc);
+    for (std::size_t i = 0; i < in.size(); ++i) {
+        f.keypoints[i].pt = out[i];
+        if (f.depth[i] > 0) f.points_c[i] = core::backproject(out[i].x, out[i].y, f.depth[i], K);
+    }
+}
+
 FrameFeatures OrbExtractor::extract(const core::Frame& frame, const cv::Mat& mask) const {
     if (!mask.empty() && (mask.type() != CV_8UC1 || mask.size() != frame.bgr.size()))
         throw std::invalid_argument("orb extractor: mask must be CV_8UC1 of the frame size");
@@ -141,6 +157,7 @@ FrameFeatures OrbExtractor::extract(const core::Frame& frame, const cv::Mat& mas
                                    : Eigen::Vector3d::Zero());
         f.colors.push_back(frame.bgr.at<cv::Vec3b>(v, u));
     }
+    undistortKeypoints(f, frame.K);
     return f;
 }
 

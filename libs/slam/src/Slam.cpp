@@ -5,13 +5,17 @@
 #include <mrpt/config/CConfigFileBase.h>
 
 #include <cmath>
+#include <cstdlib>
+#include <filesystem>
 
 namespace devslam::slam {
 
 void MappingOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, const std::string& s) {
-    core::requireKnownKeys(c, s,
-                           {"min_init_points", "cull_min_found_ratio", "cull_min_visible",
-                            "cull_keyframe_age", "odometry_sigma_t", "odometry_sigma_r_deg"});
+    core::requireKnownKeys(
+        c, s,
+        {"min_init_points", "cull_min_found_ratio", "cull_min_visible", "cull_keyframe_age",
+         "odometry_sigma_t", "odometry_sigma_r_deg", "depth_time_compensation"});
+    depth_time_compensation = c.read_bool(s, "depth_time_compensation", depth_time_compensation);
     min_init_points = c.read_int(s, "min_init_points", min_init_points);
     cull_min_found_ratio = c.read_double(s, "cull_min_found_ratio", cull_min_found_ratio);
     cull_min_visible = c.read_int(s, "cull_min_visible", cull_min_visible);
@@ -32,6 +36,33 @@ void MappingOptions::saveToConfig(mrpt::config::CConfigFileBase& c, const std::s
     c.write(s, "cull_keyframe_age", cull_keyframe_age);
     c.write(s, "odometry_sigma_t", odometry_sigma_t);
     c.write(s, "odometry_sigma_r_deg", odometry_sigma_r_deg);
+    c.write(s, "depth_time_compensation", depth_time_compensation);
+}
+
+std::optional<double> depthStamp(const core::Frame& frame) {
+    const std::string stem = std::filesystem::path(frame.depth_source).stem().string();
+    if (stem.empty() || frame.depth_source == frame.rgb_source) return std::nullopt;
+    char* end = nullptr;
+    const double t = std::strtod(stem.c_str(), &end);
+    if (end != stem.c_str() + stem.size() || !(t > 1e8)) return std::nullopt;
+    return t;
+}
+
+void compensateDepthTime(FrameFeatures& f, const Eigen::Isometry3d& T_prev_cur, double dt_prev,
+                         double t_rgb, double t_depth) {
+    if (dt_prev <= 0) return;
+    // Fraction of the last interval between the depth and the colour exposure (negative:
+    // depth earlier); pose of the depth camera in the colour camera = (T_prev_cur)^a.
+    const double a = (t_depth - t_rgb) / dt_prev;
+    const Eigen::AngleAxisd aa(T_prev_cur.linear());
+    Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+    T.linear() = Eigen::AngleAxisd(aa.angle() * a, aa.axis()).toRotationMatrix();
+    T.translation() = T_prev_cur.translation() * a;
+    for (std::size_t i = 0; i < f.size(); ++i) {
+        if (f.depth[i] <= 0) continue;
+        f.points_c[i] = T * f.points_c[i];
+        f.depth[i] = static_cast<float>(f.points_c[i].z());
+    }
 }
 
 SlamOptions SlamOptions::fromConfig(const mrpt::config::CConfigFileBase& cfg) {
@@ -49,6 +80,8 @@ SlamOptions SlamOptions::fromConfig(const mrpt::config::CConfigFileBase& cfg) {
                        "must be > 0");
     // The level sigmas of tracking and BA follow the ORB pyramid.
     o.local_ba.scale_factor = o.orb.scale_factor;
+    o.tracker.scale_factor = o.orb.scale_factor;
+    o.loop.scale_factor = o.orb.scale_factor;
     return o;
 }
 
@@ -66,7 +99,15 @@ void SlamOptions::saveToConfig(mrpt::config::CConfigFileBase& cfg) const {
 Slam::Slam(const SlamOptions& opts) : opts_(opts), orb_(opts.orb), tracker_(opts.tracker) {}
 
 FrameFeatures Slam::extract(const core::Frame& frame, const cv::Mat& mask) const {
-    return orb_.extract(frame, mask);
+    FrameFeatures f = orb_.extract(frame, mask);
+    if (opts_.mapping.depth_time_compensation) {
+        const auto td = depthStamp(frame);
+        const auto v = tracker_.predictPrevCur(frame.timestamp);
+        const double dt = frame.timestamp - tracker_.lastTimestamp();
+        if (td && v && std::abs(*td - frame.timestamp) < 0.1)
+            compensateDepthTime(f, *v, dt, frame.timestamp, *td);
+    }
+    return f;
 }
 
 TrackResult Slam::track(const core::Frame& frame, const FrameFeatures& features,
@@ -120,6 +161,8 @@ MappingResult Slam::mapStep(const core::Frame& frame, FrameFeatures features,
         else
             ++n_close_untracked;
     }
+    // The reference count for the tracked-ratio rule: the first frame tracked after a keyframe.
+    if (tracked_at_last_kf_ < 0) tracked_at_last_kf_ = track.n_inliers;
     if (!pending_init_) {
         KeyframeSelectorInput in;
         in.frames_since_last_kf = frames_since_kf_;
@@ -157,7 +200,7 @@ MappingResult Slam::mapStep(const core::Frame& frame, FrameFeatures features,
     out.keyframe_inserted = true;
     out.keyframe = id;
     frames_since_kf_ = 0;
-    tracked_at_last_kf_ = std::max(track.n_inliers, n_close_tracked + n_close_untracked);
+    tracked_at_last_kf_ = -1;
     if (!records_.empty()) {
         records_.back().ref_kf = id;
         records_.back().T_ref_c = Eigen::Isometry3d::Identity();

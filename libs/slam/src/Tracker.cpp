@@ -131,7 +131,6 @@ std::vector<PoseObservation> observationsOf(const Map& map, const FrameFeatures&
     }
     return obs;
 }
-constexpr double kScaleFactor = 1.2;  // pyramid scale for the level sigmas (OrbExtractor default)
 }  // namespace
 
 std::optional<PoseRefineResult> Tracker::trackWithMap(const FrameFeatures& f, Map& map,
@@ -151,7 +150,7 @@ std::optional<PoseRefineResult> Tracker::trackWithMap(const FrameFeatures& f, Ma
         res.reason = "too few projection matches (" + std::to_string(matches.size()) + ")";
         return std::nullopt;
     }
-    auto obs = observationsOf(map, f, matches, kScaleFactor);
+    auto obs = observationsOf(map, f, matches, opts_.scale_factor);
     auto pnp_opts = opts_.pnp;
     pnp_opts.seed = seed;
     const auto pnp = solvePnpRansac(obs, K, pnp_opts, pred);
@@ -168,7 +167,7 @@ std::optional<PoseRefineResult> Tracker::trackWithMap(const FrameFeatures& f, Ma
     std::vector<LandmarkId> in_view;
     matches =
         matchByProjection(map, local, f, grid, refined.T_wc, K, fine, &res.n_in_view, &in_view);
-    obs = observationsOf(map, f, matches, kScaleFactor);
+    obs = observationsOf(map, f, matches, opts_.scale_factor);
     auto refined2 = refinePose(obs, refined.T_wc, K, opts_.refine);
     if (refined2.n_inliers < opts_.min_inliers) {
         res.reason =
@@ -216,7 +215,7 @@ std::optional<Eigen::Isometry3d> Tracker::relocalize(const FrameFeatures& f, con
         std::vector<PoseObservation> obs;
         for (const auto& [q, t] : pairs) {
             const auto& kp = f.keypoints[q];
-            const double s = std::pow(kScaleFactor, kp.octave);
+            const double s = std::pow(opts_.scale_factor, kp.octave);
             obs.push_back({map.landmark(kf.landmark_of_kp[rows[t]])->p_w,
                            {kp.pt.x, kp.pt.y},
                            f.depth[q],

@@ -26,7 +26,7 @@ struct LocalBaOptions {
     double bf = 40.0;            ///< [px*m] virtual baseline * fx (as the tracker)
     double chi2_mono = 5.991;    ///< outlier test for 2-dof residuals (Huber width too)
     double chi2_stereo = 7.815;  ///< for 3-dof residuals
-    double scale_factor = 1.2;   ///< ORB pyramid scale (level sigmas)
+    double scale_factor = 1.3;   ///< ORB pyramid scale (level sigmas), copied from [orb]
 
     void loadFromConfig(const mrpt::config::CConfigFileBase& cfg,
                         const std::string& section = "local_ba");

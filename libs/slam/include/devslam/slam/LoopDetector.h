@@ -28,6 +28,7 @@ struct LoopOptions {
     int min_inliers = 40;       ///< verified inliers for a loop
     double sigma_t = 0.02;      ///< [m] loop-edge translation std (pose-graph information)
     double sigma_r_deg = 1.0;   ///< [deg] loop-edge rotation std
+    double scale_factor = 1.3;  ///< ORB pyramid scale for level sigmas (copied from [orb])
 
     void loadFromConfig(const mrpt::config::CConfigFileBase& cfg,
                         const std::string& section = "loop_closure");

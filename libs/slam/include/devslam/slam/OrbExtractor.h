@@ -23,8 +23,8 @@ class OrbExtractor {
   public:
     struct Options {
         int n_features = 1250;       ///< features kept per frame (the paper: 1250)
-        double scale_factor = 1.2;   ///< pyramid scale between levels
-        int n_levels = 8;            ///< pyramid levels
+        double scale_factor = 1.3;   ///< pyramid scale between levels
+        int n_levels = 4;            ///< pyramid levels
         int fast_threshold = 20;     ///< FAST threshold (intensity units)
         int min_fast_threshold = 7;  ///< retried with this when a frame yields too few corners
         double oversample = 1.6;     ///< ORB asked for oversample*n_features, then spread
@@ -52,6 +52,11 @@ class OrbExtractor {
     Options opts_;
     cv::Ptr<cv::ORB> orb_, orb_low_;
 };
+
+/// Replaces keypoint positions by their undistorted pixels (K.dist, OpenCV model) and
+/// re-back-projects the points with depth; no-op for an undistorted camera. Depth and
+/// colour are looked up at the raw (distorted) pixel, where the registered depth lies.
+void undistortKeypoints(FrameFeatures& f, const core::CameraIntrinsics& K);
 
 /// Keeps at most `n` keypoints spread over a cols x rows grid: each cell first keeps its
 /// strongest n/(cols*rows) responses, the rest of the budget goes to the strongest left.

@@ -40,12 +40,25 @@ struct MappingOptions {
     int cull_keyframe_age = 3;  ///< landmarks this many keyframes old need >= 2 observations
     double odometry_sigma_t = 0.01;     ///< [m] consecutive-keyframe edge std in the pose graph
     double odometry_sigma_r_deg = 0.5;  ///< [deg]
+    /// Move depth points to the colour image's time with the constant-velocity model when
+    /// the depth image has its own stamp (TUM: up to 20 ms apart; see depthStamp()).
+    bool depth_time_compensation = true;
 
     void loadFromConfig(const mrpt::config::CConfigFileBase& cfg,
                         const std::string& section = "mapping");
     void saveToConfig(mrpt::config::CConfigFileBase& cfg,
                       const std::string& section = "mapping") const;
 };
+
+/// Stamp of the depth image when its file name is a TUM stamp ("depth/1305031102.160407.png");
+/// std::nullopt otherwise (rawlogs: depth and colour share the observation's stamp).
+[[nodiscard]] std::optional<double> depthStamp(const core::Frame& frame);
+
+/// Moves the back-projected points of `f` from the depth image's time to the colour
+/// image's: p <- T_cur_depth * p, with T_cur_depth interpolated from the motion
+/// `T_prev_cur` over `dt_prev` [s] (constant velocity). Depths follow the points.
+void compensateDepthTime(FrameFeatures& f, const Eigen::Isometry3d& T_prev_cur, double dt_prev,
+                         double t_rgb, double t_depth);
 
 struct SlamOptions {
     OrbExtractor::Options orb;
@@ -93,6 +106,7 @@ class Slam {
   public:
     explicit Slam(const SlamOptions& opts);
 
+    /// ORB features with depth (and depth-time compensation, see MappingOptions).
     [[nodiscard]] FrameFeatures extract(const core::Frame& frame, const cv::Mat& mask) const;
     /// Tracks (or, first, initializes on) the frame; records its trajectory entry.
     [[nodiscard]] TrackResult track(const core::Frame& frame, const FrameFeatures& features,

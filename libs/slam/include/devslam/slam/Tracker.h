@@ -42,6 +42,7 @@ struct TrackerOptions {
     int reloc_min_inliers = 25;   ///< PnP inliers needed to relocalize
     int reloc_max_hamming = 64;   ///< brute-force matching threshold
     double reloc_ratio = 0.8;     ///< brute-force ratio test
+    double scale_factor = 1.3;    ///< ORB pyramid scale for level sigmas (copied from [orb])
 
     void loadFromConfig(const mrpt::config::CConfigFileBase& cfg,
                         const std::string& section = "tracker");
@@ -86,6 +87,7 @@ class Tracker {
     void applyCorrection(const Eigen::Isometry3d& T_new_old);
     [[nodiscard]] TrackingState state() const { return state_; }
     [[nodiscard]] const Eigen::Isometry3d& lastPose() const { return last_T_wc_; }
+    [[nodiscard]] double lastTimestamp() const { return last_t_; }
 
   private:
     std::optional<PoseRefineResult> trackWithMap(const FrameFeatures& f, Map& map,
