@@ -1,0 +1,237 @@
+// The whole SLAM on the 37 shipped TUM frames (fr1_xyz_first37), and on sequences
+// synthesized from them to test robustness: black frames, zero depth, a repeated frame,
+// a 2 s gap, a dynamic mask, and a forward-backward run that must close a loop.
+#include <devslam/core/Config.h>
+#include <devslam/eval/Metrics.h>
+#include <devslam/io/RgbdReader.h>
+#include <devslam/slam/Slam.h>
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+using namespace devslam;
+
+namespace {
+
+const std::string kData = std::string(DEVSLAM_SOURCE_DIR) + "/data/tum/fr1_xyz_first37";
+const std::string kIni = std::string(DEVSLAM_SOURCE_DIR) + "/config_ini/slam_tum_fr1.ini";
+
+struct Sequence {
+    std::vector<core::Frame> frames;
+    core::Trajectory gt;
+};
+
+const Sequence& realSequence() {
+    static const Sequence seq = [] {
+        Sequence s;
+        io::ReaderOptions ro;
+        ro.camera = "freiburg1";
+        auto reader = io::openRgbd(kData, ro);
+        while (auto f = reader->next()) s.frames.push_back(std::move(*f));
+        s.gt = reader->groundTruth().value();
+        return s;
+    }();
+    return seq;
+}
+
+/// Deep copy (cv::Mat copies share pixels; the tests modify images).
+std::vector<core::Frame> cloneFrames() {
+    std::vector<core::Frame> out = realSequence().frames;
+    for (auto& f : out) {
+        f.bgr = f.bgr.clone();
+        f.depth = f.depth.clone();
+    }
+    return out;
+}
+
+slam::SlamOptions options() {
+    return slam::SlamOptions::fromConfig(*core::loadIni(kIni));
+}
+
+struct RunOut {
+    core::Trajectory traj;
+    std::vector<std::size_t> lost;
+    std::vector<slam::TrackingState> states;
+    std::size_t keyframes = 0, landmarks = 0;
+    int loops = 0;
+};
+
+RunOut runSlam(const std::vector<core::Frame>& frames, const slam::SlamOptions& opts,
+               const cv::Mat& mask = {}, slam::Slam** keep = nullptr) {
+    static std::unique_ptr<slam::Slam> last;
+    last = std::make_unique<slam::Slam>(opts);
+    RunOut out;
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+        core::Frame f = frames[i];
+        f.index = i;
+        const auto r = last->process(f, mask);
+        out.states.push_back(r.track.state);
+        if (std::getenv("SLAM_TEST_VERBOSE"))
+            std::printf("%zu %s inl=%d match=%d kf=%d %s\n", i,
+                        slam::toString(r.track.state).c_str(), r.track.n_inliers, r.track.n_matches,
+                        r.mapping.keyframe_inserted ? 1 : 0, r.track.reason.c_str());
+    }
+    out.traj = last->trajectory();
+    out.lost = last->lostFrames();
+    out.keyframes = last->map().keyframes().size();
+    out.landmarks = last->map().landmarks().size();
+    out.loops = last->loopsClosed();
+    if (keep) *keep = last.get();
+    return out;
+}
+
+/// ATE over the frames that are not in `skip` (e.g. frames lost on purpose).
+double ate(const core::Trajectory& gt, const core::Trajectory& est,
+           const std::vector<std::size_t>& skip = {}) {
+    core::Trajectory e;
+    for (std::size_t i = 0; i < est.size(); ++i)
+        if (std::find(skip.begin(), skip.end(), i) == skip.end()) e.push_back(est[i]);
+    return eval::computeAte(gt, e).trans.rmse;
+}
+
+}  // namespace
+
+TEST(SlamIntegration, RealFramesMeetTheAteBound) {
+    const auto& seq = realSequence();
+    ASSERT_GE(seq.frames.size(), 30u);
+    const auto r = runSlam(seq.frames, options());
+    EXPECT_EQ(r.traj.size(), seq.frames.size());  // every frame has a pose
+    EXPECT_TRUE(r.lost.empty());
+    EXPECT_GE(r.keyframes, 3u);
+    EXPECT_GT(r.landmarks, 1000u);
+    const double rmse = ate(seq.gt, r.traj);
+    std::printf("ATE RMSE %.5f m, keyframes %zu, landmarks %zu\n", rmse, r.keyframes, r.landmarks);
+    EXPECT_LE(rmse, 0.0065);  // issue 4 target 0.006; measured 0.0060 (see docs/RESULTS.md)
+}
+
+TEST(SlamIntegration, DeterministicRuns) {
+    const auto& seq = realSequence();
+    std::vector<core::Frame> first(seq.frames.begin(), seq.frames.begin() + 15);
+    const auto a = runSlam(first, options());
+    const auto b = runSlam(first, options());
+    ASSERT_EQ(a.traj.size(), b.traj.size());
+    for (std::size_t i = 0; i < a.traj.size(); ++i)
+        EXPECT_EQ(a.traj[i].pose.asVectorVal(), b.traj[i].pose.asVectorVal()) << i;
+}
+
+TEST(SlamIntegration, BlackFramesAreLostThenRecovered) {
+    auto frames = cloneFrames();
+    for (int i = 10; i <= 12; ++i) frames[i].bgr.setTo(cv::Scalar::all(0));
+    const auto r = runSlam(frames, options());
+    EXPECT_EQ(r.lost, (std::vector<std::size_t>{10, 11, 12}));
+    EXPECT_EQ(r.states[13], slam::TrackingState::Relocalized);
+    for (std::size_t i = 14; i < frames.size(); ++i)
+        EXPECT_EQ(r.states[i], slam::TrackingState::Ok) << i;
+    EXPECT_LE(ate(realSequence().gt, r.traj, r.lost), 0.01);
+}
+
+TEST(SlamIntegration, ZeroDepthFramesDoNotBreakTracking) {
+    auto frames = cloneFrames();
+    for (int i = 8; i <= 13; ++i) frames[i].depth.setTo(0.0f);
+    const auto r = runSlam(frames, options());
+    // Without depth the frames still track on the map (2D-3D); nothing is lost.
+    EXPECT_TRUE(r.lost.empty());
+    EXPECT_LE(ate(realSequence().gt, r.traj), 0.01);
+}
+
+TEST(SlamIntegration, AllZeroDepthFromTheStartIsReportedNotInitialized) {
+    auto frames = cloneFrames();
+    frames.resize(5);
+    for (auto& f : frames) f.depth.setTo(0.0f);
+    const auto r = runSlam(frames, options());
+    EXPECT_EQ(r.lost.size(), 5u);
+    for (auto s : r.states) EXPECT_EQ(s, slam::TrackingState::NotInitialized);
+    EXPECT_EQ(r.keyframes, 0u);
+}
+
+TEST(SlamIntegration, RepeatedFrame) {
+    const auto& src = realSequence().frames;
+    std::vector<core::Frame> frames(src.begin(), src.begin() + 11);
+    for (int k = 1; k <= 3; ++k) {
+        core::Frame f = src[10];
+        f.timestamp += 0.005 * k;  // the same image again (a driver hiccup)
+        frames.push_back(f);
+    }
+    frames.insert(frames.end(), src.begin() + 11, src.end());
+    const auto r = runSlam(frames, options());
+    EXPECT_TRUE(r.lost.empty());
+    EXPECT_LE(ate(realSequence().gt, r.traj), 0.01);
+}
+
+TEST(SlamIntegration, TwoSecondGap) {
+    const auto& seq = realSequence();
+    std::vector<core::Frame> frames;
+    core::Trajectory gt;
+    const double t_gap = seq.frames[12].timestamp;
+    for (std::size_t i = 0; i < seq.frames.size(); ++i) {
+        if (i >= 12 && i < 20) continue;  // 8 frames missing...
+        core::Frame f = seq.frames[i];
+        if (i >= 20) f.timestamp += 2.0;  // ...and 2 s without data
+        frames.push_back(f);
+    }
+    for (auto g : seq.gt) {
+        if (g.t > t_gap) g.t += 2.0;
+        gt.push_back(g);
+    }
+    const auto r = runSlam(frames, options());
+    EXPECT_LE(r.lost.size(), 1u);  // measured: 0 (wide search / relocalization)
+    for (std::size_t i = frames.size() - 5; i < frames.size(); ++i)
+        EXPECT_EQ(r.states[i], slam::TrackingState::Ok);
+    EXPECT_LE(ate(gt, r.traj, r.lost), 0.012);
+}
+
+TEST(SlamIntegration, NoLandmarkIsCreatedInsideTheDynamicMask) {
+    const auto& seq = realSequence();
+    cv::Mat mask(seq.frames[0].bgr.size(), CV_8UC1, cv::Scalar(0));
+    mask(cv::Rect(0, 0, 320, mask.rows)).setTo(255);  // left half "moving person"
+    slam::Slam* s = nullptr;
+    std::vector<core::Frame> frames(seq.frames.begin(), seq.frames.begin() + 20);
+    const auto r = runSlam(frames, options(), mask, &s);
+    ASSERT_NE(s, nullptr);
+    ASSERT_GT(r.landmarks, 100u);
+    for (const auto& [id, lm] : s->map().landmarks()) {
+        ASSERT_FALSE(lm.observations.empty());
+        for (const auto& [kf, kp] : lm.observations) {
+            const auto& pt = s->map().keyframe(kf).features.keypoints[kp].pt;
+            // Keypoints are stored undistorted; near the image centre column the
+            // undistortion moves them by less than a pixel.
+            EXPECT_GE(pt.x, 318.0f) << "landmark " << id;
+        }
+    }
+}
+
+TEST(SlamIntegration, ForwardBackwardClosesALoop) {
+    const auto& seq = realSequence();
+    std::vector<core::Frame> frames = cloneFrames();
+    core::Trajectory gt = seq.gt;
+    const double t_end = seq.frames.back().timestamp;
+    const double dt = 1.0 / 30.0;
+    // Back along the same path: frame i again, at a later stamp.
+    for (int i = static_cast<int>(seq.frames.size()) - 2; i >= 0; --i) {
+        core::Frame f = seq.frames[i];
+        f.timestamp = t_end + dt * (static_cast<int>(seq.frames.size()) - 1 - i);
+        frames.push_back(f);
+    }
+    for (std::size_t i = seq.frames.size(); i < frames.size(); ++i) {
+        // Ground truth for the replayed frames: the pose at the original stamp.
+        const double t_orig = seq.frames[2 * seq.frames.size() - 2 - i].timestamp;
+        const auto it =
+            std::min_element(seq.gt.begin(), seq.gt.end(), [&](const auto& a, const auto& b) {
+                return std::abs(a.t - t_orig) < std::abs(b.t - t_orig);
+            });
+        gt.push_back({frames[i].timestamp, it->pose});
+    }
+    std::sort(gt.begin(), gt.end(), [](const auto& a, const auto& b) { return a.t < b.t; });
+    auto opts = options();
+    opts.loop.min_keyframe_gap = 4;
+    opts.keyframes.max_frames = 5;
+    const auto r = runSlam(frames, opts);
+    EXPECT_TRUE(r.lost.empty());
+    EXPECT_GE(r.loops, 1);
+    EXPECT_LE(ate(gt, r.traj), 0.01);
+}
