@@ -141,4 +141,5 @@ TEST(IntegrationNav, AppsSmokeTest) {
     EXPECT_TRUE(mrpt::system::fileExists(out + "/nav_bench_success.png"));
     const std::string md = mrpt::system::getFileSize(out + "/bench.md") > 0 ? "ok" : "";
     EXPECT_EQ(md, "ok");
+    mrpt::system::deleteFilesInDirectory(out, true);
 }
