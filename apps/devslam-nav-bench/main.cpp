@@ -1,1 +1,325 @@
-int main() { return 0; }
+// devslam-nav-bench: N seeded random worlds per category (open clutter, corridor with
+// people, office, obstacle near goal), the same worlds for every holonomic method, tables
+// per category written to the `nav` section of docs/RESULTS.md, plus PNGs. Also times one
+// VFH+ step and A* on a 400x400 grid. --quick: a smoke test (2 worlds per category, no
+// RESULTS.md unless --results is given).
+#include <devslam/core/Config.h>
+#include <devslam/core/Progress.h>
+#include <devslam/core/Results.h>
+#include <devslam/core/Stats.h>
+#include <devslam/nav/CHolonomicVFHPlus.h>
+#include <devslam/nav/GridPlanner.h>
+#include <devslam/nav/VfhPlus.h>
+#include <devslam/sim/Episode.h>
+#include <devslam/sim/RandomWorlds.h>
+
+#include <mrpt/system/filesystem.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <iostream>
+#include <map>
+#include <random>
+#include <sstream>
+
+namespace {
+using Clock = std::chrono::steady_clock;
+
+struct Args {
+    int per_category = 25;
+    bool quick = false;
+    std::string config = std::string(DEVSLAM_SOURCE_DIR) + "/config_ini/nav_reactive.ini";
+    std::string results;  // empty: default unless --quick
+    std::string png_dir = std::string(DEVSLAM_SOURCE_DIR) + "/docs/images";
+    std::vector<std::string> methods{"CHolonomicVFHPlus", "CHolonomicND", "CHolonomicVFF",
+                                     "CHolonomicFullEval"};
+    uint32_t seed = 1;
+};
+
+void usage() {
+    std::cerr << "usage: devslam-nav-bench [options]\n"
+                 "  --per-category N  worlds per category (default 25 -> 100 worlds)\n"
+                 "  --quick           smoke test: 2 worlds per category, RESULTS.md untouched\n"
+                 "  --methods a,b     holonomic methods (default all four)\n"
+                 "  --config FILE     navigation INI (default config_ini/nav_reactive.ini)\n"
+                 "  --results FILE    RESULTS.md to update (default docs/RESULTS.md)\n"
+                 "  --png-dir DIR     where PNGs go (default docs/images)\n"
+                 "  --seed S          first world seed (default 1)\n";
+}
+
+struct Tally {
+    int n = 0, success = 0, collision = 0, static_collision = 0, person_collision = 0, timeout = 0;
+    std::vector<double> success_time, ratio, score;
+};
+
+std::string pct(int k, int n) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%.1f%%", n ? 100.0 * k / n : 0.0);
+    return b;
+}
+std::string num(double v, int prec = 2) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%.*f", prec, v);
+    return b;
+}
+std::string shortName(const std::string& m) {
+    return m.rfind("CHolonomic", 0) == 0 ? m.substr(10) : m;
+}
+
+/// Median wall time of vfhPlusStep on synthetic 121-sector fields.
+double timeVfhStep() {
+    std::mt19937 g(3);
+    std::uniform_real_distribution<double> u(0.05, 1.0);
+    devslam::nav::VfhPlusOptions o;
+    devslam::nav::VfhState st;
+    std::vector<double> t;
+    for (int i = 0; i < 2000; i++) {
+        devslam::nav::VfhInput in;
+        in.obstacles.resize(121);
+        for (auto& d : in.obstacles) d = u(g);
+        in.target_x = 0.6;
+        in.target_y = 0.2;
+        in.ref_distance = 2.5;
+        const auto t0 = Clock::now();
+        const auto out = devslam::nav::vfhPlusStep(in, st, o);
+        t.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
+        st = out.next;
+    }
+    return devslam::core::median(t);
+}
+
+/// Median A* time on a 400x400 grid (20 m x 20 m at 5 cm) with random boxes, corner to corner.
+double timeAStar400(double* length) {
+    mrpt::maps::COccupancyGridMap2D grid;
+    grid.setSize(0, 20, 0, 20, 0.05f, 1.0f);
+    std::mt19937 g(5);
+    std::uniform_real_distribution<double> u(2.0, 18.0);
+    for (int k = 0; k < 60; k++) {
+        const double cx = u(g), cy = u(g);
+        for (double y = cy - 0.5; y <= cy + 0.5; y += 0.05)
+            for (double x = cx - 0.5; x <= cx + 0.5; x += 0.05) grid.setPos(x, y, 0.0f);
+    }
+    devslam::nav::GridPlanner planner;
+    planner.setMap(grid);
+    std::vector<double> t;
+    for (int i = 0; i < 15; i++) {
+        const auto t0 = Clock::now();
+        const auto p = planner.plan({0.6, 0.6}, {19.4, 19.4});
+        t.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t0).count());
+        if (p && length) *length = p->length;
+    }
+    return devslam::core::median(t);
+}
+
+void writeChart(const std::string& path, const std::vector<devslam::sim::Category>& cats,
+                const std::vector<std::string>& methods,
+                const std::map<std::pair<int, std::string>, Tally>& tally) {
+    const int W = 900, H = 420, left = 60, bottom = 60, top = 40;
+    cv::Mat img(H, W, CV_8UC3, cv::Scalar(255, 255, 255));
+    const cv::Scalar colours[] = {{40, 40, 220}, {200, 120, 30}, {60, 160, 60}, {150, 60, 150}};
+    const int group_w = (W - left - 20) / static_cast<int>(cats.size());
+    const int bar_w = (group_w - 20) / static_cast<int>(methods.size());
+    const int plot_h = H - bottom - top;
+    for (int p = 0; p <= 100; p += 25) {
+        const int y = H - bottom - plot_h * p / 100;
+        cv::line(img, {left, y}, {W - 10, y}, cv::Scalar(225, 225, 225), 1);
+        cv::putText(img, std::to_string(p) + "%", {8, y + 4}, cv::FONT_HERSHEY_SIMPLEX, 0.4,
+                    cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+    }
+    for (size_t c = 0; c < cats.size(); c++) {
+        const int gx = left + static_cast<int>(c) * group_w + 10;
+        for (size_t m = 0; m < methods.size(); m++) {
+            const auto it = tally.find({static_cast<int>(c), methods[m]});
+            const double rate = it == tally.end() || it->second.n == 0
+                                    ? 0.0
+                                    : static_cast<double>(it->second.success) / it->second.n;
+            const int x = gx + static_cast<int>(m) * bar_w;
+            const int h = static_cast<int>(plot_h * rate);
+            cv::rectangle(img, {x, H - bottom - h}, {x + bar_w - 4, H - bottom}, colours[m % 4],
+                          cv::FILLED);
+        }
+        cv::putText(img, devslam::sim::toString(cats[c]), {gx, H - bottom + 20},
+                    cv::FONT_HERSHEY_SIMPLEX, 0.45, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+    }
+    for (size_t m = 0; m < methods.size(); m++) {
+        const int x = left + static_cast<int>(m) * 190;
+        cv::rectangle(img, {x, H - 25}, {x + 14, H - 11}, colours[m % 4], cv::FILLED);
+        cv::putText(img, shortName(methods[m]), {x + 20, H - 13}, cv::FONT_HERSHEY_SIMPLEX, 0.45,
+                    cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+    }
+    cv::putText(img, "success rate per category (devslam-nav-bench)", {left, 25},
+                cv::FONT_HERSHEY_SIMPLEX, 0.55, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+    if (!cv::imwrite(path, img)) throw std::runtime_error("cannot write " + path);
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+    Args a;
+    bool results_given = false;
+    try {
+        for (int i = 1; i < argc; i++) {
+            const std::string s = argv[i];
+            auto next = [&]() -> std::string {
+                if (i + 1 >= argc) throw std::invalid_argument("missing value after " + s);
+                return argv[++i];
+            };
+            if (s == "--per-category")
+                a.per_category = std::stoi(next());
+            else if (s == "--quick")
+                a.quick = true;
+            else if (s == "--config")
+                a.config = next();
+            else if (s == "--results") {
+                a.results = next();
+                results_given = true;
+            } else if (s == "--png-dir")
+                a.png_dir = next();
+            else if (s == "--seed")
+                a.seed = static_cast<uint32_t>(std::stoul(next()));
+            else if (s == "--methods") {
+                a.methods.clear();
+                std::stringstream ss(next());
+                std::string m;
+                while (std::getline(ss, m, ','))
+                    if (!m.empty()) a.methods.push_back(m);
+            } else if (s == "-h" || s == "--help") {
+                usage();
+                return 0;
+            } else
+                throw std::invalid_argument("unknown option " + s);
+        }
+        if (a.quick) a.per_category = 2;
+        if (a.per_category < 1) throw std::invalid_argument("--per-category must be >= 1");
+        if (a.methods.empty()) throw std::invalid_argument("--methods is empty");
+    } catch (const std::exception& e) {
+        std::cerr << "devslam-nav-bench: " << e.what() << "\n";
+        usage();
+        return 2;
+    }
+    if (!results_given && !a.quick)
+        a.results = std::string(DEVSLAM_SOURCE_DIR) + "/docs/RESULTS.md";
+
+    try {
+        devslam::nav::registerNavClasses();
+        const auto ini = devslam::core::loadIni(a.config);
+        const auto nav_opts = devslam::nav::NavigatorOptions::fromConfig(*ini, a.config);
+        const auto cats = devslam::sim::allCategories();
+        mrpt::system::createDirectory(a.png_dir);
+
+        std::map<std::pair<int, std::string>, Tally> tally;
+        std::map<std::string, std::vector<double>> step_ms;
+        const size_t total = cats.size() * a.per_category * a.methods.size();
+        devslam::core::ProgressBar bar("nav-bench", total);
+        size_t done = 0;
+        const auto t_start = Clock::now();
+        double sim_seconds = 0;
+        for (size_t c = 0; c < cats.size(); c++) {
+            for (int i = 0; i < a.per_category; i++) {
+                auto planner_opts = nav_opts.planner;
+                const auto world = devslam::sim::randomWorld(cats[c], a.seed + i, planner_opts);
+                for (const auto& m : a.methods) {
+                    devslam::sim::EpisodeOptions eo;
+                    eo.holonomic_method = m;
+                    const auto r = devslam::sim::runEpisode(world, *ini, nav_opts, eo);
+                    sim_seconds += r.time;
+                    auto& t = tally[{static_cast<int>(c), m}];
+                    t.n++;
+                    const double ot = r.astar_length / world.robot.max_v;  // optimal time
+                    double score = 0;
+                    switch (r.outcome) {
+                        case devslam::sim::Outcome::Success:
+                            t.success++;
+                            t.success_time.push_back(r.time);
+                            if (r.astar_length > 0)
+                                t.ratio.push_back(r.path_length / r.astar_length);
+                            score = ot / std::clamp(r.time, ot, 8.0 * ot);
+                            break;
+                        case devslam::sim::Outcome::Collision:
+                            t.collision++;
+                            break;
+                        default:
+                            t.timeout++;
+                            break;
+                    }
+                    t.static_collision += r.static_collisions > 0 ? 1 : 0;
+                    t.person_collision += r.person_collisions > 0 ? 1 : 0;
+                    t.score.push_back(score);
+                    for (double s : r.step_seconds) step_ms[m].push_back(1e3 * s);
+                    if (i == 0 && m == a.methods.front())
+                        devslam::sim::writeEpisodePng(
+                            world, r,
+                            a.png_dir + "/nav_bench_" + devslam::sim::toString(cats[c]) + ".png",
+                            world.name + " / " + m);
+                    bar.update(++done,
+                               std::string(devslam::sim::toString(cats[c])) + " " + shortName(m));
+                }
+            }
+        }
+        bar.finish();
+        const double wall = std::chrono::duration<double>(Clock::now() - t_start).count();
+
+        double astar_len = 0;
+        const double vfh_ms = timeVfhStep();
+        const double astar_ms = timeAStar400(&astar_len);
+
+        std::ostringstream md;
+        md << "## Navigation benchmark (`devslam-nav-bench`)\n\n"
+           << "Command: `devslam-nav-bench --per-category " << a.per_category << " --seed "
+           << a.seed << "` (config `config_ini/nav_reactive.ini`). " << a.per_category
+           << " seeded random worlds "
+           << "per category, " << a.per_category * cats.size()
+           << " worlds in all, the same worlds for every method; Bullet simulation at 100 Hz, "
+              "navigator at 10 Hz, simulated clock. Success: within the goal tolerance before the "
+              "timeout without touching anything; a run ends at the first contact. Path ratio = "
+              "driven length / A* length (A* on the 5 cm grid, so a staircase: ratios below 1 "
+              "are normal). Score (BARN-style) = success x OT / clip(T, OT, 8 OT) with OT = A* "
+              "length / max speed, averaged over all runs.\n\n";
+        for (size_t c = 0; c < cats.size(); c++) {
+            md << "### " << devslam::sim::toString(cats[c])
+               << (devslam::sim::hasPeople(cats[c]) ? " (moving people)" : " (static)") << "\n\n"
+               << "| method | success | collision (static / people) | timeout | mean time to goal "
+                  "(s) "
+                  "| path / A* | score |\n|---|---|---|---|---|---|---|\n";
+            for (const auto& m : a.methods) {
+                const auto& t = tally[{static_cast<int>(c), m}];
+                const auto st = devslam::core::summarize(t.success_time);
+                const auto rt = devslam::core::summarize(t.ratio);
+                const auto sc = devslam::core::summarize(t.score);
+                md << "| " << shortName(m) << " | " << pct(t.success, t.n) << " (" << t.success
+                   << "/" << t.n << ") | " << pct(t.collision, t.n) << " (" << t.static_collision
+                   << " / " << t.person_collision << ") | " << pct(t.timeout, t.n) << " | "
+                   << (t.success_time.empty() ? "-" : num(st.mean, 1)) << " | "
+                   << (t.ratio.empty() ? "-" : num(rt.mean, 2)) << " | " << num(sc.mean, 3)
+                   << " |\n";
+            }
+            md << "\n![" << devslam::sim::toString(cats[c]) << "](images/nav_bench_"
+               << devslam::sim::toString(cats[c]) << ".png)\n\n";
+        }
+        md << "![success rates](images/nav_bench_success.png)\n\n"
+           << "### Timing\n\n| measure | median |\n|---|---|\n"
+           << "| one VFH+ step (`vfhPlusStep`, 121 sectors, synthetic fields, 2000 calls) | "
+           << num(vfh_ms * 1e3, 1) << " us |\n";
+        for (const auto& m : a.methods)
+            md << "| one MRPT `navigationStep()` with " << shortName(m)
+               << " (3 PTGs, 181-ray laser, all runs) | "
+               << num(devslam::core::median(step_ms[m]), 3) << " ms |\n";
+        md << "| A* on a 400x400 grid (20 m, 5 cm cells, 60 boxes, corner to corner, path "
+           << num(astar_len, 1) << " m; 15 plans) | " << num(astar_ms, 1) << " ms |\n"
+           << "| whole benchmark: simulated / wall time | " << num(sim_seconds, 0) << " s / "
+           << num(wall, 0) << " s |\n\n"
+           << devslam::core::measuredOnLine() << "\n";
+        std::cout << md.str();
+        writeChart(a.png_dir + "/nav_bench_success.png", cats, a.methods, tally);
+        if (!a.results.empty()) {
+            devslam::core::replaceResultsSection(a.results, "nav", md.str());
+            std::cerr << "devslam-nav-bench: updated section 'nav' of " << a.results << "\n";
+        }
+        return 0;
+    } catch (const std::exception& e) {
+        std::cerr << "devslam-nav-bench: " << e.what() << "\n";
+        return 2;
+    }
+}
