@@ -9,10 +9,13 @@
 
 #include <gtest/gtest.h>
 #include <mrpt/core/Clock.h>
+#include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/kinematics/CVehicleSimul_DiffDriven.h>
 #include <mrpt/maps/CSimplePointsMap.h>
+#include <mrpt/nav/reactive/CLogFileRecord.h>
 #include <mrpt/nav/reactive/CRobot2NavInterfaceForSimulator.h>
 #include <mrpt/obs/CObservation2DRangeScan.h>
+#include <mrpt/serialization/CArchive.h>
 #include <mrpt/system/CDirectoryExplorer.h>
 #include <mrpt/system/filesystem.h>
 
@@ -128,7 +131,24 @@ TEST(IntegrationNav, AppsSmokeTest) {
     std::vector<std::string> logs;
     mrpt::system::CDirectoryExplorer::TFileInfoList files;
     mrpt::system::CDirectoryExplorer::explore(out + "/navlog", FILE_ATTRIB_ARCHIVE, files);
-    EXPECT_FALSE(files.empty()) << "no navlog written";
+    ASSERT_FALSE(files.empty()) << "no navlog written";
+    {
+        // the navlog holds MRPT records whose holonomic part is our VFH+ record
+        devslam::nav::registerNavClasses();
+        mrpt::io::CFileGZInputStream f(files.front().wholePath);
+        auto arch = mrpt::serialization::archiveFrom(f);
+        int vfh_records = 0;
+        for (int i = 0; i < 20; i++) {
+            mrpt::serialization::CSerializable::Ptr obj;
+            arch >> obj;
+            auto rec = std::dynamic_pointer_cast<mrpt::nav::CLogFileRecord>(obj);
+            ASSERT_TRUE(rec);
+            for (const auto& ptg : rec->infoPerPTG)
+                if (std::dynamic_pointer_cast<devslam::nav::CLogFileRecord_VFHPlus>(ptg.HLFR))
+                    vfh_records++;
+        }
+        EXPECT_GT(vfh_records, 20);
+    }
     // bad world: clear error, exit code 2
     const std::string bad = bin + "/devslam-nav " + kSrc +
                             "/tests/sim/data/obstacle_on_goal.ini > " + out + "/bad.txt 2>&1";
