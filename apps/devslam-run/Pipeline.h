@@ -51,6 +51,7 @@ struct RunReport {
     std::optional<eval::RpeResult> rpe_1s, rpe_frame;
     double median_fps = 0, mean_fps = 0, median_ms = 0;
     FrameTiming stage_mean_ms, stage_median_ms;
+    double finalize_ms = 0;  ///< end-of-sequence BA + frame refinement (not in FPS)
     double peak_rss_mb = 0;  ///< VmHWM of the process at the end
     double map_mb = 0;       ///< approximate map heap
     double bytes_per_keyframe = 0;

@@ -16,7 +16,7 @@ void OrbExtractor::Options::loadFromConfig(const mrpt::config::CConfigFileBase& 
     core::requireKnownKeys(
         c, s,
         {"n_features", "scale_factor", "n_levels", "fast_threshold", "min_fast_threshold",
-         "oversample", "grid_cols", "grid_rows", "min_depth", "max_depth"});
+         "oversample", "grid_cols", "grid_rows", "min_depth", "max_depth", "depth_factor"});
     n_features = c.read_int(s, "n_features", n_features);
     scale_factor = c.read_double(s, "scale_factor", scale_factor);
     n_levels = c.read_int(s, "n_levels", n_levels);
@@ -27,6 +27,9 @@ void OrbExtractor::Options::loadFromConfig(const mrpt::config::CConfigFileBase& 
     grid_rows = c.read_int(s, "grid_rows", grid_rows);
     min_depth = c.read_double(s, "min_depth", min_depth);
     max_depth = c.read_double(s, "max_depth", max_depth);
+    depth_factor = c.read_double(s, "depth_factor", depth_factor);
+    core::requireValue(depth_factor > 0.5 && depth_factor < 2.0, s, "depth_factor",
+                       "must be in (0.5, 2)");
     core::requireValue(n_features > 0, s, "n_features", "must be > 0");
     core::requireValue(scale_factor > 1.0, s, "scale_factor", "must be > 1");
     core::requireValue(n_levels >= 1, s, "n_levels", "must be >= 1");
@@ -48,6 +51,7 @@ void OrbExtractor::Options::saveToConfig(mrpt::config::CConfigFileBase& c,
     c.write(s, "grid_rows", grid_rows);
     c.write(s, "min_depth", min_depth);
     c.write(s, "max_depth", max_depth);
+    c.write(s, "depth_factor", depth_factor);
 }
 
 OrbExtractor::OrbExtractor(const Options& opts) : opts_(opts) {
@@ -151,6 +155,7 @@ FrameFeatures OrbExtractor::extract(const core::Frame& frame, const cv::Mat& mas
         const int u = std::clamp(static_cast<int>(kp.pt.x + 0.5f), 0, gray.cols - 1);
         const int v = std::clamp(static_cast<int>(kp.pt.y + 0.5f), 0, gray.rows - 1);
         float z = has_depth ? frame.depth.at<float>(v, u) : 0.f;
+        z *= static_cast<float>(opts_.depth_factor);
         if (!(z >= opts_.min_depth && z <= opts_.max_depth)) z = 0.f;  // also rejects NaN
         f.depth.push_back(z);
         f.points_c.push_back(z > 0 ? core::backproject(kp.pt.x, kp.pt.y, z, frame.K)

@@ -14,8 +14,9 @@ void MappingOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, cons
     core::requireKnownKeys(
         c, s,
         {"min_init_points", "cull_min_found_ratio", "cull_min_visible", "cull_keyframe_age",
-         "odometry_sigma_t", "odometry_sigma_r_deg", "depth_time_compensation"});
+         "odometry_sigma_t", "odometry_sigma_r_deg", "depth_time_compensation", "refine_frames"});
     depth_time_compensation = c.read_bool(s, "depth_time_compensation", depth_time_compensation);
+    refine_frames = c.read_bool(s, "refine_frames", refine_frames);
     min_init_points = c.read_int(s, "min_init_points", min_init_points);
     cull_min_found_ratio = c.read_double(s, "cull_min_found_ratio", cull_min_found_ratio);
     cull_min_visible = c.read_int(s, "cull_min_visible", cull_min_visible);
@@ -37,6 +38,7 @@ void MappingOptions::saveToConfig(mrpt::config::CConfigFileBase& c, const std::s
     c.write(s, "odometry_sigma_t", odometry_sigma_t);
     c.write(s, "odometry_sigma_r_deg", odometry_sigma_r_deg);
     c.write(s, "depth_time_compensation", depth_time_compensation);
+    c.write(s, "refine_frames", refine_frames);
 }
 
 std::optional<double> depthStamp(const core::Frame& frame) {
@@ -144,7 +146,19 @@ TrackResult Slam::track(const core::Frame& frame, const FrameFeatures& features,
     } else {
         rec.T_ref_c = res.T_wc;
     }
-    records_.push_back(rec);
+    if (res.pose_valid && opts_.mapping.refine_frames) {
+        for (std::size_t i = 0; i < features.size(); ++i) {
+            const LandmarkId lm = res.landmark_of_kp[i];
+            if (lm == kNoId) continue;
+            const auto& kp = features.keypoints[i];
+            const double sc = std::pow(opts_.orb.scale_factor, kp.octave);
+            rec.obs.emplace_back(lm, PoseObservation{Eigen::Vector3d::Zero(),
+                                                     {kp.pt.x, kp.pt.y},
+                                                     features.depth[i],
+                                                     1.0 / (sc * sc)});
+        }
+    }
+    records_.push_back(std::move(rec));
     return res;
 }
 
@@ -204,6 +218,8 @@ MappingResult Slam::mapStep(const core::Frame& frame, FrameFeatures features,
     if (!records_.empty()) {
         records_.back().ref_kf = id;
         records_.back().T_ref_c = Eigen::Isometry3d::Identity();
+        records_.back().is_keyframe = true;
+        records_.back().obs.clear();
     }
     // Cull landmarks that are rarely found where they should be seen, or that no later
     // keyframe confirmed.
@@ -217,10 +233,56 @@ MappingResult Slam::mapStep(const core::Frame& frame, FrameFeatures features,
     }
     for (LandmarkId lid : cull) map_.removeLandmark(lid);
     out.culled_landmarks = static_cast<int>(cull.size());
-    if (opts_.local_ba.enabled) out.ba = localBundleAdjust(map_, id, frame.K, opts_.local_ba);
+    if (opts_.local_ba.enabled) {
+        out.ba = localBundleAdjust(map_, id, frame.K, opts_.local_ba);
+        if (opts_.mapping.refine_frames)
+            refineFrames(map_.lastKeyframes(static_cast<std::size_t>(opts_.local_ba.window)),
+                         frame.K);
+    }
     // The tracker continues from the (possibly adjusted) keyframe pose.
     tracker_.applyCorrection(map_.keyframe(id).T_wc * track.T_wc.inverse());
     return out;
+}
+
+void Slam::refineFrames(const std::vector<KeyframeId>& window, const core::CameraIntrinsics& K) {
+    if (window.empty()) return;
+    const KeyframeId oldest = window.front();
+    bool release = true;
+    for (std::size_t i = first_record_with_obs_; i < records_.size(); ++i) {
+        FrameRecord& r = records_[i];
+        if (r.obs.empty()) {
+            if (release) first_record_with_obs_ = i + 1;
+            continue;
+        }
+        if (r.ref_kf < oldest) {  // the keyframe has left the window: final
+            r.obs.clear();
+            r.obs.shrink_to_fit();
+            if (release) first_record_with_obs_ = i + 1;
+            continue;
+        }
+        release = false;
+        if (r.is_keyframe || !r.valid || r.ref_kf == kNoId) continue;
+        std::vector<PoseObservation> obs;
+        obs.reserve(r.obs.size());
+        for (const auto& [lm, o] : r.obs) {
+            const Landmark* l = map_.landmark(lm);
+            if (!l) continue;
+            obs.push_back(o);
+            obs.back().p_w = l->p_w;
+        }
+        if (static_cast<int>(obs.size()) < opts_.tracker.min_inliers) continue;
+        const Eigen::Isometry3d T_wk = map_.keyframe(r.ref_kf).T_wc;
+        const auto ref = refinePose(obs, T_wk * r.T_ref_c, K, opts_.tracker.refine);
+        if (ref.n_inliers >= opts_.tracker.min_inliers) r.T_ref_c = T_wk.inverse() * ref.T_wc;
+    }
+}
+
+void Slam::finalize(const core::CameraIntrinsics& K) {
+    const auto last = map_.lastKeyframes(1);
+    if (last.empty()) return;
+    if (opts_.local_ba.enabled) (void)localBundleAdjust(map_, last.front(), K, opts_.local_ba);
+    if (opts_.mapping.refine_frames)
+        refineFrames(map_.lastKeyframes(static_cast<std::size_t>(opts_.local_ba.window)), K);
 }
 
 BackendResult Slam::backendStep(const MappingResult& mapping, const core::CameraIntrinsics& K) {

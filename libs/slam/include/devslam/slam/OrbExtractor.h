@@ -32,6 +32,8 @@ class OrbExtractor {
         int grid_rows = 6;           ///< spreading grid (cells over the image height)
         double min_depth = 0.1;      ///< [m] nearer depth is treated as missing
         double max_depth = 6.0;      ///< [m] farther depth is treated as missing
+        /// Multiplies every depth reading (sensor depth-scale calibration; 1 = as recorded).
+        double depth_factor = 1.0;
 
         void loadFromConfig(const mrpt::config::CConfigFileBase& cfg,
                             const std::string& section = "orb");

@@ -43,6 +43,9 @@ struct MappingOptions {
     /// Move depth points to the colour image's time with the constant-velocity model when
     /// the depth image has its own stamp (TUM: up to 20 ms apart; see depthStamp()).
     bool depth_time_compensation = true;
+    /// After each local BA, re-refine the poses of the frames between the optimised
+    /// keyframes against the adjusted landmarks (frames get keyframe-like accuracy).
+    bool refine_frames = true;
 
     void loadFromConfig(const mrpt::config::CConfigFileBase& cfg,
                         const std::string& section = "mapping");
@@ -117,6 +120,9 @@ class Slam {
     /// Loop detection and pose-graph optimisation after a keyframe insertion.
     [[nodiscard]] BackendResult backendStep(const MappingResult& mapping,
                                             const core::CameraIntrinsics& K);
+    /// End of sequence: a last local BA over the newest keyframes and the re-refinement of
+    /// the frames that reference them (see MappingOptions::refine_frames).
+    void finalize(const core::CameraIntrinsics& K);
     /// All stages for one frame.
     [[nodiscard]] FrameResult process(
         const core::Frame& frame, const cv::Mat& mask,
@@ -142,8 +148,16 @@ class Slam {
         KeyframeId ref_kf = kNoId;  ///< kNoId: pose is absolute (before the first keyframe)
         Eigen::Isometry3d T_ref_c = Eigen::Isometry3d::Identity();
         bool valid = false;
+        bool is_keyframe = false;
+        /// Inlier observations kept while the reference keyframe is in the BA window, so
+        /// the frame can be re-refined against the adjusted map (then released).
+        std::vector<std::pair<LandmarkId, PoseObservation>> obs;
     };
     void applyCorrections(const std::map<std::int64_t, Eigen::Isometry3d>& new_poses);
+    /// Motion-only refinement of the non-keyframe frames whose reference keyframe is in
+    /// `window`, against the current landmark positions; releases older observations.
+    void refineFrames(const std::vector<KeyframeId>& window, const core::CameraIntrinsics& K);
+    std::size_t first_record_with_obs_ = 0;
 
     SlamOptions opts_;
     OrbExtractor orb_;
