@@ -24,7 +24,7 @@ namespace {
 
 const char* kUsage =
     "usage: devslam-run [--input PATH] [--mode none|all_persons|dynamic] [--config INI]\n"
-    "                   [--out DIR] [--max-frames N] [--quiet]\n"
+    "                   [--out DIR] [--max-frames N] [--quiet] [--set SECTION.KEY=VALUE]...\n"
     "       devslam-run --bench N [--input PATH] [--config INI] [--results FILE]\n"
     "defaults: --input " DEVSLAM_SOURCE_DIR
     "/data/tum/fr1_xyz_first37\n"
@@ -41,6 +41,7 @@ struct Args {
     std::size_t max_frames = 0;
     int bench = 0;
     bool quiet = false;
+    std::vector<std::string> sets;  ///< INI overrides "section.key=value"
 };
 
 Args parse(int argc, char** argv) {
@@ -67,6 +68,8 @@ Args parse(int argc, char** argv) {
             a.bench = std::stoi(value(i));
         else if (k == "--quiet")
             a.quiet = true;
+        else if (k == "--set")
+            a.sets.push_back(value(i));
         else if (k == "-h" || k == "--help") {
             std::cout << kUsage;
             std::exit(0);
@@ -82,9 +85,22 @@ struct Loaded {
     std::string mode;
 };
 
-Loaded loadConfig(const Args& a) {
+/// Applies "section.key=value" overrides to an INI held in memory.
+void applySets(mrpt::config::CConfigFileMemory& cfg, const std::vector<std::string>& sets) {
+    for (const auto& s : sets) {
+        const auto dot = s.find('.'), eq = s.find('=');
+        if (dot == std::string::npos || eq == std::string::npos || dot > eq || dot == 0 ||
+            eq == dot + 1)
+            throw std::invalid_argument("--set '" + s + "': expected SECTION.KEY=VALUE");
+        cfg.write(s.substr(0, dot), s.substr(dot + 1, eq - dot - 1), s.substr(eq + 1));
+    }
+}
+
+Loaded loadConfig(const Args& a, const std::vector<std::string>& extra_sets = {}) {
     Loaded l;
     l.cfg = core::loadIni(a.config);
+    applySets(*l.cfg, a.sets);
+    applySets(*l.cfg, extra_sets);
     core::requireKnownKeys(*l.cfg, "run", {"mode", "filter_config"}, a.config);
     l.mode = a.mode.empty() ? l.cfg->read_string("run", "mode", "dynamic") : a.mode;
     const std::string fc = l.cfg->read_string("run", "filter_config", "");
@@ -95,6 +111,8 @@ Loaded loadConfig(const Args& a) {
     } else {
         l.filter_cfg = core::loadIni(a.config);
     }
+    applySets(*l.filter_cfg, a.sets);
+    applySets(*l.filter_cfg, extra_sets);
     l.reader.loadFromConfig(*l.cfg, "dataset");
     return l;
 }
@@ -177,7 +195,36 @@ int runBench(const Args& a) {
         for (int k = 0; k < 6; ++k) stages << " | " << fmt(median(st[k]), 2);
         stages << " |\n";
     }
-    md << stages.str() << "\nPeak RSS is the whole process (libraries, detector network, "
+    // Ablation: one design choice changed at a time (mode none; ATE is deterministic).
+    std::ostringstream abl;
+    abl << "\nAblation (mode none, one run each, `devslam-run --mode none --set KEY=VALUE`):\n\n"
+        << "| change | ATE RMSE [m] | keyframes | median FPS |\n|---|---|---|---|\n";
+    const std::vector<std::pair<std::string, std::vector<std::string>>> ablations = {
+        {"(defaults of the INI)", {}},
+        {"orb.depth_factor=1.0 (no depth-scale correction)", {"orb.depth_factor=1.0"}},
+        {"mapping.depth_time_compensation=false", {"mapping.depth_time_compensation=false"}},
+        {"mapping.refine_frames=false", {"mapping.refine_frames=false"}},
+        {"local_ba.enabled=false", {"local_ba.enabled=false"}},
+        {"orb.n_levels=8, orb.scale_factor=1.2 (ORB-SLAM2 pyramid)",
+         {"orb.n_levels=8", "orb.scale_factor=1.2"}},
+        {"keyframes.max_frames=1 (every frame a keyframe)", {"keyframes.max_frames=1"}},
+    };
+    for (const auto& [name, sets] : ablations) {
+        auto l = loadConfig(a, sets);
+        auto reader = io::openRgbd(a.input, l.reader);
+        run::RunConfig rc;
+        rc.input = a.input;
+        rc.mode = "none";
+        rc.progress = false;
+        rc.max_frames = a.max_frames;
+        const auto rep = run::runSequence(*reader, rc, *l.cfg, *l.filter_cfg);
+        abl << "| " << name << " | " << (rep.ate ? fmt(rep.ate->trans.rmse, 4) : "-") << " | "
+            << rep.keyframes << " | " << fmt(rep.median_fps, 1) << " |\n";
+        std::cerr << "ablation " << name << ": ATE "
+                  << (rep.ate ? fmt(rep.ate->trans.rmse, 4) : "-") << "\n";
+    }
+    md << stages.str() << abl.str()
+       << "\nPeak RSS is the whole process (libraries, detector network, "
        << "all runs so far). Measured on " << core::measuredOnLine() << ".\n";
     core::replaceResultsSection(a.results, "slam", md.str());
     std::cout << md.str();
