@@ -29,7 +29,7 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 struct Args {
-    int per_category = 25;
+    int per_category = 50;
     bool quick = false;
     std::string config = std::string(DEVSLAM_SOURCE_DIR) + "/config_ini/nav_reactive.ini";
     std::string results;  // empty: default unless --quick
@@ -41,7 +41,7 @@ struct Args {
 
 void usage() {
     std::cerr << "usage: devslam-nav-bench [options]\n"
-                 "  --per-category N  worlds per category (default 25 -> 100 worlds)\n"
+                 "  --per-category N  worlds per category (default 50 -> 200 worlds)\n"
                  "  --quick           smoke test: 2 worlds per category, RESULTS.md untouched\n"
                  "  --methods a,b     holonomic methods (default all four)\n"
                  "  --config FILE     navigation INI (default config_ini/nav_reactive.ini)\n"
