@@ -114,7 +114,7 @@ LocalBaResult localBundleAdjust(Map& map, KeyframeId newest, const core::CameraI
                 cost += 100.0;
                 continue;
             }
-            const double e2 = r.head(rows).squaredNorm() * o.inv_sigma2;
+            const double e2 = r.squaredNorm() * o.inv_sigma2;
             const double d2 = rows == 3 ? opts.chi2_stereo : opts.chi2_mono;
             cost += e2 <= d2 ? e2 : 2 * std::sqrt(e2 * d2) - d2;
         }
@@ -141,16 +141,16 @@ LocalBaResult localBundleAdjust(Map& map, KeyframeId newest, const core::CameraI
             if (!observationJacobians(T_cw[o.pose], X[o.landmark], o.uv, o.depth, K, opts.bf, r, Jp,
                                       Jl, rows))
                 continue;
-            const double e2 = r.head(rows).squaredNorm() * o.inv_sigma2;
+            const double e2 = r.squaredNorm() * o.inv_sigma2;
             const double d2 = rows == 3 ? opts.chi2_stereo : opts.chi2_mono;
             const double w = o.inv_sigma2 * (e2 <= d2 ? 1.0 : std::sqrt(d2 / e2));
-            const auto Jpr = Jp.topRows(rows);
-            const auto Jlr = Jl.topRows(rows);
+            const auto Jpr = Jp;
+            const auto Jlr = Jl;
             Hll[o.landmark] += w * Jlr.transpose() * Jlr;
-            gl[o.landmark] += w * Jlr.transpose() * r.head(rows);
+            gl[o.landmark] += w * Jlr.transpose() * r;
             if (o.pose < P) {
                 Hpp.block<6, 6>(6 * o.pose, 6 * o.pose) += w * Jpr.transpose() * Jpr;
-                gp.segment<6>(6 * o.pose) += w * Jpr.transpose() * r.head(rows);
+                gp.segment<6>(6 * o.pose) += w * Jpr.transpose() * r;
                 Hpl[k] = w * Jpr.transpose() * Jlr;
             }
         }
@@ -221,8 +221,7 @@ LocalBaResult localBundleAdjust(Map& map, KeyframeId newest, const core::CameraI
         bool bad = !observationJacobians(T_cw[o.pose], X[o.landmark], o.uv, o.depth, K, opts.bf, r,
                                          Jp, Jl, rows);
         if (!bad)
-            bad = r.head(rows).squaredNorm() * o.inv_sigma2 >
-                  (rows == 3 ? opts.chi2_stereo : opts.chi2_mono);
+            bad = r.squaredNorm() * o.inv_sigma2 > (rows == 3 ? opts.chi2_stereo : opts.chi2_mono);
         if (!bad) continue;
         map.removeObservation(lm_ids[o.landmark], o.kf, o.kp);
         ++res.n_outliers_removed;

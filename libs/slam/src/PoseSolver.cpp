@@ -116,12 +116,12 @@ PoseRefineResult refinePose(const std::vector<PoseObservation>& obs,
                 const auto& o = obs[i];
                 if (!observationJacobians(T_cw, o.p_w, o.uv, o.depth, K, opts.bf, r, Jp, Jl, rows))
                     continue;
-                const double e2 = r.head(rows).squaredNorm() * o.inv_sigma2;
+                const double e2 = r.squaredNorm() * o.inv_sigma2;
                 const double delta2 = rows == 3 ? opts.chi2_stereo : opts.chi2_mono;
                 double w = o.inv_sigma2;
                 if (robust && e2 > delta2) w *= std::sqrt(delta2 / e2);  // Huber
-                H += w * Jp.topRows(rows).transpose() * Jp.topRows(rows);
-                g += w * Jp.topRows(rows).transpose() * r.head(rows);
+                H += w * Jp.transpose() * Jp;
+                g += w * Jp.transpose() * r;
                 ++n;
             }
             if (n < 3) break;
@@ -138,7 +138,7 @@ PoseRefineResult refinePose(const std::vector<PoseObservation>& obs,
                 res.inlier[i] = 0;
                 continue;
             }
-            const double e2 = r.head(rows).squaredNorm() * o.inv_sigma2;
+            const double e2 = r.squaredNorm() * o.inv_sigma2;
             res.inlier[i] = e2 <= (rows == 3 ? opts.chi2_stereo : opts.chi2_mono) ? 1 : 0;
             res.n_inliers += res.inlier[i];
         }

@@ -62,7 +62,8 @@ struct PoseRefineResult {
                                           const PoseRefineOptions& opts);
 
 /// Residual and Jacobian of one observation w.r.t. a left perturbation [v, w] of T_cw and
-/// w.r.t. the world point: r = predicted - measured (2 or 3 rows). false when behind the camera.
+/// w.r.t. the world point: r = predicted - measured; `rows` = 2 (no depth: third row of r and
+/// of both Jacobians is zero) or 3. false when behind the camera.
 bool observationJacobians(const Eigen::Isometry3d& T_cw, const Eigen::Vector3d& p_w,
                           const Eigen::Vector2d& uv, double depth, const core::CameraIntrinsics& K,
                           double bf, Eigen::Vector3d& r, Eigen::Matrix<double, 3, 6>& J_pose,
