@@ -6,6 +6,7 @@
 //               --config config_ini/slam_tum_fr1.ini --out DIR
 //   devslam-run --bench 5                         # all modes x 5 runs -> docs/RESULTS.md
 #include "Pipeline.h"
+#include "ReplayReader.h"
 
 #include <devslam/core/Config.h>
 #include <devslam/core/Results.h>
@@ -25,6 +26,7 @@ namespace {
 const char* kUsage =
     "usage: devslam-run [--input PATH] [--mode none|all_persons|dynamic] [--config INI]\n"
     "                   [--out DIR] [--max-frames N] [--quiet] [--set SECTION.KEY=VALUE]...\n"
+    "                   [--replay N]  (play the input forward/backward N times)\n"
     "       devslam-run --bench N [--input PATH] [--config INI] [--results FILE]\n"
     "defaults: --input " DEVSLAM_SOURCE_DIR
     "/data/tum/fr1_xyz_first37\n"
@@ -42,6 +44,7 @@ struct Args {
     int bench = 0;
     bool quiet = false;
     std::vector<std::string> sets;  ///< INI overrides "section.key=value"
+    int replay = 0;                 ///< > 0: ReplayReader with that many passes
 };
 
 Args parse(int argc, char** argv) {
@@ -68,6 +71,8 @@ Args parse(int argc, char** argv) {
             a.bench = std::stoi(value(i));
         else if (k == "--quiet")
             a.quiet = true;
+        else if (k == "--replay")
+            a.replay = std::stoi(value(i));
         else if (k == "--set")
             a.sets.push_back(value(i));
         else if (k == "-h" || k == "--help") {
@@ -117,9 +122,17 @@ Loaded loadConfig(const Args& a, const std::vector<std::string>& extra_sets = {}
     return l;
 }
 
+/// The input reader, wrapped in a ReplayReader when asked.
+std::unique_ptr<io::RgbdReader> openInput(const std::string& input, const io::ReaderOptions& ro,
+                                          int replay) {
+    auto reader = io::openRgbd(input, ro);
+    if (replay <= 0) return reader;
+    return std::make_unique<run::ReplayReader>(*reader, replay);
+}
+
 int runOnce(const Args& a) {
     auto l = loadConfig(a);
-    auto reader = io::openRgbd(a.input, l.reader);
+    auto reader = openInput(a.input, l.reader, a.replay);
     run::RunConfig rc;
     rc.input = a.input;
     rc.mode = l.mode;

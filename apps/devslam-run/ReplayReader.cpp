@@ -1,0 +1,57 @@
+#include "ReplayReader.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace devslam::run {
+
+ReplayReader::ReplayReader(io::RgbdReader& source, int passes) : K_(source.intrinsics()) {
+    if (passes < 1) throw std::invalid_argument("replay: passes must be >= 1");
+    while (auto f = source.next()) frames_.push_back(std::move(*f));
+    if (frames_.size() < 2) throw std::invalid_argument("replay: the source has < 2 frames");
+    const double dt = (frames_.back().timestamp - frames_.front().timestamp) /
+                      static_cast<double>(frames_.size() - 1);
+    const auto n = frames_.size();
+    for (int p = 0; p < passes; ++p) {
+        for (std::size_t k = 0; k < n; ++k) {
+            if (p > 0 && k == 0) continue;  // the turning frame is not repeated
+            const std::size_t src = (p % 2 == 0) ? k : n - 1 - k;
+            const double t = order_.empty()
+                                 ? frames_[src].timestamp
+                                 : (p == 0 ? frames_[src].timestamp : stamps_.back() + dt);
+            order_.push_back(src);
+            stamps_.push_back(t);
+        }
+    }
+    if (const auto gt = source.groundTruth()) {
+        core::Trajectory g;
+        for (std::size_t i = 0; i < order_.size(); ++i) {
+            const double t0 = frames_[order_[i]].timestamp;
+            const auto it =
+                std::min_element(gt->begin(), gt->end(), [&](const auto& a, const auto& b) {
+                    return std::abs(a.t - t0) < std::abs(b.t - t0);
+                });
+            if (std::abs(it->t - t0) < 0.02) g.push_back({stamps_[i], it->pose});
+        }
+        gt_ = g;
+    }
+    what_ = source.describe() + " replayed " + std::to_string(passes) + " passes (" +
+            std::to_string(order_.size()) + " frames)";
+}
+
+std::optional<core::Frame> ReplayReader::next() {
+    if (next_ >= order_.size()) return std::nullopt;
+    core::Frame f = frames_[order_[next_]];
+    f.bgr = f.bgr.clone();  // consumers may modify their frame
+    f.depth = f.depth.clone();
+    // Depth stamp offset is kept relative to the new colour stamp (depth_source names the
+    // original file, so depth-time compensation is disabled for replayed passes > 0).
+    if (stamps_[next_] != f.timestamp) f.depth_source = f.rgb_source;
+    f.timestamp = stamps_[next_];
+    f.index = next_;
+    ++next_;
+    return f;
+}
+
+}  // namespace devslam::run
