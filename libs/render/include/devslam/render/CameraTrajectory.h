@@ -1,0 +1,61 @@
+#pragma once
+/// Camera trajectory generators shaped like the TUM fr3 hand-held sequences:
+/// `xyz` (translation along the three axes), `static` (a few mm of jitter), `halfsphere`
+/// (orbit on a half sphere around a point), `rpy` (rotation about the three axes).
+/// Amplitudes and periods default to values whose mean speeds match TUM fr3
+/// (walking_xyz 0.21 m/s, walking_static 0.01 m/s, walking_halfsphere 0.22 m/s and
+/// 18 deg/s, walking_rpy 53 deg/s). Pure functions of time.
+///
+/// Usage:
+///   devslam::render::TrajectoryOptions o; o.type = TrajectoryType::Xyz;
+///   mrpt::poses::CPose3D T_wc = devslam::render::cameraPoseAt(o, 1.5);
+
+#include <mrpt/poses/CPose3D.h>
+
+#include <Eigen/Core>
+
+#include <string>
+
+namespace mrpt::config {
+class CConfigFileBase;
+}
+
+namespace devslam::render {
+
+enum class TrajectoryType { Static, Xyz, Halfsphere, Rpy };
+/// "static" | "xyz" | "halfsphere" | "rpy"; throws std::invalid_argument listing them.
+[[nodiscard]] TrajectoryType parseTrajectoryType(const std::string& name);
+[[nodiscard]] std::string toString(TrajectoryType t);
+
+struct TrajectoryOptions {
+    TrajectoryType type = TrajectoryType::Xyz;
+    Eigen::Vector3d position{0.6, 2.5, 1.3};  ///< mean optical centre in the world [m]
+    Eigen::Vector3d look_at{4.0, 2.5, 1.0};   ///< point the mean view direction aims at [m]
+    /// xyz/static: translation amplitude along camera right, down, forward [m].
+    Eigen::Vector3d amplitude{0.35, 0.15, 0.25};
+    /// xyz/static: periods of the three translation sines [s].
+    Eigen::Vector3d period{7.0, 9.0, 11.0};
+    /// rpy/all: rotation amplitude about camera forward (roll), right (pitch), down (yaw) [deg].
+    Eigen::Vector3d rot_amplitude_deg{1.0, 1.5, 2.0};
+    /// periods of the three rotation sines [s].
+    Eigen::Vector3d rot_period{5.0, 6.5, 8.0};
+    /// halfsphere: azimuth and elevation swing around the mean direction [deg], their periods [s].
+    double azimuth_amplitude_deg = 45.0, elevation_amplitude_deg = 15.0;
+    double azimuth_period = 20.0, elevation_period = 13.0;
+
+    /// Reads `[section]` (all keys optional, defaults for the chosen type; unknown keys rejected).
+    void loadFromConfig(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
+    /// Defaults that give TUM fr3-like speeds for `t` (keeps position/look_at).
+    void setDefaultsFor(TrajectoryType t);
+};
+
+/// Pose T_wc of the optical centre (x right, y down, z forward) at time t [s] since start.
+[[nodiscard]] mrpt::poses::CPose3D cameraPoseAt(const TrajectoryOptions& o, double t);
+
+/// Optical-frame orientation looking from `eye` towards `target` with world z up
+/// (the image's "down" is world -z). Throws std::invalid_argument if they coincide or
+/// the view is vertical.
+[[nodiscard]] mrpt::poses::CPose3D lookAtPose(const Eigen::Vector3d& eye,
+                                              const Eigen::Vector3d& target);
+
+}  // namespace devslam::render

@@ -1,0 +1,52 @@
+#pragma once
+/// Scripted people: walkers follow a polyline back and forth at constant speed (with a
+/// small vertical bob); sitting/standing people stay in place with a small side sway of
+/// the torso. Pure functions of time.
+///
+/// Usage:
+///   devslam::render::PersonSpec p; p.kind = PersonKind::Walking; p.path = {{2,1},{2,4}};
+///   auto s = devslam::render::personStateAt(p, t);   // s.position, s.sway, s.moving
+
+#include <Eigen/Core>
+
+#include <string>
+#include <vector>
+
+namespace devslam::render {
+
+enum class PersonKind { Walking, Sitting, Standing };
+/// "walking" | "sitting" | "standing"; throws std::invalid_argument listing them.
+[[nodiscard]] PersonKind parsePersonKind(const std::string& name);
+[[nodiscard]] std::string toString(PersonKind k);
+
+struct PersonSpec {
+    std::string name;  ///< INI section name (person_1 ...)
+    PersonKind kind = PersonKind::Walking;
+    std::string texture;   ///< RGBA PNG (absolute path): the person's photo, alpha = silhouette
+    double height = 1.75;  ///< height of the photo's full extent in the world [m]
+    std::vector<Eigen::Vector2d>
+        path;                   ///< walking: polyline on the floor; others: path[0] = place [m]
+    double speed = 0.8;         ///< walking speed along the path [m/s]
+    double start_offset = 0.0;  ///< walking: arc length already walked at t = 0 [m]
+    double base_z = 0.0;    ///< height of the photo's bottom edge above the floor [m] (sitting: < 0
+                            ///< hides legs in a desk)
+    double sway_deg = 3.0;  ///< sitting/standing: side sway amplitude about the base [deg]
+    double sway_period = 3.0;  ///< [s]
+    double bob = 0.02;         ///< walking: vertical bob amplitude [m]
+};
+
+struct PersonState {
+    Eigen::Vector3d position{0, 0, 0};  ///< bottom centre of the photo in the world [m]
+    double sway = 0.0;                  ///< in-plane rotation about the bottom centre [rad]
+    bool moving = false;                ///< true while the person walks
+    Eigen::Vector2d velocity{0, 0};     ///< on the floor [m/s]
+};
+
+/// State at time t [s] since the start of the sequence. Walkers go along the path and back
+/// (ping-pong), so their motion is continuous and never ends.
+[[nodiscard]] PersonState personStateAt(const PersonSpec& p, double t);
+
+/// Length of a polyline [m].
+[[nodiscard]] double pathLength(const std::vector<Eigen::Vector2d>& path);
+
+}  // namespace devslam::render

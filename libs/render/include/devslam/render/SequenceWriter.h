@@ -1,0 +1,43 @@
+#pragma once
+/// Writes a rendered Scenario as a TUM RGB-D folder (rgb/, depth/, rgb.txt, depth.txt,
+/// groundtruth.txt), plus the person truth (persons.txt, labels/<t>.png), the intrinsics
+/// (camera.ini) and optionally an MRPT rawlog.
+///
+/// Usage:
+///   devslam::render::WriteOptions o; o.out_dir = "out/walking_xyz";
+///   auto summary = devslam::render::writeSequence(scenario, o);
+
+#include <devslam/render/Scenario.h>
+
+#include <cstddef>
+#include <functional>
+#include <string>
+
+namespace devslam::render {
+
+struct WriteOptions {
+    std::string out_dir;         ///< created if missing; existing files are overwritten
+    std::string rawlog_path;     ///< empty = no rawlog
+    bool write_labels = true;    ///< labels/<timestamp>.png (person id per pixel)
+    std::size_t max_frames = 0;  ///< 0 = all frames of the scenario
+};
+
+struct WriteSummary {
+    std::size_t n_frames = 0;
+    std::size_t frames_with_moving_person = 0;  ///< frames where a walking person is visible
+    std::size_t frames_with_static_person =
+        0;                          ///< frames where a sitting/standing person is visible
+    double render_ms_median = 0.0;  ///< GL render + read-back per frame [ms]
+};
+
+/// Renders and writes every frame; `progress(done, total)` is called after each frame.
+/// Throws std::runtime_error naming the path when a file cannot be written.
+WriteSummary writeSequence(const Scenario& sc, const WriteOptions& o,
+                           const std::function<void(std::size_t, std::size_t)>& progress = {});
+
+/// persons.txt line format (also written as the file's header comment).
+inline constexpr const char* kPersonsHeader =
+    "# timestamp id name state x y w h visible_pixels   (state: moving|static; box of the "
+    "visible pixels in px, w = h = 0 when not visible)";
+
+}  // namespace devslam::render

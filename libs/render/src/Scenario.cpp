@@ -1,0 +1,239 @@
+#include <devslam/core/Config.h>
+#include <devslam/render/Scenario.h>
+
+#include <mrpt/config/CConfigFileBase.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <sstream>
+#include <stdexcept>
+
+namespace devslam::render {
+namespace fs = std::filesystem;
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+std::string dirOf(const std::string& path) {
+    const fs::path p = fs::absolute(path).parent_path();
+    return p.string();
+}
+
+/// Resolves a whitespace-separated list of files/folders (relative to `base`) into files.
+std::vector<std::string> resolveImages(const std::string& list, const std::string& base,
+                                       const std::string& what) {
+    std::vector<std::string> out;
+    std::istringstream ss(list);
+    std::string tok;
+    while (ss >> tok) {
+        fs::path p(tok);
+        if (p.is_relative()) p = fs::path(base) / p;
+        p = p.lexically_normal();
+        if (fs::is_directory(p)) {
+            std::vector<std::string> files;
+            for (const auto& e : fs::directory_iterator(p)) {
+                const auto ext = e.path().extension().string();
+                if (ext == ".png" || ext == ".jpg" || ext == ".jpeg")
+                    files.push_back(e.path().string());
+            }
+            std::sort(files.begin(), files.end());
+            if (files.empty())
+                throw std::runtime_error(what + ": folder '" + p.string() + "' has no images");
+            out.insert(out.end(), files.begin(), files.end());
+        } else if (fs::is_regular_file(p)) {
+            out.push_back(p.string());
+        } else {
+            throw std::runtime_error(what + ": no such file or folder '" + p.string() + "'");
+        }
+    }
+    return out;
+}
+
+Eigen::Vector3d vec3(const mrpt::config::CConfigFileBase& cfg, const std::string& s,
+                     const std::string& key, const std::string& src, bool required,
+                     const Eigen::Vector3d& def = Eigen::Vector3d::Zero()) {
+    const std::string txt = cfg.read_string(s, key, "");
+    if (txt.empty()) {
+        if (required) throw std::invalid_argument(src + " [" + s + "]: missing key '" + key + "'");
+        return def;
+    }
+    const auto v = parseNumberList(txt, src + " [" + s + "] " + key, 3);
+    return {v[0], v[1], v[2]};
+}
+
+std::vector<std::string> sectionsWithPrefix(const mrpt::config::CConfigFileBase& cfg,
+                                            const std::string& prefix) {
+    std::vector<std::string> all, out;
+    cfg.getAllSections(all);
+    for (const auto& s : all)
+        if (s.rfind(prefix, 0) == 0) out.push_back(s);
+    std::sort(out.begin(), out.end());
+    return out;
+}
+
+void loadRoom(const std::string& path, RoomSpec& room) {
+    const auto cfg = core::loadIni(path);
+    const std::string base = dirOf(path);
+    const std::string s = "room";
+    core::requireKnownKeys(
+        *cfg, s, {"size", "panel_width", "panel_height", "wall_textures", "floor_textures"}, path);
+    room.size = vec3(*cfg, s, "size", path, true);
+    room.panel_width = cfg->read_double(s, "panel_width", room.panel_width);
+    room.panel_height = cfg->read_double(s, "panel_height", room.panel_height);
+    core::requireValue(room.size.minCoeff() > 0.5, path + " [room]", "size", "each side > 0.5 [m]");
+    core::requireValue(room.panel_width > 0.05 && room.panel_height > 0.05, path + " [room]",
+                       "panel_width", "panels must be > 0.05 m");
+    room.wall_textures = resolveImages(cfg->read_string(s, "wall_textures", "", true), base,
+                                       path + " [room] wall_textures");
+    room.floor_textures = resolveImages(cfg->read_string(s, "floor_textures", "", true), base,
+                                        path + " [room] floor_textures");
+    for (const auto& b : sectionsWithPrefix(*cfg, "box_")) {
+        core::requireKnownKeys(*cfg, b, {"base", "size", "yaw_deg", "textures"}, path);
+        BoxSpec box;
+        box.name = b;
+        box.base = vec3(*cfg, b, "base", path, true);
+        box.size = vec3(*cfg, b, "size", path, true);
+        core::requireValue(box.size.minCoeff() > 0, path + " [" + b + "]", "size",
+                           "must be > 0 [m]");
+        box.yaw = cfg->read_double(b, "yaw_deg", 0.0) * kPi / 180.0;
+        box.textures = resolveImages(cfg->read_string(b, "textures", "", true), base,
+                                     path + " [" + b + "] textures");
+        room.boxes.push_back(std::move(box));
+    }
+}
+
+PersonSpec loadPerson(const mrpt::config::CConfigFileBase& cfg, const std::string& s,
+                      const std::string& path) {
+    core::requireKnownKeys(cfg, s,
+                           {"kind", "texture", "height", "path", "speed", "start_offset", "base_z",
+                            "sway_deg", "sway_period", "bob"},
+                           path);
+    PersonSpec p;
+    p.name = s;
+    const std::string where = path + " [" + s + "]";
+    p.kind = parsePersonKind(cfg.read_string(s, "kind", "", true));
+    const auto tex =
+        resolveImages(cfg.read_string(s, "texture", "", true), dirOf(path), where + " texture");
+    if (tex.size() != 1) throw std::invalid_argument(where + " texture: need exactly one file");
+    p.texture = tex.front();
+    p.height = cfg.read_double(s, "height", p.height);
+    p.speed = cfg.read_double(s, "speed", p.speed);
+    p.start_offset = cfg.read_double(s, "start_offset", p.start_offset);
+    p.base_z = cfg.read_double(s, "base_z", p.base_z);
+    p.sway_deg = cfg.read_double(s, "sway_deg", p.sway_deg);
+    p.sway_period = cfg.read_double(s, "sway_period", p.sway_period);
+    p.bob = cfg.read_double(s, "bob", p.bob);
+    const auto xy = parseNumberList(cfg.read_string(s, "path", "", true), where + " path");
+    if (xy.size() < 2 || xy.size() % 2)
+        throw std::invalid_argument(where + " path: need x y pairs");
+    for (std::size_t i = 0; i < xy.size(); i += 2) p.path.emplace_back(xy[i], xy[i + 1]);
+    core::requireValue(p.height > 0.2 && p.height < 3.0, where, "height",
+                       "must be in (0.2, 3) [m]");
+    core::requireValue(p.speed >= 0 && p.speed < 5, where, "speed", "must be in [0, 5) [m/s]");
+    core::requireValue(p.sway_period > 0, where, "sway_period", "must be > 0 [s]");
+    if (p.kind == PersonKind::Walking)
+        core::requireValue(p.path.size() >= 2 && pathLength(p.path) > 0.1, where, "path",
+                           "a walker needs at least two points 0.1 m apart");
+    return p;
+}
+
+}  // namespace
+
+std::vector<double> parseNumberList(const std::string& text, const std::string& what,
+                                    std::size_t expected) {
+    std::string t = text;
+    for (char& c : t)
+        if (c == '[' || c == ']' || c == ',' || c == ';') c = ' ';
+    std::istringstream ss(t);
+    std::vector<double> out;
+    std::string tok;
+    while (ss >> tok) {
+        std::size_t used = 0;
+        double v = 0;
+        try {
+            v = std::stod(tok, &used);
+        } catch (const std::exception&) {
+            used = 0;
+        }
+        if (used != tok.size() || !std::isfinite(v))
+            throw std::invalid_argument(what + ": '" + tok + "' is not a number");
+        out.push_back(v);
+    }
+    if (expected > 0 && out.size() != expected)
+        throw std::invalid_argument(what + ": expected " + std::to_string(expected) +
+                                    " numbers, got " + std::to_string(out.size()));
+    return out;
+}
+
+core::CameraIntrinsics scaleIntrinsics(const core::CameraIntrinsics& K, double s) {
+    core::CameraIntrinsics o = K;
+    o.fx = K.fx * s;
+    o.fy = K.fy * s;
+    o.cx = (K.cx + 0.5) * s - 0.5;
+    o.cy = (K.cy + 0.5) * s - 0.5;
+    o.width = int(std::lround(K.width * s));
+    o.height = int(std::lround(K.height * s));
+    return o;
+}
+
+Scenario loadScenario(const std::string& path) {
+    const auto cfg = core::loadIni(path);
+    Scenario sc;
+    sc.source = path;
+    const std::string s = "scenario";
+    core::requireKnownKeys(*cfg, s,
+                           {"name", "room", "duration", "n_frames", "rate_hz", "t0", "seed",
+                            "rgb_noise_sigma", "near_clip", "far_clip"},
+                           path);
+    sc.name = cfg->read_string(s, "name", fs::path(path).stem().string());
+    sc.rate_hz = cfg->read_double(s, "rate_hz", sc.rate_hz);
+    core::requireValue(sc.rate_hz > 0 && sc.rate_hz <= 1000, path + " [scenario]", "rate_hz",
+                       "must be in (0, 1000] [Hz]");
+    const double duration = cfg->read_double(s, "duration", 0.0);
+    const int n = cfg->read_int(s, "n_frames", 0);
+    if ((duration > 0) == (n > 0))
+        throw std::invalid_argument(
+            path + " [scenario]: give exactly one of 'duration' [s] or 'n_frames'");
+    sc.n_frames = n > 0 ? std::size_t(n) : std::size_t(std::lround(duration * sc.rate_hz));
+    sc.t0 = cfg->read_double(s, "t0", sc.t0);
+    sc.seed = std::uint64_t(cfg->read_uint64_t(s, "seed", sc.seed));
+    sc.rgb_noise_sigma = cfg->read_double(s, "rgb_noise_sigma", sc.rgb_noise_sigma);
+    sc.near_clip = cfg->read_double(s, "near_clip", sc.near_clip);
+    sc.far_clip = cfg->read_double(s, "far_clip", sc.far_clip);
+    core::requireValue(sc.rgb_noise_sigma >= 0, path + " [scenario]", "rgb_noise_sigma",
+                       "must be >= 0");
+    core::requireValue(sc.near_clip > 0 && sc.far_clip > sc.near_clip, path + " [scenario]",
+                       "far_clip", "need 0 < near_clip < far_clip [m]");
+
+    sc.K = cfg->sectionExists("camera") ? core::CameraIntrinsics::fromConfig(*cfg, "camera")
+                                        : core::CameraIntrinsics::fromPreset("freiburg3");
+    for (double d : sc.K.dist)
+        if (d != 0.0)
+            throw std::invalid_argument(path +
+                                        " [camera]: the renderer is a pinhole, 'dist' must be 0");
+
+    std::string room = cfg->read_string(s, "room", "", true);
+    if (fs::path(room).is_relative())
+        room = (fs::path(dirOf(path)) / room).lexically_normal().string();
+    loadRoom(room, sc.room);
+
+    if (cfg->sectionExists("trajectory")) sc.trajectory.loadFromConfig(*cfg, "trajectory");
+    if (cfg->sectionExists("depth_noise")) sc.depth_noise.loadFromConfig(*cfg, "depth_noise");
+    for (const auto& p : sectionsWithPrefix(*cfg, "person_"))
+        sc.people.push_back(loadPerson(*cfg, p, path));
+
+    std::vector<std::string> all;
+    cfg->getAllSections(all);
+    for (const auto& sec : all) {
+        const bool ok = sec == "scenario" || sec == "camera" || sec == "trajectory" ||
+                        sec == "depth_noise" || sec.rfind("person_", 0) == 0;
+        if (!ok)
+            throw std::invalid_argument(
+                path + ": unknown section [" + sec +
+                "] (known: scenario, camera, trajectory, depth_noise, person_*)");
+    }
+    return sc;
+}
+
+}  // namespace devslam::render

@@ -1,0 +1,349 @@
+#include <devslam/render/PersonTexture.h>
+#include <devslam/render/SequenceRenderer.h>
+
+#include <mrpt/img/CImage.h>
+#include <mrpt/img/TCamera.h>
+#include <mrpt/math/CMatrixDynamic.h>
+#include <mrpt/opengl/CFBORender.h>
+#include <mrpt/opengl/COpenGLScene.h>
+#include <mrpt/opengl/CSetOfTexturedTriangles.h>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <cmath>
+#include <map>
+#include <random>
+#include <stdexcept>
+
+namespace devslam::render {
+namespace {
+
+using mrpt::opengl::CSetOfTexturedTriangles;
+
+/// splitmix64: decorrelates (seed, frame, stream) into one 64-bit seed.
+std::uint64_t mixSeed(std::uint64_t a, std::uint64_t b, std::uint64_t c) {
+    std::uint64_t x = a * 0x9E3779B97F4A7C15ull ^
+                      (b + 0x632BE59BD9B4E019ull) * 0xBF58476D1CE4E5B9ull ^
+                      (c + 1) * 0x94D049BB133111EBull;
+    x ^= x >> 30;
+    x *= 0xBF58476D1CE4E5B9ull;
+    x ^= x >> 27;
+    x *= 0x94D049BB133111EBull;
+    return x ^ (x >> 31);
+}
+
+mrpt::math::TPoint3Df toF(const Eigen::Vector3d& p) {
+    return {float(p.x()), float(p.y()), float(p.z())};
+}
+
+/// Two triangles p0-p1-p2, p0-p2-p3 with texture corners (u0,v0) at p0 ... (uv in [0,1],
+/// v = 0 at the first image row).
+void addQuad(CSetOfTexturedTriangles& obj, const Eigen::Vector3d& p0, const Eigen::Vector3d& p1,
+             const Eigen::Vector3d& p2, const Eigen::Vector3d& p3, float u0, float v0, float u1,
+             float v1) {
+    mrpt::opengl::TTriangle a, b;
+    const auto set = [](mrpt::opengl::TTriangle& t, int k, const Eigen::Vector3d& p, float u,
+                        float v) {
+        t.vertices[k].xyzrgba.pt = toF(p);
+        t.vertices[k].xyzrgba.r = t.vertices[k].xyzrgba.g = t.vertices[k].xyzrgba.b =
+            t.vertices[k].xyzrgba.a = 255;
+        t.vertices[k].uv = {u, v};
+    };
+    set(a, 0, p0, u0, v0);
+    set(a, 1, p1, u1, v0);
+    set(a, 2, p2, u1, v1);
+    set(b, 0, p0, u0, v0);
+    set(b, 1, p2, u1, v1);
+    set(b, 2, p3, u0, v1);
+    a.computeNormals();
+    b.computeNormals();
+    obj.insertTriangle(a);
+    obj.insertTriangle(b);
+}
+
+mrpt::img::CImage toCImage(const cv::Mat& bgr) {
+    return mrpt::img::CImage(bgr, mrpt::img::DEEP_COPY);
+}
+
+/// A random crop (50-90% of each side) of a photo, flipped at random: every panel of the
+/// room looks different, so the ORB matcher does not see the same texture twice.
+cv::Mat panelCrop(const cv::Mat& img, std::mt19937_64& rng, double aspect) {
+    std::uniform_real_distribution<double> frac(0.5, 0.9), pos(0.0, 1.0);
+    int w = int(img.cols * frac(rng));
+    int h = int(w / aspect);
+    if (h > img.rows) {
+        h = img.rows;
+        w = int(h * aspect);
+    }
+    w = std::max(8, std::min(w, img.cols));
+    h = std::max(8, std::min(h, img.rows));
+    const int x = int((img.cols - w) * pos(rng)), y = int((img.rows - h) * pos(rng));
+    cv::Mat crop = img(cv::Rect(x, y, w, h)).clone();
+    if (pos(rng) < 0.5) cv::flip(crop, crop, 1);
+    return crop;
+}
+
+}  // namespace
+
+struct SequenceRenderer::Impl {
+    mrpt::opengl::COpenGLScene::Ptr scene;
+    std::unique_ptr<mrpt::opengl::CFBORender> fbo;
+    std::map<std::string, cv::Mat> photos;  // path -> BGR
+    struct Person {
+        PersonTexture tex;
+        double width = 0, height = 0;  // [m]
+        CSetOfTexturedTriangles::Ptr mesh;
+    };
+    std::vector<Person> people;
+
+    const cv::Mat& photo(const std::string& path) {
+        auto it = photos.find(path);
+        if (it != photos.end()) return it->second;
+        cv::Mat img = cv::imread(path, cv::IMREAD_COLOR);
+        if (img.empty()) throw std::runtime_error("render: cannot read texture '" + path + "'");
+        return photos.emplace(path, img).first->second;
+    }
+
+    /// A rectangle given by an origin corner and two edge vectors, covered by panels of at
+    /// most pw x ph metres, each with its own photo crop.
+    void addPanelled(const Eigen::Vector3d& origin, const Eigen::Vector3d& right,
+                     const Eigen::Vector3d& down, double pw, double ph,
+                     const std::vector<std::string>& files, std::size_t& counter,
+                     std::mt19937_64& rng) {
+        const double W = right.norm(), H = down.norm();
+        const Eigen::Vector3d ex = right / W, ey = down / H;
+        const int nx = std::max(1, int(std::ceil(W / pw - 1e-9)));
+        const int ny = std::max(1, int(std::ceil(H / ph - 1e-9)));
+        for (int j = 0; j < ny; ++j)
+            for (int i = 0; i < nx; ++i) {
+                const double x0 = i * W / nx, x1 = (i + 1) * W / nx;
+                const double y0 = j * H / ny, y1 = (j + 1) * H / ny;
+                const cv::Mat crop =
+                    panelCrop(photo(files[counter++ % files.size()]), rng, (x1 - x0) / (y1 - y0));
+                auto obj = CSetOfTexturedTriangles::Create();
+                addQuad(*obj, origin + ex * x0 + ey * y0, origin + ex * x1 + ey * y0,
+                        origin + ex * x1 + ey * y1, origin + ex * x0 + ey * y1, 0.f, 0.f, 1.f, 1.f);
+                obj->assignImage(toCImage(crop));
+                obj->enableLight(false);
+                scene->insert(obj);
+            }
+    }
+
+    void buildRoom(const Scenario& sc) {
+        std::mt19937_64 rng(mixSeed(sc.seed, 0xA11, 7));
+        const auto& r = sc.room;
+        const double X = r.size.x(), Y = r.size.y(), Z = r.size.z();
+        std::size_t k = 0;
+        const double pw = r.panel_width, ph = r.panel_height;
+        // Walls seen from inside: origin = top-left corner as seen from the room.
+        addPanelled({X, 0, Z}, {0, Y, 0}, {0, 0, -Z}, pw, ph, r.wall_textures, k, rng);   // x = X
+        addPanelled({0, Y, Z}, {0, -Y, 0}, {0, 0, -Z}, pw, ph, r.wall_textures, k, rng);  // x = 0
+        addPanelled({X, Y, Z}, {-X, 0, 0}, {0, 0, -Z}, pw, ph, r.wall_textures, k, rng);  // y = Y
+        addPanelled({0, 0, Z}, {X, 0, 0}, {0, 0, -Z}, pw, ph, r.wall_textures, k, rng);   // y = 0
+        std::size_t kf = 0;
+        addPanelled({0, Y, 0}, {X, 0, 0}, {0, -Y, 0}, pw, ph, r.floor_textures, kf, rng);  // floor
+        addPanelled({0, 0, Z}, {X, 0, 0}, {0, Y, 0}, pw, ph, r.wall_textures, k, rng);  // ceiling
+        for (const auto& b : r.boxes) {
+            const double c = std::cos(b.yaw), s = std::sin(b.yaw);
+            const auto P = [&](double lx, double ly, double lz) {
+                return Eigen::Vector3d(b.base.x() + c * lx - s * ly, b.base.y() + s * lx + c * ly,
+                                       b.base.z() + lz);
+            };
+            const double hx = b.size.x() / 2, hy = b.size.y() / 2, hz = b.size.z();
+            std::size_t kb = 0;
+            const auto face = [&](const Eigen::Vector3d& o, const Eigen::Vector3d& a,
+                                  const Eigen::Vector3d& d) {
+                addPanelled(o, a - o, d - o, 1e9, 1e9, b.textures, kb, rng);
+            };
+            face(P(hx, -hy, hz), P(hx, hy, hz), P(hx, -hy, 0));     // +x
+            face(P(-hx, hy, hz), P(-hx, -hy, hz), P(-hx, hy, 0));   // -x
+            face(P(hx, hy, hz), P(-hx, hy, hz), P(hx, hy, 0));      // +y
+            face(P(-hx, -hy, hz), P(hx, -hy, hz), P(-hx, -hy, 0));  // -y
+            face(P(-hx, hy, hz), P(hx, hy, hz), P(-hx, -hy, hz));   // top
+        }
+    }
+
+    void buildPeople(const Scenario& sc) {
+        for (const auto& spec : sc.people) {
+            Person p;
+            p.tex = loadPersonTexture(spec.texture);
+            p.height = spec.height;
+            p.width = spec.height * p.tex.aspect();
+            p.mesh = CSetOfTexturedTriangles::Create();
+            const auto& m = p.tex.cell_mask;
+            const double tw = p.tex.bgr.cols, th = p.tex.bgr.rows, cp = p.tex.cell_px;
+            // Local frame: x lateral, y towards the viewer, z up; texture column 0 at +x so
+            // that the photo reads the right way round for a viewer on the +y side.
+            for (int r = 0; r < m.rows; ++r)
+                for (int c = 0; c < m.cols; ++c) {
+                    if (!m.at<uchar>(r, c)) continue;
+                    const double c0 = c * cp, c1 = std::min(tw, (c + 1) * cp);
+                    const double r0 = r * cp, r1 = std::min(th, (r + 1) * cp);
+                    const auto X = [&](double col) { return p.width / 2 - col / tw * p.width; };
+                    const auto Z = [&](double row) { return p.height - row / th * p.height; };
+                    addQuad(*p.mesh, {X(c0), 0, Z(r0)}, {X(c1), 0, Z(r0)}, {X(c1), 0, Z(r1)},
+                            {X(c0), 0, Z(r1)}, float(c0 / tw), float(r0 / th), float(c1 / tw),
+                            float(r1 / th));
+                }
+            p.mesh->assignImage(toCImage(p.tex.bgr));
+            p.mesh->enableLight(false);
+            scene->insert(p.mesh);
+            people.push_back(std::move(p));
+        }
+    }
+};
+
+SequenceRenderer::SequenceRenderer(Scenario sc)
+    : sc_(std::move(sc)), impl_(std::make_unique<Impl>()) {
+    if (sc_.K.width < 8 || sc_.K.height < 8)
+        throw std::invalid_argument("render: image size must be at least 8x8");
+    impl_->scene = mrpt::opengl::COpenGLScene::Create();
+    auto vp = impl_->scene->getViewport();
+    vp->setViewportClipDistances(sc_.near_clip, sc_.far_clip);
+    vp->setCustomBackgroundColor({0.f, 0.f, 0.f});
+    impl_->buildRoom(sc_);
+    impl_->buildPeople(sc_);
+    try {
+        impl_->fbo = std::make_unique<mrpt::opengl::CFBORender>(unsigned(sc_.K.width),
+                                                                unsigned(sc_.K.height));
+    } catch (const std::exception& e) {
+        throw std::runtime_error(std::string("render: cannot create the headless EGL context: ") +
+                                 e.what());
+    }
+    auto& cam = impl_->fbo->getCamera(*impl_->scene);
+    // OpenGL samples pixel i at i + 0.5, OpenCV/TUM at i: shift the principal point so that
+    // the images follow the OpenCV convention exactly (verified by tests/render).
+    mrpt::img::TCamera gl;
+    gl.ncols = uint32_t(sc_.K.width);
+    gl.nrows = uint32_t(sc_.K.height);
+    gl.fx(sc_.K.fx);
+    gl.fy(sc_.K.fy);
+    gl.cx(sc_.K.cx + 0.5);
+    gl.cy(sc_.K.cy + 0.5);
+    cam.setProjectiveFromPinhole(gl);
+    cam.set6DOFMode(true);
+}
+
+SequenceRenderer::~SequenceRenderer() = default;
+
+RenderedFrame SequenceRenderer::render(std::size_t i) {
+    const double t = sc_.elapsed(i);
+    RenderedFrame out;
+    out.T_wc = cameraPoseAt(sc_.trajectory, t);
+    const Eigen::Vector3d eye(out.T_wc.x(), out.T_wc.y(), out.T_wc.z());
+
+    std::vector<mrpt::poses::CPose3D> person_pose(sc_.people.size());
+    std::vector<PersonState> state(sc_.people.size());
+    for (std::size_t k = 0; k < sc_.people.size(); ++k) {
+        state[k] = personStateAt(sc_.people[k], t);
+        const Eigen::Vector3d& p = state[k].position;
+        // Billboard facing the camera (yaw only), swaying in its own plane.
+        const double yaw = std::atan2(-(eye.x() - p.x()), eye.y() - p.y());
+        person_pose[k] = mrpt::poses::CPose3D(p.x(), p.y(), p.z(), yaw, state[k].sway, 0);
+        impl_->people[k].mesh->setPose(person_pose[k]);
+    }
+
+    auto& cam = impl_->fbo->getCamera(*impl_->scene);
+    cam.setPose(out.T_wc);
+    mrpt::img::CImage rgb;
+    mrpt::math::CMatrixFloat depth;
+    impl_->fbo->render_RGBD(*impl_->scene, rgb, depth);
+
+    const auto& K = sc_.K;
+    cv::Mat bgr = rgb.asCvMat<cv::Mat>(mrpt::img::DEEP_COPY);
+    if (bgr.channels() == 1) cv::cvtColor(bgr, bgr, cv::COLOR_GRAY2BGR);
+    out.clean_depth = cv::Mat(K.height, K.width, CV_32FC1);
+    for (int v = 0; v < K.height; ++v)
+        for (int u = 0; u < K.width; ++u) out.clean_depth.at<float>(v, u) = depth(v, u);
+
+    if (sc_.rgb_noise_sigma > 0) {
+        cv::Mat noise(bgr.size(), CV_32FC3);
+        std::mt19937_64 rng(mixSeed(sc_.seed, i, 1));
+        std::normal_distribution<float> g(0.f, float(sc_.rgb_noise_sigma));
+        for (auto it = noise.begin<cv::Vec3f>(); it != noise.end<cv::Vec3f>(); ++it)
+            *it = cv::Vec3f(g(rng), g(rng), g(rng));
+        cv::Mat f;
+        bgr.convertTo(f, CV_32FC3);
+        f += noise;
+        f.convertTo(bgr, CV_8UC3);  // saturating
+    }
+
+    // Person truth: pixels whose ray hits the person's solid cells at the rendered depth.
+    out.labels = cv::Mat(K.height, K.width, CV_8UC1, cv::Scalar(0));
+    const auto Rwc = out.T_wc.getRotationMatrix();
+    for (std::size_t k = 0; k < sc_.people.size(); ++k) {
+        const auto& P = person_pose[k];
+        const auto& person = impl_->people[k];
+        PersonTruth pt;
+        pt.id = int(k + 1);
+        pt.name = sc_.people[k].name;
+        pt.moving = state[k].moving;
+        const auto Rp = P.getRotationMatrix();
+        const Eigen::Vector3d n(Rp(0, 1), Rp(1, 1), Rp(2, 1)), p0(P.x(), P.y(), P.z());
+        // Projected bounding box of the billboard's corners (whole image if one is behind).
+        cv::Rect roi(0, 0, K.width, K.height);
+        {
+            double u0 = 1e9, v0 = 1e9, u1 = -1e9, v1 = -1e9;
+            bool behind = false;
+            for (double lx : {-person.width / 2, person.width / 2})
+                for (double lz : {0.0, person.height}) {
+                    mrpt::math::TPoint3D w;
+                    P.composePoint(lx, 0, lz, w.x, w.y, w.z);
+                    mrpt::math::TPoint3D c;
+                    out.T_wc.inverseComposePoint(w, c);
+                    if (c.z < 1e-3) {
+                        behind = true;
+                        continue;
+                    }
+                    const double u = K.fx * c.x / c.z + K.cx, v = K.fy * c.y / c.z + K.cy;
+                    u0 = std::min(u0, u), u1 = std::max(u1, u), v0 = std::min(v0, v),
+                    v1 = std::max(v1, v);
+                }
+            if (!behind)
+                roi &= cv::Rect(int(std::floor(u0)) - 1, int(std::floor(v0)) - 1,
+                                int(std::ceil(u1 - u0)) + 3, int(std::ceil(v1 - v0)) + 3);
+        }
+        const auto& m = person.tex.cell_mask;
+        const double tw = person.tex.bgr.cols, th = person.tex.bgr.rows, cp = person.tex.cell_px;
+        int umin = K.width, vmin = K.height, umax = -1, vmax = -1;
+        for (int v = roi.y; v < roi.y + roi.height; ++v)
+            for (int u = roi.x; u < roi.x + roi.width; ++u) {
+                const float zr = out.clean_depth.at<float>(v, u);
+                if (zr <= 0) continue;
+                const Eigen::Vector3d dc((u - K.cx) / K.fx, (v - K.cy) / K.fy, 1.0);
+                Eigen::Vector3d dw;
+                for (int r = 0; r < 3; ++r)
+                    dw[r] = Rwc(r, 0) * dc[0] + Rwc(r, 1) * dc[1] + Rwc(r, 2) * dc[2];
+                const double den = n.dot(dw);
+                if (std::abs(den) < 1e-9) continue;
+                const double s = n.dot(p0 - eye) / den;  // = depth along the optical axis
+                if (s <= 0 || std::abs(zr - s) > std::max(0.01, 0.005 * s)) continue;
+                const Eigen::Vector3d q = eye + s * dw - p0;
+                const double lx = Rp(0, 0) * q[0] + Rp(1, 0) * q[1] + Rp(2, 0) * q[2];
+                const double lz = Rp(0, 2) * q[0] + Rp(1, 2) * q[1] + Rp(2, 2) * q[2];
+                const double col = (person.width / 2 - lx) / person.width * tw;
+                const double row = (person.height - lz) / person.height * th;
+                if (col < 0 || row < 0 || col >= tw || row >= th) continue;
+                if (!m.at<uchar>(int(row / cp), int(col / cp))) continue;
+                out.labels.at<uchar>(v, u) = uchar(pt.id);
+                ++pt.visible_pixels;
+                umin = std::min(umin, u), umax = std::max(umax, u);
+                vmin = std::min(vmin, v), vmax = std::max(vmax, v);
+            }
+        if (pt.visible_pixels > 0) pt.box = cv::Rect(umin, vmin, umax - umin + 1, vmax - vmin + 1);
+        out.persons.push_back(pt);
+    }
+
+    auto& f = out.frame;
+    f.index = i;
+    f.timestamp = sc_.timeOf(i);
+    f.bgr = bgr;
+    f.depth = applyDepthNoise(out.clean_depth, sc_.depth_noise, K.fx, mixSeed(sc_.seed, i, 2));
+    f.K = K;
+    f.depth_scale = 5000.0;
+    f.rgb_source = f.depth_source = "synthetic:" + sc_.name + "#" + std::to_string(i);
+    return out;
+}
+
+}  // namespace devslam::render

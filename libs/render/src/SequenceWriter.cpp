@@ -1,0 +1,91 @@
+#include <devslam/core/Stats.h>
+#include <devslam/io/Rawlog.h>
+#include <devslam/io/TumWriter.h>
+#include <devslam/render/SequenceRenderer.h>
+#include <devslam/render/SequenceWriter.h>
+
+#include <mrpt/config/CConfigFileMemory.h>
+
+#include <opencv2/imgcodecs.hpp>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <stdexcept>
+
+namespace devslam::render {
+namespace fs = std::filesystem;
+
+WriteSummary writeSequence(const Scenario& sc, const WriteOptions& o,
+                           const std::function<void(std::size_t, std::size_t)>& progress) {
+    if (o.out_dir.empty()) throw std::invalid_argument("writeSequence: empty output folder");
+    const std::size_t n = o.max_frames > 0 ? std::min(o.max_frames, sc.n_frames) : sc.n_frames;
+    io::TumWriter tum(o.out_dir, "devslam-synth scenario " + sc.name);
+    std::unique_ptr<io::RawlogWriter> rawlog;
+    if (!o.rawlog_path.empty())
+        rawlog = std::make_unique<io::RawlogWriter>(o.rawlog_path, io::RawlogWriterOptions{});
+    if (o.write_labels) fs::create_directories(fs::path(o.out_dir) / "labels");
+
+    const std::string persons_path = (fs::path(o.out_dir) / "persons.txt").string();
+    std::ofstream persons(persons_path);
+    if (!persons) throw std::runtime_error("cannot write '" + persons_path + "'");
+    persons << "# person truth of devslam-synth scenario " << sc.name << "\n"
+            << kPersonsHeader << "\n";
+
+    SequenceRenderer renderer(sc);
+    core::Trajectory gt;
+    WriteSummary sum;
+    std::vector<double> ms;
+    for (std::size_t i = 0; i < n; ++i) {
+        const auto t0 = std::chrono::steady_clock::now();
+        const RenderedFrame rf = renderer.render(i);
+        ms.push_back(
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0)
+                .count());
+        tum.write(rf.frame);
+        if (rawlog) rawlog->write(rf.frame);
+        gt.push_back({rf.frame.timestamp, rf.T_wc});
+        char stamp[64];
+        std::snprintf(stamp, sizeof stamp, "%.6f", rf.frame.timestamp);
+        bool moving_visible = false, static_visible = false;
+        for (const auto& p : rf.persons) {
+            persons << stamp << ' ' << p.id << ' ' << p.name << ' '
+                    << (p.moving ? "moving" : "static") << ' ' << p.box.x << ' ' << p.box.y << ' '
+                    << p.box.width << ' ' << p.box.height << ' ' << p.visible_pixels << '\n';
+            if (p.visible_pixels > 0) (p.moving ? moving_visible : static_visible) = true;
+        }
+        sum.frames_with_moving_person += moving_visible;
+        sum.frames_with_static_person += static_visible;
+        if (o.write_labels) {
+            const std::string lp =
+                (fs::path(o.out_dir) / "labels" / (std::string(stamp) + ".png")).string();
+            if (!cv::imwrite(lp, rf.labels)) throw std::runtime_error("cannot write '" + lp + "'");
+        }
+        if (progress) progress(i + 1, n);
+    }
+    persons.close();
+    if (!persons) throw std::runtime_error("error writing '" + persons_path + "'");
+    tum.writeGroundTruth(gt);
+    tum.close();
+    if (rawlog) rawlog->close();
+
+    // The exact intrinsics of the rendered images, in the [camera] format core reads.
+    mrpt::config::CConfigFileMemory cam;
+    sc.K.saveToConfig(cam, "camera");
+    std::string text;
+    cam.getContent(text);
+    const std::string cam_path = (fs::path(o.out_dir) / "camera.ini").string();
+    std::ofstream cf(cam_path);
+    cf << "# exact pinhole intrinsics of this synthetic sequence (no distortion), scenario "
+       << sc.name << "\n"
+       << text;
+    if (!cf) throw std::runtime_error("cannot write '" + cam_path + "'");
+
+    sum.n_frames = n;
+    sum.render_ms_median = core::median(ms);
+    return sum;
+}
+
+}  // namespace devslam::render

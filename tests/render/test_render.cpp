@@ -1,0 +1,400 @@
+// Tests of devslam::render: exact depth of a known plane from a known pose (which also pins
+// the intrinsics and the pixel-centre convention), ground truth = poses used, determinism,
+// person truth, depth noise, trajectories and scenario files.
+#include <devslam/core/Config.h>
+#include <devslam/core/Pose.h>
+#include <devslam/io/TrajectoryIO.h>
+#include <devslam/render/DepthNoise.h>
+#include <devslam/render/PersonTexture.h>
+#include <devslam/render/Scenario.h>
+#include <devslam/render/SequenceRenderer.h>
+#include <devslam/render/SequenceWriter.h>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+namespace fs = std::filesystem;
+using namespace devslam;
+using namespace devslam::render;
+
+namespace {
+
+const std::string kRoot = DEVSLAM_SOURCE_DIR;
+const std::string kSynth = kRoot + "/sim_worlds/synth";
+constexpr double kPi = 3.14159265358979323846;
+
+class TempDir {
+  public:
+    TempDir() {
+        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+        path_ = fs::temp_directory_path() /
+                ("devslam_render_" + std::string(info->test_suite_name()) + "_" + info->name());
+        fs::remove_all(path_);
+        fs::create_directories(path_);
+    }
+    ~TempDir() { fs::remove_all(path_); }
+    [[nodiscard]] std::string str(const std::string& sub = {}) const {
+        return sub.empty() ? path_.string() : (path_ / sub).string();
+    }
+
+  private:
+    fs::path path_;
+};
+
+std::string readFile(const std::string& p) {
+    std::ifstream in(p, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+/// The shipped short scenario at a quarter resolution (160x120) for speed.
+Scenario smallShort() {
+    Scenario sc = loadScenario(kSynth + "/short_walking.ini");
+    sc.K = scaleIntrinsics(sc.K, 0.25);
+    return sc;
+}
+
+/// An empty 4 x 4 x 3 m room and a camera that does not move.
+Scenario bareRoom(const Eigen::Vector3d& eye, const Eigen::Vector3d& target) {
+    Scenario sc;
+    sc.name = "bare";
+    sc.K = scaleIntrinsics(core::CameraIntrinsics::fromPreset("freiburg3"), 0.25);
+    sc.n_frames = 1;
+    sc.rgb_noise_sigma = 0;
+    sc.depth_noise.enabled = false;
+    sc.room.size = {4, 4, 3};
+    sc.room.wall_textures = {kRoot + "/data/images/dog.jpg"};
+    sc.room.floor_textures = {kRoot + "/data/images/dog.jpg"};
+    sc.trajectory.setDefaultsFor(TrajectoryType::Static);
+    sc.trajectory.amplitude.setZero();
+    sc.trajectory.rot_amplitude_deg.setZero();
+    sc.trajectory.position = eye;
+    sc.trajectory.look_at = target;
+    return sc;
+}
+
+/// Runs f and expects an exception whose message contains `needle`.
+template <class F>
+void expectMessage(F&& f, const std::string& needle) {
+    try {
+        f();
+        ADD_FAILURE() << "no error, expected one containing: " << needle;
+    } catch (const std::exception& e) {
+        EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+    }
+}
+
+}  // namespace
+
+// The wall x = 4 and the floor seen from a known, oblique pose: every pixel that sees them
+// must hold the analytic depth z = n.(p0 - o) / n.(R K^-1 [u v 1]) with fr3 intrinsics
+// (scaled to 160x120). The best-fitting principal point must be the declared one, which
+// checks that the GL camera reproduces the OpenCV pixel-centre convention exactly.
+TEST(RenderGeometry, KnownPlaneGivesAnalyticDepth) {
+    const Eigen::Vector3d eye(1.0, 1.7, 1.9), target(4.0, 2.9, 0.6);
+    SequenceRenderer r(bareRoom(eye, target));
+    const auto f = r.render(0);
+    const auto& K = f.frame.K;
+    ASSERT_EQ(f.frame.depth.cols, 160);
+    ASSERT_EQ(f.frame.depth.rows, 120);
+    const auto R = f.T_wc.getRotationMatrix();
+    EXPECT_NEAR(f.T_wc.x(), eye.x(), 1e-12);
+    // Mean and max |rendered - analytic| over pixels well inside the wall x = 4, for a
+    // principal point shifted by (dx, dy) px from the declared one.
+    const auto error = [&](double dx, double dy, double& worst) {
+        int n = 0;
+        double sum = 0;
+        worst = 0;
+        for (int v = 5; v < K.height - 5; v += 2)
+            for (int u = 5; u < K.width - 5; u += 2) {
+                const Eigen::Vector3d dc((u - K.cx - dx) / K.fx, (v - K.cy - dy) / K.fy, 1.0);
+                Eigen::Vector3d dw;
+                for (int i = 0; i < 3; ++i)
+                    dw[i] = R(i, 0) * dc[0] + R(i, 1) * dc[1] + R(i, 2) * dc[2];
+                // Ray parameter = optical depth, on the wall x = 4 or on the floor z = 0,
+                // away from the room's edges.
+                double s = 0;
+                const double s_wall = dw.x() > 0 ? (4.0 - eye.x()) / dw.x() : 1e9;
+                const double s_floor = dw.z() < 0 ? -eye.z() / dw.z() : 1e9;
+                const Eigen::Vector3d hw = eye + s_wall * dw, hf = eye + s_floor * dw;
+                if (s_wall < s_floor && hw.y() > 0.2 && hw.y() < 3.8 && hw.z() > 0.2 &&
+                    hw.z() < 2.8)
+                    s = s_wall;
+                else if (s_floor < s_wall && hf.x() > 0.2 && hf.x() < 3.8 && hf.y() > 0.2 &&
+                         hf.y() < 3.8)
+                    s = s_floor;
+                else
+                    continue;
+                const double e = std::abs(f.frame.depth.at<float>(v, u) - s);
+                worst = std::max(worst, e);
+                sum += e;
+                ++n;
+            }
+        EXPECT_GT(n, 1000);
+        return sum / std::max(n, 1);
+    };
+    double worst = 0;
+    const double at_declared = error(0, 0, worst);
+    EXPECT_LT(at_declared, 1e-3) << "mean depth error on the known plane [m]";
+    EXPECT_LT(worst, 3e-3) << "max depth error on the known plane [m]";
+    // The best principal point is the declared one (within 0.1 px), not the GL pixel corner.
+    double best = 1e9, best_dx = 0, best_dy = 0, w = 0;
+    for (double dx = -0.6; dx <= 0.6; dx += 0.05)
+        for (double dy = -0.6; dy <= 0.6; dy += 0.05) {
+            const double e = error(dx, dy, w);
+            if (e < best) best = e, best_dx = dx, best_dy = dy;
+        }
+    EXPECT_LE(std::abs(best_dx), 0.1 + 1e-9);
+    EXPECT_LE(std::abs(best_dy), 0.1 + 1e-9);
+    EXPECT_GT(error(0.5, 0.5, w), 3 * at_declared) << "a half-pixel shift must be clearly worse";
+    std::cout << "plane depth error: mean " << at_declared << " m, max " << worst
+              << " m; best principal-point offset (" << best_dx << ", " << best_dy << ") px\n";
+}
+
+// Looking straight at the wall from 3 m: centre pixel depth 3 m, colour comes from the photo.
+TEST(RenderGeometry, FrontalWallDepthAndColour) {
+    SequenceRenderer r(bareRoom({1.0, 2.0, 1.5}, {4.0, 2.0, 1.5}));
+    const auto f = r.render(0);
+    for (int v : {10, 60, 110})
+        for (int u : {10, 80, 150})
+            EXPECT_NEAR(f.frame.depth.at<float>(v, u), 3.0, 1e-3) << u << "," << v;
+    cv::Scalar mean = cv::mean(f.frame.bgr);
+    EXPECT_GT(mean[0] + mean[1] + mean[2], 60.0) << "walls must be textured, not black";
+    EXPECT_EQ(cv::countNonZero(f.labels), 0);
+}
+
+TEST(RenderSequence, GroundTruthMatchesPosesUsed) {
+    TempDir tmp;
+    const Scenario sc = smallShort();
+    WriteOptions o;
+    o.out_dir = tmp.str("seq");
+    o.max_frames = 6;
+    const auto sum = writeSequence(sc, o);
+    EXPECT_EQ(sum.n_frames, 6u);
+    const auto gt = io::readTumTrajectory(o.out_dir + "/groundtruth.txt");
+    ASSERT_EQ(gt.size(), 6u);
+    for (std::size_t i = 0; i < gt.size(); ++i) {
+        EXPECT_NEAR(gt[i].t, sc.timeOf(i), 1e-6);
+        const auto expected = cameraPoseAt(sc.trajectory, sc.elapsed(i));
+        const auto d = expected - gt[i].pose;
+        EXPECT_LT(d.norm(), 1e-8);
+        EXPECT_LT(core::rotationAngle(d), 1e-7);
+    }
+    for (const char* f : {"rgb.txt", "depth.txt", "persons.txt", "camera.ini"})
+        EXPECT_TRUE(fs::exists(o.out_dir + "/" + f)) << f;
+    EXPECT_EQ(std::distance(fs::directory_iterator(o.out_dir + "/rgb"), fs::directory_iterator{}),
+              6);
+    EXPECT_EQ(
+        std::distance(fs::directory_iterator(o.out_dir + "/labels"), fs::directory_iterator{}), 6);
+    // camera.ini holds the exact intrinsics.
+    const auto K =
+        core::CameraIntrinsics::fromConfig(*core::loadIni(o.out_dir + "/camera.ini"), "camera");
+    EXPECT_EQ(K, sc.K);
+}
+
+TEST(RenderSequence, SameSeedSameFilesOtherSeedOtherNoise) {
+    TempDir tmp;
+    Scenario sc = smallShort();
+    WriteOptions o;
+    o.max_frames = 3;
+    o.out_dir = tmp.str("a");
+    (void)writeSequence(sc, o);
+    o.out_dir = tmp.str("b");
+    (void)writeSequence(sc, o);
+    sc.seed += 1;
+    o.out_dir = tmp.str("c");
+    (void)writeSequence(sc, o);
+    std::size_t compared = 0, differ_c = 0;
+    for (const auto& e : fs::recursive_directory_iterator(tmp.str("a"))) {
+        if (!e.is_regular_file()) continue;
+        const auto rel = fs::relative(e.path(), tmp.str("a")).string();
+        EXPECT_EQ(readFile(e.path().string()), readFile(tmp.str("b/" + rel))) << rel;
+        if (rel.rfind("depth/", 0) == 0 || rel.rfind("rgb/", 0) == 0)
+            differ_c += readFile(e.path().string()) != readFile(tmp.str("c/" + rel));
+        ++compared;
+    }
+    EXPECT_EQ(compared, 14u);  // 3 x (rgb, depth, labels) + 4 lists + camera.ini
+    EXPECT_EQ(differ_c, 6u) << "another seed must change the noise of every image";
+}
+
+// The walking person of the short scenario: moving, visible, and the labelled pixels lie at
+// the person's distance from the camera.
+TEST(RenderSequence, PersonTruthIsConsistent) {
+    SequenceRenderer r(smallShort());
+    const auto f = r.render(30);
+    ASSERT_EQ(f.persons.size(), 2u);
+    const auto& walker = f.persons[0];
+    EXPECT_TRUE(walker.moving);
+    EXPECT_FALSE(f.persons[1].moving);
+    ASSERT_GT(walker.visible_pixels, 200);
+    EXPECT_EQ(cv::countNonZero(f.labels == walker.id), walker.visible_pixels);
+    EXPECT_EQ(walker.box, cv::boundingRect(f.labels == walker.id));
+    const auto s = personStateAt(r.scenario().people[0], r.scenario().elapsed(30));
+    mrpt::math::TPoint3D c;
+    f.T_wc.inverseComposePoint({s.position.x(), s.position.y(), 1.0}, c);
+    const cv::Scalar mean_z = cv::mean(f.clean_depth, f.labels == walker.id);
+    EXPECT_NEAR(mean_z[0], c.z, 0.25) << "person pixels at the person's depth";
+}
+
+TEST(DepthNoise, RangesEdgesNoiseAndSeed) {
+    DepthNoiseOptions o;
+    o.dropout = 0;
+    cv::Mat d(100, 200, CV_32FC1, cv::Scalar(2.0f));
+    d(cv::Rect(150, 0, 50, 100)).setTo(7.0f);  // beyond max_range
+    d(cv::Rect(0, 0, 20, 100)).setTo(0.2f);    // closer than min_range
+    const cv::Mat n = applyDepthNoise(d, o, 535.4, 7);
+    EXPECT_EQ(cv::countNonZero(n(cv::Rect(160, 0, 40, 100))), 0);
+    EXPECT_EQ(cv::countNonZero(n(cv::Rect(0, 0, 20, 100))), 0);
+    // the discontinuity at u = 150 (2 m | 7 m) is missing on both sides within edge_dilate
+    for (int v = 0; v < 100; v += 10) EXPECT_EQ(n.at<float>(v, 149), 0.f);
+    const cv::Mat flat = n(cv::Rect(40, 10, 90, 80));
+    cv::Scalar mean, sd;
+    cv::meanStdDev(flat, mean, sd);
+    const double q = 2.0 * 2.0 / (535.4 * o.baseline) * o.disparity_step;  // quantum at 2 m
+    EXPECT_NEAR(mean[0], 2.0, 2e-3);
+    EXPECT_GT(sd[0], 0.5 * depthSigma(o, 2.0));
+    EXPECT_LT(sd[0], depthSigma(o, 2.0) + q);
+    EXPECT_EQ(cv::norm(n, applyDepthNoise(d, o, 535.4, 7), cv::NORM_INF), 0.0);
+    EXPECT_GT(cv::norm(n, applyDepthNoise(d, o, 535.4, 8), cv::NORM_INF), 0.0);
+    o.enabled = false;
+    EXPECT_EQ(cv::norm(d, applyDepthNoise(d, o, 535.4, 7), cv::NORM_INF), 0.0);
+}
+
+TEST(CameraTrajectory, SpeedsLikeTumFr3AndHalfsphereRadius) {
+    const auto meanSpeed = [](const TrajectoryOptions& o, double& deg_s) {
+        double L = 0, A = 0;
+        const double dt = 1.0 / 30;
+        auto prev = cameraPoseAt(o, 0);
+        for (int i = 1; i <= 750; ++i) {
+            const auto p = cameraPoseAt(o, i * dt);
+            const auto d = p - prev;
+            L += d.norm();
+            A += core::rotationAngle(d);
+            prev = p;
+        }
+        deg_s = A * 180 / kPi / 25.0;
+        return L / 25.0;
+    };
+    TrajectoryOptions o;
+    double deg_s = 0;
+    o.setDefaultsFor(TrajectoryType::Xyz);
+    const double v_xyz = meanSpeed(o, deg_s);
+    EXPECT_GT(v_xyz, 0.12);  // TUM fr3 walking_xyz: 0.208 m/s, 5.5 deg/s
+    EXPECT_LT(v_xyz, 0.30);
+    EXPECT_LT(deg_s, 10.0);
+    o.setDefaultsFor(TrajectoryType::Static);
+    EXPECT_LT(meanSpeed(o, deg_s), 0.03);  // fr3 walking_static: 0.012 m/s
+    o.setDefaultsFor(TrajectoryType::Rpy);
+    (void)meanSpeed(o, deg_s);
+    EXPECT_GT(deg_s, 25.0);  // fr3 walking_rpy: 53 deg/s
+    o.setDefaultsFor(TrajectoryType::Halfsphere);
+    const double r0 = (o.position - o.look_at).norm();
+    for (double t : {0.0, 3.3, 7.1, 12.0}) {
+        const auto p = cameraPoseAt(o, t);
+        EXPECT_NEAR((Eigen::Vector3d(p.x(), p.y(), p.z()) - o.look_at).norm(), r0, 1e-9);
+    }
+    // lookAtPose: the optical axis points at the target, image "down" is world -z.
+    const auto L = lookAtPose({0, 0, 1}, {3, 4, 1});
+    const auto R = L.getRotationMatrix();
+    EXPECT_NEAR(R(0, 2), 0.6, 1e-12);
+    EXPECT_NEAR(R(1, 2), 0.8, 1e-12);
+    EXPECT_NEAR(R(2, 1), -1.0, 1e-12);
+    EXPECT_THROW((void)lookAtPose({0, 0, 0}, {0, 0, 2}), std::invalid_argument);
+}
+
+TEST(PersonMotion, PingPongAlongThePath) {
+    PersonSpec p;
+    p.kind = PersonKind::Walking;
+    p.path = {{0, 0}, {2, 0}};
+    p.speed = 1.0;
+    p.bob = 0;
+    EXPECT_NEAR(personStateAt(p, 0.5).position.x(), 0.5, 1e-12);
+    EXPECT_NEAR(personStateAt(p, 2.5).position.x(), 1.5, 1e-12);  // on the way back
+    EXPECT_NEAR(personStateAt(p, 2.5).velocity.x(), -1.0, 1e-12);
+    EXPECT_TRUE(personStateAt(p, 1.0).moving);
+    p.kind = PersonKind::Sitting;
+    const auto s = personStateAt(p, p.sway_period / 4);
+    EXPECT_FALSE(s.moving);
+    EXPECT_NEAR(s.sway, p.sway_deg * kPi / 180, 1e-12);
+    EXPECT_THROW((void)parsePersonKind("running"), std::invalid_argument);
+}
+
+TEST(Scenario, ShippedFilesLoadAndTyposAreReported) {
+    std::size_t n = 0;
+    for (const auto& e : fs::directory_iterator(kSynth)) {
+        const auto name = e.path().stem().string();
+        if (e.path().extension() != ".ini" || name.find("_room") != std::string::npos) continue;
+        const auto sc = loadScenario(e.path().string());
+        EXPECT_FALSE(sc.people.empty()) << name;
+        EXPECT_FALSE(sc.room.boxes.empty()) << name;
+        EXPECT_EQ(sc.K, core::CameraIntrinsics::fromPreset("freiburg3")) << name;
+        if (name == "short_walking")
+            EXPECT_EQ(sc.n_frames, 60u);
+        else
+            EXPECT_TRUE(sc.n_frames >= 600 && sc.n_frames <= 900) << name << ": 20-30 s at 30 Hz";
+        ++n;
+    }
+    EXPECT_EQ(n, 5u);
+    TempDir tmp;
+    const std::string room = "room            = office_room.ini";
+    const auto withEdit = [&](std::string s, const std::string& from, const std::string& to) {
+        const auto pos = s.find(from);
+        EXPECT_NE(pos, std::string::npos) << from;
+        if (pos != std::string::npos) s.replace(pos, from.size(), to);
+        std::ofstream(tmp.str("s.ini")) << s;
+        return tmp.str("s.ini");
+    };
+    const std::string shipped = readFile(kSynth + "/short_walking.ini");
+    // Paths are relative to the file that names them: a copy elsewhere names what is missing.
+    fs::copy_file(kSynth + "/office_room.ini", tmp.str("office_room.ini"));
+    expectMessage([&] { (void)loadScenario(withEdit(shipped, "seed ", "seed ")); },
+                  "wall_textures: no such file or folder");
+    std::string abs = shipped;  // the same scenario with absolute paths
+    for (std::size_t p = abs.find("../../data"); p != std::string::npos; p = abs.find("../../data"))
+        abs.replace(p, 5, kRoot);
+    const std::string base = withEdit(abs, room, "room = " + kSynth + "/office_room.ini"),
+                      text = readFile(base);
+    EXPECT_NO_THROW((void)loadScenario(base));
+    expectMessage([&] { (void)loadScenario(withEdit(text, "rate_hz", "speeed = 3\nrate_hz")); },
+                  "[scenario]: unknown key 'speeed'");
+    expectMessage([&] { (void)loadScenario(withEdit(text, "kind    = walking", "kind = flying")); },
+                  "unknown person kind 'flying'");
+    expectMessage(
+        [&] {
+            (void)loadScenario(
+                withEdit(text, "n_frames        = 60", "n_frames = 60\nduration = 3"));
+        },
+        "exactly one of 'duration'");
+    expectMessage(
+        [&] {
+            (void)loadScenario(
+                withEdit(text, "path    = [2.4 1.6  2.4 4.4]", "path = [2.4 1.6 x 4.4]"));
+        },
+        "[person_1] path: 'x' is not a number");
+}
+
+TEST(PersonTexture, GrabCutCutsThePhotoAndCellsFollowAlpha) {
+    const cv::Mat img = cv::imread(kRoot + "/data/images/person.jpg");
+    ASSERT_FALSE(img.empty());
+    const cv::Mat rgba = cutPersonTexture(img, {178, 88, 102, 292}, 2);
+    ASSERT_EQ(rgba.type(), CV_8UC4);
+    std::vector<cv::Mat> ch;
+    cv::split(rgba, ch);
+    const double frac = cv::countNonZero(ch[3]) / double(rgba.total());
+    EXPECT_GT(frac, 0.3);
+    EXPECT_LT(frac, 0.9);
+    EXPECT_THROW((void)cutPersonTexture(img, {600, 400, 100, 100}), std::invalid_argument);
+    const auto tex = loadPersonTexture(kRoot + "/data/textures/person_standing.png", 4);
+    EXPECT_GT(cv::countNonZero(tex.cell_mask), 100);
+    EXPECT_LT(cv::countNonZero(tex.cell_mask), int(tex.cell_mask.total()));
+    EXPECT_THROW((void)loadPersonTexture(kRoot + "/data/images/dog.jpg"), std::runtime_error);
+}
