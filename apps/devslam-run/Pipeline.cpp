@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <future>
 #include <sstream>
 
 namespace devslam::run {
@@ -66,6 +67,7 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
     rep.input = rc.input;
     rep.mode = rc.mode;
     rep.mask_source = masks->describe();
+    rep.async_filter = rc.async_filter;
     const auto K = reader.intrinsics();
     rep.camera = "fx=" + num(K.fx, 1) + " fy=" + num(K.fy, 1) + " cx=" + num(K.cx, 1) +
                  " cy=" + num(K.cy, 1) + " " + std::to_string(K.width) + "x" +
@@ -76,46 +78,70 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
     if (rc.progress) bar.emplace("devslam-run " + rc.mode, total);
     std::size_t n = 0;
     double elapsed_ms = 0;
-    while (auto frame = reader.next()) {
-        if (rc.max_frames && n >= rc.max_frames) break;
-        frame->index = n;
+    // With async_filter the filter works on frame k+1 in a second thread while the SLAM
+    // processes frame k (its prior is the constant-velocity motion known before frame k).
+    std::future<MaskStep> pending;
+    auto launch = [&](const core::Frame& f, std::optional<Eigen::Isometry3d> prior) {
+        pending =
+            std::async(std::launch::async, [&masks, f, prior] { return masks->step(f, prior); });
+    };
+    auto within = [&](std::size_t i) { return rc.max_frames == 0 || i < rc.max_frames; };
+    std::optional<core::Frame> cur = reader.next();
+    if (cur) cur->index = 0;
+    if (rc.async_filter && cur) launch(*cur, std::nullopt);
+    while (cur && within(n)) {
+        const auto t_iter = Clock::now();
         FrameLog fl;
         fl.index = n;
-        fl.t = frame->timestamp;
-        const auto prior = slam.predictPrevCur(frame->timestamp);
-        const MaskStep ms = masks->step(*frame, prior);
+        fl.t = cur->timestamp;
+        const MaskStep ms = rc.async_filter
+                                ? pending.get()
+                                : masks->step(*cur, slam.predictPrevCur(cur->timestamp));
+        // Reading/decoding the next frame is not part of the pipeline time.
+        const auto t_read = Clock::now();
+        std::optional<core::Frame> nxt = within(n + 1) ? reader.next() : std::nullopt;
+        if (nxt) nxt->index = n + 1;
+        const double read_ms = msSince(t_read);
+        if (rc.async_filter && nxt)
+            launch(*nxt, slam.predictMotion(nxt->timestamp - cur->timestamp));
         fl.ms.detect = ms.detect_ms;
         fl.ms.filter = ms.filter_ms;
         fl.n_boxes = ms.n_boxes;
         fl.n_moving = ms.n_moving;
         auto t0 = Clock::now();
-        auto feats = slam.extract(*frame, ms.mask);
+        auto feats = slam.extract(*cur, ms.mask);
         fl.ms.features = msSince(t0);
         fl.n_features = static_cast<int>(feats.size());
         fl.n_masked = feats.n_masked;
         t0 = Clock::now();
-        const auto tr = slam.track(*frame, feats, std::nullopt);
+        const auto tr = slam.track(*cur, feats, std::nullopt);
         fl.ms.tracking = msSince(t0);
         t0 = Clock::now();
-        const auto mr = slam.mapStep(*frame, std::move(feats), tr);
+        const auto mr = slam.mapStep(*cur, std::move(feats), tr);
         fl.ms.mapping = msSince(t0);
         t0 = Clock::now();
-        const auto br = slam.backendStep(mr, frame->K);
+        const auto br = slam.backendStep(mr, cur->K);
         fl.ms.backend = msSince(t0);
         fl.state = slam::toString(tr.state);
         fl.n_inliers = tr.n_inliers;
         fl.keyframe = mr.keyframe_inserted;
         fl.keyframe_reason = slam::toString(mr.reason);
         fl.loop = br.loop_closed;
-        if (tr.state == slam::TrackingState::Lost) masks->reset();
-        elapsed_ms += fl.ms.total();
+        if (tr.state == slam::TrackingState::Lost) {
+            if (pending.valid()) pending.wait();  // never reset while the filter runs
+            masks->reset();
+        }
+        fl.wall_ms = msSince(t_iter) - read_ms;
+        elapsed_ms += fl.wall_ms;
         rep.log.push_back(fl);
         ++n;
+        cur = std::move(nxt);
         if (bar) {
             const double fps = elapsed_ms > 0 ? 1000.0 * n / elapsed_ms : 0.0;
             bar->update(n, num(fps, 1) + " fps, " + fl.state);
         }
     }
+    if (pending.valid()) pending.wait();
     if (bar) bar->finish();
     {
         const auto t0 = Clock::now();
@@ -133,7 +159,7 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
     std::vector<double> fps, total_ms;
     std::vector<double> st[6];
     for (const auto& l : rep.log) {
-        const double t = l.ms.total();
+        const double t = l.wall_ms;
         total_ms.push_back(t);
         fps.push_back(t > 0 ? 1000.0 / t : 0.0);
         const double v[6] = {l.ms.detect,   l.ms.filter,  l.ms.features,
@@ -228,7 +254,8 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
 std::string formatSummary(const RunReport& r) {
     std::ostringstream o;
     o << "input      : " << r.input << "\n"
-      << "mode       : " << r.mode << " (" << r.mask_source << ")\n"
+      << "mode       : " << r.mode << " (" << r.mask_source
+      << (r.async_filter ? ", filter one frame ahead in a second thread" : "") << ")\n"
       << "camera     : " << r.camera << "\n"
       << "frames     : " << r.frames << "   keyframes: " << r.keyframes
       << "   landmarks: " << r.landmarks << "   loops closed: " << r.loops << "\n"
@@ -321,7 +348,7 @@ std::string toJson(const RunReport& r) {
           << ", \"boxes\": " << l.n_boxes << ", \"moving\": " << l.n_moving
           << ", \"keyframe\": " << (l.keyframe ? "true" : "false") << ", \"keyframe_reason\": \""
           << l.keyframe_reason << "\""
-          << ", \"ms\": " << timingJson(l.ms) << "}";
+          << ", \"wall_ms\": " << num(l.wall_ms, 3) << ", \"ms\": " << timingJson(l.ms) << "}";
     }
     o << "\n  ]\n}\n";
     return o.str();

@@ -21,6 +21,9 @@ struct RunConfig {
     std::string out_dir;         ///< empty: write nothing
     bool progress = true;        ///< progress bar on stderr
     std::size_t max_frames = 0;  ///< 0 = all
+    /// Run the dynamic filter for frame k+1 in a second thread while the SLAM processes
+    /// frame k (INI [run] async_filter). Results do not depend on timing.
+    bool async_filter = false;
 };
 
 /// Wall time per stage of one frame [ms].
@@ -37,11 +40,13 @@ struct FrameLog {
     std::string state, keyframe_reason;
     int n_features = 0, n_masked = 0, n_inliers = 0, n_boxes = 0, n_moving = 0;
     bool keyframe = false, loop = false;
-    FrameTiming ms;
+    FrameTiming ms;      ///< per stage (detect/filter overlap the SLAM when async)
+    double wall_ms = 0;  ///< wall time of the frame's pipeline step (disk reading excluded)
 };
 
 struct RunReport {
     std::string input, mode, camera, mask_source;
+    bool async_filter = false;
     std::size_t frames = 0, keyframes = 0, landmarks = 0, loops = 0;
     std::vector<std::size_t> lost;  ///< frame indices without a tracked pose
     std::vector<FrameLog> log;

@@ -88,6 +88,7 @@ struct Loaded {
     std::unique_ptr<mrpt::config::CConfigFileMemory> cfg, filter_cfg;
     io::ReaderOptions reader;
     std::string mode;
+    bool async_filter = false;
 };
 
 /// Applies "section.key=value" overrides to an INI held in memory.
@@ -106,7 +107,8 @@ Loaded loadConfig(const Args& a, const std::vector<std::string>& extra_sets = {}
     l.cfg = core::loadIni(a.config);
     applySets(*l.cfg, a.sets);
     applySets(*l.cfg, extra_sets);
-    core::requireKnownKeys(*l.cfg, "run", {"mode", "filter_config"}, a.config);
+    core::requireKnownKeys(*l.cfg, "run", {"mode", "filter_config", "async_filter"}, a.config);
+    l.async_filter = l.cfg->read_bool("run", "async_filter", false);
     l.mode = a.mode.empty() ? l.cfg->read_string("run", "mode", "dynamic") : a.mode;
     const std::string fc = l.cfg->read_string("run", "filter_config", "");
     if (!fc.empty()) {
@@ -140,6 +142,7 @@ int runOnce(const Args& a) {
     rc.out_dir = a.out;
     rc.progress = !a.quiet;
     rc.max_frames = a.max_frames;
+    rc.async_filter = l.async_filter;
     const auto rep = run::runSequence(*reader, rc, *l.cfg, *l.filter_cfg);
     std::cout << run::formatSummary(rep);
     return 0;
@@ -177,6 +180,7 @@ int runBench(const Args& a) {
             rc.mode = mode;
             rc.progress = false;
             rc.max_frames = a.max_frames;
+            rc.async_filter = l.async_filter;
             const auto rep = run::runSequence(*reader, rc, *l.cfg, *l.filter_cfg);
             if (rep.ate) {
                 ate.push_back(rep.ate->trans.rmse);

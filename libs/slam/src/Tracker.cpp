@@ -99,9 +99,12 @@ void Tracker::initialize(const Eigen::Isometry3d& T_wc, double timestamp) {
 }
 
 std::optional<Eigen::Isometry3d> Tracker::predictPrevCur(double timestamp) const {
+    return predictMotion(timestamp - last_t_);
+}
+
+std::optional<Eigen::Isometry3d> Tracker::predictMotion(double dt) const {
     if (state_ == TrackingState::NotInitialized || state_ == TrackingState::Lost)
         return std::nullopt;
-    const double dt = timestamp - last_t_;
     if (!has_velocity_ || dt <= 0 || dt > opts_.max_motion_dt || velocity_dt_ <= 0)
         return Eigen::Isometry3d::Identity();
     // Scale the last inter-frame motion to this frame's interval.

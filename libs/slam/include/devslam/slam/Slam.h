@@ -132,6 +132,11 @@ class Slam {
     [[nodiscard]] std::optional<Eigen::Isometry3d> predictPrevCur(double timestamp) const {
         return tracker_.predictPrevCur(timestamp);
     }
+    /// Constant-velocity motion over `dt` [s] (see Tracker::predictMotion); for a filter
+    /// that runs one frame ahead of the tracker.
+    [[nodiscard]] std::optional<Eigen::Isometry3d> predictMotion(double dt) const {
+        return tracker_.predictMotion(dt);
+    }
     /// Pose of every frame so far (relative to its reference keyframe, so later keyframe
     /// corrections carry over). Lost frames hold their motion-model prediction.
     [[nodiscard]] core::Trajectory trajectory() const;

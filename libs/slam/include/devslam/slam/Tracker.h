@@ -83,6 +83,9 @@ class Tracker {
     /// Constant-velocity prediction of the next camera in the last one (p_prev = T * p_cur)
     /// for a frame at `timestamp`; nullopt when unknown (not initialized, lost, big gap).
     [[nodiscard]] std::optional<Eigen::Isometry3d> predictPrevCur(double timestamp) const;
+    /// Constant-velocity motion over an interval `dt` [s] between two consecutive frames
+    /// (p_prev = T * p_cur); nullopt when unknown, identity without a velocity or dt too big.
+    [[nodiscard]] std::optional<Eigen::Isometry3d> predictMotion(double dt) const;
     /// Moves the tracker's last pose by a world correction (after loop closure).
     void applyCorrection(const Eigen::Isometry3d& T_new_old);
     [[nodiscard]] TrackingState state() const { return state_; }
