@@ -10,11 +10,13 @@
 namespace devslam::slam {
 
 void LoopOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, const std::string& s) {
-    core::requireKnownKeys(c, s,
-                           {"enabled", "min_keyframe_gap", "max_distance", "max_candidates",
-                            "max_hamming", "ratio", "min_inliers", "sigma_t", "sigma_r_deg"});
+    core::requireKnownKeys(
+        c, s,
+        {"enabled", "min_keyframe_gap", "cooldown_keyframes", "max_distance", "max_candidates",
+         "max_hamming", "ratio", "min_inliers", "sigma_t", "sigma_r_deg"});
     enabled = c.read_bool(s, "enabled", enabled);
     min_keyframe_gap = c.read_int(s, "min_keyframe_gap", min_keyframe_gap);
+    cooldown_keyframes = c.read_int(s, "cooldown_keyframes", cooldown_keyframes);
     max_distance = c.read_double(s, "max_distance", max_distance);
     max_candidates = c.read_int(s, "max_candidates", max_candidates);
     max_hamming = c.read_int(s, "max_hamming", max_hamming);
@@ -31,6 +33,7 @@ void LoopOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, const s
 void LoopOptions::saveToConfig(mrpt::config::CConfigFileBase& c, const std::string& s) const {
     c.write(s, "enabled", enabled);
     c.write(s, "min_keyframe_gap", min_keyframe_gap);
+    c.write(s, "cooldown_keyframes", cooldown_keyframes);
     c.write(s, "max_distance", max_distance);
     c.write(s, "max_candidates", max_candidates);
     c.write(s, "max_hamming", max_hamming);

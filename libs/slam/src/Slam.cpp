@@ -288,6 +288,9 @@ void Slam::finalize(const core::CameraIntrinsics& K) {
 BackendResult Slam::backendStep(const MappingResult& mapping, const core::CameraIntrinsics& K) {
     BackendResult out;
     if (!mapping.keyframe_inserted || !opts_.loop.enabled) return out;
+    if (!loop_edges_.empty() &&
+        mapping.keyframe - loop_edges_.back().to < opts_.loop.cooldown_keyframes)
+        return out;
     out.loop = detectLoop(map_, mapping.keyframe, K, opts_.loop, opts_.tracker.refine,
                           opts_.seed + static_cast<unsigned long long>(mapping.keyframe));
     if (!out.loop) return out;

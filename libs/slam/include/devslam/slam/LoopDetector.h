@@ -20,15 +20,16 @@ namespace devslam::slam {
 
 struct LoopOptions {
     bool enabled = true;
-    int min_keyframe_gap = 20;  ///< candidates are at least this many keyframes older
-    double max_distance = 1.0;  ///< [m] candidate keyframes within this of the current pose
-    int max_candidates = 3;     ///< nearest candidates verified
-    int max_hamming = 50;       ///< descriptor threshold
-    double ratio = 0.8;         ///< ratio test
-    int min_inliers = 40;       ///< verified inliers for a loop
-    double sigma_t = 0.02;      ///< [m] loop-edge translation std (pose-graph information)
-    double sigma_r_deg = 1.0;   ///< [deg] loop-edge rotation std
-    double scale_factor = 1.3;  ///< ORB pyramid scale for level sigmas (copied from [orb])
+    int min_keyframe_gap = 20;   ///< candidates are at least this many keyframes older
+    int cooldown_keyframes = 5;  ///< no loop search for this many keyframes after a loop
+    double max_distance = 1.0;   ///< [m] candidate keyframes within this of the current pose
+    int max_candidates = 3;      ///< nearest candidates verified
+    int max_hamming = 50;        ///< descriptor threshold
+    double ratio = 0.8;          ///< ratio test
+    int min_inliers = 40;        ///< verified inliers for a loop
+    double sigma_t = 0.02;       ///< [m] loop-edge translation std (pose-graph information)
+    double sigma_r_deg = 1.0;    ///< [deg] loop-edge rotation std
+    double scale_factor = 1.3;   ///< ORB pyramid scale for level sigmas (copied from [orb])
 
     void loadFromConfig(const mrpt::config::CConfigFileBase& cfg,
                         const std::string& section = "loop_closure");
