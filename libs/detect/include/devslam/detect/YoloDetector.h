@@ -1,0 +1,61 @@
+#pragma once
+/// YOLO through OpenCV's cv::dnn: darknet .cfg + .weights (YOLOv3/v4/v4-tiny, Yolo-Fastest)
+/// or an .onnx export (YOLOv5-style output). Output rows are decoded as
+/// [cx, cy, w, h, objectness, class scores...]; boxes of the configured classes above
+/// `conf_threshold` are kept after per-class NMS.
+///
+/// Usage:
+///   YoloDetector::Options o;   // defaults: the shipped yolo-fastest-1.1-xl, class person
+///   YoloDetector det(o);       // throws std::runtime_error naming a missing/corrupt file
+///   auto people = det.detect(bgr);
+#include <devslam/detect/PersonDetector.h>
+
+#include <opencv2/dnn.hpp>
+
+namespace devslam::detect {
+
+class YoloDetector final : public PersonDetector {
+  public:
+    struct Options {
+        /// Darknet .cfg or .onnx. Relative paths are tried from the working directory,
+        /// then from the repository root.
+        std::string model = "models/yolo-fastest-1.1/yolo-fastest-1.1-xl.cfg";
+        std::string weights =
+            "models/yolo-fastest-1.1/yolo-fastest-1.1-xl.weights";  ///< darknet only
+        std::string names = "models/yolo-fastest-1.1/coco.names";   ///< one class name a line
+        int input_width = 320;         ///< [px] network input (multiple of 32)
+        int input_height = 320;        ///< [px]
+        float conf_threshold = 0.35f;  ///< min score (objectness * class score)
+        float nms_threshold = 0.45f;   ///< IoU above which the weaker box is suppressed
+        std::vector<std::string> classes{"person"};  ///< classes reported (potentially dynamic)
+        bool validate_on_load = true;  ///< run one forward pass at load to catch bad weights
+
+        /// Keys: model weights names input_width input_height conf_threshold nms_threshold
+        /// classes (comma separated) validate_on_load; unknown keys (besides `detector`) throw.
+        void loadFromConfig(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
+        void saveToConfig(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
+    };
+
+    explicit YoloDetector(const Options& opts);
+    [[nodiscard]] std::vector<Detection> detect(const cv::Mat& bgr) override;
+    [[nodiscard]] std::string name() const override;
+    [[nodiscard]] const std::vector<std::string>& classNames() const { return names_; }
+
+  private:
+    Options opts_;
+    cv::dnn::Net net_;
+    bool onnx_ = false;
+    std::vector<std::string> names_;
+    std::vector<int> wanted_;  ///< class ids reported
+    std::vector<std::string> out_names_;
+};
+
+/// Resolves a model path: as given if it exists, else relative to the repository root;
+/// throws std::runtime_error naming every path tried when none exists.
+[[nodiscard]] std::string resolveModelPath(const std::string& path, const std::string& what);
+
+/// Darknet network from a .cfg alone (random weights), e.g. to check a cfg parses.
+/// Throws std::runtime_error naming the file on a parse error.
+[[nodiscard]] cv::dnn::Net readDarknetCfg(const std::string& cfg_path);
+
+}  // namespace devslam::detect

@@ -1,0 +1,81 @@
+#include <devslam/detect/HogDetector.h>
+
+#include <devslam/core/Config.h>
+
+#include <mrpt/config/CConfigFileBase.h>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace devslam::detect {
+
+void HogDetector::Options::loadFromConfig(const mrpt::config::CConfigFileBase& c,
+                                          const std::string& s) {
+    core::requireKnownKeys(c, s,
+                           {"detector", "hit_threshold", "win_stride", "scale", "group_threshold",
+                            "min_score", "resize"});
+    hit_threshold = c.read_double(s, "hit_threshold", hit_threshold);
+    win_stride = c.read_int(s, "win_stride", win_stride);
+    scale = c.read_double(s, "scale", scale);
+    group_threshold = c.read_int(s, "group_threshold", group_threshold);
+    min_score = c.read_double(s, "min_score", min_score);
+    resize = c.read_double(s, "resize", resize);
+    core::requireValue(win_stride > 0 && win_stride % 8 == 0, s, "win_stride",
+                       "must be a positive multiple of 8 (HOG cell size)");
+    core::requireValue(scale > 1.0, s, "scale", "must be > 1");
+    core::requireValue(group_threshold >= 0, s, "group_threshold", "must be >= 0");
+    core::requireValue(resize > 0.0, s, "resize", "must be > 0");
+}
+
+void HogDetector::Options::saveToConfig(mrpt::config::CConfigFileBase& c,
+                                        const std::string& s) const {
+    c.write(s, "detector", std::string("hog"));
+    c.write(s, "hit_threshold", hit_threshold);
+    c.write(s, "win_stride", win_stride);
+    c.write(s, "scale", scale);
+    c.write(s, "group_threshold", group_threshold);
+    c.write(s, "min_score", min_score);
+    c.write(s, "resize", resize);
+}
+
+HogDetector::HogDetector(const Options& opts) : opts_(opts) {
+    hog_.setSVMDetector(cv::HOGDescriptor::getDefaultPeopleDetector());
+}
+
+std::string HogDetector::name() const {
+    return "hog(default people SVM)";
+}
+
+std::vector<Detection> HogDetector::detect(const cv::Mat& bgr) {
+    if (bgr.empty() || bgr.type() != CV_8UC3)
+        throw std::invalid_argument("hog: detect() needs a non-empty CV_8UC3 image");
+    cv::Mat img = bgr;
+    if (opts_.resize != 1.0) cv::resize(bgr, img, cv::Size(), opts_.resize, opts_.resize);
+    std::vector<cv::Rect> rects;
+    std::vector<double> weights;
+    hog_.detectMultiScale(img, rects, weights, opts_.hit_threshold,
+                          cv::Size(opts_.win_stride, opts_.win_stride), cv::Size(), opts_.scale,
+                          opts_.group_threshold);
+    std::vector<Detection> dets;
+    const cv::Rect2f image(0.f, 0.f, static_cast<float>(bgr.cols), static_cast<float>(bgr.rows));
+    for (std::size_t i = 0; i < rects.size(); ++i) {
+        const double w = i < weights.size() ? weights[i] : 0.0;
+        const float score = static_cast<float>(1.0 / (1.0 + std::exp(-w)));
+        if (score < opts_.min_score) continue;
+        // The default SVM's 64x128 window has ~16 px of margin around the person at each
+        // side; shrink so the box hugs the body like a YOLO box.
+        const auto s = static_cast<float>(1.0 / opts_.resize);
+        cv::Rect2f b(rects[i].x * s, rects[i].y * s, rects[i].width * s, rects[i].height * s);
+        const float mx = 0.15f * b.width, my = 0.06f * b.height;
+        b = cv::Rect2f(b.x + mx, b.y + my, b.width - 2 * mx, b.height - 2 * my) & image;
+        if (b.area() <= 0.f) continue;
+        dets.push_back({b, 0, "person", score});
+    }
+    std::sort(dets.begin(), dets.end(),
+              [](const Detection& a, const Detection& b) { return a.score > b.score; });
+    return dets;
+}
+
+}  // namespace devslam::detect

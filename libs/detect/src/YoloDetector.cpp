@@ -1,0 +1,251 @@
+#include <devslam/detect/YoloDetector.h>
+
+#include <devslam/core/Config.h>
+
+#include <mrpt/config/CConfigFileBase.h>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+namespace devslam::detect {
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string trim(const std::string& s) {
+    const auto b = s.find_first_not_of(" \t\r\n");
+    if (b == std::string::npos) return {};
+    const auto e = s.find_last_not_of(" \t\r\n");
+    return s.substr(b, e - b + 1);
+}
+
+std::vector<std::string> splitList(const std::string& s) {
+    std::vector<std::string> out;
+    std::stringstream ss(s);
+    std::string item;
+    while (std::getline(ss, item, ',')) {
+        item = trim(item);
+        if (!item.empty()) out.push_back(item);
+    }
+    return out;
+}
+
+bool endsWith(const std::string& s, const std::string& suffix) {
+    if (s.size() < suffix.size()) return false;
+    std::string tail = s.substr(s.size() - suffix.size());
+    std::transform(tail.begin(), tail.end(), tail.begin(), ::tolower);
+    return tail == suffix;
+}
+
+std::vector<std::string> readNames(const std::string& path) {
+    std::ifstream in(path);
+    if (!in) throw std::runtime_error("yolo: cannot open class names file '" + path + "'");
+    std::vector<std::string> names;
+    std::string line;
+    while (std::getline(in, line)) {
+        line = trim(line);
+        if (!line.empty()) names.push_back(line);
+    }
+    if (names.empty()) throw std::runtime_error("yolo: class names file '" + path + "' is empty");
+    return names;
+}
+
+const std::vector<std::string> kYoloKeys{
+    "detector",     "model",          "weights",       "names",   "input_width",
+    "input_height", "conf_threshold", "nms_threshold", "classes", "validate_on_load"};
+}  // namespace
+
+std::string resolveModelPath(const std::string& path, const std::string& what) {
+    if (path.empty()) throw std::runtime_error(what + ": no file given");
+    if (fs::exists(path)) return path;
+    std::string tried = "'" + path + "'";
+#ifdef DEVSLAM_SOURCE_DIR
+    if (fs::path(path).is_relative()) {
+        const std::string alt = (fs::path(DEVSLAM_SOURCE_DIR) / path).string();
+        if (fs::exists(alt)) return alt;
+        tried += " and '" + alt + "'";
+    }
+#endif
+    throw std::runtime_error(what + ": file not found (tried " + tried + ")");
+}
+
+cv::dnn::Net readDarknetCfg(const std::string& cfg_path) {
+    const std::string path = resolveModelPath(cfg_path, "darknet cfg");
+    try {
+        cv::dnn::Net net = cv::dnn::readNetFromDarknet(path);
+        if (net.empty()) throw std::runtime_error("empty network");
+        return net;
+    } catch (const cv::Exception& e) {
+        throw std::runtime_error("darknet cfg '" + path + "' does not parse: " + e.what());
+    }
+}
+
+void YoloDetector::Options::loadFromConfig(const mrpt::config::CConfigFileBase& c,
+                                           const std::string& s) {
+    core::requireKnownKeys(c, s, kYoloKeys);
+    model = c.read_string(s, "model", model);
+    weights = c.read_string(s, "weights", weights);
+    names = c.read_string(s, "names", names);
+    input_width = c.read_int(s, "input_width", input_width);
+    input_height = c.read_int(s, "input_height", input_height);
+    conf_threshold = c.read_float(s, "conf_threshold", conf_threshold);
+    nms_threshold = c.read_float(s, "nms_threshold", nms_threshold);
+    if (c.keyExists(s, "classes")) classes = splitList(c.read_string(s, "classes", ""));
+    validate_on_load = c.read_bool(s, "validate_on_load", validate_on_load);
+    core::requireValue(input_width > 0 && input_width % 32 == 0, s, "input_width",
+                       "must be a positive multiple of 32");
+    core::requireValue(input_height > 0 && input_height % 32 == 0, s, "input_height",
+                       "must be a positive multiple of 32");
+    core::requireValue(conf_threshold >= 0 && conf_threshold <= 1, s, "conf_threshold",
+                       "must be in [0, 1]");
+    core::requireValue(nms_threshold >= 0 && nms_threshold <= 1, s, "nms_threshold",
+                       "must be in [0, 1]");
+    core::requireValue(!classes.empty(), s, "classes", "needs at least one class name");
+}
+
+void YoloDetector::Options::saveToConfig(mrpt::config::CConfigFileBase& c,
+                                         const std::string& s) const {
+    c.write(s, "detector", std::string("yolo"));
+    c.write(s, "model", model);
+    c.write(s, "weights", weights);
+    c.write(s, "names", names);
+    c.write(s, "input_width", input_width);
+    c.write(s, "input_height", input_height);
+    c.write(s, "conf_threshold", conf_threshold);
+    c.write(s, "nms_threshold", nms_threshold);
+    std::string list;
+    for (const auto& n : classes) list += (list.empty() ? "" : ", ") + n;
+    c.write(s, "classes", list);
+    c.write(s, "validate_on_load", validate_on_load);
+}
+
+YoloDetector::YoloDetector(const Options& opts) : opts_(opts) {
+    const std::string model = resolveModelPath(opts_.model, "yolo model");
+    onnx_ = endsWith(model, ".onnx");
+    names_ = readNames(resolveModelPath(opts_.names, "yolo class names"));
+    for (const auto& c : opts_.classes) {
+        const auto it = std::find(names_.begin(), names_.end(), c);
+        if (it == names_.end())
+            throw std::invalid_argument("yolo: class '" + c + "' is not in '" + opts_.names + "'");
+        wanted_.push_back(static_cast<int>(it - names_.begin()));
+    }
+    std::string weights;
+    try {
+        if (onnx_) {
+            net_ = cv::dnn::readNetFromONNX(model);
+        } else {
+            weights = resolveModelPath(opts_.weights, "yolo weights");
+            // A truncated or foreign file must not silently give a half-loaded network.
+            if (fs::file_size(weights) < 1024)
+                throw std::runtime_error("yolo weights '" + weights + "' is too small (" +
+                                         std::to_string(fs::file_size(weights)) +
+                                         " bytes) to be a darknet weights file");
+            net_ = cv::dnn::readNetFromDarknet(model, weights);
+            // cv::dnn reads a truncated weights file without complaint (missing values
+            // stay uninitialised): compare the file size with the parameters the cfg needs.
+            std::size_t n_params = 0;
+            for (const auto& layer : net_.getLayerNames())
+                for (const auto& blob : net_.getLayer(net_.getLayerId(layer))->blobs)
+                    n_params += blob.total();
+            const double expected = 4.0 * static_cast<double>(n_params);  // float32
+            const auto actual = static_cast<double>(fs::file_size(weights));
+            if (std::abs(actual - expected) > 0.01 * expected + 64)
+                throw std::runtime_error("yolo weights '" + weights + "' has " +
+                                         std::to_string(fs::file_size(weights)) +
+                                         " bytes but cfg '" + model + "' needs about " +
+                                         std::to_string(static_cast<long long>(expected)) +
+                                         " (truncated file, or weights of another model?)");
+        }
+    } catch (const cv::Exception& e) {
+        throw std::runtime_error("yolo: cannot load model '" + model + "'" +
+                                 (weights.empty() ? "" : " with weights '" + weights + "'") + ": " +
+                                 e.what());
+    }
+    if (net_.empty()) throw std::runtime_error("yolo: model '" + model + "' gave an empty network");
+    net_.setPreferableBackend(cv::dnn::DNN_BACKEND_OPENCV);
+    net_.setPreferableTarget(cv::dnn::DNN_TARGET_CPU);
+    out_names_ = net_.getUnconnectedOutLayersNames();
+    if (opts_.validate_on_load) {
+        try {
+            (void)detect(
+                cv::Mat(opts_.input_height, opts_.input_width, CV_8UC3, cv::Scalar(127, 127, 127)));
+        } catch (const std::exception& e) {
+            throw std::runtime_error(
+                "yolo: model '" + model + "'" +
+                (weights.empty() ? "" : " with weights '" + weights + "'") +
+                " fails on a test image (corrupt or mismatched file?): " + e.what());
+        }
+    }
+}
+
+std::string YoloDetector::name() const {
+    return "yolo(" + fs::path(opts_.model).filename().string() + ", " +
+           std::to_string(opts_.input_width) + "x" + std::to_string(opts_.input_height) + ")";
+}
+
+std::vector<Detection> YoloDetector::detect(const cv::Mat& bgr) {
+    if (bgr.empty() || bgr.type() != CV_8UC3)
+        throw std::invalid_argument("yolo: detect() needs a non-empty CV_8UC3 image");
+    // Darknet models are trained on stretched (not letterboxed) RGB images in [0, 1].
+    const cv::Mat blob = cv::dnn::blobFromImage(
+        bgr, 1.0 / 255.0, cv::Size(opts_.input_width, opts_.input_height), cv::Scalar(),
+        /*swapRB=*/true, /*crop=*/false);
+    net_.setInput(blob);
+    std::vector<cv::Mat> outs;
+    net_.forward(outs, out_names_);
+
+    const int n_classes = static_cast<int>(names_.size());
+    std::vector<std::vector<cv::Rect2d>> boxes(wanted_.size());
+    std::vector<std::vector<float>> scores(wanted_.size());
+    for (cv::Mat out : outs) {
+        // ONNX exports give 1 x N x (5 + C); darknet gives N x (5 + C).
+        if (out.dims == 3) out = out.reshape(1, out.size[1]);
+        if (out.dims != 2 || out.cols != 5 + n_classes)
+            throw std::runtime_error("yolo: output of " + std::to_string(out.cols) +
+                                     " columns, expected 5 + " + std::to_string(n_classes) +
+                                     " (class names file does not match the model?)");
+        for (int r = 0; r < out.rows; ++r) {
+            const float* row = out.ptr<float>(r);
+            const float obj = row[4];
+            if (obj < opts_.conf_threshold) continue;
+            for (std::size_t k = 0; k < wanted_.size(); ++k) {
+                // cv::dnn's darknet region layer already multiplies class scores by
+                // objectness; ONNX (YOLOv5-style) outputs keep them separate.
+                const float cls = row[5 + wanted_[k]];
+                const float score = onnx_ ? obj * cls : cls;
+                if (score < opts_.conf_threshold) continue;
+                double cx = row[0], cy = row[1], w = row[2], h = row[3];
+                if (onnx_) {  // input pixels -> normalized
+                    cx /= opts_.input_width;
+                    w /= opts_.input_width;
+                    cy /= opts_.input_height;
+                    h /= opts_.input_height;
+                }
+                boxes[k].emplace_back((cx - w / 2) * bgr.cols, (cy - h / 2) * bgr.rows,
+                                      w * bgr.cols, h * bgr.rows);
+                scores[k].push_back(score);
+            }
+        }
+    }
+    std::vector<Detection> dets;
+    const cv::Rect2f image(0.f, 0.f, static_cast<float>(bgr.cols), static_cast<float>(bgr.rows));
+    for (std::size_t k = 0; k < wanted_.size(); ++k) {
+        std::vector<int> keep;
+        cv::dnn::NMSBoxes(boxes[k], scores[k], opts_.conf_threshold, opts_.nms_threshold, keep);
+        for (int i : keep) {
+            const cv::Rect2f b = cv::Rect2f(boxes[k][i]) & image;
+            if (b.area() <= 0.f) continue;
+            dets.push_back({b, wanted_[k], names_[wanted_[k]], scores[k][i]});
+        }
+    }
+    std::sort(dets.begin(), dets.end(),
+              [](const Detection& a, const Detection& b) { return a.score > b.score; });
+    return dets;
+}
+
+}  // namespace devslam::detect
