@@ -9,12 +9,20 @@
 
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <functional>
 #include <sstream>
 
 namespace devslam::nav {
 
 namespace {
+/// CPU time of the calling thread [s]: step timings that do not depend on machine load.
+double threadCpuSeconds() {
+    timespec ts{};
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+    return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
 /// Exposes the per-PTG holonomic objects and silences MRPT's timing table.
 class ReactiveNav : public mrpt::nav::CReactiveNavigationSystem {
   public:
@@ -211,9 +219,9 @@ NavState Navigator::step(double t) {
         last_error_ = "robot did not report its pose";
         return NavState::Error;
     }
-    const auto t0 = std::chrono::steady_clock::now();
+    const double t0 = threadCpuSeconds();
     nav_->navigationStep();
-    last_step_s_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    last_step_s_ = threadCpuSeconds() - t0;
 
     const double goal_dist = std::hypot(pose.x - goal_.x, pose.y - goal_.y);
     const auto st = nav_->getCurrentState();

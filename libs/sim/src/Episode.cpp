@@ -67,7 +67,15 @@ EpisodeResult runEpisode(const WorldSpec& world, const mrpt::config::CConfigFile
         return res;
     }
     res.global_path = navigator.globalPath();
-    res.astar_length = res.global_path.length;
+    res.astar_cells_length = res.global_path.length;
+    {
+        // any-angle reference: string-pull the cell path (no spacing limit)
+        nav::GridPlanner ref(nav_opts.planner);
+        ref.setMap(grid);
+        auto pulled = nav::decimateWaypoints(ref, res.global_path, 1e9);
+        pulled.insert(pulled.begin(), res.global_path.points.front());
+        res.astar_length = nav::polylineLength(pulled);
+    }
     res.waypoints = navigator.waypoints();
     res.pedestrian_tracks.resize(world.pedestrians.size());
 

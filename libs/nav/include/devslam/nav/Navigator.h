@@ -73,7 +73,8 @@ class Navigator {
     [[nodiscard]] const GridPath& globalPath() const { return first_path_; }
     [[nodiscard]] const std::vector<mrpt::math::TPoint2D>& waypoints() const { return waypoints_; }
     [[nodiscard]] int replanCount() const { return replans_; }
-    [[nodiscard]] double lastStepSeconds() const { return last_step_s_; }  ///< wall time
+    /// Thread CPU time [s] of the last navigationStep() (independent of machine load).
+    [[nodiscard]] double lastStepSeconds() const { return last_step_s_; }
     [[nodiscard]] std::string lastError() const { return last_error_; }
     [[nodiscard]] double refDistance() const { return ref_distance_; }
     [[nodiscard]] mrpt::nav::CReactiveNavigationSystem& reactive();

@@ -31,10 +31,12 @@ enum class Outcome { Success, Collision, Timeout, NoPath };
 
 struct EpisodeResult {
     Outcome outcome = Outcome::Timeout;
-    std::string reason;                 ///< human-readable detail
-    double time = 0;                    ///< [s] simulated time at the end
-    double path_length = 0;             ///< [m] driven distance
-    double astar_length = 0;            ///< [m] first global path
+    std::string reason;       ///< human-readable detail
+    double time = 0;          ///< [s] simulated time at the end
+    double path_length = 0;   ///< [m] driven distance
+    double astar_length = 0;  ///< [m] first global path after string pulling (line-of-sight
+                              ///< shortcuts keeping the path's clearance): the reference length
+    double astar_cells_length = 0;      ///< [m] the same path through cell centres (staircase)
     double min_clearance_static = 1e9;  ///< [m] robot edge to nearest static obstacle
     double min_clearance_people = 1e9;  ///< [m] robot edge to nearest person edge
     int static_collisions = 0;          ///< contact events with walls/boxes
