@@ -81,11 +81,11 @@ class DynamicObjectFilter {
         int detect_every = 1;  ///< run the detector every k-th frame (1 = every frame)
 
         // Flow points (Shi-Tomasi on the previous frame, pyramidal LK into the current one)
-        int max_corners = 400;             ///< corners in the whole image
+        int max_corners = 300;             ///< corners in the whole image
         int max_corners_per_box = 60;      ///< extra corners seeded inside each person box
         double corner_quality = 0.01;      ///< Shi-Tomasi quality level (fraction of best)
-        double corner_min_distance = 7.0;  ///< [px] between corners
-        int lk_window = 21;                ///< [px] LK window side
+        double corner_min_distance = 8.0;  ///< [px] between corners
+        int lk_window = 15;                ///< [px] LK window side
         int lk_levels = 3;                 ///< pyramid levels above the base
         double fb_max_error = 1.0;         ///< [px] forward-backward check
 

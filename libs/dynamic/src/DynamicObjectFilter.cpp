@@ -1,0 +1,477 @@
+#include <devslam/dynamic/DynamicObjectFilter.h>
+
+#include <devslam/core/Config.h>
+
+#include <mrpt/config/CConfigFileBase.h>
+#include <opencv2/calib3d.hpp>
+#include <opencv2/core/eigen.hpp>
+#include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+namespace devslam::dynamic {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+const std::vector<std::string> kKeys{"mode",
+                                     "detect_every",
+                                     "max_corners",
+                                     "max_corners_per_box",
+                                     "corner_quality",
+                                     "corner_min_distance",
+                                     "lk_window",
+                                     "lk_levels",
+                                     "fb_max_error",
+                                     "refine_ego_motion",
+                                     "min_background_points",
+                                     "ransac_reprojection",
+                                     "max_depth",
+                                     "threshold1",
+                                     "threshold2_count",
+                                     "threshold2_fraction",
+                                     "min_points",
+                                     "box_shrink",
+                                     "iou_match",
+                                     "release_frames",
+                                     "max_missed_detections",
+                                     "mask_margin"};
+
+cv::Rect2f shrink(const cv::Rect2f& b, double f) {
+    const auto dx = static_cast<float>(f * b.width), dy = static_cast<float>(f * b.height);
+    return {b.x + dx, b.y + dy, b.width - 2 * dx, b.height - 2 * dy};
+}
+
+/// Depth at (u, v) if it is valid and not on a depth discontinuity (3x3 spread below 5%):
+/// corners on the silhouette of a person often sample the background's depth.
+std::optional<float> stableDepth(const cv::Mat& depth, const cv::Point2f& p, double max_depth) {
+    const int u = cvRound(p.x), v = cvRound(p.y);
+    if (u < 1 || v < 1 || u >= depth.cols - 1 || v >= depth.rows - 1) return std::nullopt;
+    float lo = 1e9f, hi = 0.f;
+    for (int dv = -1; dv <= 1; ++dv) {
+        const float* row = depth.ptr<float>(v + dv);
+        for (int du = -1; du <= 1; ++du) {
+            const float z = row[u + du];
+            if (!(z > 0.f)) return std::nullopt;
+            lo = std::min(lo, z);
+            hi = std::max(hi, z);
+        }
+    }
+    const float z = depth.at<float>(v, u);
+    if (z > max_depth || hi - lo > 0.05f * z) return std::nullopt;
+    return z;
+}
+
+}  // namespace
+
+MaskMode parseMaskMode(const std::string& name) {
+    if (name == "none") return MaskMode::None;
+    if (name == "all_persons") return MaskMode::AllPersons;
+    if (name == "dynamic") return MaskMode::Dynamic;
+    throw std::invalid_argument("unknown mask mode '" + name +
+                                "' (known: none, all_persons, dynamic)");
+}
+
+std::string toString(MaskMode mode) {
+    switch (mode) {
+        case MaskMode::None:
+            return "none";
+        case MaskMode::AllPersons:
+            return "all_persons";
+        case MaskMode::Dynamic:
+            return "dynamic";
+    }
+    return "?";
+}
+
+std::string toString(BoxState state) {
+    switch (state) {
+        case BoxState::Unknown:
+            return "unknown";
+        case BoxState::Static:
+            return "static";
+        case BoxState::Moving:
+            return "moving";
+    }
+    return "?";
+}
+
+void DynamicObjectFilter::Options::loadFromConfig(const mrpt::config::CConfigFileBase& c,
+                                                  const std::string& s) {
+    core::requireKnownKeys(c, s, kKeys);
+    if (c.keyExists(s, "mode")) {
+        try {
+            mode = parseMaskMode(c.read_string(s, "mode", ""));
+        } catch (const std::invalid_argument& e) {
+            throw std::invalid_argument("[" + s + "] mode: " + e.what());
+        }
+    }
+    detect_every = c.read_int(s, "detect_every", detect_every);
+    max_corners = c.read_int(s, "max_corners", max_corners);
+    max_corners_per_box = c.read_int(s, "max_corners_per_box", max_corners_per_box);
+    corner_quality = c.read_double(s, "corner_quality", corner_quality);
+    corner_min_distance = c.read_double(s, "corner_min_distance", corner_min_distance);
+    lk_window = c.read_int(s, "lk_window", lk_window);
+    lk_levels = c.read_int(s, "lk_levels", lk_levels);
+    fb_max_error = c.read_double(s, "fb_max_error", fb_max_error);
+    refine_ego_motion = c.read_bool(s, "refine_ego_motion", refine_ego_motion);
+    min_background_points = c.read_int(s, "min_background_points", min_background_points);
+    ransac_reprojection = c.read_double(s, "ransac_reprojection", ransac_reprojection);
+    max_depth = c.read_double(s, "max_depth", max_depth);
+    threshold1 = c.read_double(s, "threshold1", threshold1);
+    threshold2_count = c.read_int(s, "threshold2_count", threshold2_count);
+    threshold2_fraction = c.read_double(s, "threshold2_fraction", threshold2_fraction);
+    min_points = c.read_int(s, "min_points", min_points);
+    box_shrink = c.read_double(s, "box_shrink", box_shrink);
+    iou_match = c.read_double(s, "iou_match", iou_match);
+    release_frames = c.read_int(s, "release_frames", release_frames);
+    max_missed_detections = c.read_int(s, "max_missed_detections", max_missed_detections);
+    mask_margin = c.read_int(s, "mask_margin", mask_margin);
+    core::requireValue(detect_every >= 1, s, "detect_every", "must be >= 1");
+    core::requireValue(max_corners > 0, s, "max_corners", "must be > 0");
+    core::requireValue(max_corners_per_box >= 0, s, "max_corners_per_box", "must be >= 0");
+    core::requireValue(corner_quality > 0 && corner_quality < 1, s, "corner_quality",
+                       "must be in (0, 1)");
+    core::requireValue(lk_window >= 5 && lk_window % 2 == 1, s, "lk_window",
+                       "must be odd and >= 5");
+    core::requireValue(lk_levels >= 0 && lk_levels <= 6, s, "lk_levels", "must be in [0, 6]");
+    core::requireValue(fb_max_error > 0, s, "fb_max_error", "must be > 0");
+    core::requireValue(min_background_points >= 6, s, "min_background_points", "must be >= 6");
+    core::requireValue(ransac_reprojection > 0, s, "ransac_reprojection", "must be > 0");
+    core::requireValue(max_depth > 0, s, "max_depth", "must be > 0");
+    core::requireValue(threshold1 > 0, s, "threshold1", "must be > 0");
+    core::requireValue(threshold2_count >= 1, s, "threshold2_count", "must be >= 1");
+    core::requireValue(threshold2_fraction >= 0 && threshold2_fraction <= 1, s,
+                       "threshold2_fraction", "must be in [0, 1]");
+    core::requireValue(min_points >= 1, s, "min_points", "must be >= 1");
+    core::requireValue(box_shrink >= 0 && box_shrink < 0.5, s, "box_shrink", "must be in [0, 0.5)");
+    core::requireValue(iou_match > 0 && iou_match <= 1, s, "iou_match", "must be in (0, 1]");
+    core::requireValue(release_frames >= 1, s, "release_frames", "must be >= 1");
+    core::requireValue(max_missed_detections >= 0, s, "max_missed_detections", "must be >= 0");
+    core::requireValue(mask_margin >= 0, s, "mask_margin", "must be >= 0");
+}
+
+void DynamicObjectFilter::Options::saveToConfig(mrpt::config::CConfigFileBase& c,
+                                                const std::string& s) const {
+    c.write(s, "mode", toString(mode));
+    c.write(s, "detect_every", detect_every);
+    c.write(s, "max_corners", max_corners);
+    c.write(s, "max_corners_per_box", max_corners_per_box);
+    c.write(s, "corner_quality", corner_quality);
+    c.write(s, "corner_min_distance", corner_min_distance);
+    c.write(s, "lk_window", lk_window);
+    c.write(s, "lk_levels", lk_levels);
+    c.write(s, "fb_max_error", fb_max_error);
+    c.write(s, "refine_ego_motion", refine_ego_motion);
+    c.write(s, "min_background_points", min_background_points);
+    c.write(s, "ransac_reprojection", ransac_reprojection);
+    c.write(s, "max_depth", max_depth);
+    c.write(s, "threshold1", threshold1);
+    c.write(s, "threshold2_count", threshold2_count);
+    c.write(s, "threshold2_fraction", threshold2_fraction);
+    c.write(s, "min_points", min_points);
+    c.write(s, "box_shrink", box_shrink);
+    c.write(s, "iou_match", iou_match);
+    c.write(s, "release_frames", release_frames);
+    c.write(s, "max_missed_detections", max_missed_detections);
+    c.write(s, "mask_margin", mask_margin);
+}
+
+struct DynamicObjectFilter::Impl {
+    struct Track {
+        TrackedBox tb;
+        int quiet = 0;   ///< consecutive frames without moving evidence
+        int missed = 0;  ///< detector runs without a matching detection
+    };
+    cv::Mat prev_gray, prev_depth;
+    std::vector<cv::Mat> prev_pyr;
+    core::CameraIntrinsics prev_K;
+    std::vector<Track> tracks;
+    int next_id = 0;
+    long frame_count = 0;
+};
+
+DynamicObjectFilter::DynamicObjectFilter(const Options& opts,
+                                         std::unique_ptr<detect::PersonDetector> detector)
+    : opts_(opts), detector_(std::move(detector)), impl_(std::make_unique<Impl>()) {
+    if (!detector_ && opts_.mode != MaskMode::None)
+        throw std::invalid_argument("dynamic filter: mode '" + toString(opts_.mode) +
+                                    "' needs a detector");
+}
+
+DynamicObjectFilter::~DynamicObjectFilter() = default;
+
+void DynamicObjectFilter::reset() {
+    impl_ = std::make_unique<Impl>();
+}
+
+FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
+                                       const std::optional<Eigen::Isometry3d>& T_prev_cur_prior) {
+    if (frame.bgr.type() != CV_8UC3 || frame.depth.type() != CV_32FC1 ||
+        frame.bgr.size() != frame.depth.size() || frame.bgr.empty())
+        throw std::invalid_argument("dynamic filter: frame " + std::to_string(frame.index) +
+                                    " needs CV_8UC3 colour and CV_32FC1 depth of equal size");
+    FilterOutput out;
+    out.mask = cv::Mat::zeros(frame.bgr.size(), CV_8UC1);
+    if (opts_.mode == MaskMode::None) return out;
+
+    Impl& im = *impl_;
+    const auto t_filter0 = Clock::now();
+    double detect_ms = 0;
+    cv::Mat gray;
+    cv::cvtColor(frame.bgr, gray, cv::COLOR_BGR2GRAY);
+    const cv::Size win(opts_.lk_window, opts_.lk_window);
+    std::vector<cv::Mat> pyr;
+    cv::buildOpticalFlowPyramid(gray, pyr, win, opts_.lk_levels);
+    const cv::Rect2f image(0.f, 0.f, static_cast<float>(gray.cols), static_cast<float>(gray.rows));
+    const bool have_prev = !im.prev_gray.empty() && im.prev_gray.size() == gray.size();
+
+    // 1. Flow of Shi-Tomasi corners of the previous frame (global + inside each box).
+    std::vector<cv::Point2f> p0, p1;
+    if (have_prev) {
+        cv::goodFeaturesToTrack(im.prev_gray, p0, opts_.max_corners, opts_.corner_quality,
+                                opts_.corner_min_distance);
+        if (opts_.max_corners_per_box > 0) {
+            for (const auto& t : im.tracks) {
+                const cv::Rect roi = cv::Rect(shrink(t.tb.box, opts_.box_shrink)) &
+                                     cv::Rect(0, 0, gray.cols, gray.rows);
+                if (roi.width < 8 || roi.height < 8) continue;
+                std::vector<cv::Point2f> pts;
+                cv::goodFeaturesToTrack(im.prev_gray(roi), pts, opts_.max_corners_per_box,
+                                        opts_.corner_quality, opts_.corner_min_distance * 0.5);
+                for (auto& p : pts) p0.emplace_back(p.x + roi.x, p.y + roi.y);
+            }
+        }
+        if (!p0.empty()) {
+            std::vector<uchar> st, st_back;
+            std::vector<float> err;
+            const cv::TermCriteria term(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 20, 0.03);
+            cv::calcOpticalFlowPyrLK(im.prev_pyr, pyr, p0, p1, st, err, win, opts_.lk_levels, term);
+            std::vector<cv::Point2f> back = p0;
+            cv::calcOpticalFlowPyrLK(pyr, im.prev_pyr, p1, back, st_back, err, win, opts_.lk_levels,
+                                     term, cv::OPTFLOW_USE_INITIAL_FLOW);
+            std::size_t n = 0;
+            for (std::size_t i = 0; i < p0.size(); ++i) {
+                const float fb = static_cast<float>(cv::norm(back[i] - p0[i]));
+                if (!st[i] || !st_back[i] || fb > opts_.fb_max_error || !image.contains(p1[i]))
+                    continue;
+                p0[n] = p0[i];
+                p1[n] = p1[i];
+                ++n;
+            }
+            p0.resize(n);
+            p1.resize(n);
+        }
+    }
+
+    // 2. Carry the boxes with the median flow of their points (prediction for association,
+    //    and the boxes themselves on frames without detection).
+    for (auto& t : im.tracks) {
+        std::vector<float> dx, dy;
+        for (std::size_t i = 0; i < p0.size(); ++i)
+            if (t.tb.box.contains(p0[i])) {
+                dx.push_back(p1[i].x - p0[i].x);
+                dy.push_back(p1[i].y - p0[i].y);
+            }
+        if (dx.size() >= 3) {
+            std::nth_element(dx.begin(), dx.begin() + dx.size() / 2, dx.end());
+            std::nth_element(dy.begin(), dy.begin() + dy.size() / 2, dy.end());
+            t.tb.box.x += dx[dx.size() / 2];
+            t.tb.box.y += dy[dy.size() / 2];
+        }
+        t.tb.box &= image;
+        t.tb.detected_this_frame = false;
+    }
+
+    // 3. Detection every k-th frame, greedy IoU association, new tracks.
+    if (im.frame_count % opts_.detect_every == 0) {
+        const auto t_det0 = Clock::now();
+        const auto dets = detector_->detect(frame.bgr);
+        detect_ms = msSince(t_det0);
+        out.detector_ran = true;
+        std::vector<bool> used_det(dets.size(), false), used_trk(im.tracks.size(), false);
+        struct Pair {
+            float iou;
+            std::size_t d, t;
+        };
+        std::vector<Pair> pairs;
+        for (std::size_t d = 0; d < dets.size(); ++d)
+            for (std::size_t t = 0; t < im.tracks.size(); ++t) {
+                const float v = detect::iou(dets[d].box, im.tracks[t].tb.box);
+                if (v >= opts_.iou_match) pairs.push_back({v, d, t});
+            }
+        std::sort(pairs.begin(), pairs.end(), [](const Pair& a, const Pair& b) {
+            return a.iou > b.iou || (a.iou == b.iou && (a.d < b.d || (a.d == b.d && a.t < b.t)));
+        });
+        for (const auto& p : pairs) {
+            if (used_det[p.d] || used_trk[p.t]) continue;
+            used_det[p.d] = used_trk[p.t] = true;
+            auto& t = im.tracks[p.t];
+            t.tb.box = dets[p.d].box;
+            t.tb.score = dets[p.d].score;
+            t.tb.detected_this_frame = true;
+            t.missed = 0;
+        }
+        for (std::size_t t = 0; t < im.tracks.size(); ++t)
+            if (!used_trk[t]) ++im.tracks[t].missed;
+        im.tracks.erase(std::remove_if(im.tracks.begin(), im.tracks.end(),
+                                       [&](const Impl::Track& t) {
+                                           return t.missed > opts_.max_missed_detections;
+                                       }),
+                        im.tracks.end());
+        for (std::size_t d = 0; d < dets.size(); ++d) {
+            if (used_det[d]) continue;
+            Impl::Track t;
+            t.tb.id = im.next_id++;
+            t.tb.box = dets[d].box;
+            t.tb.score = dets[d].score;
+            t.tb.detected_this_frame = true;
+            im.tracks.push_back(t);
+        }
+    }
+    im.tracks.erase(std::remove_if(im.tracks.begin(), im.tracks.end(),
+                                   [](const Impl::Track& t) { return t.tb.box.area() < 16.f; }),
+                    im.tracks.end());
+
+    // 4. Ego-motion: 3D of each point from the previous depth; relative pose refined with
+    //    PnP-RANSAC on points outside every person box.
+    if (have_prev && !p0.empty()) {
+        const core::CameraIntrinsics& Kp = im.prev_K;
+        const core::CameraIntrinsics& Kc = frame.K;
+        auto inAnyBox = [&](const cv::Point2f& a, const cv::Point2f& b) {
+            for (const auto& t : im.tracks) {
+                const cv::Rect2f grown(t.tb.box.x - opts_.mask_margin,
+                                       t.tb.box.y - opts_.mask_margin,
+                                       t.tb.box.width + 2.f * opts_.mask_margin,
+                                       t.tb.box.height + 2.f * opts_.mask_margin);
+                if (grown.contains(a) || grown.contains(b)) return true;
+            }
+            return false;
+        };
+        std::vector<std::optional<Eigen::Vector3d>> X(p0.size());
+        std::vector<cv::Point3f> bg_obj;
+        std::vector<cv::Point2f> bg_img;
+        for (std::size_t i = 0; i < p0.size(); ++i) {
+            const auto z = stableDepth(im.prev_depth, p0[i], opts_.max_depth);
+            if (!z) continue;
+            X[i] = core::backproject(p0[i].x, p0[i].y, *z, Kp);
+            if (!inAnyBox(p0[i], p1[i])) {
+                bg_obj.emplace_back(static_cast<float>(X[i]->x()), static_cast<float>(X[i]->y()),
+                                    static_cast<float>(X[i]->z()));
+                bg_img.push_back(p1[i]);
+            }
+        }
+        Eigen::Isometry3d T_prev_cur = T_prev_cur_prior.value_or(Eigen::Isometry3d::Identity());
+        if (opts_.refine_ego_motion &&
+            static_cast<int>(bg_obj.size()) >= opts_.min_background_points) {
+            // solvePnP gives T_cur_prev (x_cur = R x_prev + t).
+            const Eigen::Isometry3d T_cp = T_prev_cur.inverse();
+            cv::Mat R_cv, rvec, tvec;
+            cv::eigen2cv(Eigen::Matrix3d(T_cp.linear()), R_cv);
+            cv::Rodrigues(R_cv, rvec);
+            cv::eigen2cv(Eigen::Vector3d(T_cp.translation()), tvec);
+            cv::Mat K_cv;
+            cv::eigen2cv(Kc.matrix(), K_cv);
+            std::vector<int> inliers;
+            // (OpenCV's RANSAC uses its own fixed-seed RNG: runs are repeatable.)
+            const bool ok =
+                cv::solvePnPRansac(bg_obj, bg_img, K_cv, cv::noArray(), rvec, tvec, true, 100,
+                                   static_cast<float>(opts_.ransac_reprojection), 0.99, inliers,
+                                   cv::SOLVEPNP_ITERATIVE);
+            if (ok && static_cast<int>(inliers.size()) >= opts_.min_background_points &&
+                inliers.size() * 2 >= bg_obj.size() / 2) {
+                cv::Mat R_new;
+                cv::Rodrigues(rvec, R_new);
+                Eigen::Matrix3d R;
+                Eigen::Vector3d t;
+                cv::cv2eigen(R_new, R);
+                cv::cv2eigen(tvec, t);
+                Eigen::Isometry3d T_cp_new = Eigen::Isometry3d::Identity();
+                T_cp_new.linear() = R;
+                T_cp_new.translation() = t;
+                T_prev_cur = T_cp_new.inverse();
+                out.T_prev_cur_refined = T_prev_cur;
+            }
+        }
+        // 5. Residual flow = observed - predicted from ego-motion and depth.
+        const Eigen::Isometry3d T_cur_prev = T_prev_cur.inverse();
+        out.flow.reserve(p0.size());
+        for (std::size_t i = 0; i < p0.size(); ++i) {
+            FilterOutput::FlowPoint fp{p0[i], p1[i], -1.f, false, false};
+            if (X[i]) {
+                if (const auto uv = core::project(T_cur_prev * *X[i], Kc))
+                    fp.residual =
+                        static_cast<float>(std::hypot(p1[i].x - uv->x(), p1[i].y - uv->y()));
+            }
+            fp.dynamic = fp.residual > opts_.threshold1;
+            out.flow.push_back(fp);
+        }
+    }
+
+    // 6. Per-box evidence (Algorithm 1 with residual flow) and hysteresis.
+    for (auto& t : im.tracks) {
+        const cv::Rect2f inner = shrink(t.tb.box, opts_.box_shrink);
+        int n = 0, n_dyn = 0;
+        for (auto& fp : out.flow) {
+            if (fp.residual < 0.f || !inner.contains(fp.cur)) continue;
+            fp.in_box = true;
+            ++n;
+            if (fp.dynamic) ++n_dyn;
+        }
+        t.tb.n_points = n;
+        t.tb.n_dynamic_points = n_dyn;
+        if (n < opts_.min_points) continue;  // no evidence: keep the state
+        const bool moving = n_dyn >= opts_.threshold2_count &&
+                            n_dyn >= opts_.threshold2_fraction * static_cast<double>(n);
+        if (moving) {
+            t.tb.state = BoxState::Moving;  // caught at once
+            t.quiet = 0;
+        } else if (t.tb.state == BoxState::Moving) {
+            if (++t.quiet >= opts_.release_frames) t.tb.state = BoxState::Static;
+        } else {
+            t.tb.state = BoxState::Static;
+        }
+    }
+
+    // 7. Mask: whole boxes, dilated by the margin.
+    for (const auto& t : im.tracks) {
+        out.boxes.push_back(t.tb);
+        const bool masked = opts_.mode == MaskMode::AllPersons || t.tb.state == BoxState::Moving;
+        if (!masked) continue;
+        const cv::Rect r =
+            cv::Rect(cv::Rect2f(t.tb.box.x - opts_.mask_margin, t.tb.box.y - opts_.mask_margin,
+                                t.tb.box.width + 2.f * opts_.mask_margin,
+                                t.tb.box.height + 2.f * opts_.mask_margin)) &
+            cv::Rect(0, 0, gray.cols, gray.rows);
+        out.mask(r).setTo(255);
+    }
+
+    im.prev_gray = gray;
+    im.prev_pyr = std::move(pyr);
+    im.prev_depth = frame.depth.clone();
+    im.prev_K = frame.K;
+    ++im.frame_count;
+    out.detect_ms = detect_ms;
+    out.filter_ms = msSince(t_filter0) - detect_ms;
+    return out;
+}
+
+std::unique_ptr<DynamicObjectFilter> makeFilterFromConfig(const mrpt::config::CConfigFileBase& cfg,
+                                                          std::optional<MaskMode> mode_override) {
+    DynamicObjectFilter::Options o;
+    o.loadFromConfig(cfg, "dynamic_filter");
+    if (mode_override) o.mode = *mode_override;
+    std::unique_ptr<detect::PersonDetector> det;
+    if (o.mode != MaskMode::None) det = detect::makeDetector(cfg, "detector");
+    return std::make_unique<DynamicObjectFilter>(o, std::move(det));
+}
+
+}  // namespace devslam::dynamic
