@@ -43,7 +43,8 @@ const std::vector<std::string> kKeys{"mode",
                                      "iou_match",
                                      "release_frames",
                                      "max_missed_detections",
-                                     "mask_margin"};
+                                     "mask_margin",
+                                     "background_factor"};
 
 cv::Rect2f shrink(const cv::Rect2f& b, double f) {
     const auto dx = static_cast<float>(f * b.width), dy = static_cast<float>(f * b.height);
@@ -127,6 +128,7 @@ void DynamicObjectFilter::Options::loadFromConfig(const mrpt::config::CConfigFil
     ransac_reprojection = c.read_double(s, "ransac_reprojection", ransac_reprojection);
     max_depth = c.read_double(s, "max_depth", max_depth);
     threshold1 = c.read_double(s, "threshold1", threshold1);
+    background_factor = c.read_double(s, "background_factor", background_factor);
     threshold2_count = c.read_int(s, "threshold2_count", threshold2_count);
     threshold2_fraction = c.read_double(s, "threshold2_fraction", threshold2_fraction);
     min_points = c.read_int(s, "min_points", min_points);
@@ -148,6 +150,7 @@ void DynamicObjectFilter::Options::loadFromConfig(const mrpt::config::CConfigFil
     core::requireValue(ransac_reprojection > 0, s, "ransac_reprojection", "must be > 0");
     core::requireValue(max_depth > 0, s, "max_depth", "must be > 0");
     core::requireValue(threshold1 > 0, s, "threshold1", "must be > 0");
+    core::requireValue(background_factor >= 0, s, "background_factor", "must be >= 0");
     core::requireValue(threshold2_count >= 1, s, "threshold2_count", "must be >= 1");
     core::requireValue(threshold2_fraction >= 0 && threshold2_fraction <= 1, s,
                        "threshold2_fraction", "must be in [0, 1]");
@@ -175,6 +178,7 @@ void DynamicObjectFilter::Options::saveToConfig(mrpt::config::CConfigFileBase& c
     c.write(s, "ransac_reprojection", ransac_reprojection);
     c.write(s, "max_depth", max_depth);
     c.write(s, "threshold1", threshold1);
+    c.write(s, "background_factor", background_factor);
     c.write(s, "threshold2_count", threshold2_count);
     c.write(s, "threshold2_fraction", threshold2_fraction);
     c.write(s, "min_points", min_points);
@@ -401,9 +405,13 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
                 out.T_prev_cur_refined = T_prev_cur;
             }
         }
-        // 5. Residual flow = observed - predicted from ego-motion and depth.
+        // 5. Residual flow = observed - predicted from ego-motion and depth. The threshold
+        //    adapts to frames where even the background fits badly (rgb/depth time offset,
+        //    motion blur): a point is dynamic above max(threshold1, background_factor *
+        //    90th percentile of the background residuals).
         const Eigen::Isometry3d T_cur_prev = T_prev_cur.inverse();
         out.flow.reserve(p0.size());
+        std::vector<float> bg_res;
         for (std::size_t i = 0; i < p0.size(); ++i) {
             FilterOutput::FlowPoint fp{p0[i], p1[i], -1.f, false, false};
             if (X[i]) {
@@ -411,9 +419,17 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
                     fp.residual =
                         static_cast<float>(std::hypot(p1[i].x - uv->x(), p1[i].y - uv->y()));
             }
-            fp.dynamic = fp.residual > opts_.threshold1;
+            if (fp.residual >= 0.f && !inAnyBox(p0[i], p1[i])) bg_res.push_back(fp.residual);
             out.flow.push_back(fp);
         }
+        double thr = opts_.threshold1;
+        if (bg_res.size() >= static_cast<std::size_t>(opts_.min_background_points)) {
+            const auto k = bg_res.begin() + static_cast<std::ptrdiff_t>(bg_res.size() * 9 / 10);
+            std::nth_element(bg_res.begin(), k, bg_res.end());
+            thr = std::max(thr, opts_.background_factor * static_cast<double>(*k));
+        }
+        out.threshold = thr;
+        for (auto& fp : out.flow) fp.dynamic = fp.residual > thr;
     }
 
     // 6. Per-box evidence (Algorithm 1 with residual flow) and hysteresis.

@@ -71,6 +71,7 @@ struct FilterOutput {
         bool dynamic = false;
     };
     std::vector<FlowPoint> flow;
+    double threshold = 0;  ///< [px] residual threshold used this step (see background_factor)
 };
 
 /// Dynamic-object filter. Not thread-safe; consumes frames in order.
@@ -96,7 +97,11 @@ class DynamicObjectFilter {
         double max_depth = 8.0;            ///< [m] depths beyond are not trusted
 
         // Classification (Algorithm 1)
-        double threshold1 = 2.0;            ///< [px] residual flow that makes a point dynamic
+        double threshold1 = 2.0;  ///< [px] residual flow that makes a point dynamic
+        /// the residual threshold is max(threshold1, background_factor * 90th percentile of
+        /// the background points' residuals): frames where the background itself fits badly
+        /// (rgb/depth time offset, blur) do not flag static people. 0 = fixed threshold1.
+        double background_factor = 2.0;
         int threshold2_count = 4;           ///< min dynamic points for a moving box
         double threshold2_fraction = 0.25;  ///< and min fraction of the box's points
         int min_points = 6;                 ///< fewer points in a box: no new evidence
