@@ -42,6 +42,7 @@ struct FrameLog {
     bool keyframe = false, loop = false;
     FrameTiming ms;      ///< per stage (detect/filter overlap the SLAM when async)
     double wall_ms = 0;  ///< wall time of the frame's pipeline step (disk reading excluded)
+    double cpu_ms = 0;   ///< process CPU time (all threads) of that step
 };
 
 struct RunReport {
@@ -55,6 +56,7 @@ struct RunReport {
     std::optional<eval::AteResult> ate;
     std::optional<eval::RpeResult> rpe_1s, rpe_frame;
     double median_fps = 0, mean_fps = 0, median_ms = 0;
+    double median_cpu_ms = 0;  ///< process CPU time per frame, all threads (load-independent)
     FrameTiming stage_mean_ms, stage_median_ms;
     double finalize_ms = 0;  ///< end-of-sequence BA + frame refinement (not in FPS)
     double peak_rss_mb = 0;  ///< VmHWM of the process at the end
