@@ -297,6 +297,12 @@ TEST(Filter, RealTumFramesHaveNoMovingRegion) {
         ++frames;
         masked += cv::countNonZero(a.mask) > 0 || cv::countNonZero(b.mask) > 0;
         for (const auto& box : b.boxes) flagged += box.state == BoxState::Moving;
+        if (std::getenv("DEVSLAM_TEST_VERBOSE")) {
+            std::printf("frame %zu thr %.2f px:", f->index, b.threshold);
+            for (const auto& box : b.boxes)
+                std::printf(" box%d %d/%d", box.id, box.n_dynamic_points, box.n_points);
+            std::printf("\n");
+        }
         EXPECT_TRUE(a.detector_ran);
     }
     EXPECT_GE(frames, 30);

@@ -44,7 +44,8 @@ const std::vector<std::string> kKeys{"mode",
                                      "release_frames",
                                      "max_missed_detections",
                                      "mask_margin",
-                                     "background_factor"};
+                                     "background_factor",
+                                     "flow_scale"};
 
 cv::Rect2f shrink(const cv::Rect2f& b, double f) {
     const auto dx = static_cast<float>(f * b.width), dy = static_cast<float>(f * b.height);
@@ -116,6 +117,7 @@ void DynamicObjectFilter::Options::loadFromConfig(const mrpt::config::CConfigFil
         }
     }
     detect_every = c.read_int(s, "detect_every", detect_every);
+    flow_scale = c.read_double(s, "flow_scale", flow_scale);
     max_corners = c.read_int(s, "max_corners", max_corners);
     max_corners_per_box = c.read_int(s, "max_corners_per_box", max_corners_per_box);
     corner_quality = c.read_double(s, "corner_quality", corner_quality);
@@ -138,6 +140,8 @@ void DynamicObjectFilter::Options::loadFromConfig(const mrpt::config::CConfigFil
     max_missed_detections = c.read_int(s, "max_missed_detections", max_missed_detections);
     mask_margin = c.read_int(s, "mask_margin", mask_margin);
     core::requireValue(detect_every >= 1, s, "detect_every", "must be >= 1");
+    core::requireValue(flow_scale > 0.1 && flow_scale <= 1.0, s, "flow_scale",
+                       "must be in (0.1, 1]");
     core::requireValue(max_corners > 0, s, "max_corners", "must be > 0");
     core::requireValue(max_corners_per_box >= 0, s, "max_corners_per_box", "must be >= 0");
     core::requireValue(corner_quality > 0 && corner_quality < 1, s, "corner_quality",
@@ -166,6 +170,7 @@ void DynamicObjectFilter::Options::saveToConfig(mrpt::config::CConfigFileBase& c
                                                 const std::string& s) const {
     c.write(s, "mode", toString(mode));
     c.write(s, "detect_every", detect_every);
+    c.write(s, "flow_scale", flow_scale);
     c.write(s, "max_corners", max_corners);
     c.write(s, "max_corners_per_box", max_corners_per_box);
     c.write(s, "corner_quality", corner_quality);
@@ -195,7 +200,7 @@ struct DynamicObjectFilter::Impl {
         int quiet = 0;   ///< consecutive frames without moving evidence
         int missed = 0;  ///< detector runs without a matching detection
     };
-    cv::Mat prev_gray, prev_depth;
+    cv::Mat prev_work, prev_depth;
     std::vector<cv::Mat> prev_pyr;
     core::CameraIntrinsics prev_K;
     std::vector<Track> tracks;
@@ -232,24 +237,34 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
     double detect_ms = 0;
     cv::Mat gray;
     cv::cvtColor(frame.bgr, gray, cv::COLOR_BGR2GRAY);
+    // Corners and flow run on a downscaled image (flow_scale) for speed; all coordinates
+    // below are full-resolution pixels.
+    cv::Mat work = gray;
+    const double sc = opts_.flow_scale;
+    if (sc != 1.0) cv::resize(gray, work, cv::Size(), sc, sc, cv::INTER_AREA);
     const cv::Size win(opts_.lk_window, opts_.lk_window);
     std::vector<cv::Mat> pyr;
-    cv::buildOpticalFlowPyramid(gray, pyr, win, opts_.lk_levels);
+    cv::buildOpticalFlowPyramid(work, pyr, win, opts_.lk_levels, false);
     const cv::Rect2f image(0.f, 0.f, static_cast<float>(gray.cols), static_cast<float>(gray.rows));
-    const bool have_prev = !im.prev_gray.empty() && im.prev_gray.size() == gray.size();
+    const bool have_prev = !im.prev_work.empty() && im.prev_work.size() == work.size() &&
+                           im.prev_depth.size() == gray.size();
 
     // 1. Flow of Shi-Tomasi corners of the previous frame (global + inside each box).
     std::vector<cv::Point2f> p0, p1;
     if (have_prev) {
-        cv::goodFeaturesToTrack(im.prev_gray, p0, opts_.max_corners, opts_.corner_quality,
+        cv::goodFeaturesToTrack(im.prev_work, p0, opts_.max_corners, opts_.corner_quality,
                                 opts_.corner_min_distance);
         if (opts_.max_corners_per_box > 0) {
             for (const auto& t : im.tracks) {
-                const cv::Rect roi = cv::Rect(shrink(t.tb.box, opts_.box_shrink)) &
-                                     cv::Rect(0, 0, gray.cols, gray.rows);
+                const cv::Rect2f b = shrink(t.tb.box, opts_.box_shrink);
+                const cv::Rect roi =
+                    cv::Rect(cv::Rect2f(static_cast<float>(b.x * sc), static_cast<float>(b.y * sc),
+                                        static_cast<float>(b.width * sc),
+                                        static_cast<float>(b.height * sc))) &
+                    cv::Rect(0, 0, work.cols, work.rows);
                 if (roi.width < 8 || roi.height < 8) continue;
                 std::vector<cv::Point2f> pts;
-                cv::goodFeaturesToTrack(im.prev_gray(roi), pts, opts_.max_corners_per_box,
+                cv::goodFeaturesToTrack(im.prev_work(roi), pts, opts_.max_corners_per_box,
                                         opts_.corner_quality, opts_.corner_min_distance * 0.5);
                 for (auto& p : pts) p0.emplace_back(p.x + roi.x, p.y + roi.y);
             }
@@ -257,18 +272,20 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
         if (!p0.empty()) {
             std::vector<uchar> st, st_back;
             std::vector<float> err;
-            const cv::TermCriteria term(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 20, 0.03);
+            const cv::TermCriteria term(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 10, 0.03);
             cv::calcOpticalFlowPyrLK(im.prev_pyr, pyr, p0, p1, st, err, win, opts_.lk_levels, term);
             std::vector<cv::Point2f> back = p0;
             cv::calcOpticalFlowPyrLK(pyr, im.prev_pyr, p1, back, st_back, err, win, opts_.lk_levels,
                                      term, cv::OPTFLOW_USE_INITIAL_FLOW);
             std::size_t n = 0;
+            const auto inv = static_cast<float>(1.0 / sc);
             for (std::size_t i = 0; i < p0.size(); ++i) {
-                const float fb = static_cast<float>(cv::norm(back[i] - p0[i]));
-                if (!st[i] || !st_back[i] || fb > opts_.fb_max_error || !image.contains(p1[i]))
+                const float fb = static_cast<float>(cv::norm(back[i] - p0[i])) * inv;
+                const cv::Point2f a = p0[i] * inv, b = p1[i] * inv;
+                if (!st[i] || !st_back[i] || fb > opts_.fb_max_error || !image.contains(b))
                     continue;
-                p0[n] = p0[i];
-                p1[n] = p1[i];
+                p0[n] = a;
+                p1[n] = b;
                 ++n;
             }
             p0.resize(n);
@@ -350,12 +367,14 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
     if (have_prev && !p0.empty()) {
         const core::CameraIntrinsics& Kp = im.prev_K;
         const core::CameraIntrinsics& Kc = frame.K;
+        // Background = outside every box grown by mask_margin plus 20% of its size (the
+        // detector's box may lag a walking person's limbs).
         auto inAnyBox = [&](const cv::Point2f& a, const cv::Point2f& b) {
             for (const auto& t : im.tracks) {
-                const cv::Rect2f grown(t.tb.box.x - opts_.mask_margin,
-                                       t.tb.box.y - opts_.mask_margin,
-                                       t.tb.box.width + 2.f * opts_.mask_margin,
-                                       t.tb.box.height + 2.f * opts_.mask_margin);
+                const float mx = opts_.mask_margin + 0.2f * t.tb.box.width;
+                const float my = opts_.mask_margin + 0.2f * t.tb.box.height;
+                const cv::Rect2f grown(t.tb.box.x - mx, t.tb.box.y - my, t.tb.box.width + 2 * mx,
+                                       t.tb.box.height + 2 * my);
                 if (grown.contains(a) || grown.contains(b)) return true;
             }
             return false;
@@ -435,10 +454,34 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
     // 6. Per-box evidence (Algorithm 1 with residual flow) and hysteresis.
     for (auto& t : im.tracks) {
         const cv::Rect2f inner = shrink(t.tb.box, opts_.box_shrink);
+        // Local threshold: the residuals of the static surroundings (a ring from 20% to 70%
+        // of the box size around it, outside every box) say how well ego-motion fits there
+        // (depth errors of near objects, rgb/depth time offset, rolling shutter).
+        double local_thr = out.threshold;
+        if (opts_.background_factor > 0) {
+            auto grow = [&](float f) {
+                return cv::Rect2f(t.tb.box.x - f * t.tb.box.width, t.tb.box.y - f * t.tb.box.height,
+                                  t.tb.box.width * (1 + 2 * f), t.tb.box.height * (1 + 2 * f));
+            };
+            const cv::Rect2f near = grow(0.2f), far = grow(0.7f);
+            std::vector<float> ring;
+            for (const auto& fp : out.flow) {
+                if (fp.residual < 0.f || !far.contains(fp.cur) || near.contains(fp.cur)) continue;
+                bool in_other = false;
+                for (const auto& o : im.tracks) in_other |= o.tb.box.contains(fp.cur);
+                if (!in_other) ring.push_back(fp.residual);
+            }
+            if (ring.size() >= 8) {
+                const auto k = ring.begin() + static_cast<std::ptrdiff_t>(ring.size() * 3 / 4);
+                std::nth_element(ring.begin(), k, ring.end());
+                local_thr = std::max(local_thr, opts_.background_factor * static_cast<double>(*k));
+            }
+        }
         int n = 0, n_dyn = 0;
         for (auto& fp : out.flow) {
             if (fp.residual < 0.f || !inner.contains(fp.cur)) continue;
             fp.in_box = true;
+            fp.dynamic = fp.residual > local_thr;
             ++n;
             if (fp.dynamic) ++n_dyn;
         }
@@ -470,7 +513,7 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
         out.mask(r).setTo(255);
     }
 
-    im.prev_gray = gray;
+    im.prev_work = work;
     im.prev_pyr = std::move(pyr);
     im.prev_depth = frame.depth.clone();
     im.prev_K = frame.K;

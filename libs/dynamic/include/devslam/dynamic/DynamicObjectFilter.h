@@ -82,12 +82,13 @@ class DynamicObjectFilter {
         int detect_every = 1;  ///< run the detector every k-th frame (1 = every frame)
 
         // Flow points (Shi-Tomasi on the previous frame, pyramidal LK into the current one)
-        int max_corners = 300;             ///< corners in the whole image
-        int max_corners_per_box = 60;      ///< extra corners seeded inside each person box
+        double flow_scale = 0.5;           ///< corners + LK run on the image scaled by this (speed)
+        int max_corners = 200;             ///< corners in the whole image
+        int max_corners_per_box = 40;      ///< extra corners seeded inside each person box
         double corner_quality = 0.01;      ///< Shi-Tomasi quality level (fraction of best)
-        double corner_min_distance = 8.0;  ///< [px] between corners
-        int lk_window = 15;                ///< [px] LK window side
-        int lk_levels = 3;                 ///< pyramid levels above the base
+        double corner_min_distance = 5.0;  ///< [px of the scaled image] between corners
+        int lk_window = 11;                ///< [px of the scaled image] LK window side
+        int lk_levels = 2;                 ///< pyramid levels above the base
         double fb_max_error = 1.0;         ///< [px] forward-backward check
 
         // Ego-motion compensation
@@ -103,7 +104,7 @@ class DynamicObjectFilter {
         /// (rgb/depth time offset, blur) do not flag static people. 0 = fixed threshold1.
         double background_factor = 2.0;
         int threshold2_count = 4;           ///< min dynamic points for a moving box
-        double threshold2_fraction = 0.25;  ///< and min fraction of the box's points
+        double threshold2_fraction = 0.4;   ///< and min fraction of the box's points
         int min_points = 6;                 ///< fewer points in a box: no new evidence
         double box_shrink = 0.1;            ///< fraction of w/h ignored at each box side
 
