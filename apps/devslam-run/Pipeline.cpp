@@ -54,6 +54,12 @@ std::string timingJson(const FrameTiming& t) {
 }
 }  // namespace
 
+void resetPeakRss() {
+    // Linux >= 4.0: writing 5 resets VmHWM to the current RSS; ignored where unsupported.
+    std::ofstream f("/proc/self/clear_refs");
+    if (f) f << "5";
+}
+
 double peakRssMb() {
     std::ifstream in("/proc/self/status");
     std::string line;
@@ -65,6 +71,7 @@ double peakRssMb() {
 RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
                       const mrpt::config::CConfigFileBase& cfg,
                       const mrpt::config::CConfigFileBase& filter_cfg) {
+    resetPeakRss();
     const auto slam_opts = slam::SlamOptions::fromConfig(cfg);
     slam::GridMapOptions grid_opts;
     grid_opts.loadFromConfig(cfg, "grid_map");

@@ -75,6 +75,8 @@ struct RunReport {
 [[nodiscard]] std::string formatSummary(const RunReport& r);
 /// All figures of the run as one JSON object.
 [[nodiscard]] std::string toJson(const RunReport& r);
+/// Resets the peak-RSS counter (each run reports its own peak).
+void resetPeakRss();
 /// Peak resident memory of this process [MB] (VmHWM), 0 if unknown.
 [[nodiscard]] double peakRssMb();
 
