@@ -107,7 +107,8 @@ Loaded loadConfig(const Args& a, const std::vector<std::string>& extra_sets = {}
     l.cfg = core::loadIni(a.config);
     applySets(*l.cfg, a.sets);
     applySets(*l.cfg, extra_sets);
-    core::requireKnownKeys(*l.cfg, "run", {"mode", "filter_config", "async_filter"}, a.config);
+    core::requireKnownKeys(*l.cfg, "run",
+                           {"mode", "filter_config", "filter_overrides", "async_filter"}, a.config);
     l.async_filter = l.cfg->read_bool("run", "async_filter", false);
     l.mode = a.mode.empty() ? l.cfg->read_string("run", "mode", "dynamic") : a.mode;
     const std::string fc = l.cfg->read_string("run", "filter_config", "");
@@ -118,6 +119,12 @@ Loaded loadConfig(const Args& a, const std::vector<std::string>& extra_sets = {}
     } else {
         l.filter_cfg = core::loadIni(a.config);
     }
+    // [run] filter_overrides: "section.key=value ..." applied to the filter's INI (so a SLAM
+    // config can pick e.g. the detection interval without copying the filter's file).
+    std::vector<std::string> overrides;
+    std::istringstream ov(l.cfg->read_string("run", "filter_overrides", ""));
+    for (std::string item; ov >> item;) overrides.push_back(item);
+    applySets(*l.filter_cfg, overrides);
     applySets(*l.filter_cfg, a.sets);
     applySets(*l.filter_cfg, extra_sets);
     l.reader.loadFromConfig(*l.cfg, "dataset");
@@ -242,7 +249,31 @@ int runBench(const Args& a) {
         std::cerr << "ablation " << name << ": ATE "
                   << (rep.ate ? fmt(rep.ate->trans.rmse, 4) : "-") << "\n";
     }
-    md << stages.str() << abl.str()
+    // Memory on the longest sequence we have: the input replayed forward/backward.
+    std::ostringstream mem;
+    {
+        constexpr int kPasses = 9;
+        auto l = loadConfig(a);
+        auto src = io::openRgbd(a.input, l.reader);
+        run::ReplayReader reader(*src, kPasses);
+        run::RunConfig rc;
+        rc.input = a.input;
+        rc.mode = "dynamic";
+        rc.progress = false;
+        rc.async_filter = l.async_filter;
+        const auto rep = run::runSequence(reader, rc, *l.cfg, *l.filter_cfg);
+        mem << "\nLong run (memory): the input replayed forward/backward " << kPasses
+            << " times (`devslam-run --replay " << kPasses << " --mode dynamic`): " << rep.frames
+            << " frames, " << rep.keyframes << " keyframes, " << rep.landmarks << " landmarks, "
+            << rep.loops << " loops closed, " << rep.lost.size() << " lost; peak RSS "
+            << fmt(rep.peak_rss_mb, 0)
+            << " MB (whole process: libraries, detector network, the source frames held by the "
+               "replay), map "
+            << fmt(rep.map_mb, 2) << " MB = " << fmt(rep.bytes_per_keyframe / 1024.0, 0)
+            << " KiB per keyframe (keypoints, descriptors, depths, landmarks); ATE "
+            << (rep.ate ? fmt(rep.ate->trans.rmse, 4) : "-") << " m.\n";
+    }
+    md << stages.str() << abl.str() << mem.str()
        << "\nPeak RSS is per run (VmHWM reset before each run). Wall-clock FPS depends on the load "
           "of this shared 2-core machine (other builds ran at the same time); the CPU time per "
           "frame (all threads) is printed by `devslam-run` beside it. Measured on "
