@@ -1,0 +1,43 @@
+#pragma once
+// Scores the dynamic-object filter's masks against the renderer's person truth
+// (labels/<t>.png and persons.txt of a devslam-synth folder).
+#include <opencv2/core/mat.hpp>
+
+#include <cstddef>
+#include <map>
+#include <string>
+#include <vector>
+
+namespace devslam::bench {
+
+/// One line of persons.txt.
+struct PersonEntry {
+    int id = 0;
+    std::string name;
+    bool moving = false;
+    int visible_pixels = 0;
+};
+
+/// persons.txt keyed by its timestamp string ("%.6f"). Throws naming file and line.
+[[nodiscard]] std::map<std::string, std::vector<PersonEntry>> readPersons(const std::string& path);
+
+struct MaskScore {
+    std::size_t moving_instances = 0;  ///< (frame, walking person) pairs with enough visible pixels
+    std::size_t moving_masked = 0;     ///< ... of which >= half the visible pixels were masked
+    std::size_t static_instances = 0;  ///< same for sitting/standing people
+    std::size_t static_masked = 0;
+    double moving_px = 0, moving_px_masked = 0;  ///< visible / masked pixels of walking people
+    double masked_px = 0;                        ///< all masked pixels
+    void add(const cv::Mat& mask, const cv::Mat& labels, const std::vector<PersonEntry>& persons,
+             int min_pixels);
+    /// Fraction of walking-person instances that were masked (recall per person and frame).
+    [[nodiscard]] double movingRecall() const;
+    /// Fraction of static-person instances that were masked (should be small).
+    [[nodiscard]] double staticMasked() const;
+    /// Fraction of the walking people's visible area that was masked.
+    [[nodiscard]] double movingAreaRecall() const;
+    /// Fraction of the masked area that lies on walking people.
+    [[nodiscard]] double precision() const;
+};
+
+}  // namespace devslam::bench

@@ -1,0 +1,68 @@
+// Two-frame smoke test of the whole devslam-bench command: renders a synthetic sequence,
+// runs devslam-run in the three modes on it and on the shipped TUM frames, scores the
+// filter against the person truth, and writes the tables and the RESULTS section.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+namespace fs = std::filesystem;
+
+namespace {
+std::string readFile(const fs::path& p) {
+    std::ifstream in(p);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+/// Lines that are not '#' comments.
+std::size_t countLines(const std::string& s) {
+    std::istringstream in(s);
+    std::size_t n = 0;
+    for (std::string l; std::getline(in, l);) n += !l.empty() && l[0] != '#';
+    return n;
+}
+}  // namespace
+
+TEST(DevslamBench, TwoFrameSmokeRunOfTheWholeCommand) {
+    const std::string root = DEVSLAM_SOURCE_DIR, bin = DEVSLAM_BIN_DIR;
+    const fs::path tmp = fs::temp_directory_path() / "devslam_bench_smoke";
+    fs::remove_all(tmp);
+    fs::create_directories(tmp);
+    std::ofstream(tmp / "bench.ini") << "[bench]\nrepeats = 1\nslam_config = " << root
+                                     << "/config_ini/slam_synthetic.ini\n"
+                                        "[sequence_short]\nscenario = short_walking\n"
+                                        "[sequence_fr1]\npath = "
+                                     << root << "/data/tum/fr1_xyz_first37\nslam_config = " << root
+                                     << "/config_ini/slam_tum_fr1.ini\n";
+    std::ofstream(tmp / "RESULTS.md") << "# Results\n";
+    const std::string cmd =
+        "'" + bin + "/devslam-bench' --config '" + (tmp / "bench.ini").string() +
+        "' --max-frames 2 --out '" + (tmp / "out").string() + "' --results '" +
+        (tmp / "RESULTS.md").string() + "' > '" + (tmp / "log.txt").string() + "' 2>&1";
+    ASSERT_EQ(std::system(cmd.c_str()), 0) << readFile(tmp / "log.txt");
+    // The synthetic sequence was rendered (2 frames) with its person truth.
+    EXPECT_TRUE(fs::exists(tmp / "out/synth/short/groundtruth.txt"));
+    EXPECT_EQ(countLines(readFile(tmp / "out/synth/short/groundtruth.txt")), 2u);
+    // 2 sequences x 3 modes x 1 repeat, every run succeeded.
+    const std::string runs = readFile(tmp / "out/runs.csv");
+    EXPECT_EQ(countLines(runs), 1u + 6u) << runs;
+    const std::string ate = readFile(tmp / "out/table2_ate.csv");
+    EXPECT_EQ(countLines(ate), 1u + 6u);
+    std::istringstream lines(ate);
+    std::string line;
+    std::getline(lines, line);  // header
+    while (std::getline(lines, line)) EXPECT_EQ(line.substr(line.rfind(',') + 1), "1") << line;
+    for (const char* f : {"table1_rpe.csv", "table3_fps.csv", "filter_truth.csv", "tables.md"})
+        EXPECT_TRUE(fs::exists(tmp / "out" / f)) << f;
+    EXPECT_EQ(countLines(readFile(tmp / "out/filter_truth.csv")),
+              1u + 2u);  // short x {all_persons, dynamic}
+    const std::string results = readFile(tmp / "RESULTS.md");
+    EXPECT_NE(results.find("Table 1: RPE"), std::string::npos);
+    EXPECT_NE(results.find("Table 2: ATE"), std::string::npos);
+    EXPECT_NE(results.find("Table 3: speed"), std::string::npos);
+    fs::remove_all(tmp);
+}
