@@ -99,7 +99,8 @@ int main(int argc, char** argv) {
         // 1. Detectors.
         md << "| detector | INI | median ms | mean ms | median thread-CPU ms | frames |\n"
               "|---|---|---|---|---|---|\n";
-        for (const std::string ini : {"detector_yolo_fastest.ini", "detector_hog.ini"}) {
+        for (const std::string ini :
+             {"detector_yolo_fastest.ini", "detector_yolo_fastest_small.ini", "detector_hog.ini"}) {
             auto cfg = core::loadIni(kRoot + "/config_ini/" + ini);
             auto det = detect::makeDetector(*cfg);
             for (int w = 0; w < 3; ++w) (void)det->detect(tum[0].bgr);  // warm-up

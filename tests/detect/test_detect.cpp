@@ -57,6 +57,14 @@ TEST(Yolo, DogPhotoGivesNoPerson) {
     EXPECT_TRUE(det->detect(readImage("data/images/dog.jpg")).empty());
 }
 
+TEST(Yolo, SmallModelAlsoFindsThePersonAndNoneOnTheDogPhoto) {
+    auto det = fromIni("config_ini/detector_yolo_fastest_small.ini");
+    const auto dets = det->detect(readImage("data/images/person.jpg"));
+    ASSERT_EQ(dets.size(), 1u);
+    EXPECT_GE(detect::iou(dets[0].box, kPersonBox), 0.7f) << dets[0].box;
+    EXPECT_TRUE(det->detect(readImage("data/images/dog.jpg")).empty());
+}
+
 TEST(Yolo, OtherClassesCanBeSelected) {
     auto cfg = core::loadIni(kRoot + "/config_ini/detector_yolo_fastest.ini");
     cfg->write("detector", "classes", std::string("dog"));
