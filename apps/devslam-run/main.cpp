@@ -32,13 +32,13 @@ const char* kUsage =
     "/data/tum/fr1_xyz_first37\n"
     "          --config " DEVSLAM_SOURCE_DIR
     "/config_ini/slam_tum_fr1.ini\n"
-    "          --mode from the INI's [run] mode (dynamic), --out ./devslam-run-out\n";
+    "          --mode from the INI's [run] mode (dynamic), --out ./out/devslam-run\n";
 
 struct Args {
     std::string input = std::string(DEVSLAM_SOURCE_DIR) + "/data/tum/fr1_xyz_first37";
     std::string config = std::string(DEVSLAM_SOURCE_DIR) + "/config_ini/slam_tum_fr1.ini";
     std::string mode;  // empty: from INI
-    std::string out = "devslam-run-out";
+    std::string out = "out/devslam-run";
     std::string results = std::string(DEVSLAM_SOURCE_DIR) + "/docs/RESULTS.md";
     std::size_t max_frames = 0;
     int bench = 0;
