@@ -3,6 +3,8 @@
 // person truth, depth noise, trajectories and scenario files.
 #include <devslam/core/Config.h>
 #include <devslam/core/Pose.h>
+#include <devslam/io/Rawlog.h>
+#include <devslam/io/RgbdReader.h>
 #include <devslam/io/TrajectoryIO.h>
 #include <devslam/render/DepthNoise.h>
 #include <devslam/render/PersonTexture.h>
@@ -177,9 +179,21 @@ TEST(RenderSequence, GroundTruthMatchesPosesUsed) {
     const Scenario sc = smallShort();
     WriteOptions o;
     o.out_dir = tmp.str("seq");
+    o.rawlog_path = tmp.str("seq.rawlog");
     o.max_frames = 6;
     const auto sum = writeSequence(sc, o);
     EXPECT_EQ(sum.n_frames, 6u);
+    // The rawlog holds the same frames as the TUM folder.
+    auto tum = io::openRgbd(o.out_dir, {});
+    io::RawlogReader rawlog(o.rawlog_path);
+    ASSERT_EQ(rawlog.size(), std::optional<std::size_t>(6));
+    for (int i = 0; i < 6; ++i) {
+        const auto a = tum->next(), b = rawlog.next();
+        ASSERT_TRUE(a && b);
+        EXPECT_NEAR(a->timestamp, b->timestamp, 1e-6);
+        EXPECT_EQ(cv::norm(a->bgr, b->bgr, cv::NORM_INF), 0.0);
+        EXPECT_LT(cv::norm(a->depth, b->depth, cv::NORM_INF), 1e-3);
+    }
     const auto gt = io::readTumTrajectory(o.out_dir + "/groundtruth.txt");
     ASSERT_EQ(gt.size(), 6u);
     for (std::size_t i = 0; i < gt.size(); ++i) {
