@@ -103,10 +103,10 @@ class DynamicObjectFilter {
         /// the background points' residuals): frames where the background itself fits badly
         /// (rgb/depth time offset, blur) do not flag static people. 0 = fixed threshold1.
         double background_factor = 2.0;
-        int threshold2_count = 4;           ///< min dynamic points for a moving box
-        double threshold2_fraction = 0.4;   ///< and min fraction of the box's points
-        int min_points = 6;                 ///< fewer points in a box: no new evidence
-        double box_shrink = 0.1;            ///< fraction of w/h ignored at each box side
+        int threshold2_count = 4;          ///< min dynamic points for a moving box
+        double threshold2_fraction = 0.4;  ///< and min fraction of the box's points
+        int min_points = 6;                ///< fewer points in a box: no new evidence
+        double box_shrink = 0.1;           ///< fraction of w/h ignored at each box side
 
         // Tracking and hysteresis
         double iou_match = 0.3;         ///< min IoU to associate a detection with a track
