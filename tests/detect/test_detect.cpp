@@ -34,14 +34,14 @@ std::unique_ptr<detect::PersonDetector> fromIni(const std::string& rel) {
 }
 }  // namespace
 
-TEST(Iou, KnownValues) {
+TEST(DetectIou, KnownValues) {
     EXPECT_FLOAT_EQ(detect::iou({0, 0, 10, 10}, {0, 0, 10, 10}), 1.f);
     EXPECT_FLOAT_EQ(detect::iou({0, 0, 10, 10}, {5, 0, 10, 10}), 50.f / 150.f);
     EXPECT_FLOAT_EQ(detect::iou({0, 0, 10, 10}, {20, 20, 5, 5}), 0.f);
     EXPECT_FLOAT_EQ(detect::iou({0, 0, 0, 0}, {0, 0, 0, 0}), 0.f);
 }
 
-TEST(Yolo, PersonPhotoGivesOneMatchingPerson) {
+TEST(DetectYolo, PersonPhotoGivesOneMatchingPerson) {
     auto det = fromIni("config_ini/detector_yolo_fastest.ini");
     const auto dets = det->detect(readImage("data/images/person.jpg"));
     ASSERT_EQ(dets.size(), 1u) << "the photo holds one person (and a dog and a horse)";
@@ -52,12 +52,12 @@ TEST(Yolo, PersonPhotoGivesOneMatchingPerson) {
         << "box " << dets[0].box << " vs hand-measured " << kPersonBox;
 }
 
-TEST(Yolo, DogPhotoGivesNoPerson) {
+TEST(DetectYolo, DogPhotoGivesNoPerson) {
     auto det = fromIni("config_ini/detector_yolo_fastest.ini");
     EXPECT_TRUE(det->detect(readImage("data/images/dog.jpg")).empty());
 }
 
-TEST(Yolo, SmallModelAlsoFindsThePersonAndNoneOnTheDogPhoto) {
+TEST(DetectYolo, SmallModelAlsoFindsThePersonAndNoneOnTheDogPhoto) {
     auto det = fromIni("config_ini/detector_yolo_fastest_small.ini");
     const auto dets = det->detect(readImage("data/images/person.jpg"));
     ASSERT_EQ(dets.size(), 1u);
@@ -65,7 +65,7 @@ TEST(Yolo, SmallModelAlsoFindsThePersonAndNoneOnTheDogPhoto) {
     EXPECT_TRUE(det->detect(readImage("data/images/dog.jpg")).empty());
 }
 
-TEST(Yolo, OtherClassesCanBeSelected) {
+TEST(DetectYolo, OtherClassesCanBeSelected) {
     auto cfg = core::loadIni(kRoot + "/config_ini/detector_yolo_fastest.ini");
     cfg->write("detector", "classes", std::string("dog"));
     auto det = detect::makeDetector(*cfg);
@@ -77,7 +77,7 @@ TEST(Yolo, OtherClassesCanBeSelected) {
     EXPECT_GE(detect::iou(dets[0].box, cv::Rect2f(65.f, 262.f, 140.f, 83.f)), 0.5f) << dets[0].box;
 }
 
-TEST(Yolo, DeterministicOutput) {
+TEST(DetectYolo, DeterministicOutput) {
     auto det = fromIni("config_ini/detector_yolo_fastest.ini");
     const cv::Mat img = readImage("data/images/person.jpg");
     const auto a = det->detect(img);
@@ -89,7 +89,7 @@ TEST(Yolo, DeterministicOutput) {
     }
 }
 
-TEST(Yolo, Yolov4TinyCfgParsesIntoANetwork) {
+TEST(DetectYolo, Yolov4TinyCfgParsesIntoANetwork) {
     // The INI for the paper's YOLOv4-tiny loads; its weights are not shipped, so only the
     // cfg is parsed (random weights) and the missing weights give a clear error.
     auto cfg = core::loadIni(kRoot + "/config_ini/detector_yolov4_tiny.ini");
@@ -107,7 +107,7 @@ TEST(Yolo, Yolov4TinyCfgParsesIntoANetwork) {
     }
 }
 
-TEST(Yolo, MissingWeightsGiveAClearError) {
+TEST(DetectYolo, MissingWeightsGiveAClearError) {
     detect::YoloDetector::Options o;
     o.weights = "/nonexistent/dir/model.weights";
     try {
@@ -119,7 +119,7 @@ TEST(Yolo, MissingWeightsGiveAClearError) {
     }
 }
 
-TEST(Yolo, CorruptWeightsGiveAClearError) {
+TEST(DetectYolo, CorruptWeightsGiveAClearError) {
     const fs::path dir = fs::temp_directory_path() / "devslam_test_detect";
     fs::create_directories(dir);
     // A truncated copy of the real weights (half of the file) and a tiny garbage file.
@@ -144,7 +144,7 @@ TEST(Yolo, CorruptWeightsGiveAClearError) {
     fs::remove_all(dir);
 }
 
-TEST(Yolo, BadOptionsAreRejected) {
+TEST(DetectYolo, BadOptionsAreRejected) {
     mrpt::config::CConfigFileMemory cfg;
     cfg.write("detector", "detector", std::string("yolo"));
     cfg.write("detector", "input_widht", 320);
@@ -157,7 +157,7 @@ TEST(Yolo, BadOptionsAreRejected) {
     EXPECT_THROW((void)detect::makeDetector(cfg3), std::invalid_argument);
 }
 
-TEST(Yolo, OptionsRoundTrip) {
+TEST(DetectYolo, OptionsRoundTrip) {
     detect::YoloDetector::Options a;
     a.input_width = 416;
     a.conf_threshold = 0.2f;
@@ -171,7 +171,7 @@ TEST(Yolo, OptionsRoundTrip) {
     EXPECT_EQ(b.classes, a.classes);
 }
 
-TEST(Factory, UnknownNameListsKnownNames) {
+TEST(DetectFactory, UnknownNameListsKnownNames) {
     mrpt::config::CConfigFileMemory cfg;
     cfg.write("detector", "detector", std::string("ssd"));
     try {
@@ -185,7 +185,7 @@ TEST(Factory, UnknownNameListsKnownNames) {
     }
 }
 
-TEST(Hog, FindsThePersonAndNotTheDog) {
+TEST(DetectHog, FindsThePersonAndNotTheDog) {
     auto det = fromIni("config_ini/detector_hog.ini");
     EXPECT_EQ(det->name().rfind("hog", 0), 0u);
     const auto dets = det->detect(readImage("data/images/person.jpg"));

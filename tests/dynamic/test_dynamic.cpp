@@ -102,7 +102,7 @@ RunStats runSynthetic(const dynamic::SyntheticOptions& so, DynamicObjectFilter::
 }
 }  // namespace
 
-TEST(Synthetic, TruthIsConsistent) {
+TEST(DynamicSynthetic, TruthIsConsistent) {
     dynamic::SyntheticOptions so;
     so.n_frames = 3;
     const auto seq = dynamic::makeSyntheticSequence(so, wallTexture(), personSprite());
@@ -117,7 +117,7 @@ TEST(Synthetic, TruthIsConsistent) {
     EXPECT_NEAR(step, so.cam_velocity.norm() / so.fps, 1e-9);
 }
 
-TEST(Filter, WalkingPersonIsMovingUnderCameraMotion) {
+TEST(DynamicFilter, WalkingPersonIsMovingUnderCameraMotion) {
     dynamic::SyntheticOptions so;
     so.person = dynamic::PersonMotion::Walking;
     so.n_frames = kFrames;
@@ -129,7 +129,7 @@ TEST(Filter, WalkingPersonIsMovingUnderCameraMotion) {
     }
 }
 
-TEST(Filter, StaticPersonIsStaticUnderCameraMotion) {
+TEST(DynamicFilter, StaticPersonIsStaticUnderCameraMotion) {
     dynamic::SyntheticOptions so;
     so.person = dynamic::PersonMotion::Static;
     so.person_x0 = 0.3;
@@ -143,7 +143,7 @@ TEST(Filter, StaticPersonIsStaticUnderCameraMotion) {
     }
 }
 
-TEST(Filter, PureCameraMotionFlagsNothing) {
+TEST(DynamicFilter, PureCameraMotionFlagsNothing) {
     // No person; two boxes on the wall (false detections) must never be flagged, with or
     // without ego-motion prior. Raw displacement (no compensation) flags them: that is the
     // failure of the uncompensated Algorithm 1 this filter fixes.
@@ -164,7 +164,7 @@ TEST(Filter, PureCameraMotionFlagsNothing) {
     EXPECT_GE(r.moving, r.frames / 2);
 }
 
-TEST(Filter, HysteresisReleasesAfterQuietFrames) {
+TEST(DynamicFilter, HysteresisReleasesAfterQuietFrames) {
     // Walking for 12 frames, then standing: caught at once, released after release_frames.
     dynamic::SyntheticOptions so;
     so.person = dynamic::PersonMotion::Walking;
@@ -198,7 +198,7 @@ TEST(Filter, HysteresisReleasesAfterQuietFrames) {
     EXPECT_EQ(states[23], BoxState::Static);
 }
 
-TEST(Filter, DetectEveryKCarriesBoxes) {
+TEST(DynamicFilter, DetectEveryKCarriesBoxes) {
     dynamic::SyntheticOptions so;
     so.person = dynamic::PersonMotion::Walking;
     auto fo = testOptions();
@@ -224,7 +224,7 @@ TEST(Filter, DetectEveryKCarriesBoxes) {
     EXPECT_GE(good_iou, kFrames - 2) << "boxes carried by the flow stay on the person";
 }
 
-TEST(Filter, ModesAndMask) {
+TEST(DynamicFilter, ModesAndMask) {
     dynamic::SyntheticOptions so;
     so.person = dynamic::PersonMotion::Static;
     so.person_x0 = 0.3;
@@ -260,7 +260,7 @@ TEST(Filter, ModesAndMask) {
     EXPECT_THROW(DynamicObjectFilter(fo, nullptr), std::invalid_argument);
 }
 
-TEST(Filter, RefinedEgoMotionMatchesTruth) {
+TEST(DynamicFilter, RefinedEgoMotionMatchesTruth) {
     dynamic::SyntheticOptions so;
     so.person = dynamic::PersonMotion::Walking;
     so.n_frames = kFrames;
@@ -280,7 +280,7 @@ TEST(Filter, RefinedEgoMotionMatchesTruth) {
     }
 }
 
-TEST(Filter, RealTumFramesHaveNoMovingRegion) {
+TEST(DynamicFilter, RealTumFramesHaveNoMovingRegion) {
     // Static desk scene, moving camera (the io reader pairs 32 of the 37 rgb images with a
     // depth image within 0.02 s): the real detector finds no person, and boxes put on
     // static objects (monitor, desk) are never flagged either.
@@ -311,7 +311,7 @@ TEST(Filter, RealTumFramesHaveNoMovingRegion) {
     EXPECT_EQ(masked, 0);
 }
 
-TEST(Filter, RealDetectorOnSyntheticSequences) {
+TEST(DynamicFilter, RealDetectorOnSyntheticSequences) {
     // End to end with the shipped YOLO model on the rendered frames (6 frames each).
     auto cfg = core::loadIni(kRoot + "/config_ini/dynamic_filter.ini");
     for (auto motion : {dynamic::PersonMotion::Walking, dynamic::PersonMotion::Static}) {
@@ -341,7 +341,7 @@ TEST(Filter, RealDetectorOnSyntheticSequences) {
     }
 }
 
-TEST(Config, ShippedIniLoadsAndRoundTrips) {
+TEST(DynamicConfig, ShippedIniLoadsAndRoundTrips) {
     auto cfg = core::loadIni(kRoot + "/config_ini/dynamic_filter.ini");
     DynamicObjectFilter::Options a;
     a.loadFromConfig(*cfg);
@@ -357,7 +357,7 @@ TEST(Config, ShippedIniLoadsAndRoundTrips) {
     EXPECT_EQ(f->options().mode, MaskMode::None);
 }
 
-TEST(Config, BadValuesAreRejected) {
+TEST(DynamicConfig, BadValuesAreRejected) {
     mrpt::config::CConfigFileMemory cfg;
     cfg.write("dynamic_filter", "threshold_1", 2.0);
     DynamicObjectFilter::Options o;
