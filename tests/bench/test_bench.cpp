@@ -9,6 +9,8 @@
 #include <sstream>
 #include <string>
 
+#include <unistd.h>
+
 namespace fs = std::filesystem;
 
 namespace {
@@ -29,7 +31,8 @@ std::size_t countLines(const std::string& s) {
 
 TEST(DevslamBench, TwoFrameSmokeRunOfTheWholeCommand) {
     const std::string root = DEVSLAM_SOURCE_DIR, bin = DEVSLAM_BIN_DIR;
-    const fs::path tmp = fs::temp_directory_path() / "devslam_bench_smoke";
+    const fs::path tmp =
+        fs::temp_directory_path() / ("devslam_bench_smoke_" + std::to_string(::getpid()));
     fs::remove_all(tmp);
     fs::create_directories(tmp);
     std::ofstream(tmp / "bench.ini") << "[bench]\nrepeats = 1\nslam_config = " << root

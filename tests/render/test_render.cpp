@@ -23,6 +23,8 @@
 #include <iostream>
 #include <sstream>
 
+#include <unistd.h>
+
 namespace fs = std::filesystem;
 using namespace devslam;
 using namespace devslam::render;
@@ -37,8 +39,9 @@ class TempDir {
   public:
     TempDir() {
         const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-        path_ = fs::temp_directory_path() /
-                ("devslam_render_" + std::string(info->test_suite_name()) + "_" + info->name());
+        path_ =
+            fs::temp_directory_path() / ("devslam_render_" + std::string(info->test_suite_name()) +
+                                         "_" + info->name() + "_" + std::to_string(::getpid()));
         fs::remove_all(path_);
         fs::create_directories(path_);
     }
