@@ -40,7 +40,8 @@ const std::string kRoot = DEVSLAM_SOURCE_DIR;
 
 const char* kUsage =
     "usage: devslam-bench [--config INI] [--repeats N] [--max-frames N] [--out DIR]\n"
-    "                     [--results FILE] [--bin DIR]\n"
+    "                     [--results FILE] [--bin DIR] [--reuse-runs]\n"
+    "--reuse-runs: keep the run.json of runs already in the output folder (resume a bench)\n"
     "defaults: --config " DEVSLAM_SOURCE_DIR
     "/config_ini/bench.ini, repeats and out from the INI,\n"
     "          --results " DEVSLAM_SOURCE_DIR
@@ -220,6 +221,7 @@ int run(int argc, char** argv) {
                 results = kRoot + "/docs/RESULTS.md";
     std::string bin = fs::absolute(argv[0]).parent_path().string();
     int repeats = 0;
+    bool reuse = false;
     std::size_t max_frames = 0;
     for (int i = 1; i < argc; ++i) {
         const std::string k = argv[i];
@@ -239,6 +241,8 @@ int run(int argc, char** argv) {
             results = value();
         else if (k == "--bin")
             bin = value();
+        else if (k == "--reuse-runs")
+            reuse = true;
         else if (k == "-h" || k == "--help") {
             std::cout << kUsage;
             return 0;
@@ -288,7 +292,8 @@ int run(int argc, char** argv) {
                 std::cout << "[" << ++done << "/" << total << "] " << q.name << " " << m << " run "
                           << r + 1 << "\n"
                           << std::flush;
-                const int rc = std::system(cmd.c_str());
+                const bool have = reuse && fs::exists(dir / "run.json");
+                const int rc = have ? 0 : std::system(cmd.c_str());
                 RunFigures f = rc == 0 ? readRun((dir / "run.json").string()) : RunFigures{};
                 if (!f.ok)
                     std::cerr << "  devslam-run failed (exit " << rc << "), see "
@@ -311,6 +316,7 @@ int run(int argc, char** argv) {
         return x.empty() ? std::numeric_limits<double>::quiet_NaN() : core::median(x);
     };
     std::ostringstream t1, t2, t3, t4;
+    std::map<std::string, std::vector<std::string>> plots;  // sequence -> modes with a plot
     std::ofstream c1(fs::path(b.out_dir) / "table1_rpe.csv"),
         c2(fs::path(b.out_dir) / "table2_ate.csv"), c3(fs::path(b.out_dir) / "table3_fps.csv"),
         c4(fs::path(b.out_dir) / "filter_truth.csv");
@@ -358,10 +364,18 @@ int run(int argc, char** argv) {
                 if (v[r].ok && v[r].ate_rmse == target) {
                     const fs::path src = fs::path(b.out_dir) / "runs" / q.name / m /
                                          ("r" + std::to_string(r)) / "trajectory.png";
-                    if (fs::exists(src))
+                    if (fs::exists(src)) {
                         fs::copy_file(src,
                                       fs::path(b.out_dir) / (q.name + "_" + m + "_trajectory.png"),
                                       fs::copy_options::overwrite_existing);
+                        if (!results.empty()) {  // beside RESULTS.md, for its figures
+                            const fs::path img = fs::path(results).parent_path() / "images";
+                            fs::create_directories(img);
+                            fs::copy_file(src, img / ("bench_" + q.name + "_" + m + ".png"),
+                                          fs::copy_options::overwrite_existing);
+                            plots[q.name].push_back(m);
+                        }
+                    }
                     break;
                 }
             if (m == "none") continue;
@@ -378,8 +392,20 @@ int run(int argc, char** argv) {
                << s->static_instances << "\n";
         }
 
+    std::ostringstream figs;
+    for (const auto& [seq, modes] : plots) {
+        figs << "| " << seq << " |";
+        for (const auto& m : modes) figs << " " << m << " |";
+        figs << "\n|---|";
+        for (std::size_t k = 0; k < modes.size(); ++k) figs << "---|";
+        figs << "\n| |";
+        for (const auto& m : modes)
+            figs << " ![" << seq << " " << m << "](images/bench_" << seq << "_" << m << ".png) |";
+        figs << "\n\n";
+    }
     std::ostringstream md;
-    md << "Measured " << core::measuredOnLine() << " by `devslam-bench --config "
+    md << "## Dynamic-SLAM benchmark: the paper's Tables 1-3 (`devslam-bench`)\n\n"
+       << "Measured " << core::measuredOnLine() << " by `devslam-bench --config "
        << fs::path(config).filename().string()
        << (repeats ? " --repeats " + std::to_string(b.repeats) : std::string())
        << (max_frames ? " --max-frames " + std::to_string(b.max_frames) : std::string())
@@ -397,7 +423,10 @@ int run(int argc, char** argv) {
           "visible pixels are masked; people with fewer than "
        << b.min_person_pixels << " visible pixels are not counted)\n\n"
        << t4.str()
-       << "\nFor reference, the paper's figures on the real TUM fr3 sequences (not comparable one "
+       << "\n**Trajectories** (estimate vs ground truth after alignment, the run with the median "
+          "ATE)\n\n"
+       << figs.str()
+       << "For reference, the paper's figures on the real TUM fr3 sequences (not comparable one "
           "to one: "
           "different scenes and sensors): walking_xyz ATE RMSE ORB-SLAM2 0.197 m (paper re-run), "
           "DynaSLAM "
