@@ -28,6 +28,7 @@ const char* kUsage =
     "                   [--out DIR] [--max-frames N] [--quiet] [--set SECTION.KEY=VALUE]...\n"
     "                   [--replay N]  (play the input forward/backward N times)\n"
     "       devslam-run --bench N [--input PATH] [--config INI] [--results FILE]\n"
+    "                   [--section NAME] [--modes-only]\n"
     "defaults: --input " DEVSLAM_SOURCE_DIR
     "/data/tum/fr1_xyz_first37\n"
     "          --config " DEVSLAM_SOURCE_DIR
@@ -45,6 +46,8 @@ struct Args {
     bool quiet = false;
     std::vector<std::string> sets;  ///< INI overrides "section.key=value"
     int replay = 0;                 ///< > 0: ReplayReader with that many passes
+    std::string section = "slam";   ///< RESULTS.md section written by --bench
+    bool modes_only = false;        ///< --bench without the ablation and the long run
 };
 
 Args parse(int argc, char** argv) {
@@ -71,6 +74,10 @@ Args parse(int argc, char** argv) {
             a.bench = std::stoi(value(i));
         else if (k == "--quiet")
             a.quiet = true;
+        else if (k == "--section")
+            a.section = value(i);
+        else if (k == "--modes-only")
+            a.modes_only = true;
         else if (k == "--replay")
             a.replay = std::stoi(value(i));
         else if (k == "--set")
@@ -163,7 +170,8 @@ std::string fmt(double v, int p) {
 
 int runBench(const Args& a) {
     std::ostringstream md;
-    md << "## SLAM (`devslam-run --bench " << a.bench << "`)\n\n"
+    md << "## SLAM (`devslam-run --bench " << a.bench
+       << (a.section != "slam" ? " --section " + a.section : std::string()) << "`)\n\n"
        << "Sequence `" << fs::path(a.input).filename().string() << "`, config `"
        << fs::path(a.config).filename().string() << "`, " << a.bench
        << " runs per mode, medians over runs. FPS = whole pipeline per frame (detector, filter, "
@@ -242,6 +250,7 @@ int runBench(const Args& a) {
         {"keyframes.max_frames=1 (every frame a keyframe)", {"keyframes.max_frames=1"}},
     };
     for (const auto& [name, sets] : ablations) {
+        if (a.modes_only) break;
         auto l = loadConfig(a, sets);
         auto reader = io::openRgbd(a.input, l.reader);
         run::RunConfig rc;
@@ -257,7 +266,7 @@ int runBench(const Args& a) {
     }
     // Memory on the longest sequence we have: the input replayed forward/backward.
     std::ostringstream mem;
-    {
+    if (!a.modes_only) {
         constexpr int kPasses = 9;
         auto l = loadConfig(a);
         auto src = io::openRgbd(a.input, l.reader);
@@ -279,12 +288,12 @@ int runBench(const Args& a) {
             << " KiB per keyframe (keypoints, descriptors, depths, landmarks); ATE "
             << (rep.ate ? fmt(rep.ate->trans.rmse, 4) : "-") << " m.\n";
     }
-    md << stages.str() << abl.str() << mem.str()
+    md << stages.str() << (a.modes_only ? std::string() : abl.str()) << mem.str()
        << "\nPeak RSS is per run (VmHWM reset before each run). Wall-clock FPS depends on the load "
           "of this shared 2-core machine (other builds ran at the same time); the CPU time per "
           "frame (all threads) is printed by `devslam-run` beside it. Measured on "
        << core::measuredOnLine() << ".\n";
-    core::replaceResultsSection(a.results, "slam", md.str());
+    core::replaceResultsSection(a.results, a.section, md.str());
     std::cout << md.str();
     return 0;
 }
