@@ -96,7 +96,7 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
     // With async_filter the filter works on frame k+1 in a second thread while the SLAM
     // processes frame k (its prior is the constant-velocity motion known before frame k).
     std::future<MaskStep> pending;
-    auto launch = [&](const core::Frame& f, std::optional<Eigen::Isometry3d> prior) {
+    auto launch = [&](const core::Frame& f, const std::optional<Eigen::Isometry3d>& prior) {
         pending =
             std::async(std::launch::async, [&masks, f, prior] { return masks->step(f, prior); });
     };
@@ -226,7 +226,7 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
         namespace fs = std::filesystem;
         fs::create_directories(rc.out_dir);
         auto out = [&](const std::string& name) {
-            const std::string p = (fs::path(rc.out_dir) / name).string();
+            std::string p = (fs::path(rc.out_dir) / name).string();
             rep.outputs.push_back(p);
             return p;
         };

@@ -127,8 +127,8 @@ LocalBaResult localBundleAdjust(Map& map, KeyframeId newest, const core::CameraI
     double lambda = 1e-3;
     using Mat63 = Eigen::Matrix<double, 6, 3>;
     for (int it = 0; it < opts.iterations; ++it) {
-        Eigen::MatrixXd Hpp = Eigen::MatrixXd::Zero(6 * P, 6 * P);
-        Eigen::VectorXd gp = Eigen::VectorXd::Zero(6 * P);
+        Eigen::MatrixXd Hpp = Eigen::MatrixXd::Zero(Eigen::Index{6} * P, Eigen::Index{6} * P);
+        Eigen::VectorXd gp = Eigen::VectorXd::Zero(Eigen::Index{6} * P);
         std::vector<Eigen::Matrix3d> Hll(L, Eigen::Matrix3d::Zero());
         std::vector<Eigen::Vector3d> gl(L, Eigen::Vector3d::Zero());
         std::vector<Mat63> Hpl(obs.size(), Mat63::Zero());
@@ -149,8 +149,9 @@ LocalBaResult localBundleAdjust(Map& map, KeyframeId newest, const core::CameraI
             Hll[o.landmark] += w * Jlr.transpose() * Jlr;
             gl[o.landmark] += w * Jlr.transpose() * r;
             if (o.pose < P) {
-                Hpp.block<6, 6>(6 * o.pose, 6 * o.pose) += w * Jpr.transpose() * Jpr;
-                gp.segment<6>(6 * o.pose) += w * Jpr.transpose() * r;
+                Hpp.block<6, 6>(Eigen::Index{6} * o.pose, Eigen::Index{6} * o.pose) +=
+                    w * Jpr.transpose() * Jpr;
+                gp.segment<6>(Eigen::Index{6} * o.pose) += w * Jpr.transpose() * r;
                 Hpl[k] = w * Jpr.transpose() * Jlr;
             }
         }
@@ -158,7 +159,8 @@ LocalBaResult localBundleAdjust(Map& map, KeyframeId newest, const core::CameraI
         bool accepted = false;
         for (int attempt = 0; attempt < 5 && !accepted; ++attempt) {
             Eigen::MatrixXd S = Hpp;
-            S.diagonal() += lambda * Hpp.diagonal() + Eigen::VectorXd::Constant(6 * P, 1e-9);
+            S.diagonal() +=
+                lambda * Hpp.diagonal() + Eigen::VectorXd::Constant(Eigen::Index{6} * P, 1e-9);
             Eigen::VectorXd rhs = -gp;
             std::vector<Eigen::Matrix3d> Hll_inv(L);
             for (int l = 0; l < L; ++l) {
@@ -174,9 +176,10 @@ LocalBaResult localBundleAdjust(Map& map, KeyframeId newest, const core::CameraI
                 const auto& ks = obs_of_lm[l];
                 for (int a : ks) {
                     const Mat63 A = Hpl[a] * Hll_inv[l];
-                    rhs.segment<6>(6 * obs[a].pose) += A * gl[l];
+                    rhs.segment<6>(Eigen::Index{6} * obs[a].pose) += A * gl[l];
                     for (int b : ks)
-                        S.block<6, 6>(6 * obs[a].pose, 6 * obs[b].pose) -= A * Hpl[b].transpose();
+                        S.block<6, 6>(Eigen::Index{6} * obs[a].pose,
+                                      Eigen::Index{6} * obs[b].pose) -= A * Hpl[b].transpose();
                 }
             }
             const Eigen::VectorXd dp = S.ldlt().solve(rhs);
@@ -187,10 +190,11 @@ LocalBaResult localBundleAdjust(Map& map, KeyframeId newest, const core::CameraI
             std::vector<Eigen::Vector3d> gl_red = gl;
             for (int l = 0; l < L; ++l)
                 for (int a : obs_of_lm[l])
-                    gl_red[l] += Hpl[a].transpose() * dp.segment<6>(6 * obs[a].pose);
+                    gl_red[l] += Hpl[a].transpose() * dp.segment<6>(Eigen::Index{6} * obs[a].pose);
             auto T_new = T_cw;
             auto X_new = X;
-            for (int p = 0; p < P; ++p) T_new[p] = expTwist(dp.segment<6>(6 * p)) * T_cw[p];
+            for (int p = 0; p < P; ++p)
+                T_new[p] = expTwist(dp.segment<6>(Eigen::Index{6} * p)) * T_cw[p];
             for (int l = 0; l < L; ++l) X_new[l] = X[l] - Hll_inv[l] * gl_red[l];
             const double new_cost = robustCost(T_new, X_new);
             if (new_cost < cost) {

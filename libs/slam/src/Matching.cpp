@@ -9,7 +9,7 @@ namespace devslam::slam {
 
 int hamming32(const uchar* a, const uchar* b) {
     int d = 0;
-    for (int i = 0; i < 4; ++i) {
+    for (std::ptrdiff_t i = 0; i < 4; ++i) {
         std::uint64_t x, y;
         std::memcpy(&x, a + 8 * i, 8);
         std::memcpy(&y, b + 8 * i, 8);

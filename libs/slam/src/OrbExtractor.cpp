@@ -130,8 +130,8 @@ FrameFeatures OrbExtractor::extract(const core::Frame& frame, const cv::Mat& mas
     std::vector<cv::KeyPoint> unmasked;
     unmasked.reserve(kps.size());
     for (int i = 0; i < static_cast<int>(kps.size()); ++i) {
-        const int u = std::clamp(static_cast<int>(kps[i].pt.x + 0.5f), 0, gray.cols - 1);
-        const int v = std::clamp(static_cast<int>(kps[i].pt.y + 0.5f), 0, gray.rows - 1);
+        const int u = std::clamp(cvRound(kps[i].pt.x), 0, gray.cols - 1);
+        const int v = std::clamp(cvRound(kps[i].pt.y), 0, gray.rows - 1);
         if (!mask.empty() && mask.at<uchar>(v, u) != 0) {
             ++f.n_masked;
             continue;
@@ -152,8 +152,8 @@ FrameFeatures OrbExtractor::extract(const core::Frame& frame, const cv::Mat& mas
         const cv::KeyPoint& kp = kps[i];
         f.keypoints.push_back(kp);
         desc.row(i).copyTo(f.descriptors.row(static_cast<int>(r)));
-        const int u = std::clamp(static_cast<int>(kp.pt.x + 0.5f), 0, gray.cols - 1);
-        const int v = std::clamp(static_cast<int>(kp.pt.y + 0.5f), 0, gray.rows - 1);
+        const int u = std::clamp(cvRound(kp.pt.x), 0, gray.cols - 1);
+        const int v = std::clamp(cvRound(kp.pt.y), 0, gray.rows - 1);
         float z = has_depth ? frame.depth.at<float>(v, u) : 0.f;
         z *= static_cast<float>(opts_.depth_factor);
         if (!(z >= opts_.min_depth && z <= opts_.max_depth)) z = 0.f;  // also rejects NaN

@@ -225,11 +225,11 @@ MappingResult Slam::mapStep(const core::Frame& frame, FrameFeatures features,
     // keyframe confirmed.
     std::vector<LandmarkId> cull;
     for (const auto& [lid, lm] : map_.landmarks()) {
-        if (lm.n_visible >= opts_.mapping.cull_min_visible &&
-            lm.n_found < opts_.mapping.cull_min_found_ratio * lm.n_visible)
-            cull.push_back(lid);
-        else if (lm.ref_kf == id - opts_.mapping.cull_keyframe_age && lm.observations.size() < 2)
-            cull.push_back(lid);
+        const bool rarely_found = lm.n_visible >= opts_.mapping.cull_min_visible &&
+                                  lm.n_found < opts_.mapping.cull_min_found_ratio * lm.n_visible;
+        const bool unconfirmed =
+            lm.ref_kf == id - opts_.mapping.cull_keyframe_age && lm.observations.size() < 2;
+        if (rarely_found || unconfirmed) cull.push_back(lid);
     }
     for (LandmarkId lid : cull) map_.removeLandmark(lid);
     out.culled_landmarks = static_cast<int>(cull.size());
