@@ -54,8 +54,16 @@ case "${1:-}" in
     build "$BUILD_DIR-asan" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDEVSLAM_SANITIZE=ON -DDEVSLAM_BUILD_BENCHMARKS=OFF
     ASAN_OPTIONS=detect_leaks=0:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
       run_tests "$BUILD_DIR-asan" ;;
-  bench)
+  bench)  # every section of docs/RESULTS.md, regenerated (long: see docs/bench.md)
     setup; build "$BUILD_DIR"
-    for b in "$ROOT"/benchmarks/run_*.sh; do [ -e "$b" ] && bash "$b" "$BUILD_DIR"; done ;;
+    B="$BUILD_DIR/bin"
+    "$B/devslam-filter-bench"                                   # section detect
+    "$B/devslam-run" --bench 5                                  # section slam
+    "$B/devslam-synth" walking_xyz --frames 300 -o out/synth/walking_xyz_300 --no-labels
+    "$B/devslam-run" --bench 3 --modes-only --section slam-synthetic \
+      --config config_ini/slam_synthetic.ini --input out/synth/walking_xyz_300   # section slam-synthetic
+    "$B/devslam-bench"                                          # section bench (Tables 1-3)
+    "$B/devslam-nav-bench"                                      # section nav
+    "$BUILD_DIR/benchmarks/bench_nav" ;;                        # Google Benchmark: A*, VFH+ step
   *) sed -n '2,9p' "$0"; exit 2 ;;
 esac
