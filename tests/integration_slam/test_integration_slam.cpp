@@ -106,7 +106,7 @@ TEST(SlamIntegration, RealFramesMeetTheAteBound) {
     EXPECT_GT(r.landmarks, 1000u);
     const double rmse = ate(seq.gt, r.traj);
     std::printf("ATE RMSE %.5f m, keyframes %zu, landmarks %zu\n", rmse, r.keyframes, r.landmarks);
-    EXPECT_LE(rmse, 0.006);  // issue 4 target; measured 0.0050 (see docs/RESULTS.md)
+    EXPECT_LE(rmse, 0.006);  // issue 4 target; measured 0.0059 (see docs/RESULTS.md)
 }
 
 TEST(SlamIntegration, DeterministicRuns) {
