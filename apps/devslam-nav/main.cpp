@@ -21,9 +21,11 @@ devslam::sim::WorldSpec loadOrGenerate(const std::string& spec) {
     const std::string cat = spec.substr(prefix.size(), colon - prefix.size());
     for (auto c : devslam::sim::allCategories())
         if (cat == devslam::sim::toString(c))
-            return devslam::sim::randomWorld(c, static_cast<uint32_t>(std::stoul(spec.substr(colon + 1))));
-    throw std::invalid_argument("unknown random world category '" + cat +
-                                "' (known: open_clutter, corridor_people, office, obstacle_near_goal)");
+            return devslam::sim::randomWorld(
+                c, static_cast<uint32_t>(std::stoul(spec.substr(colon + 1))));
+    throw std::invalid_argument(
+        "unknown random world category '" + cat +
+        "' (known: open_clutter, corridor_people, office, obstacle_near_goal)");
 }
 
 void usage() {

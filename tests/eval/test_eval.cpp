@@ -16,14 +16,16 @@ using mrpt::poses::CPose3D;
 
 namespace {
 
-const std::string kGt = std::string(DEVSLAM_SOURCE_DIR) + "/data/tum/fr1_xyz_first37/groundtruth.txt";
+const std::string kGt =
+    std::string(DEVSLAM_SOURCE_DIR) + "/data/tum/fr1_xyz_first37/groundtruth.txt";
 
 // A smooth synthetic trajectory at `hz` (helix with changing orientation).
 core::Trajectory helix(std::size_t n, double hz) {
     core::Trajectory t;
     for (std::size_t i = 0; i < n; ++i) {
         const double s = static_cast<double>(i) / hz;
-        t.push_back({100.0 + s, CPose3D(std::cos(s), std::sin(s), 0.1 * s, 0.3 * s, 0.1 * std::sin(s), 0.05)});
+        t.push_back({100.0 + s,
+                     CPose3D(std::cos(s), std::sin(s), 0.1 * s, 0.3 * s, 0.1 * std::sin(s), 0.05)});
     }
     return t;
 }
@@ -56,7 +58,8 @@ TEST(Horn, RecoversAKnownRigidTransform) {
         model.push_back(Ti * data.back());
     }
     EXPECT_TRUE(eval::hornAlign(model, data).matrix().isApprox(Ti.matrix(), 1e-10));
-    EXPECT_THROW((void)eval::hornAlign({model[0], model[1]}, {data[0], data[1]}), std::invalid_argument);
+    EXPECT_THROW((void)eval::hornAlign({model[0], model[1]}, {data[0], data[1]}),
+                 std::invalid_argument);
 }
 
 TEST(Ate, RigidlyMovedTrajectoryHasZeroError) {
@@ -132,7 +135,8 @@ TEST(Rpe, ReproducesEvaluateRpeQuirks) {
     core::Trajectory line, rotated;
     for (int i = 0; i < 50; ++i) {
         line.push_back({double(i), CPose3D(0.1 * i, 0, 0, 0, 0, 0)});
-        rotated.push_back({double(i), CPose3D(0.1 * i, 0, 0, 0, 0, 0) + CPose3D(0, 0, 0, 0.2, 0, 0)});
+        rotated.push_back(
+            {double(i), CPose3D(0.1 * i, 0, 0, 0, 0, 0) + CPose3D(0, 0, 0, 0.2, 0, 0)});
     }
     o.delta = 5;
     const auto r = eval::computeRpe(line, rotated, o);
@@ -182,31 +186,37 @@ TEST(RealGroundTruth, KnownPerturbationsGiveKnownFigures) {
 TEST(Report, TableJsonPlotAndApp) {
     const auto gt = helix(100, 30);
     auto est = gt;
-    for (std::size_t i = 0; i < est.size(); ++i) est[i].pose = shifted(est[i].pose, {0.002 * (i % 3), 0, 0});
+    for (std::size_t i = 0; i < est.size(); ++i)
+        est[i].pose = shifted(est[i].pose, {0.002 * (i % 3), 0, 0});
     const auto a = eval::computeAte(gt, est);
     const auto r = eval::computeRpe(gt, est, {});
     const std::string table = eval::formatTable(&a, &r);
     EXPECT_NE(table.find("ATE translation"), std::string::npos);
     EXPECT_NE(table.find("RPE rotation"), std::string::npos);
     const std::string json = eval::toJson(&a, &r);
-    EXPECT_NE(json.find("\"rmse\": " + std::to_string(a.trans.rmse).substr(0, 6)), std::string::npos) << json;
+    EXPECT_NE(json.find("\"rmse\": " + std::to_string(a.trans.rmse).substr(0, 6)),
+              std::string::npos)
+        << json;
 
     const auto dir = std::filesystem::temp_directory_path() / "devslam_eval_report";
     std::filesystem::create_directories(dir);
     io::writeTumTrajectory((dir / "gt.txt").string(), gt);
     io::writeTumTrajectory((dir / "est.txt").string(), est);
-    const std::string cmd = std::string(DEVSLAM_BIN_DIR) + "/devslam-eval " + (dir / "gt.txt").string() +
-                            " " + (dir / "est.txt").string() + " --json " + (dir / "e.json").string() +
-                            " --plot " + (dir / "e.png").string() + " > " + (dir / "out.txt").string();
+    const std::string cmd = std::string(DEVSLAM_BIN_DIR) + "/devslam-eval " +
+                            (dir / "gt.txt").string() + " " + (dir / "est.txt").string() +
+                            " --json " + (dir / "e.json").string() + " --plot " +
+                            (dir / "e.png").string() + " > " + (dir / "out.txt").string();
     ASSERT_EQ(std::system(cmd.c_str()), 0);
     EXPECT_GT(std::filesystem::file_size(dir / "e.png"), 10000u);
     std::ifstream in(dir / "e.json");
-    const std::string app_json((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string app_json((std::istreambuf_iterator<char>(in)),
+                               std::istreambuf_iterator<char>());
     EXPECT_NE(app_json.find("\"translation_m\""), std::string::npos);
     // bad input: a clear error and a non-zero exit status
     std::ofstream(dir / "bad.txt") << "1 2 3\n";
-    const std::string bad = std::string(DEVSLAM_BIN_DIR) + "/devslam-eval " + (dir / "gt.txt").string() +
-                            " " + (dir / "bad.txt").string() + " 2> " + (dir / "err.txt").string();
+    const std::string bad = std::string(DEVSLAM_BIN_DIR) + "/devslam-eval " +
+                            (dir / "gt.txt").string() + " " + (dir / "bad.txt").string() + " 2> " +
+                            (dir / "err.txt").string();
     EXPECT_NE(std::system(bad.c_str()), 0);
     std::ifstream err(dir / "err.txt");
     const std::string msg((std::istreambuf_iterator<char>(err)), std::istreambuf_iterator<char>());

@@ -156,8 +156,7 @@ TEST(IntegrationNav, AppsSmokeTest) {
     // bench smoke test: one method, one world per category, RESULTS.md untouched
     const std::string bench =
         bin + "/devslam-nav-bench --per-category 1 --methods CHolonomicVFHPlus --png-dir " + out +
-        " --results " + out + "/RESULTS.md" +
-        " > " + out + "/bench.md 2> " + out + "/bench.err";
+        " --results " + out + "/RESULTS.md" + " > " + out + "/bench.md 2> " + out + "/bench.err";
     EXPECT_EQ(std::system(bench.c_str()), 0) << bench;
     EXPECT_TRUE(mrpt::system::fileExists(out + "/nav_bench_success.png"));
     EXPECT_TRUE(mrpt::system::fileExists(out + "/RESULTS.md"));  // not the repository's
