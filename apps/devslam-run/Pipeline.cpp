@@ -89,6 +89,9 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
                  std::to_string(K.height);
     const std::size_t total = rc.max_frames ? std::min(rc.max_frames, reader.size().value_or(0))
                                             : reader.size().value_or(0);
+    std::optional<eval::PersonTruth> truth;
+    if (rc.score_masks) truth = eval::PersonTruth::open(rc.input);
+    if (truth) rep.mask_score.emplace();
     std::optional<core::ProgressBar> bar;
     if (rc.progress) bar.emplace("devslam-run " + rc.mode, total);
     std::size_t n = 0;
@@ -118,10 +121,17 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
         const double cpu_read = processCpuMs();
         std::optional<core::Frame> nxt = within(n + 1) ? reader.next() : std::nullopt;
         if (nxt) nxt->index = n + 1;
-        const double read_ms = msSince(t_read);
-        const double read_cpu_ms = processCpuMs() - cpu_read;
+        fl.read_ms = msSince(t_read);
+        fl.read_cpu_ms = processCpuMs() - cpu_read;
         if (rc.async_filter && nxt)
             launch(*nxt, slam.predictMotion(nxt->timestamp - cur->timestamp));
+        if (truth) {  // not part of the pipeline time either
+            const auto t_score = Clock::now();
+            const double cpu_score = processCpuMs();
+            truth->score(ms.mask, cur->timestamp, rc.min_person_pixels, *rep.mask_score);
+            fl.read_ms += msSince(t_score);
+            fl.read_cpu_ms += processCpuMs() - cpu_score;
+        }
         fl.ms.detect = ms.detect_ms;
         fl.ms.filter = ms.filter_ms;
         fl.n_boxes = ms.n_boxes;
@@ -131,6 +141,7 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
         fl.ms.features = msSince(t0);
         fl.n_features = static_cast<int>(feats.size());
         fl.n_masked = feats.n_masked;
+        fl.masked_fraction = feats.masked_fraction;
         t0 = Clock::now();
         const auto tr = slam.track(*cur, feats, std::nullopt);
         fl.ms.tracking = msSince(t0);
@@ -149,8 +160,8 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
             if (pending.valid()) pending.wait();  // never reset while the filter runs
             masks->reset();
         }
-        fl.wall_ms = msSince(t_iter) - read_ms;
-        fl.cpu_ms = processCpuMs() - cpu_iter - read_cpu_ms;
+        fl.wall_ms = msSince(t_iter) - fl.read_ms;
+        fl.cpu_ms = processCpuMs() - cpu_iter - fl.read_cpu_ms;
         elapsed_ms += fl.wall_ms;
         rep.log.push_back(fl);
         ++n;
@@ -264,6 +275,19 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
         if (rep.ate)
             eval::plotAte(out("trajectory.png"), *rep.ate,
                           fs::path(rc.input).filename().string() + ", mode " + rc.mode);
+        if (rep.mask_score) {
+            std::ofstream mf(out("mask_errors.csv"));
+            mf << "# person instances the masks got wrong (renderer truth): walkers not masked, "
+                  "static people masked\ntimestamp,frame,person_id,truth,visible_px,"
+                  "masked_fraction\n";
+            for (const auto& e : rep.mask_score->errors) {
+                std::size_t frame = 0;
+                while (frame + 1 < rep.log.size() && rep.log[frame].t < e.timestamp - 1e-6) ++frame;
+                mf << num(e.timestamp, 6) << "," << frame << "," << e.person_id << ","
+                   << (e.moving ? "moving" : "static") << "," << e.visible_pixels << ","
+                   << num(e.masked_fraction, 3) << "\n";
+            }
+        }
         rep.peak_rss_mb = peakRssMb();
         std::ofstream js(out("run.json"));
         js << toJson(rep);
@@ -324,6 +348,15 @@ std::string formatSummary(const RunReport& r) {
     if (r.rpe_frame)
         o << "RPE (1 f)  : trans RMSE " << num(r.rpe_frame->trans.rmse, 4) << " m, rot RMSE "
           << num(r.rpe_frame->rot.rmse, 3) << " deg (" << r.rpe_frame->n_pairs << " pairs)\n";
+    if (r.mask_score) {
+        const auto& m = *r.mask_score;
+        o << "masks      : walking people masked in " << num(100.0 * m.movingRecall(), 1)
+          << " % of " << m.moving_instances << " person-frames ("
+          << num(100.0 * m.movingAreaRecall(), 1) << " % of their area), static people in "
+          << num(100.0 * m.staticMasked(), 1) << " % of " << m.static_instances << "; "
+          << num(100.0 * m.precision(), 1)
+          << " % of the masked area is on walking people (renderer truth)\n";
+    }
     if (!r.outputs.empty()) {
         o << "outputs    :";
         for (const auto& p : r.outputs) o << "\n  " << p;
@@ -358,6 +391,15 @@ std::string toJson(const RunReport& r) {
       << ",\n  \"map_mb\": " << num(r.map_mb, 3)
       << ",\n  \"bytes_per_keyframe\": " << num(r.bytes_per_keyframe, 0);
     if (r.ate) o << ",\n  \"ate\": " << summaryJson(r.ate->trans);
+    if (r.mask_score) {
+        const auto& m = *r.mask_score;
+        o << ",\n  \"mask_truth\": {\"moving_recall\": " << num(m.movingRecall())
+          << ", \"moving_area_recall\": " << num(m.movingAreaRecall())
+          << ", \"precision\": " << num(m.precision())
+          << ", \"static_masked\": " << num(m.staticMasked())
+          << ", \"moving_instances\": " << m.moving_instances
+          << ", \"static_instances\": " << m.static_instances << "}";
+    }
     if (r.rpe_1s)
         o << ",\n  \"rpe_1s\": {\"trans\": " << summaryJson(r.rpe_1s->trans)
           << ", \"rot_deg\": " << summaryJson(r.rpe_1s->rot) << "}";
@@ -369,10 +411,10 @@ std::string toJson(const RunReport& r) {
         const auto& l = r.log[i];
         o << (i ? ",\n    " : "\n    ") << "{\"index\": " << l.index << ", \"t\": " << num(l.t, 6)
           << ", \"state\": \"" << l.state << "\", \"features\": " << l.n_features
-          << ", \"masked\": " << l.n_masked << ", \"inliers\": " << l.n_inliers
-          << ", \"boxes\": " << l.n_boxes << ", \"moving\": " << l.n_moving
-          << ", \"keyframe\": " << (l.keyframe ? "true" : "false") << ", \"keyframe_reason\": \""
-          << l.keyframe_reason << "\""
+          << ", \"masked\": " << l.n_masked << ", \"masked_area\": " << num(l.masked_fraction, 3)
+          << ", \"inliers\": " << l.n_inliers << ", \"boxes\": " << l.n_boxes
+          << ", \"moving\": " << l.n_moving << ", \"keyframe\": " << (l.keyframe ? "true" : "false")
+          << ", \"keyframe_reason\": \"" << l.keyframe_reason << "\""
           << ", \"wall_ms\": " << num(l.wall_ms, 3) << ", \"cpu_ms\": " << num(l.cpu_ms, 3)
           << ", \"ms\": " << timingJson(l.ms) << "}";
     }

@@ -2,6 +2,7 @@
 /// One run of the whole pipeline over a sequence: reader -> dynamic mask -> SLAM, with
 /// per-frame timings per stage, then evaluation against ground truth and the output files.
 #include <devslam/core/Trajectory.h>
+#include <devslam/eval/MaskScore.h>
 #include <devslam/eval/Metrics.h>
 #include <devslam/io/RgbdReader.h>
 #include <devslam/slam/Slam.h>
@@ -24,6 +25,10 @@ struct RunConfig {
     /// Run the dynamic filter for frame k+1 in a second thread while the SLAM processes
     /// frame k (INI [run] async_filter). Results do not depend on timing.
     bool async_filter = false;
+    /// Score each frame's mask against the renderer's person truth when the input folder
+    /// has one (persons.txt + labels/, written by devslam-synth). Off for replayed inputs.
+    bool score_masks = true;
+    int min_person_pixels = 500;  ///< [px] smaller person instances are not scored
 };
 
 /// Wall time per stage of one frame [ms].
@@ -39,10 +44,12 @@ struct FrameLog {
     double t = 0;
     std::string state, keyframe_reason;
     int n_features = 0, n_masked = 0, n_inliers = 0, n_boxes = 0, n_moving = 0;
+    double masked_fraction = 0;  ///< of the image, by the dynamic mask
     bool keyframe = false, loop = false;
     FrameTiming ms;      ///< per stage (detect/filter overlap the SLAM when async)
     double wall_ms = 0;  ///< wall time of the frame's pipeline step (disk reading excluded)
     double cpu_ms = 0;   ///< process CPU time (all threads) of that step
+    double read_ms = 0, read_cpu_ms = 0;  ///< reading the next frame and scoring (excluded)
 };
 
 struct RunReport {
@@ -63,6 +70,8 @@ struct RunReport {
     double map_mb = 0;       ///< approximate map heap
     double bytes_per_keyframe = 0;
     std::vector<std::string> outputs;  ///< files written
+    /// The masks scored against the person truth (rendered inputs only).
+    std::optional<eval::MaskScore> mask_score;
 };
 
 /// Runs the pipeline over `reader` with the INI `cfg` (SLAM sections) and `filter_cfg`

@@ -156,6 +156,7 @@ int runOnce(const Args& a) {
     rc.out_dir = a.out;
     rc.progress = !a.quiet;
     rc.max_frames = a.max_frames;
+    rc.score_masks = a.replay <= 0;
     rc.async_filter = l.async_filter;
     const auto rep = run::runSequence(*reader, rc, *l.cfg, *l.filter_cfg);
     std::cout << run::formatSummary(rep);
@@ -276,6 +277,7 @@ int runBench(const Args& a) {
         rc.mode = "dynamic";
         rc.progress = false;
         rc.async_filter = l.async_filter;
+        rc.score_masks = false;  // replayed: timestamps are not the truth's
         const auto rep = run::runSequence(reader, rc, *l.cfg, *l.filter_cfg);
         mem << "\nLong run (memory): the input replayed forward/backward " << kPasses
             << " times (`devslam-run --replay " << kPasses << " --mode dynamic`): " << rep.frames

@@ -268,15 +268,22 @@ TEST(OrbExtractor, MaskDropsKeypointsAndDepthIsRangeChecked) {
         const bool top = all.keypoints[i].pt.y < 99.5f;
         if (top) {
             EXPECT_EQ(all.depth[i], 0.f);
-        } else if (all.keypoints[i].pt.y > 100.5f) {
+        } else if (all.keypoints[i].pt.y > 102.5f) {  // 2 px: the depth-edge window
             EXPECT_FLOAT_EQ(all.depth[i], 2.0f);
         }
     }
     cv::Mat mask(480, 640, CV_8UC1, cv::Scalar(0));
     mask(cv::Rect(0, 0, 320, 480)).setTo(255);
-    const auto half = orb.extract(f, mask);
+    const auto half = orb.extract(f, mask);  // default: detect everywhere, drop the masked
+    EXPECT_DOUBLE_EQ(half.masked_fraction, 0.5);
     EXPECT_GT(half.n_masked, 100);
     for (const auto& kp : half.keypoints) EXPECT_GE(kp.pt.x, 319.5f);
+    OrbExtractor::Options outside;
+    outside.detect_outside_mask = true;  // the budget goes to the free half
+    const auto free_half = OrbExtractor(outside).extract(f, mask);
+    EXPECT_EQ(free_half.n_masked, 0);
+    EXPECT_GE(free_half.size(), half.size());
+    for (const auto& kp : free_half.keypoints) EXPECT_GE(kp.pt.x, 319.5f);
     mask.setTo(255);
     const auto none = orb.extract(f, mask);
     EXPECT_EQ(none.size(), 0u);

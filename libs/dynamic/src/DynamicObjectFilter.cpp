@@ -45,7 +45,9 @@ const std::vector<std::string> kKeys{"mode",
                                      "max_missed_detections",
                                      "mask_margin",
                                      "background_factor",
-                                     "flow_scale"};
+                                     "flow_scale",
+                                     "mask_unknown",
+                                     "mask_border_snap"};
 
 cv::Rect2f shrink(const cv::Rect2f& b, double f) {
     const auto dx = static_cast<float>(f * b.width), dy = static_cast<float>(f * b.height);
@@ -139,6 +141,9 @@ void DynamicObjectFilter::Options::loadFromConfig(const mrpt::config::CConfigFil
     release_frames = c.read_int(s, "release_frames", release_frames);
     max_missed_detections = c.read_int(s, "max_missed_detections", max_missed_detections);
     mask_margin = c.read_int(s, "mask_margin", mask_margin);
+    mask_unknown = c.read_bool(s, "mask_unknown", mask_unknown);
+    mask_border_snap = c.read_int(s, "mask_border_snap", mask_border_snap);
+    core::requireValue(mask_border_snap >= 0, s, "mask_border_snap", "must be >= 0");
     core::requireValue(detect_every >= 1, s, "detect_every", "must be >= 1");
     core::requireValue(flow_scale > 0.1 && flow_scale <= 1.0, s, "flow_scale",
                        "must be in (0.1, 1]");
@@ -192,6 +197,8 @@ void DynamicObjectFilter::Options::saveToConfig(mrpt::config::CConfigFileBase& c
     c.write(s, "release_frames", release_frames);
     c.write(s, "max_missed_detections", max_missed_detections);
     c.write(s, "mask_margin", mask_margin);
+    c.write(s, "mask_unknown", mask_unknown);
+    c.write(s, "mask_border_snap", mask_border_snap);
 }
 
 struct DynamicObjectFilter::Impl {
@@ -503,13 +510,20 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
     // 7. Mask: whole boxes, dilated by the margin.
     for (const auto& t : im.tracks) {
         out.boxes.push_back(t.tb);
-        const bool masked = opts_.mode == MaskMode::AllPersons || t.tb.state == BoxState::Moving;
+        const bool masked = opts_.mode == MaskMode::AllPersons || t.tb.state == BoxState::Moving ||
+                            (opts_.mask_unknown && t.tb.state == BoxState::Unknown);
         if (!masked) continue;
+        const auto m = static_cast<float>(opts_.mask_margin);
+        const auto snap = static_cast<float>(opts_.mask_border_snap);
+        const auto W = static_cast<float>(gray.cols), H = static_cast<float>(gray.rows);
+        float x0 = t.tb.box.x - m, y0 = t.tb.box.y - m;
+        float x1 = t.tb.box.br().x + m, y1 = t.tb.box.br().y + m;
+        if (x0 < snap) x0 = 0.f;
+        if (y0 < snap) y0 = 0.f;
+        if (x1 > W - snap) x1 = W;
+        if (y1 > H - snap) y1 = H;
         const cv::Rect r =
-            cv::Rect(cv::Rect2f(t.tb.box.x - opts_.mask_margin, t.tb.box.y - opts_.mask_margin,
-                                t.tb.box.width + 2.f * opts_.mask_margin,
-                                t.tb.box.height + 2.f * opts_.mask_margin)) &
-            cv::Rect(0, 0, gray.cols, gray.rows);
+            cv::Rect(cv::Rect2f(x0, y0, x1 - x0, y1 - y0)) & cv::Rect(0, 0, gray.cols, gray.rows);
         out.mask(r).setTo(255);
     }
 

@@ -10,10 +10,10 @@
 namespace devslam::slam {
 
 void LoopOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, const std::string& s) {
-    core::requireKnownKeys(
-        c, s,
-        {"enabled", "min_keyframe_gap", "cooldown_keyframes", "max_distance", "max_candidates",
-         "max_hamming", "ratio", "min_inliers", "sigma_t", "sigma_r_deg"});
+    core::requireKnownKeys(c, s,
+                           {"enabled", "min_keyframe_gap", "cooldown_keyframes", "max_distance",
+                            "max_candidates", "max_hamming", "ratio", "min_inliers", "sigma_t",
+                            "sigma_r_deg", "max_correction", "max_correction_deg"});
     enabled = c.read_bool(s, "enabled", enabled);
     min_keyframe_gap = c.read_int(s, "min_keyframe_gap", min_keyframe_gap);
     cooldown_keyframes = c.read_int(s, "cooldown_keyframes", cooldown_keyframes);
@@ -22,11 +22,15 @@ void LoopOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, const s
     max_hamming = c.read_int(s, "max_hamming", max_hamming);
     ratio = c.read_double(s, "ratio", ratio);
     min_inliers = c.read_int(s, "min_inliers", min_inliers);
+    max_correction = c.read_double(s, "max_correction", max_correction);
+    max_correction_deg = c.read_double(s, "max_correction_deg", max_correction_deg);
     sigma_t = c.read_double(s, "sigma_t", sigma_t);
     sigma_r_deg = c.read_double(s, "sigma_r_deg", sigma_r_deg);
     core::requireValue(min_keyframe_gap >= 1, s, "min_keyframe_gap", "must be >= 1");
     core::requireValue(max_distance > 0, s, "max_distance", "must be > 0");
     core::requireValue(min_inliers >= 6, s, "min_inliers", "must be >= 6");
+    core::requireValue(max_correction > 0 && max_correction_deg > 0, s,
+                       "max_correction/max_correction_deg", "must be > 0");
     core::requireValue(sigma_t > 0 && sigma_r_deg > 0, s, "sigma_t/sigma_r_deg", "must be > 0");
 }
 
@@ -39,6 +43,8 @@ void LoopOptions::saveToConfig(mrpt::config::CConfigFileBase& c, const std::stri
     c.write(s, "max_hamming", max_hamming);
     c.write(s, "ratio", ratio);
     c.write(s, "min_inliers", min_inliers);
+    c.write(s, "max_correction", max_correction);
+    c.write(s, "max_correction_deg", max_correction_deg);
     c.write(s, "sigma_t", sigma_t);
     c.write(s, "sigma_r_deg", sigma_r_deg);
 }
@@ -59,9 +65,12 @@ std::optional<LoopConstraint> detectLoop(const Map& map, KeyframeId current,
     std::optional<LoopConstraint> best;
     for (const auto& [d, id] : cands) {
         const Keyframe& old = map.keyframe(id);
+        // The old keyframe's own keypoints with depth, in its camera frame: the measured
+        // relative pose depends on the two keyframes' images only, not on how the map
+        // between them was adjusted.
         std::vector<int> rows;
-        for (int i = 0; i < static_cast<int>(old.landmark_of_kp.size()); ++i)
-            if (old.landmark_of_kp[i] != kNoId) rows.push_back(i);
+        for (int i = 0; i < static_cast<int>(old.features.size()); ++i)
+            if (old.features.depth[i] > 0) rows.push_back(i);
         if (static_cast<int>(rows.size()) < opts.min_inliers) continue;
         cv::Mat train(static_cast<int>(rows.size()), 32, CV_8U);
         for (std::size_t r = 0; r < rows.size(); ++r)
@@ -69,13 +78,11 @@ std::optional<LoopConstraint> detectLoop(const Map& map, KeyframeId current,
         const auto pairs =
             matchBruteForce(cur.features.descriptors, train, opts.max_hamming, opts.ratio);
         if (static_cast<int>(pairs.size()) < opts.min_inliers) continue;
-        // Points in the OLD camera frame: the verified pose is relative, free of drift.
-        const Eigen::Isometry3d T_cw_old = old.T_wc.inverse();
         std::vector<PoseObservation> obs;
         for (const auto& [q, t] : pairs) {
             const auto& kp = cur.features.keypoints[q];
             const double s = std::pow(opts.scale_factor, kp.octave);
-            obs.push_back({T_cw_old * map.landmark(old.landmark_of_kp[rows[t]])->p_w,
+            obs.push_back({old.features.points_c[rows[t]],
                            {kp.pt.x, kp.pt.y},
                            cur.features.depth[q],
                            1.0 / (s * s)});
@@ -88,6 +95,10 @@ std::optional<LoopConstraint> detectLoop(const Map& map, KeyframeId current,
         if (!sol) continue;
         const auto ref = refinePose(obs, sol->T_wc, K, refine);
         if (ref.n_inliers < opts.min_inliers) continue;
+        const Eigen::Isometry3d correction = (old.T_wc.inverse() * cur.T_wc).inverse() * ref.T_wc;
+        if (correction.translation().norm() > opts.max_correction ||
+            Eigen::AngleAxisd(correction.linear()).angle() > opts.max_correction_deg * M_PI / 180.0)
+            continue;
         if (!best || ref.n_inliers > best->n_inliers)
             best = LoopConstraint{id, current, ref.T_wc, ref.n_inliers};
     }

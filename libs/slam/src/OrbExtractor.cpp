@@ -16,13 +16,17 @@ void OrbExtractor::Options::loadFromConfig(const mrpt::config::CConfigFileBase& 
     core::requireKnownKeys(
         c, s,
         {"n_features", "scale_factor", "n_levels", "fast_threshold", "min_fast_threshold",
-         "oversample", "grid_cols", "grid_rows", "min_depth", "max_depth", "depth_factor"});
+         "oversample", "grid_cols", "grid_rows", "min_depth", "max_depth", "depth_factor",
+         "detect_outside_mask", "depth_edge_threshold"});
     n_features = c.read_int(s, "n_features", n_features);
     scale_factor = c.read_double(s, "scale_factor", scale_factor);
     n_levels = c.read_int(s, "n_levels", n_levels);
     fast_threshold = c.read_int(s, "fast_threshold", fast_threshold);
     min_fast_threshold = c.read_int(s, "min_fast_threshold", min_fast_threshold);
     oversample = c.read_double(s, "oversample", oversample);
+    detect_outside_mask = c.read_bool(s, "detect_outside_mask", detect_outside_mask);
+    depth_edge_threshold = c.read_double(s, "depth_edge_threshold", depth_edge_threshold);
+    core::requireValue(depth_edge_threshold >= 0, s, "depth_edge_threshold", "must be >= 0");
     grid_cols = c.read_int(s, "grid_cols", grid_cols);
     grid_rows = c.read_int(s, "grid_rows", grid_rows);
     min_depth = c.read_double(s, "min_depth", min_depth);
@@ -47,6 +51,8 @@ void OrbExtractor::Options::saveToConfig(mrpt::config::CConfigFileBase& c,
     c.write(s, "fast_threshold", fast_threshold);
     c.write(s, "min_fast_threshold", min_fast_threshold);
     c.write(s, "oversample", oversample);
+    c.write(s, "detect_outside_mask", detect_outside_mask);
+    c.write(s, "depth_edge_threshold", depth_edge_threshold);
     c.write(s, "grid_cols", grid_cols);
     c.write(s, "grid_rows", grid_rows);
     c.write(s, "min_depth", min_depth);
@@ -95,6 +101,25 @@ std::vector<int> spreadOverGrid(const std::vector<cv::KeyPoint>& kps, cv::Size i
     return out;
 }
 
+/// True when the valid depths of the 5x5 window around (u, v) spread more than
+/// `threshold` times the centre depth (an occlusion edge).
+static bool onDepthEdge(const cv::Mat& depth, int u, int v, double threshold) {
+    constexpr int r = 2;
+    if (u < r || v < r || u >= depth.cols - r || v >= depth.rows - r) return true;
+    const float zc = depth.at<float>(v, u);
+    float lo = zc, hi = zc;
+    for (int dv = -r; dv <= r; ++dv) {
+        const float* row = depth.ptr<float>(v + dv);
+        for (int du = -r; du <= r; ++du) {
+            const float z = row[u + du];
+            if (!(z > 0.f)) continue;  // holes: Kinect shadows, not evidence either way
+            lo = std::min(lo, z);
+            hi = std::max(hi, z);
+        }
+    }
+    return hi - lo > threshold * zc;
+}
+
 void undistortKeypoints(FrameFeatures& f, const core::CameraIntrinsics& K) {
     const bool distorted =
         std::any_of(K.dist.begin(), K.dist.end(), [](double d) { return d != 0.0; });
@@ -119,10 +144,15 @@ FrameFeatures OrbExtractor::extract(const core::Frame& frame, const cv::Mat& mas
     cv::cvtColor(frame.bgr, gray, cv::COLOR_BGR2GRAY);
     std::vector<cv::KeyPoint> kps;
     cv::Mat desc;
-    orb_->detectAndCompute(gray, cv::noArray(), kps, desc);
+    cv::Mat allowed;  // ORB's mask: non-zero = detect here
+    if (!mask.empty()) {
+        f.masked_fraction = cv::countNonZero(mask) / static_cast<double>(mask.total());
+        if (opts_.detect_outside_mask) allowed = mask == 0;
+    }
+    orb_->detectAndCompute(gray, allowed, kps, desc);
     if (static_cast<int>(kps.size()) < opts_.n_features / 2) {
         kps.clear();
-        orb_low_->detectAndCompute(gray, cv::noArray(), kps, desc);
+        orb_low_->detectAndCompute(gray, allowed, kps, desc);
     }
     // Drop keypoints in the dynamic mask (after detection, so the count is reported).
     std::vector<int> keep_idx;
@@ -157,6 +187,9 @@ FrameFeatures OrbExtractor::extract(const core::Frame& frame, const cv::Mat& mas
         float z = has_depth ? frame.depth.at<float>(v, u) : 0.f;
         z *= static_cast<float>(opts_.depth_factor);
         if (!(z >= opts_.min_depth && z <= opts_.max_depth)) z = 0.f;  // also rejects NaN
+        if (z > 0.f && opts_.depth_edge_threshold > 0 &&
+            onDepthEdge(frame.depth, u, v, opts_.depth_edge_threshold))
+            z = 0.f;
         f.depth.push_back(z);
         f.points_c.push_back(z > 0 ? core::backproject(kp.pt.x, kp.pt.y, z, frame.K)
                                    : Eigen::Vector3d::Zero());

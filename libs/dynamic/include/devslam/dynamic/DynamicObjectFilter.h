@@ -115,6 +115,14 @@ class DynamicObjectFilter {
 
         // Mask
         int mask_margin = 10;  ///< [px] dilation of each masked box
+        /// mode dynamic: also mask boxes whose state is still Unknown (a person first seen,
+        /// no flow evidence yet). Unmasked, such a person enters the map for the frames the
+        /// evidence takes (always the first frame) and corrupts it if they walk.
+        bool mask_unknown = true;
+        /// [px] a masked box edge this close to the image border is extended to it: a
+        /// person cut off by the border is detected with a box that stops short of it,
+        /// leaving a strip of the person unmasked.
+        int mask_border_snap = 0;
 
         /// Reads `[section]`; unknown keys throw std::invalid_argument naming them.
         void loadFromConfig(const mrpt::config::CConfigFileBase& cfg,

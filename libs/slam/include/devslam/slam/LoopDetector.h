@@ -27,9 +27,14 @@ struct LoopOptions {
     int max_hamming = 50;        ///< descriptor threshold
     double ratio = 0.8;          ///< ratio test
     int min_inliers = 40;        ///< verified inliers for a loop
-    double sigma_t = 0.02;       ///< [m] loop-edge translation std (pose-graph information)
-    double sigma_r_deg = 1.0;    ///< [deg] loop-edge rotation std
-    double scale_factor = 1.3;   ///< ORB pyramid scale for level sigmas (copied from [orb])
+    /// A verified loop whose measured relative pose differs from the current estimate's
+    /// by more than this is rejected: repeated textures (the same poster on two walls) can
+    /// verify a false loop with many inliers, and one false loop wrecks the whole graph.
+    double max_correction = 0.25;      ///< [m]
+    double max_correction_deg = 10.0;  ///< [deg]
+    double sigma_t = 0.02;             ///< [m] loop-edge translation std (pose-graph information)
+    double sigma_r_deg = 1.0;          ///< [deg] loop-edge rotation std
+    double scale_factor = 1.3;         ///< ORB pyramid scale for level sigmas (copied from [orb])
 
     void loadFromConfig(const mrpt::config::CConfigFileBase& cfg,
                         const std::string& section = "loop_closure");

@@ -34,6 +34,17 @@ class OrbExtractor {
         double max_depth = 6.0;      ///< [m] farther depth is treated as missing
         /// Multiplies every depth reading (sensor depth-scale calibration; 1 = as recorded).
         double depth_factor = 1.0;
+        /// true: ORB detects only outside the dynamic mask, so the whole feature budget
+        /// goes to the static part of the image (a walker covering half of the view halves
+        /// the features otherwise). false: detect everywhere, then drop the masked keypoints
+        /// (the paper's wording; n_masked counts them).
+        bool detect_outside_mask = false;
+        /// A keypoint whose 5x5 depth neighbourhood spreads more than this fraction of its
+        /// depth (or has holes) sits on an occlusion edge - often a corner formed by a
+        /// person's silhouette against the background, which moves with the person while
+        /// its depth is the wall's. Its depth is discarded, so it never becomes a landmark.
+        /// 0 = off.
+        double depth_edge_threshold = 0.05;
 
         void loadFromConfig(const mrpt::config::CConfigFileBase& cfg,
                             const std::string& section = "orb");
@@ -44,7 +55,7 @@ class OrbExtractor {
     explicit OrbExtractor(const Options& opts);
 
     /// Features of `frame`. `mask`: empty, or CV_8UC1 of the frame size with 255 = dynamic
-    /// (keypoints there are dropped and counted in n_masked). Throws std::invalid_argument
+    /// (no keypoints there; see detect_outside_mask). Throws std::invalid_argument
     /// for a mask of the wrong size/type.
     [[nodiscard]] FrameFeatures extract(const core::Frame& frame, const cv::Mat& mask) const;
 

@@ -22,7 +22,8 @@ struct FrameFeatures {
     std::vector<float> depth;               ///< [m] per keypoint, 0 = none (missing/out of range)
     std::vector<Eigen::Vector3d> points_c;  ///< back-projected point [m] (valid iff depth > 0)
     std::vector<cv::Vec3b> colors;          ///< BGR at the keypoint
-    int n_masked = 0;  ///< keypoints dropped because they fell in the dynamic mask
+    int n_masked = 0;            ///< keypoints dropped because they fell in the dynamic mask
+    double masked_fraction = 0;  ///< fraction of the image covered by the dynamic mask
     [[nodiscard]] std::size_t size() const { return keypoints.size(); }
 };
 

@@ -1,12 +1,16 @@
-#include "MaskScore.h"
+#include <devslam/eval/MaskScore.h>
 
 #include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+
+#include <cstdio>
+#include <filesystem>
 
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
 
-namespace devslam::bench {
+namespace devslam::eval {
 
 std::map<std::string, std::vector<PersonEntry>> readPersons(const std::string& path) {
     std::ifstream in(path);
@@ -31,7 +35,7 @@ std::map<std::string, std::vector<PersonEntry>> readPersons(const std::string& p
 }
 
 void MaskScore::add(const cv::Mat& mask, const cv::Mat& labels,
-                    const std::vector<PersonEntry>& persons, int min_pixels) {
+                    const std::vector<PersonEntry>& persons, int min_pixels, double timestamp) {
     const bool has_mask = !mask.empty();
     if (has_mask) masked_px += cv::countNonZero(mask);
     for (const auto& p : persons) {
@@ -44,6 +48,8 @@ void MaskScore::add(const cv::Mat& mask, const cv::Mat& labels,
         }
         if (vis < min_pixels) continue;
         const bool masked = hit >= 0.5 * vis;
+        if (masked != p.moving)
+            errors.push_back({timestamp, p.id, p.moving, static_cast<int>(vis), hit / vis});
         if (p.moving) {
             ++moving_instances;
             moving_masked += masked;
@@ -67,4 +73,27 @@ double MaskScore::precision() const {
     return masked_px > 0 ? moving_px_masked / masked_px : 0.0;
 }
 
-}  // namespace devslam::bench
+std::optional<PersonTruth> PersonTruth::open(const std::string& folder) {
+    namespace fs = std::filesystem;
+    const fs::path p = fs::path(folder) / "persons.txt";
+    if (!fs::is_directory(folder) || !fs::exists(p)) return std::nullopt;
+    PersonTruth t;
+    t.folder_ = folder;
+    t.persons_ = readPersons(p.string());
+    return t;
+}
+
+void PersonTruth::score(const cv::Mat& mask, double timestamp, int min_pixels,
+                        MaskScore& score) const {
+    char stamp[64];
+    std::snprintf(stamp, sizeof stamp, "%.6f", timestamp);
+    const auto it = persons_.find(stamp);
+    if (it == persons_.end())
+        throw std::runtime_error(folder_ + "/persons.txt: no entry for frame " + stamp);
+    const std::string label_path = folder_ + "/labels/" + stamp + ".png";
+    const cv::Mat labels = cv::imread(label_path, cv::IMREAD_UNCHANGED);
+    if (labels.empty()) throw std::runtime_error("cannot read person labels '" + label_path + "'");
+    score.add(mask, labels, it->second, min_pixels, timestamp);
+}
+
+}  // namespace devslam::eval

@@ -5,10 +5,11 @@
 
 #include <cstddef>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
-namespace devslam::bench {
+namespace devslam::eval {
 
 /// One line of persons.txt.
 struct PersonEntry {
@@ -28,8 +29,18 @@ struct MaskScore {
     std::size_t static_masked = 0;
     double moving_px = 0, moving_px_masked = 0;  ///< visible / masked pixels of walking people
     double masked_px = 0;                        ///< all masked pixels
+    /// Scored person instances whose mask state is wrong (a walker not masked, a static
+    /// person masked), for diagnosis.
+    struct Error {
+        double timestamp = 0;
+        int person_id = 0;
+        bool moving = false;
+        int visible_pixels = 0;
+        double masked_fraction = 0;
+    };
+    std::vector<Error> errors;
     void add(const cv::Mat& mask, const cv::Mat& labels, const std::vector<PersonEntry>& persons,
-             int min_pixels);
+             int min_pixels, double timestamp = 0);
     /// Fraction of walking-person instances that were masked (recall per person and frame).
     [[nodiscard]] double movingRecall() const;
     /// Fraction of static-person instances that were masked (should be small).
@@ -40,4 +51,19 @@ struct MaskScore {
     [[nodiscard]] double precision() const;
 };
 
-}  // namespace devslam::bench
+/// The person truth of a rendered folder (persons.txt + labels/<timestamp>.png), to score
+/// the masks of a run frame by frame.
+class PersonTruth {
+  public:
+    /// nullopt when `folder` has no persons.txt (real data); throws on a malformed one.
+    [[nodiscard]] static std::optional<PersonTruth> open(const std::string& folder);
+    /// Adds the frame at `timestamp` to `score`. Throws naming the file when the frame has
+    /// no truth (a missing label image or persons.txt entry).
+    void score(const cv::Mat& mask, double timestamp, int min_pixels, MaskScore& score) const;
+
+  private:
+    std::string folder_;
+    std::map<std::string, std::vector<PersonEntry>> persons_;
+};
+
+}  // namespace devslam::eval
