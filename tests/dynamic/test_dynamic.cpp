@@ -380,3 +380,36 @@ TEST(DynamicConfig, BadValuesAreRejected) {
     EXPECT_EQ(dynamic::parseMaskMode("all_persons"), MaskMode::AllPersons);
     EXPECT_THROW((void)dynamic::parseMaskMode("dyn"), std::invalid_argument);
 }
+
+TEST(DynamicFilter, UnknownBoxesAreMaskedUntilThereIsEvidence) {
+    // Frame 0 has no flow yet: with mask_unknown the new person box is masked (a walker is
+    // not mapped while the filter waits for evidence); without it, nothing is masked.
+    core::Frame f;
+    f.bgr = wallTexture();
+    f.depth = cv::Mat(f.bgr.size(), CV_32FC1, cv::Scalar(2.0f));
+    f.K.fx = f.K.fy = 525;
+    f.K.cx = 319.5;
+    f.K.cy = 239.5;
+    f.K.width = f.bgr.cols;
+    f.K.height = f.bgr.rows;
+    const cv::Rect2f box(300, 100, 80, 200);
+    for (bool mask_unknown : {true, false}) {
+        auto o = testOptions();
+        o.mode = MaskMode::Dynamic;
+        o.mask_unknown = mask_unknown;
+        auto det = std::make_unique<ScriptedDetector>();
+        det->next = {{box, 0, "person", 0.9f}};
+        DynamicObjectFilter filter(o, std::move(det));
+        const auto out = filter.step(f, std::nullopt);
+        ASSERT_EQ(out.boxes.size(), 1u);
+        EXPECT_EQ(out.boxes[0].state, BoxState::Unknown);
+        const int masked = cv::countNonZero(out.mask);
+        if (mask_unknown) {
+            // the box dilated by mask_margin on each side
+            const int m = o.mask_margin;
+            EXPECT_EQ(masked, (80 + 2 * m) * (200 + 2 * m));
+        } else {
+            EXPECT_EQ(masked, 0);
+        }
+    }
+}

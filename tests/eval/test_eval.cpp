@@ -1,7 +1,11 @@
 #include <devslam/core/Pose.h>
+#include <devslam/eval/MaskScore.h>
 #include <devslam/eval/Metrics.h>
 #include <devslam/eval/Report.h>
 #include <devslam/io/TrajectoryIO.h>
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
 
 #include <gtest/gtest.h>
 
@@ -222,4 +226,72 @@ TEST(Report, TableJsonPlotAndApp) {
     const std::string msg((std::istreambuf_iterator<char>(err)), std::istreambuf_iterator<char>());
     EXPECT_NE(msg.find("bad.txt line 1: expected"), std::string::npos) << msg;
     std::filesystem::remove_all(dir);
+}
+
+TEST(MaskScore, CountsWalkersStaticPeopleAndArea) {
+    // Labels: person 1 (walking) 100x100 px, person 2 (static) 50x50 px, person 3 (walking)
+    // 10x10 px - below min_pixels, so only its area counts.
+    cv::Mat labels(200, 300, CV_8UC1, cv::Scalar(0));
+    labels(cv::Rect(0, 0, 100, 100)).setTo(1);
+    labels(cv::Rect(200, 0, 50, 50)).setTo(2);
+    labels(cv::Rect(150, 150, 10, 10)).setTo(3);
+    const std::vector<eval::PersonEntry> persons{
+        {1, "a", true, 10000}, {2, "b", false, 2500}, {3, "c", true, 100}};
+    cv::Mat mask(200, 300, CV_8UC1, cv::Scalar(0));
+    mask(cv::Rect(0, 0, 60, 100)).setTo(255);     // 60 % of person 1
+    mask(cv::Rect(100, 100, 40, 50)).setTo(255);  // background
+    eval::MaskScore s;
+    s.add(mask, labels, persons, 500, 1.5);
+    EXPECT_EQ(s.moving_instances, 1u);
+    EXPECT_EQ(s.moving_masked, 1u);
+    EXPECT_EQ(s.static_instances, 1u);
+    EXPECT_EQ(s.static_masked, 0u);
+    EXPECT_DOUBLE_EQ(s.movingRecall(), 1.0);
+    EXPECT_DOUBLE_EQ(s.movingAreaRecall(), 6000.0 / 10100.0);
+    EXPECT_DOUBLE_EQ(s.precision(), 6000.0 / 8000.0);
+    EXPECT_TRUE(s.errors.empty());
+    // 40 % masked is not masked; the error list names the frame and the person.
+    mask.setTo(0);
+    mask(cv::Rect(0, 0, 40, 100)).setTo(255);
+    s.add(mask, labels, persons, 500, 2.5);
+    EXPECT_DOUBLE_EQ(s.movingRecall(), 0.5);
+    ASSERT_EQ(s.errors.size(), 1u);
+    EXPECT_EQ(s.errors[0].person_id, 1);
+    EXPECT_DOUBLE_EQ(s.errors[0].timestamp, 2.5);
+    EXPECT_NEAR(s.errors[0].masked_fraction, 0.4, 1e-12);
+}
+
+TEST(MaskScore, PersonTruthOfAFolder) {
+    namespace fs = std::filesystem;
+    const fs::path dir = fs::temp_directory_path() / "devslam_test_person_truth";
+    fs::remove_all(dir);
+    EXPECT_FALSE(eval::PersonTruth::open(dir.string()).has_value());  // no folder: real data
+    fs::create_directories(dir / "labels");
+    {
+        std::ofstream p(dir / "persons.txt");
+        p << "# t id name state x y w h visible\n1.000000 1 p moving 0 0 10 10 100\n";
+    }
+    const auto truth = eval::PersonTruth::open(dir.string());
+    ASSERT_TRUE(truth.has_value());
+    eval::MaskScore s;
+    // the label image is missing: a clear error naming it
+    try {
+        truth->score(cv::Mat(), 1.0, 1, s);
+        ADD_FAILURE() << "no error";
+    } catch (const std::runtime_error& e) {
+        EXPECT_NE(std::string(e.what()).find("labels/1.000000.png"), std::string::npos) << e.what();
+    }
+    cv::Mat labels(20, 20, CV_8UC1, cv::Scalar(0));
+    labels(cv::Rect(0, 0, 10, 10)).setTo(1);
+    cv::imwrite((dir / "labels" / "1.000000.png").string(), labels);
+    truth->score(cv::Mat(), 1.0, 1, s);  // empty mask: nothing masked
+    EXPECT_EQ(s.moving_instances, 1u);
+    EXPECT_EQ(s.moving_masked, 0u);
+    EXPECT_THROW(truth->score(cv::Mat(), 2.0, 1, s), std::runtime_error);  // no entry
+    {
+        std::ofstream p(dir / "persons.txt");
+        p << "1.0 1 p walking 0 0 10 10 100\n";  // bad state
+    }
+    EXPECT_THROW((void)eval::PersonTruth::open(dir.string()), std::runtime_error);
+    fs::remove_all(dir);
 }

@@ -2,6 +2,7 @@
 #include <devslam/core/Config.h>
 #include <devslam/slam/KeyframeSelector.h>
 #include <devslam/slam/LocalBundleAdjuster.h>
+#include <devslam/slam/LoopDetector.h>
 #include <devslam/slam/Map.h>
 #include <devslam/slam/MapExporter.h>
 #include <devslam/slam/Matching.h>
@@ -288,6 +289,76 @@ TEST(OrbExtractor, MaskDropsKeypointsAndDepthIsRangeChecked) {
     const auto none = orb.extract(f, mask);
     EXPECT_EQ(none.size(), 0u);
     EXPECT_THROW((void)orb.extract(f, cv::Mat(10, 10, CV_8UC1)), std::invalid_argument);
+}
+
+TEST(OrbExtractor, KeypointsOnOcclusionEdgesGetNoDepth) {
+    // A person-like step in depth (1.5 m in front of a 3 m wall) at column 320: corners on
+    // the edge would take either depth while moving with the front object. Within the 5x5
+    // window of the step they get none; away from it the depth is kept. Holes are ignored.
+    core::Frame f;
+    f.K = fr1NoDist();
+    f.bgr = cv::Mat(480, 640, CV_8UC3);
+    cv::RNG rng(5);
+    rng.fill(f.bgr, cv::RNG::UNIFORM, 0, 255);
+    cv::GaussianBlur(f.bgr, f.bgr, cv::Size(5, 5), 1.0);
+    f.depth = cv::Mat(480, 640, CV_32FC1, cv::Scalar(3.0f));
+    f.depth(cv::Rect(0, 0, 320, 480)).setTo(1.5f);
+    f.depth(cv::Rect(500, 200, 1, 1)).setTo(0.f);  // a single hole
+    const auto feats = OrbExtractor({}).extract(f, cv::Mat());
+    int near_edge = 0, kept = 0;
+    for (std::size_t i = 0; i < feats.size(); ++i) {
+        const int u = cvRound(feats.keypoints[i].pt.x);
+        if (u >= 318 && u <= 321) {
+            EXPECT_EQ(feats.depth[i], 0.f) << "u " << u;
+            ++near_edge;
+        } else if (u < 316 || u > 323) {
+            EXPECT_GT(feats.depth[i], 0.f) << "u " << u;
+            ++kept;
+        }
+    }
+    EXPECT_GT(near_edge, 0);
+    EXPECT_GT(kept, 1000);
+    OrbExtractor::Options off;
+    off.depth_edge_threshold = 0;
+    const auto all = OrbExtractor(off).extract(f, cv::Mat());
+    for (std::size_t i = 0; i < all.size(); ++i) EXPECT_GT(all.depth[i], 0.f);
+}
+
+TEST(LoopDetector, MeasuresFromTheKeyframesAndRejectsImplausibleCorrections) {
+    // Two keyframes of the same textured plane seen from the same place: the loop's
+    // measured relative pose is the identity. It is accepted when the current estimate
+    // agrees, and rejected when the estimate says the cameras are 0.5 m apart (a false
+    // loop on a repeated texture looks exactly like this).
+    core::Frame f;
+    f.K = fr1NoDist();
+    f.bgr = cv::Mat(480, 640, CV_8UC3);
+    cv::RNG rng(9);
+    rng.fill(f.bgr, cv::RNG::UNIFORM, 0, 255);
+    cv::GaussianBlur(f.bgr, f.bgr, cv::Size(5, 5), 1.0);
+    f.depth = cv::Mat(480, 640, CV_32FC1, cv::Scalar(2.0f));
+    const auto feats = OrbExtractor({}).extract(f, cv::Mat());
+    LoopOptions lo;
+    lo.min_keyframe_gap = 1;
+    for (double offset : {0.0, 0.5}) {
+        Map map;
+        Keyframe a;
+        a.features = feats;
+        a.landmark_of_kp.assign(feats.size(), kNoId);
+        const KeyframeId ida = map.addKeyframe(a);
+        Keyframe b = a;
+        b.T_wc.translation() = Eigen::Vector3d(offset, 0, 0);
+        const KeyframeId idb = map.addKeyframe(b);
+        const auto loop = detectLoop(map, idb, f.K, lo);
+        if (offset == 0.0) {
+            ASSERT_TRUE(loop.has_value());
+            EXPECT_EQ(loop->old_kf, ida);
+            EXPECT_LT(loop->T_old_new.translation().norm(), 0.005);
+            EXPECT_GE(loop->n_inliers, lo.min_inliers);
+        } else {
+            EXPECT_FALSE(loop.has_value())
+                << "0.5 m correction > max_correction " << lo.max_correction;
+        }
+    }
 }
 
 TEST(Matching, HammingAndBruteForce) {

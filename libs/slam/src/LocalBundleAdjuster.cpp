@@ -12,10 +12,14 @@
 namespace devslam::slam {
 
 void LocalBaOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, const std::string& s) {
-    core::requireKnownKeys(c, s,
-                           {"enabled", "window", "iterations", "bf", "chi2_mono", "chi2_stereo"});
+    core::requireKnownKeys(
+        c, s,
+        {"enabled", "window", "iterations", "bf", "chi2_mono", "chi2_stereo", "outlier_rounds"});
     enabled = c.read_bool(s, "enabled", enabled);
     window = c.read_int(s, "window", window);
+    outlier_rounds = c.read_int(s, "outlier_rounds", outlier_rounds);
+    core::requireValue(outlier_rounds >= 0 && outlier_rounds <= 5, s, "outlier_rounds",
+                       "must be in [0, 5]");
     iterations = c.read_int(s, "iterations", iterations);
     bf = c.read_double(s, "bf", bf);
     chi2_mono = c.read_double(s, "chi2_mono", chi2_mono);
@@ -28,6 +32,7 @@ void LocalBaOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, cons
 void LocalBaOptions::saveToConfig(mrpt::config::CConfigFileBase& c, const std::string& s) const {
     c.write(s, "enabled", enabled);
     c.write(s, "window", window);
+    c.write(s, "outlier_rounds", outlier_rounds);
     c.write(s, "iterations", iterations);
     c.write(s, "bf", bf);
     c.write(s, "chi2_mono", chi2_mono);
@@ -101,6 +106,10 @@ LocalBaResult localBundleAdjust(Map& map, KeyframeId newest, const core::CameraI
     std::vector<Eigen::Vector3d> X(lm_ids.size());
     for (std::size_t i = 0; i < lm_ids.size(); ++i) X[i] = map.landmark(lm_ids[i])->p_w;
 
+    // Observations taken out after the first round (ORB-SLAM2's two-round local BA: the
+    // Huber kernel bounds an outlier's pull but does not remove it; people at the mask
+    // borders give many such outliers that pull together).
+    std::vector<char> active(obs.size(), 1);
     auto robustCost = [&](const std::vector<Eigen::Isometry3d>& T,
                           const std::vector<Eigen::Vector3d>& Xs) {
         double cost = 0;
@@ -108,7 +117,9 @@ LocalBaResult localBundleAdjust(Map& map, KeyframeId newest, const core::CameraI
         Eigen::Matrix<double, 3, 6> Jp;
         Eigen::Matrix3d Jl;
         int rows;
-        for (const auto& o : obs) {
+        for (std::size_t k = 0; k < obs.size(); ++k) {
+            if (!active[k]) continue;
+            const auto& o = obs[k];
             if (!observationJacobians(T[o.pose], Xs[o.landmark], o.uv, o.depth, K, opts.bf, r, Jp,
                                       Jl, rows)) {
                 cost += 100.0;
@@ -126,91 +137,118 @@ LocalBaResult localBundleAdjust(Map& map, KeyframeId newest, const core::CameraI
     res.initial_cost = cost;
     double lambda = 1e-3;
     using Mat63 = Eigen::Matrix<double, 6, 3>;
-    for (int it = 0; it < opts.iterations; ++it) {
-        Eigen::MatrixXd Hpp = Eigen::MatrixXd::Zero(Eigen::Index{6} * P, Eigen::Index{6} * P);
-        Eigen::VectorXd gp = Eigen::VectorXd::Zero(Eigen::Index{6} * P);
-        std::vector<Eigen::Matrix3d> Hll(L, Eigen::Matrix3d::Zero());
-        std::vector<Eigen::Vector3d> gl(L, Eigen::Vector3d::Zero());
-        std::vector<Mat63> Hpl(obs.size(), Mat63::Zero());
-        Eigen::Vector3d r;
-        Eigen::Matrix<double, 3, 6> Jp;
-        Eigen::Matrix3d Jl;
-        int rows;
-        for (std::size_t k = 0; k < obs.size(); ++k) {
-            const auto& o = obs[k];
-            if (!observationJacobians(T_cw[o.pose], X[o.landmark], o.uv, o.depth, K, opts.bf, r, Jp,
-                                      Jl, rows))
-                continue;
-            const double e2 = r.squaredNorm() * o.inv_sigma2;
-            const double d2 = rows == 3 ? opts.chi2_stereo : opts.chi2_mono;
-            const double w = o.inv_sigma2 * (e2 <= d2 ? 1.0 : std::sqrt(d2 / e2));
-            const auto Jpr = Jp;
-            const auto Jlr = Jl;
-            Hll[o.landmark] += w * Jlr.transpose() * Jlr;
-            gl[o.landmark] += w * Jlr.transpose() * r;
-            if (o.pose < P) {
-                Hpp.block<6, 6>(Eigen::Index{6} * o.pose, Eigen::Index{6} * o.pose) +=
-                    w * Jpr.transpose() * Jpr;
-                gp.segment<6>(Eigen::Index{6} * o.pose) += w * Jpr.transpose() * r;
-                Hpl[k] = w * Jpr.transpose() * Jlr;
-            }
-        }
-        // Schur complement over landmarks, with LM damping on all diagonal blocks.
-        bool accepted = false;
-        for (int attempt = 0; attempt < 5 && !accepted; ++attempt) {
-            Eigen::MatrixXd S = Hpp;
-            S.diagonal() +=
-                lambda * Hpp.diagonal() + Eigen::VectorXd::Constant(Eigen::Index{6} * P, 1e-9);
-            Eigen::VectorXd rhs = -gp;
-            std::vector<Eigen::Matrix3d> Hll_inv(L);
-            for (int l = 0; l < L; ++l) {
-                Eigen::Matrix3d H = Hll[l];
-                H.diagonal() += lambda * Hll[l].diagonal() + Eigen::Vector3d::Constant(1e-9);
-                Hll_inv[l] = H.inverse();
-            }
-            // Group observations of each landmark to form S -= Hpl Hll^-1 Hlp.
-            std::vector<std::vector<int>> obs_of_lm(L);
-            for (std::size_t k = 0; k < obs.size(); ++k)
-                if (obs[k].pose < P) obs_of_lm[obs[k].landmark].push_back(static_cast<int>(k));
-            for (int l = 0; l < L; ++l) {
-                const auto& ks = obs_of_lm[l];
-                for (int a : ks) {
-                    const Mat63 A = Hpl[a] * Hll_inv[l];
-                    rhs.segment<6>(Eigen::Index{6} * obs[a].pose) += A * gl[l];
-                    for (int b : ks)
-                        S.block<6, 6>(Eigen::Index{6} * obs[a].pose,
-                                      Eigen::Index{6} * obs[b].pose) -= A * Hpl[b].transpose();
+    const int rounds = opts.outlier_rounds + 1;
+    for (int round = 0; round < rounds; ++round) {
+        if (round > 0) {
+            Eigen::Vector3d r;
+            Eigen::Matrix<double, 3, 6> Jp;
+            Eigen::Matrix3d Jl;
+            int rows;
+            int dropped = 0;
+            for (std::size_t k = 0; k < obs.size(); ++k) {
+                if (!active[k]) continue;
+                const auto& o = obs[k];
+                const bool ok = observationJacobians(T_cw[o.pose], X[o.landmark], o.uv, o.depth, K,
+                                                     opts.bf, r, Jp, Jl, rows);
+                if (!ok || r.squaredNorm() * o.inv_sigma2 >
+                               (rows == 3 ? opts.chi2_stereo : opts.chi2_mono)) {
+                    active[k] = 0;
+                    ++dropped;
                 }
             }
-            const Eigen::VectorXd dp = S.ldlt().solve(rhs);
-            if (!dp.allFinite()) {
-                lambda *= 10;
-                continue;
-            }
-            std::vector<Eigen::Vector3d> gl_red = gl;
-            for (int l = 0; l < L; ++l)
-                for (int a : obs_of_lm[l])
-                    gl_red[l] += Hpl[a].transpose() * dp.segment<6>(Eigen::Index{6} * obs[a].pose);
-            auto T_new = T_cw;
-            auto X_new = X;
-            for (int p = 0; p < P; ++p)
-                T_new[p] = expTwist(dp.segment<6>(Eigen::Index{6} * p)) * T_cw[p];
-            for (int l = 0; l < L; ++l) X_new[l] = X[l] - Hll_inv[l] * gl_red[l];
-            const double new_cost = robustCost(T_new, X_new);
-            if (new_cost < cost) {
-                T_cw = std::move(T_new);
-                X = std::move(X_new);
-                const double rel = (cost - new_cost) / std::max(cost, 1e-12);
-                cost = new_cost;
-                lambda = std::max(lambda / 10, 1e-7);
-                accepted = true;
-                if (rel < 1e-6) it = opts.iterations;
-            } else {
-                lambda *= 10;
-            }
+            if (dropped == 0) break;
+            cost = robustCost(T_cw, X);
+            lambda = 1e-3;
         }
-        ++res.iterations;
-        if (!accepted) break;
+        for (int it = 0; it < opts.iterations; ++it) {
+            Eigen::MatrixXd Hpp = Eigen::MatrixXd::Zero(Eigen::Index{6} * P, Eigen::Index{6} * P);
+            Eigen::VectorXd gp = Eigen::VectorXd::Zero(Eigen::Index{6} * P);
+            std::vector<Eigen::Matrix3d> Hll(L, Eigen::Matrix3d::Zero());
+            std::vector<Eigen::Vector3d> gl(L, Eigen::Vector3d::Zero());
+            std::vector<Mat63> Hpl(obs.size(), Mat63::Zero());
+            Eigen::Vector3d r;
+            Eigen::Matrix<double, 3, 6> Jp;
+            Eigen::Matrix3d Jl;
+            int rows;
+            for (std::size_t k = 0; k < obs.size(); ++k) {
+                if (!active[k]) continue;
+                const auto& o = obs[k];
+                if (!observationJacobians(T_cw[o.pose], X[o.landmark], o.uv, o.depth, K, opts.bf, r,
+                                          Jp, Jl, rows))
+                    continue;
+                const double e2 = r.squaredNorm() * o.inv_sigma2;
+                const double d2 = rows == 3 ? opts.chi2_stereo : opts.chi2_mono;
+                const double w = o.inv_sigma2 * (e2 <= d2 ? 1.0 : std::sqrt(d2 / e2));
+                const auto Jpr = Jp;
+                const auto Jlr = Jl;
+                Hll[o.landmark] += w * Jlr.transpose() * Jlr;
+                gl[o.landmark] += w * Jlr.transpose() * r;
+                if (o.pose < P) {
+                    Hpp.block<6, 6>(Eigen::Index{6} * o.pose, Eigen::Index{6} * o.pose) +=
+                        w * Jpr.transpose() * Jpr;
+                    gp.segment<6>(Eigen::Index{6} * o.pose) += w * Jpr.transpose() * r;
+                    Hpl[k] = w * Jpr.transpose() * Jlr;
+                }
+            }
+            // Schur complement over landmarks, with LM damping on all diagonal blocks.
+            bool accepted = false;
+            for (int attempt = 0; attempt < 5 && !accepted; ++attempt) {
+                Eigen::MatrixXd S = Hpp;
+                S.diagonal() +=
+                    lambda * Hpp.diagonal() + Eigen::VectorXd::Constant(Eigen::Index{6} * P, 1e-9);
+                Eigen::VectorXd rhs = -gp;
+                std::vector<Eigen::Matrix3d> Hll_inv(L);
+                for (int l = 0; l < L; ++l) {
+                    Eigen::Matrix3d H = Hll[l];
+                    H.diagonal() += lambda * Hll[l].diagonal() + Eigen::Vector3d::Constant(1e-9);
+                    Hll_inv[l] = H.inverse();
+                }
+                // Group observations of each landmark to form S -= Hpl Hll^-1 Hlp.
+                std::vector<std::vector<int>> obs_of_lm(L);
+                for (std::size_t k = 0; k < obs.size(); ++k)
+                    if (active[k] && obs[k].pose < P)
+                        obs_of_lm[obs[k].landmark].push_back(static_cast<int>(k));
+                for (int l = 0; l < L; ++l) {
+                    const auto& ks = obs_of_lm[l];
+                    for (int a : ks) {
+                        const Mat63 A = Hpl[a] * Hll_inv[l];
+                        rhs.segment<6>(Eigen::Index{6} * obs[a].pose) += A * gl[l];
+                        for (int b : ks)
+                            S.block<6, 6>(Eigen::Index{6} * obs[a].pose,
+                                          Eigen::Index{6} * obs[b].pose) -= A * Hpl[b].transpose();
+                    }
+                }
+                const Eigen::VectorXd dp = S.ldlt().solve(rhs);
+                if (!dp.allFinite()) {
+                    lambda *= 10;
+                    continue;
+                }
+                std::vector<Eigen::Vector3d> gl_red = gl;
+                for (int l = 0; l < L; ++l)
+                    for (int a : obs_of_lm[l])
+                        gl_red[l] +=
+                            Hpl[a].transpose() * dp.segment<6>(Eigen::Index{6} * obs[a].pose);
+                auto T_new = T_cw;
+                auto X_new = X;
+                for (int p = 0; p < P; ++p)
+                    T_new[p] = expTwist(dp.segment<6>(Eigen::Index{6} * p)) * T_cw[p];
+                for (int l = 0; l < L; ++l) X_new[l] = X[l] - Hll_inv[l] * gl_red[l];
+                const double new_cost = robustCost(T_new, X_new);
+                if (new_cost < cost) {
+                    T_cw = std::move(T_new);
+                    X = std::move(X_new);
+                    const double rel = (cost - new_cost) / std::max(cost, 1e-12);
+                    cost = new_cost;
+                    lambda = std::max(lambda / 10, 1e-7);
+                    accepted = true;
+                    if (rel < 1e-6) it = opts.iterations;
+                } else {
+                    lambda *= 10;
+                }
+            }
+            ++res.iterations;
+            if (!accepted) break;
+        }
     }
     res.final_cost = cost;
     for (int p = 0; p < P; ++p) map.keyframe(pose_ids[p]).T_wc = T_cw[p].inverse();

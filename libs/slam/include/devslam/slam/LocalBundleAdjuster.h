@@ -21,8 +21,11 @@ namespace devslam::slam {
 
 struct LocalBaOptions {
     bool enabled = true;
-    int window = 5;              ///< keyframes optimised (newest ones)
-    int iterations = 8;          ///< LM iterations
+    int window = 5;      ///< keyframes optimised (newest ones)
+    int iterations = 8;  ///< LM iterations (per round)
+    /// rounds after the first, each without the observations the previous round left
+    /// outside chi2 (ORB-SLAM2 local BA: 1)
+    int outlier_rounds = 1;
     double bf = 40.0;            ///< [px*m] virtual baseline * fx (as the tracker)
     double chi2_mono = 5.991;    ///< outlier test for 2-dof residuals (Huber width too)
     double chi2_stereo = 7.815;  ///< for 3-dof residuals
