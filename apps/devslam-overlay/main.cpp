@@ -32,7 +32,8 @@ namespace {
 const char* kUsage =
     "usage: devslam-overlay --input DIR|FILE.rawlog|synthetic:walking|synthetic:static\n"
     "                       --out DIR [--config INI] [--mode none|all_persons|dynamic]\n"
-    "                       [--every N (write every N-th frame, default 1)] [--frames N]\n"
+    "                       [--every N (write every N-th frame, default 1)] [--frames N (default: "
+    "synthetic 30, files all)]\n"
     "                       [--threads N (OpenCV threads, default 1)] [--no-prior]\n";
 
 cv::Scalar stateColour(dynamic::BoxState s) {
@@ -93,7 +94,7 @@ cv::Mat drawOverlay(const core::Frame& f, const dynamic::FilterOutput& out) {
 int main(int argc, char** argv) {
     std::string input, out_dir, mode;
     std::string config = std::string(DEVSLAM_SOURCE_DIR) + "/config_ini/dynamic_filter.ini";
-    int every = 1, frames = 30, threads = 1;
+    int every = 1, frames = 0, threads = 1;  // frames 0: synthetic 30, real input all
     bool use_prior = true;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
@@ -128,7 +129,7 @@ int main(int argc, char** argv) {
             return 2;
         }
     }
-    if (input.empty() || out_dir.empty() || every < 1 || frames < 1) {
+    if (input.empty() || out_dir.empty() || every < 1 || frames < 0) {
         std::cerr << kUsage;
         return 2;
     }
@@ -144,7 +145,7 @@ int main(int argc, char** argv) {
         std::unique_ptr<io::RgbdReader> reader;
         if (input.rfind("synthetic:", 0) == 0) {
             dynamic::SyntheticOptions so;
-            so.n_frames = frames;
+            so.n_frames = frames > 0 ? frames : 30;
             const std::string kind = input.substr(10);
             if (kind == "walking")
                 so.person = dynamic::PersonMotion::Walking;
@@ -164,7 +165,13 @@ int main(int argc, char** argv) {
         } else {
             reader = io::openRgbd(input, {});
         }
-        core::ProgressBar bar("overlay", synth.empty() ? 0 : synth.size());
+        std::size_t total = synth.size();
+        if (reader) {
+            total = reader->size().value_or(0);
+            if (frames > 0 && (total == 0 || static_cast<std::size_t>(frames) < total))
+                total = static_cast<std::size_t>(frames);
+        }
+        core::ProgressBar bar("overlay", total);
         std::size_t k = 0, written = 0;
         while (true) {
             std::optional<core::Frame> f;
@@ -174,6 +181,7 @@ int main(int argc, char** argv) {
                 f = synth[k].frame;
                 if (use_prior) prior = synth[k].T_prev_cur;
             } else {
+                if (frames > 0 && k >= static_cast<std::size_t>(frames)) break;
                 f = reader->next();
                 if (!f) break;
             }

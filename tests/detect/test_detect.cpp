@@ -107,6 +107,32 @@ TEST(DetectYolo, Yolov4TinyCfgParsesIntoANetwork) {
     }
 }
 
+TEST(DetectYolo, OnnxOutputIsDecoded) {
+    // tests/detect/data/constant_yolo.onnx (written by make_constant_yolo_onnx.py next to
+    // it) outputs four fixed YOLOv5-style rows in input pixels whatever the image: a person
+    // (objectness 0.9 x class 0.8), an overlapping weaker person (NMS), a dog (not a wanted
+    // class) and a person whose objectness passes but whose product 0.27 does not.
+    detect::YoloDetector::Options o;
+    o.model = kRoot + "/tests/detect/data/constant_yolo.onnx";
+    o.weights = "";
+    detect::YoloDetector det(o);
+    const auto dets = det.detect(cv::Mat(480, 640, CV_8UC3, cv::Scalar(30, 60, 90)));
+    ASSERT_EQ(dets.size(), 1u);
+    EXPECT_EQ(dets[0].class_name, "person");
+    EXPECT_NEAR(dets[0].score, 0.72f, 1e-5);
+    // (cx, cy, w, h) = (160, 160, 64, 192) of a 320x320 input, stretched to 640x480
+    EXPECT_NEAR(dets[0].box.x, 256.f, 1e-3);
+    EXPECT_NEAR(dets[0].box.y, 96.f, 1e-3);
+    EXPECT_NEAR(dets[0].box.width, 128.f, 1e-3);
+    EXPECT_NEAR(dets[0].box.height, 288.f, 1e-3);
+    o.classes = {"person", "dog"};  // now the dog is reported too
+    detect::YoloDetector both(o);
+    const auto d2 = both.detect(cv::Mat(480, 640, CV_8UC3, cv::Scalar(0, 0, 0)));
+    ASSERT_EQ(d2.size(), 2u);
+    EXPECT_EQ(d2[0].class_name, "dog");  // highest score first (0.95 x 0.9)
+    EXPECT_NEAR(d2[0].box.x, (80.f - 20.f) * 2.f, 1e-3);
+}
+
 TEST(DetectYolo, MissingWeightsGiveAClearError) {
     detect::YoloDetector::Options o;
     o.weights = "/nonexistent/dir/model.weights";

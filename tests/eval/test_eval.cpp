@@ -266,11 +266,13 @@ TEST(MaskScore, PersonTruthOfAFolder) {
     const fs::path dir = fs::temp_directory_path() / "devslam_test_person_truth";
     fs::remove_all(dir);
     EXPECT_FALSE(eval::PersonTruth::open(dir.string()).has_value());  // no folder: real data
-    fs::create_directories(dir / "labels");
+    fs::create_directories(dir);
     {
         std::ofstream p(dir / "persons.txt");
         p << "# t id name state x y w h visible\n1.000000 1 p moving 0 0 10 10 100\n";
     }
+    EXPECT_FALSE(eval::PersonTruth::open(dir.string()).has_value());  // no labels/ (--no-labels)
+    fs::create_directories(dir / "labels");
     const auto truth = eval::PersonTruth::open(dir.string());
     ASSERT_TRUE(truth.has_value());
     eval::MaskScore s;

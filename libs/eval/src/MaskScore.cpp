@@ -76,7 +76,10 @@ double MaskScore::precision() const {
 std::optional<PersonTruth> PersonTruth::open(const std::string& folder) {
     namespace fs = std::filesystem;
     const fs::path p = fs::path(folder) / "persons.txt";
-    if (!fs::is_directory(folder) || !fs::exists(p)) return std::nullopt;
+    // Both parts of the truth are needed (devslam-synth --no-labels writes persons.txt only).
+    if (!fs::is_directory(folder) || !fs::exists(p) ||
+        !fs::is_directory(fs::path(folder) / "labels"))
+        return std::nullopt;
     PersonTruth t;
     t.folder_ = folder;
     t.persons_ = readPersons(p.string());

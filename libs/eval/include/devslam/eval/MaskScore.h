@@ -55,7 +55,8 @@ struct MaskScore {
 /// the masks of a run frame by frame.
 class PersonTruth {
   public:
-    /// nullopt when `folder` has no persons.txt (real data); throws on a malformed one.
+    /// nullopt when `folder` lacks persons.txt or labels/ (real data, or rendered with
+    /// --no-labels); throws on a malformed persons.txt.
     [[nodiscard]] static std::optional<PersonTruth> open(const std::string& folder);
     /// Adds the frame at `timestamp` to `score`. Throws naming the file when the frame has
     /// no truth (a missing label image or persons.txt entry).
