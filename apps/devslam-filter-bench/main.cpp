@@ -53,6 +53,25 @@ class TruthDetector : public detect::PersonDetector {
     std::string name() const override { return "truth"; }
 };
 
+/// Per-frame wall and thread-CPU times [ms] of `det` over `frames`, after three warm-up runs.
+struct DetectorTimes {
+    std::vector<double> ms, cpu;
+};
+DetectorTimes timeDetector(detect::PersonDetector& det, const std::vector<core::Frame>& frames,
+                           core::ProgressBar* bar = nullptr) {
+    for (int w = 0; w < 3; ++w) (void)det.detect(frames.front().bgr);  // warm-up
+    DetectorTimes t;
+    for (const auto& f : frames) {
+        const auto t0 = std::chrono::steady_clock::now();
+        const double c0 = threadCpuMs();
+        (void)det.detect(f.bgr);
+        t.cpu.push_back(threadCpuMs() - c0);
+        t.ms.push_back(msSince(t0));
+        if (bar) bar->update(t.ms.size());
+    }
+    return t;
+}
+
 struct TradeOff {
     int frames = 0, walking_moving = 0, static_ok = 0, none_flagged = 0;
     double iou_sum = 0;
@@ -103,40 +122,39 @@ int main(int argc, char** argv) {
              {"detector_yolo_fastest.ini", "detector_yolo_fastest_small.ini", "detector_hog.ini"}) {
             auto cfg = core::loadIni(kRoot + "/config_ini/" + ini);
             auto det = detect::makeDetector(*cfg);
-            for (int w = 0; w < 3; ++w) (void)det->detect(tum[0].bgr);  // warm-up
-            std::vector<double> ms, cpu;
             core::ProgressBar bar("detector " + det->name(), tum.size());
-            for (const auto& f : tum) {
-                const auto t0 = std::chrono::steady_clock::now();
-                const double c0 = threadCpuMs();
-                (void)det->detect(f.bgr);
-                cpu.push_back(threadCpuMs() - c0);
-                ms.push_back(msSince(t0));
-                bar.update(ms.size());
-            }
+            const auto t = timeDetector(*det, tum, &bar);
             bar.finish();
-            const auto s = core::summarize(ms);
+            const auto s = core::summarize(t.ms);
             md << "| " << det->name() << " | " << ini << " | " << fmt(s.median) << " | "
-               << fmt(s.mean) << " | " << fmt(core::median(cpu)) << " | " << ms.size() << " |\n";
+               << fmt(s.mean) << " | " << fmt(core::median(t.cpu)) << " | " << t.ms.size()
+               << " |\n";
         }
 
-        // 1b. The default model at smaller network inputs: speed against accuracy (the hand
-        //     box of person.jpg, no person in dog.jpg, the person of the synthetic frames).
-        const cv::Mat person_jpg = cv::imread(kRoot + "/data/images/person.jpg");
-        const cv::Mat dog_jpg = cv::imread(kRoot + "/data/images/dog.jpg");
-        const cv::Rect2f person_box(190.f, 98.f, 85.f, 277.f);  // as tests/detect
-        const cv::Mat wall0 =
+        // The synthetic sequences (TUM wall, pasted person.jpg) of sections 1b, 2 and 3.
+        const cv::Mat wall =
             cv::imread(kRoot + "/data/tum/fr1_xyz_first37/rgb/1305031102.175304.png");
-        const cv::Mat person_crop = person_jpg(cv::Rect(180, 90, 105, 295)).clone();
-        std::vector<dynamic::SyntheticFrame> sweep_frames;
-        for (auto m : {dynamic::PersonMotion::Walking, dynamic::PersonMotion::Static}) {
+        const cv::Mat person_jpg = cv::imread(kRoot + "/data/images/person.jpg");
+        const cv::Mat person = person_jpg(cv::Rect(180, 90, 105, 295)).clone();
+        auto render = [&](dynamic::PersonMotion m) {
             dynamic::SyntheticOptions so;
             so.n_frames = n_frames;
             so.person = m;
             if (m == dynamic::PersonMotion::Static) so.person_x0 = 0.3;
-            for (auto& f : dynamic::makeSyntheticSequence(so, wall0, person_crop))
-                if (f.person_box) sweep_frames.push_back(f);
-        }
+            return dynamic::makeSyntheticSequence(so, wall, person);
+        };
+        const auto walking = render(dynamic::PersonMotion::Walking);
+        const auto standing = render(dynamic::PersonMotion::Static);
+        const auto empty = render(dynamic::PersonMotion::None);
+
+        // 1b. The default model at smaller network inputs: speed against accuracy (the hand
+        //     box of person.jpg, no person in dog.jpg, the person of the synthetic frames).
+        const cv::Mat dog_jpg = cv::imread(kRoot + "/data/images/dog.jpg");
+        const cv::Rect2f person_box(190.f, 98.f, 85.f, 277.f);  // as tests/detect
+        std::vector<const dynamic::SyntheticFrame*> sweep_frames;
+        for (const auto* seq : {&walking, &standing})
+            for (const auto& f : *seq)
+                if (f.person_box) sweep_frames.push_back(&f);
         md << "\n**Default model (Yolo-Fastest-XL) at smaller network inputs** (the 640x480 frame "
               "is stretched to the input; same frames as above; person.jpg IoU against the "
               "hand-measured box of tests/detect; synthetic: the pasted person found with IoU "
@@ -151,31 +169,23 @@ int main(int argc, char** argv) {
             dcfg->write("detector", "input_width", w);
             dcfg->write("detector", "input_height", h);
             auto det = detect::makeDetector(*dcfg);
-            for (int k = 0; k < 3; ++k) (void)det->detect(tum[0].bgr);
-            std::vector<double> ms, cpu;
-            for (const auto& f : tum) {
-                const auto t0 = std::chrono::steady_clock::now();
-                const double c0 = threadCpuMs();
-                (void)det->detect(f.bgr);
-                cpu.push_back(threadCpuMs() - c0);
-                ms.push_back(msSince(t0));
-            }
+            const auto t = timeDetector(*det, tum);
             double best = 0;
             for (const auto& d : det->detect(person_jpg))
                 best = std::max(best, static_cast<double>(detect::iou(d.box, person_box)));
             const auto dog = det->detect(dog_jpg).size();
             int found = 0;
             double iou_sum = 0;
-            for (const auto& f : sweep_frames) {
+            for (const auto* f : sweep_frames) {
                 double b = 0;
-                for (const auto& d : det->detect(f.frame.bgr))
-                    b = std::max(b, static_cast<double>(detect::iou(d.box, *f.person_box)));
+                for (const auto& d : det->detect(f->frame.bgr))
+                    b = std::max(b, static_cast<double>(detect::iou(d.box, *f->person_box)));
                 found += b >= 0.5;
                 iou_sum += b;
             }
-            md << "| " << w << " x " << h << " | " << fmt(core::median(ms)) << " | "
-               << fmt(core::median(cpu)) << " | " << fmt(best, 2) << " | " << dog << " | " << found
-               << "/" << sweep_frames.size() << " | "
+            md << "| " << w << " x " << h << " | " << fmt(core::median(t.ms)) << " | "
+               << fmt(core::median(t.cpu)) << " | " << fmt(best, 2) << " | " << dog << " | "
+               << found << "/" << sweep_frames.size() << " | "
                << fmt(sweep_frames.empty() ? 0.0 : iou_sum / sweep_frames.size(), 2) << " |\n";
         }
 
@@ -183,20 +193,6 @@ int main(int argc, char** argv) {
         auto cfg = core::loadIni(filter_ini);
         dynamic::DynamicObjectFilter::Options fo;
         fo.loadFromConfig(*cfg);
-        const cv::Mat wall =
-            cv::imread(kRoot + "/data/tum/fr1_xyz_first37/rgb/1305031102.175304.png");
-        const cv::Mat person =
-            cv::imread(kRoot + "/data/images/person.jpg")(cv::Rect(180, 90, 105, 295)).clone();
-        auto render = [&](dynamic::PersonMotion m) {
-            dynamic::SyntheticOptions so;
-            so.n_frames = n_frames;
-            so.person = m;
-            if (m == dynamic::PersonMotion::Static) so.person_x0 = 0.3;
-            return dynamic::makeSyntheticSequence(so, wall, person);
-        };
-        const auto walking = render(dynamic::PersonMotion::Walking);
-        const auto standing = render(dynamic::PersonMotion::Static);
-        const auto empty = render(dynamic::PersonMotion::None);
 
         md << "\n| filter stage (detector excluded) | sequence | median ms | mean ms | median "
               "thread-CPU ms | frames |\n|---|---|---|---|---|---|\n";

@@ -16,6 +16,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <random>
 
@@ -42,6 +43,19 @@ core::CameraIntrinsics fr1NoDist() {
     auto K = core::CameraIntrinsics::fromPreset("freiburg1");
     K.dist = {0, 0, 0, 0, 0};
     return K;
+}
+
+/// A 640x480 frame of blurred noise (ORB finds well over 1000 corners) on a plane at
+/// `depth` [m], fr1 intrinsics without distortion.
+core::Frame noisePlaneFrame(std::uint64_t seed, float depth) {
+    core::Frame f;
+    f.K = fr1NoDist();
+    f.bgr = cv::Mat(480, 640, CV_8UC3);
+    cv::RNG rng(seed);
+    rng.fill(f.bgr, cv::RNG::UNIFORM, 0, 255);
+    cv::GaussianBlur(f.bgr, f.bgr, cv::Size(5, 5), 1.0);
+    f.depth = cv::Mat(480, 640, CV_32FC1, cv::Scalar(depth));
+    return f;
 }
 
 /// World points in front of the camera pose T_wc, with their exact observations.
@@ -253,13 +267,7 @@ TEST(OrbExtractor, GridSpreadingKeepsEveryCell) {
 }
 
 TEST(OrbExtractor, MaskDropsKeypointsAndDepthIsRangeChecked) {
-    core::Frame f;
-    f.K = fr1NoDist();
-    f.bgr = cv::Mat(480, 640, CV_8UC3);
-    cv::RNG rng(3);
-    rng.fill(f.bgr, cv::RNG::UNIFORM, 0, 255);
-    cv::GaussianBlur(f.bgr, f.bgr, cv::Size(5, 5), 1.0);
-    f.depth = cv::Mat(480, 640, CV_32FC1, cv::Scalar(2.0f));
+    core::Frame f = noisePlaneFrame(3, 2.0f);
     f.depth(cv::Rect(0, 0, 640, 100)).setTo(9.0f);  // beyond max_depth 6 m
     OrbExtractor orb({});
     const auto all = orb.extract(f, cv::Mat());
@@ -295,13 +303,7 @@ TEST(OrbExtractor, KeypointsOnOcclusionEdgesGetNoDepth) {
     // A person-like step in depth (1.5 m in front of a 3 m wall) at column 320: corners on
     // the edge would take either depth while moving with the front object. Within the 5x5
     // window of the step they get none; away from it the depth is kept. Holes are ignored.
-    core::Frame f;
-    f.K = fr1NoDist();
-    f.bgr = cv::Mat(480, 640, CV_8UC3);
-    cv::RNG rng(5);
-    rng.fill(f.bgr, cv::RNG::UNIFORM, 0, 255);
-    cv::GaussianBlur(f.bgr, f.bgr, cv::Size(5, 5), 1.0);
-    f.depth = cv::Mat(480, 640, CV_32FC1, cv::Scalar(3.0f));
+    core::Frame f = noisePlaneFrame(5, 3.0f);
     f.depth(cv::Rect(0, 0, 320, 480)).setTo(1.5f);
     f.depth(cv::Rect(500, 200, 1, 1)).setTo(0.f);  // a single hole
     const auto feats = OrbExtractor({}).extract(f, cv::Mat());
@@ -329,13 +331,7 @@ TEST(LoopDetector, MeasuresFromTheKeyframesAndRejectsImplausibleCorrections) {
     // measured relative pose is the identity. It is accepted when the current estimate
     // agrees, and rejected when the estimate says the cameras are 0.5 m apart (a false
     // loop on a repeated texture looks exactly like this).
-    core::Frame f;
-    f.K = fr1NoDist();
-    f.bgr = cv::Mat(480, 640, CV_8UC3);
-    cv::RNG rng(9);
-    rng.fill(f.bgr, cv::RNG::UNIFORM, 0, 255);
-    cv::GaussianBlur(f.bgr, f.bgr, cv::Size(5, 5), 1.0);
-    f.depth = cv::Mat(480, 640, CV_32FC1, cv::Scalar(2.0f));
+    const core::Frame f = noisePlaneFrame(9, 2.0f);
     const auto feats = OrbExtractor({}).extract(f, cv::Mat());
     LoopOptions lo;
     lo.min_keyframe_gap = 1;

@@ -132,6 +132,18 @@ LocalBaResult localBundleAdjust(Map& map, KeyframeId newest, const core::CameraI
         return cost;
     };
 
+    // Outside chi2 (or behind the camera) at the current estimate.
+    auto isOutlier = [&](const Obs& o) {
+        Eigen::Vector3d r;
+        Eigen::Matrix<double, 3, 6> Jp;
+        Eigen::Matrix3d Jl;
+        int rows;
+        if (!observationJacobians(T_cw[o.pose], X[o.landmark], o.uv, o.depth, K, opts.bf, r, Jp, Jl,
+                                  rows))
+            return true;
+        return r.squaredNorm() * o.inv_sigma2 > (rows == 3 ? opts.chi2_stereo : opts.chi2_mono);
+    };
+
     const int L = static_cast<int>(lm_ids.size());
     double cost = robustCost(T_cw, X);
     res.initial_cost = cost;
@@ -140,18 +152,9 @@ LocalBaResult localBundleAdjust(Map& map, KeyframeId newest, const core::CameraI
     const int rounds = opts.outlier_rounds + 1;
     for (int round = 0; round < rounds; ++round) {
         if (round > 0) {
-            Eigen::Vector3d r;
-            Eigen::Matrix<double, 3, 6> Jp;
-            Eigen::Matrix3d Jl;
-            int rows;
             int dropped = 0;
             for (std::size_t k = 0; k < obs.size(); ++k) {
-                if (!active[k]) continue;
-                const auto& o = obs[k];
-                const bool ok = observationJacobians(T_cw[o.pose], X[o.landmark], o.uv, o.depth, K,
-                                                     opts.bf, r, Jp, Jl, rows);
-                if (!ok || r.squaredNorm() * o.inv_sigma2 >
-                               (rows == 3 ? opts.chi2_stereo : opts.chi2_mono)) {
+                if (active[k] && isOutlier(obs[k])) {
                     active[k] = 0;
                     ++dropped;
                 }
@@ -255,16 +258,8 @@ LocalBaResult localBundleAdjust(Map& map, KeyframeId newest, const core::CameraI
     for (int l = 0; l < L; ++l) map.landmark(lm_ids[l])->p_w = X[l];
 
     // Drop observations that are still outliers; landmarks left without any go too.
-    Eigen::Vector3d r;
-    Eigen::Matrix<double, 3, 6> Jp;
-    Eigen::Matrix3d Jl;
-    int rows;
     for (const auto& o : obs) {
-        bool bad = !observationJacobians(T_cw[o.pose], X[o.landmark], o.uv, o.depth, K, opts.bf, r,
-                                         Jp, Jl, rows);
-        if (!bad)
-            bad = r.squaredNorm() * o.inv_sigma2 > (rows == 3 ? opts.chi2_stereo : opts.chi2_mono);
-        if (!bad) continue;
+        if (!isOutlier(o)) continue;
         map.removeObservation(lm_ids[o.landmark], o.kf, o.kp);
         ++res.n_outliers_removed;
     }
