@@ -33,7 +33,10 @@ class FilterMask final : public MaskSource {
         s.filter_ms = out.filter_ms;
         s.detector_ran = out.detector_ran;
         s.n_boxes = static_cast<int>(out.boxes.size());
-        for (const auto& b : out.boxes) s.n_moving += b.state == dynamic::BoxState::Moving ? 1 : 0;
+        for (const auto& b : out.boxes) {
+            s.n_moving += b.state == dynamic::BoxState::Moving ? 1 : 0;
+            s.boxes.push_back({b.box, dynamic::toString(b.state)});
+        }
         s.T_prev_cur_refined = out.T_prev_cur_refined;
         return s;
     }

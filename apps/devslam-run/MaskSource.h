@@ -3,6 +3,7 @@
 /// devslam::dynamic (DEVSLAM_HAVE_DYNAMIC), otherwise an empty mask (MaskMode::None
 /// behaviour) and an error for the other modes.
 #include <devslam/core/Frame.h>
+#include <devslam/eval/MaskScore.h>
 
 #include <mrpt/config/CConfigFileBase.h>
 #include <Eigen/Geometry>
@@ -11,6 +12,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace devslam::run {
 
@@ -19,6 +21,7 @@ struct MaskStep {
     double detect_ms = 0, filter_ms = 0;
     bool detector_ran = false;
     int n_boxes = 0, n_moving = 0;
+    std::vector<eval::FilterBox> boxes;  ///< tracked boxes and their states
     std::optional<Eigen::Isometry3d> T_prev_cur_refined;
 };
 

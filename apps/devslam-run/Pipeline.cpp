@@ -128,7 +128,7 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
         if (truth) {  // not part of the pipeline time either
             const auto t_score = Clock::now();
             const double cpu_score = processCpuMs();
-            truth->score(ms.mask, cur->timestamp, rc.min_person_pixels, *rep.mask_score);
+            truth->score(ms.mask, cur->timestamp, rc.min_person_pixels, *rep.mask_score, ms.boxes);
             fl.read_ms += msSince(t_score);
             fl.read_cpu_ms += processCpuMs() - cpu_score;
         }
@@ -278,14 +278,19 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
         if (rep.mask_score) {
             std::ofstream mf(out("mask_errors.csv"));
             mf << "# person instances the masks got wrong (renderer truth): walkers not masked, "
-                  "static people masked\ntimestamp,frame,person_id,truth,visible_px,"
-                  "masked_fraction\n";
+                  "static people masked. filter_box: state of the filter box covering most of "
+                  "the person (none: no box covers "
+               << num(100 * eval::MaskScore::min_box_cover, 0)
+               << " % of them, the detector missed them)\ntimestamp,frame,person_id,truth,"
+                  "visible_px,masked_fraction,filter_box,box_cover\n";
+            // The errors are in frame order: one running index finds each one's frame.
+            std::size_t frame = 0;
             for (const auto& e : rep.mask_score->errors) {
-                std::size_t frame = 0;
                 while (frame + 1 < rep.log.size() && rep.log[frame].t < e.timestamp - 1e-6) ++frame;
                 mf << num(e.timestamp, 6) << "," << frame << "," << e.person_id << ","
                    << (e.moving ? "moving" : "static") << "," << e.visible_pixels << ","
-                   << num(e.masked_fraction, 3) << "\n";
+                   << num(e.masked_fraction, 3) << "," << e.filter_box << ","
+                   << num(e.box_cover, 2) << "\n";
             }
         }
         rep.peak_rss_mb = peakRssMb();
@@ -356,6 +361,12 @@ std::string formatSummary(const RunReport& r) {
           << num(100.0 * m.staticMasked(), 1) << " % of " << m.static_instances << "; "
           << num(100.0 * m.precision(), 1)
           << " % of the masked area is on walking people (renderer truth)\n";
+        const std::size_t missed = m.moving_instances - m.moving_masked;
+        if (missed > 0)
+            o << "             of the " << missed << " walker-frames not masked, "
+              << m.movingMissedWithoutBox()
+              << " had no filter box (detector miss), the rest a box judged not moving "
+                 "(mask_errors.csv)\n";
     }
     if (!r.outputs.empty()) {
         o << "outputs    :";
@@ -398,7 +409,8 @@ std::string toJson(const RunReport& r) {
           << ", \"precision\": " << num(m.precision())
           << ", \"static_masked\": " << num(m.staticMasked())
           << ", \"moving_instances\": " << m.moving_instances
-          << ", \"static_instances\": " << m.static_instances << "}";
+          << ", \"static_instances\": " << m.static_instances
+          << ", \"moving_missed_without_box\": " << m.movingMissedWithoutBox() << "}";
     }
     if (r.rpe_1s)
         o << ",\n  \"rpe_1s\": {\"trans\": " << summaryJson(r.rpe_1s->trans)

@@ -413,3 +413,53 @@ TEST(DynamicFilter, UnknownBoxesAreMaskedUntilThereIsEvidence) {
         }
     }
 }
+
+TEST(DynamicFilter, DepthBandFindsAWalkerInABoxOfBackground) {
+    // The detector's box is three times wider than the walking person: most of its corners
+    // lie on the static wall behind. Counting only points in the person's depth band
+    // (fg_depth_band) keeps the walker Moving; a silhouette mask covers the person but
+    // leaves most of the wall in the box unmasked.
+    dynamic::SyntheticOptions so;
+    so.person = dynamic::PersonMotion::Walking;
+    so.n_frames = kFrames;
+    const auto& seq = sequence(so);
+    auto run = [&](double band, bool silhouette, double* person_cover, double* box_masked) {
+        auto fo = testOptions();
+        fo.fg_depth_band = band;
+        fo.mask_silhouette = silhouette;
+        auto det = std::make_unique<ScriptedDetector>();
+        ScriptedDetector* script = det.get();
+        DynamicObjectFilter filter(fo, std::move(det));
+        int moving = 0, frames = 0;
+        double cover = 0, masked = 0;
+        for (const auto& s : seq) {
+            script->next.clear();
+            if (!s.person_box) continue;
+            const cv::Rect2f p = *s.person_box;
+            const cv::Rect2f wide =
+                cv::Rect2f(p.x - p.width, p.y, 3 * p.width, p.height) & cv::Rect2f(0, 0, 640, 480);
+            script->next.push_back({wide, 0, "person", 0.9f});
+            const auto out = filter.step(s.frame, s.T_prev_cur);
+            if (s.frame.index == 0) continue;
+            ++frames;
+            for (const auto& b : out.boxes) moving += b.state == BoxState::Moving ? 1 : 0;
+            const cv::Rect pr = cv::Rect(p) & cv::Rect(0, 0, 640, 480);
+            const cv::Rect wr = cv::Rect(wide) & cv::Rect(0, 0, 640, 480);
+            cover += cv::countNonZero(out.mask(pr)) / static_cast<double>(pr.area());
+            masked += cv::countNonZero(out.mask(wr)) / static_cast<double>(wr.area());
+        }
+        *person_cover = cover / frames;
+        *box_masked = masked / frames;
+        std::printf("box 3x wide, fg_depth_band %.1f, silhouette %d: moving in %d/%d frames, "
+                    "person covered %.2f, box masked %.2f\n",
+                    band, silhouette, moving, frames, *person_cover, *box_masked);
+        return std::pair(moving, frames);
+    };
+    double cover = 0, masked = 0;
+    const auto [moving_all, frames] = run(0.0, false, &cover, &masked);
+    const auto [moving_band, frames2] = run(0.4, true, &cover, &masked);
+    EXPECT_GE(moving_band, frames2 - 1);
+    EXPECT_GT(moving_band, moving_all) << "the background in the box outvotes the walker";
+    EXPECT_GT(cover, 0.95) << "the silhouette covers the person";
+    EXPECT_LT(masked, 0.6) << "and leaves the wall in the box";
+}

@@ -259,6 +259,20 @@ TEST(MaskScore, CountsWalkersStaticPeopleAndArea) {
     EXPECT_EQ(s.errors[0].person_id, 1);
     EXPECT_DOUBLE_EQ(s.errors[0].timestamp, 2.5);
     EXPECT_NEAR(s.errors[0].masked_fraction, 0.4, 1e-12);
+    EXPECT_EQ(s.errors[0].filter_box, "none") << "no boxes given: a detector miss";
+    EXPECT_EQ(s.movingMissedWithoutBox(), 1u);
+    // With the filter's boxes, the error names the state of the box covering the person
+    // most (a box covering under 30 % of them is not theirs).
+    const std::vector<eval::FilterBox> boxes{{{0.f, 0.f, 20.f, 100.f}, "moving"},
+                                             {{0.f, 0.f, 100.f, 80.f}, "static"}};
+    s.add(mask, labels, persons, 500, 3.5, boxes);
+    ASSERT_EQ(s.errors.size(), 2u);
+    EXPECT_EQ(s.errors[1].filter_box, "static");
+    EXPECT_NEAR(s.errors[1].box_cover, 0.8, 1e-12);
+    EXPECT_EQ(s.movingMissedWithoutBox(), 1u);
+    s.add(mask, labels, persons, 500, 4.5, {{{0.f, 0.f, 25.f, 100.f}, "moving"}});
+    ASSERT_EQ(s.errors.size(), 3u);
+    EXPECT_EQ(s.errors[2].filter_box, "none") << "25 % cover is below min_box_cover";
 }
 
 TEST(MaskScore, PersonTruthOfAFolder) {

@@ -47,7 +47,9 @@ const std::vector<std::string> kKeys{"mode",
                                      "background_factor",
                                      "flow_scale",
                                      "mask_unknown",
-                                     "mask_border_snap"};
+                                     "mask_border_snap",
+                                     "fg_depth_band",
+                                     "mask_silhouette"};
 
 cv::Rect2f shrink(const cv::Rect2f& b, double f) {
     const auto dx = static_cast<float>(f * b.width), dy = static_cast<float>(f * b.height);
@@ -73,6 +75,31 @@ std::optional<float> stableDepth(const cv::Mat& depth, const cv::Point2f& p, dou
     if (z > max_depth || hi - lo > 0.05f * z) return std::nullopt;
     return z;
 }
+
+/// The person's depth in a box: median valid depth of its torso region (30-70 % of the
+/// width, 15-55 % of the height), where a detected person box is nearly always on the
+/// person even when the rest of the box shows background or a desk in front of the legs.
+std::optional<float> personDepth(const cv::Mat& depth, const cv::Rect2f& box, double max_depth) {
+    const cv::Rect torso =
+        cv::Rect(cv::Rect2f(box.x + 0.3f * box.width, box.y + 0.15f * box.height,
+                            0.4f * box.width, 0.4f * box.height)) &
+        cv::Rect(0, 0, depth.cols, depth.rows);
+    if (torso.width < 2 || torso.height < 2) return std::nullopt;
+    std::vector<float> z;
+    z.reserve(static_cast<std::size_t>(torso.area() / 4 + 1));
+    for (int v = torso.y; v < torso.br().y; v += 2) {
+        const float* row = depth.ptr<float>(v);
+        for (int u = torso.x; u < torso.br().x; u += 2)
+            if (row[u] > 0.f && row[u] <= max_depth) z.push_back(row[u]);
+    }
+    if (z.size() < 8) return std::nullopt;
+    const auto mid = z.begin() + static_cast<std::ptrdiff_t>(z.size() / 2);
+    std::nth_element(z.begin(), mid, z.end());
+    return *mid;
+}
+
+/// Half-width [m] of the depth band around a person's depth z that belongs to them.
+float depthBand(double band, float z) { return static_cast<float>(band) + 0.1f * z; }
 
 }  // namespace
 
@@ -137,6 +164,8 @@ void DynamicObjectFilter::Options::loadFromConfig(const mrpt::config::CConfigFil
     threshold2_fraction = c.read_double(s, "threshold2_fraction", threshold2_fraction);
     min_points = c.read_int(s, "min_points", min_points);
     box_shrink = c.read_double(s, "box_shrink", box_shrink);
+    fg_depth_band = c.read_double(s, "fg_depth_band", fg_depth_band);
+    mask_silhouette = c.read_bool(s, "mask_silhouette", mask_silhouette);
     iou_match = c.read_double(s, "iou_match", iou_match);
     release_frames = c.read_int(s, "release_frames", release_frames);
     max_missed_detections = c.read_int(s, "max_missed_detections", max_missed_detections);
@@ -165,6 +194,7 @@ void DynamicObjectFilter::Options::loadFromConfig(const mrpt::config::CConfigFil
                        "threshold2_fraction", "must be in [0, 1]");
     core::requireValue(min_points >= 1, s, "min_points", "must be >= 1");
     core::requireValue(box_shrink >= 0 && box_shrink < 0.5, s, "box_shrink", "must be in [0, 0.5)");
+    core::requireValue(fg_depth_band >= 0, s, "fg_depth_band", "must be >= 0 (0 = off)");
     core::requireValue(iou_match > 0 && iou_match <= 1, s, "iou_match", "must be in (0, 1]");
     core::requireValue(release_frames >= 1, s, "release_frames", "must be >= 1");
     core::requireValue(max_missed_detections >= 0, s, "max_missed_detections", "must be >= 0");
@@ -193,6 +223,8 @@ void DynamicObjectFilter::Options::saveToConfig(mrpt::config::CConfigFileBase& c
     c.write(s, "threshold2_fraction", threshold2_fraction);
     c.write(s, "min_points", min_points);
     c.write(s, "box_shrink", box_shrink);
+    c.write(s, "fg_depth_band", fg_depth_band);
+    c.write(s, "mask_silhouette", mask_silhouette);
     c.write(s, "iou_match", iou_match);
     c.write(s, "release_frames", release_frames);
     c.write(s, "max_missed_detections", max_missed_detections);
@@ -270,9 +302,24 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
                                         static_cast<float>(b.height * sc))) &
                     cv::Rect(0, 0, work.cols, work.rows);
                 if (roi.width < 8 || roi.height < 8) continue;
+                cv::Mat fg;  // the person's depth band in the ROI (empty: whole ROI)
+                if (opts_.fg_depth_band > 0) {
+                    if (const auto zp = personDepth(im.prev_depth, t.tb.box, opts_.max_depth)) {
+                        const float h = depthBand(opts_.fg_depth_band, *zp);
+                        const cv::Rect full =
+                            cv::Rect(cv::Rect2f(static_cast<float>(roi.x / sc),
+                                                static_cast<float>(roi.y / sc),
+                                                static_cast<float>(roi.width / sc),
+                                                static_cast<float>(roi.height / sc))) &
+                            cv::Rect(0, 0, im.prev_depth.cols, im.prev_depth.rows);
+                        cv::Mat band;
+                        cv::inRange(im.prev_depth(full), *zp - h, *zp + h, band);
+                        cv::resize(band, fg, roi.size(), 0, 0, cv::INTER_NEAREST);
+                    }
+                }
                 std::vector<cv::Point2f> pts;
                 cv::goodFeaturesToTrack(im.prev_work(roi), pts, opts_.max_corners_per_box,
-                                        opts_.corner_quality, opts_.corner_min_distance * 0.5);
+                                        opts_.corner_quality, opts_.corner_min_distance * 0.5, fg);
                 for (auto& p : pts) p0.emplace_back(p.x + roi.x, p.y + roi.y);
             }
         }
@@ -369,6 +416,7 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
                                    [](const Impl::Track& t) { return t.tb.box.area() < 16.f; }),
                     im.tracks.end());
 
+    std::vector<std::optional<Eigen::Vector3d>> X;  // 3D of each point in the previous frame
     // 4. Ego-motion: 3D of each point from the previous depth; relative pose refined with
     //    PnP-RANSAC on points outside every person box.
     if (have_prev && !p0.empty()) {
@@ -386,7 +434,7 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
             }
             return false;
         };
-        std::vector<std::optional<Eigen::Vector3d>> X(p0.size());
+        X.assign(p0.size(), std::nullopt);
         std::vector<cv::Point3f> bg_obj;
         std::vector<cv::Point2f> bg_img;
         for (std::size_t i = 0; i < p0.size(); ++i) {
@@ -484,9 +532,16 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
                 local_thr = std::max(local_thr, opts_.background_factor * static_cast<double>(*k));
             }
         }
+        std::optional<float> zp;
+        if (opts_.fg_depth_band > 0) zp = personDepth(frame.depth, t.tb.box, opts_.max_depth);
         int n = 0, n_dyn = 0;
-        for (auto& fp : out.flow) {
+        for (std::size_t i = 0; i < out.flow.size(); ++i) {
+            auto& fp = out.flow[i];
             if (fp.residual < 0.f || !inner.contains(fp.cur)) continue;
+            // (a point with a residual has a depth: X[i] is set)
+            if (zp && std::abs(static_cast<float>(X[i]->z()) - *zp) >
+                          depthBand(opts_.fg_depth_band, *zp))
+                continue;  // background or foreground clutter seen inside the box
             fp.in_box = true;
             fp.dynamic = fp.residual > local_thr;
             ++n;
@@ -524,7 +579,31 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
         if (y1 > H - snap) y1 = H;
         const cv::Rect r =
             cv::Rect(cv::Rect2f(x0, y0, x1 - x0, y1 - y0)) & cv::Rect(0, 0, gray.cols, gray.rows);
-        out.mask(r).setTo(255);
+        const auto zp = opts_.mask_silhouette
+                            ? personDepth(frame.depth, t.tb.box, opts_.max_depth)
+                            : std::nullopt;
+        if (!zp) {
+            out.mask(r).setTo(255);
+            continue;
+        }
+        // Silhouette: the box's pixels in the person's depth band or without depth (the
+        // holes along a person's outline), dilated by the margin.
+        const float h = depthBand(opts_.fg_depth_band > 0 ? opts_.fg_depth_band : 0.5, *zp);
+        const cv::Rect inner =
+            cv::Rect(t.tb.box) & cv::Rect(0, 0, gray.cols, gray.rows);
+        if (inner.empty()) continue;
+        cv::Mat sil, holes;
+        cv::inRange(frame.depth(inner), *zp - h, *zp + h, sil);
+        cv::compare(frame.depth(inner), 0.f, holes, cv::CMP_LE);
+        sil |= holes;
+        cv::Mat big = cv::Mat::zeros(r.size(), CV_8UC1);
+        sil.copyTo(big(inner - r.tl()));
+        if (opts_.mask_margin > 0)
+            cv::dilate(big, big,
+                       cv::getStructuringElement(cv::MORPH_RECT,
+                                                 cv::Size(2 * opts_.mask_margin + 1,
+                                                          2 * opts_.mask_margin + 1)));
+        out.mask(r) |= big;
     }
 
     im.prev_work = work;

@@ -35,7 +35,8 @@ std::map<std::string, std::vector<PersonEntry>> readPersons(const std::string& p
 }
 
 void MaskScore::add(const cv::Mat& mask, const cv::Mat& labels,
-                    const std::vector<PersonEntry>& persons, int min_pixels, double timestamp) {
+                    const std::vector<PersonEntry>& persons, int min_pixels, double timestamp,
+                    const std::vector<FilterBox>& boxes) {
     const bool has_mask = !mask.empty();
     if (has_mask) masked_px += cv::countNonZero(mask);
     for (const auto& p : persons) {
@@ -48,8 +49,20 @@ void MaskScore::add(const cv::Mat& mask, const cv::Mat& labels,
         }
         if (vis < min_pixels) continue;
         const bool masked = hit >= 0.5 * vis;
-        if (masked != p.moving)
-            errors.push_back({timestamp, p.id, p.moving, static_cast<int>(vis), hit / vis});
+        if (masked != p.moving) {
+            Error e{timestamp, p.id, p.moving, static_cast<int>(vis), hit / vis};
+            const cv::Rect frame(0, 0, labels.cols, labels.rows);
+            for (const auto& b : boxes) {
+                const cv::Rect r = cv::Rect(b.box) & frame;
+                if (r.empty()) continue;
+                const double cover = cv::countNonZero(mine(r)) / vis;
+                if (cover >= min_box_cover && cover > e.box_cover) {
+                    e.box_cover = cover;
+                    e.filter_box = b.state;
+                }
+            }
+            errors.push_back(std::move(e));
+        }
         if (p.moving) {
             ++moving_instances;
             moving_masked += masked;
@@ -58,6 +71,12 @@ void MaskScore::add(const cv::Mat& mask, const cv::Mat& labels,
             static_masked += masked;
         }
     }
+}
+
+std::size_t MaskScore::movingMissedWithoutBox() const {
+    std::size_t n = 0;
+    for (const auto& e : errors) n += e.moving && e.filter_box == "none" ? 1 : 0;
+    return n;
 }
 
 double MaskScore::movingRecall() const {
@@ -87,7 +106,7 @@ std::optional<PersonTruth> PersonTruth::open(const std::string& folder) {
 }
 
 void PersonTruth::score(const cv::Mat& mask, double timestamp, int min_pixels,
-                        MaskScore& score) const {
+                        MaskScore& score, const std::vector<FilterBox>& boxes) const {
     char stamp[64];
     std::snprintf(stamp, sizeof stamp, "%.6f", timestamp);
     const auto it = persons_.find(stamp);
@@ -96,7 +115,7 @@ void PersonTruth::score(const cv::Mat& mask, double timestamp, int min_pixels,
     const std::string label_path = folder_ + "/labels/" + stamp + ".png";
     const cv::Mat labels = cv::imread(label_path, cv::IMREAD_UNCHANGED);
     if (labels.empty()) throw std::runtime_error("cannot read person labels '" + label_path + "'");
-    score.add(mask, labels, it->second, min_pixels, timestamp);
+    score.add(mask, labels, it->second, min_pixels, timestamp, boxes);
 }
 
 }  // namespace devslam::eval

@@ -107,6 +107,12 @@ class DynamicObjectFilter {
         double threshold2_fraction = 0.4;  ///< and min fraction of the box's points
         int min_points = 6;                ///< fewer points in a box: no new evidence
         double box_shrink = 0.1;           ///< fraction of w/h ignored at each box side
+        /// [m] only points within fg_depth_band + 10 % of the person's depth (median depth
+        /// of the box's torso region) are the person's evidence, and the per-box corners
+        /// are sought there: a near person's low-contrast clothing otherwise loses the
+        /// corners to the background seen inside the box, which votes "static".
+        /// 0 = every point in the box counts.
+        double fg_depth_band = 0.0;
 
         // Tracking and hysteresis
         double iou_match = 0.3;         ///< min IoU to associate a detection with a track
@@ -123,6 +129,11 @@ class DynamicObjectFilter {
         /// person cut off by the border is detected with a box that stops short of it,
         /// leaving a strip of the person unmasked.
         int mask_border_snap = 0;
+        /// false: the whole (dilated) box is masked, as in the paper. true: only the box's
+        /// pixels within the person's depth band (see fg_depth_band; 0.5 m when that is 0)
+        /// or without depth, dilated by mask_margin: the background seen inside the box
+        /// stays usable. Falls back to the whole box when the torso has no depth.
+        bool mask_silhouette = false;
 
         /// Reads `[section]`; unknown keys throw std::invalid_argument naming them.
         void loadFromConfig(const mrpt::config::CConfigFileBase& cfg,

@@ -2,6 +2,7 @@
 // Scores the dynamic-object filter's masks against the renderer's person truth
 // (labels/<t>.png and persons.txt of a devslam-synth folder).
 #include <opencv2/core/mat.hpp>
+#include <opencv2/core/types.hpp>
 
 #include <cstddef>
 #include <map>
@@ -17,6 +18,14 @@ struct PersonEntry {
     std::string name;
     bool moving = false;
     int visible_pixels = 0;
+};
+
+/// A box the filter tracked in the scored frame, with its state ("moving", "static",
+/// "unknown"): tells for each mask error whether the detector missed the person or the
+/// flow test judged them wrong.
+struct FilterBox {
+    cv::Rect2f box;
+    std::string state;
 };
 
 /// persons.txt keyed by its timestamp string ("%.6f"). Throws naming file and line.
@@ -37,10 +46,18 @@ struct MaskScore {
         bool moving = false;
         int visible_pixels = 0;
         double masked_fraction = 0;
+        /// State of the filter box that covers most of the person's visible pixels, "none"
+        /// when no box covers at least min_box_cover of them (the detector missed them).
+        std::string filter_box = "none";
+        double box_cover = 0;  ///< fraction of the visible pixels inside that box
     };
     std::vector<Error> errors;
+    /// A box must cover this fraction of a person's visible pixels to be theirs.
+    static constexpr double min_box_cover = 0.3;
     void add(const cv::Mat& mask, const cv::Mat& labels, const std::vector<PersonEntry>& persons,
-             int min_pixels, double timestamp = 0);
+             int min_pixels, double timestamp = 0, const std::vector<FilterBox>& boxes = {});
+    /// Walker instances not masked whose person had no filter box ("none").
+    [[nodiscard]] std::size_t movingMissedWithoutBox() const;
     /// Fraction of walking-person instances that were masked (recall per person and frame).
     [[nodiscard]] double movingRecall() const;
     /// Fraction of static-person instances that were masked (should be small).
@@ -60,7 +77,8 @@ class PersonTruth {
     [[nodiscard]] static std::optional<PersonTruth> open(const std::string& folder);
     /// Adds the frame at `timestamp` to `score`. Throws naming the file when the frame has
     /// no truth (a missing label image or persons.txt entry).
-    void score(const cv::Mat& mask, double timestamp, int min_pixels, MaskScore& score) const;
+    void score(const cv::Mat& mask, double timestamp, int min_pixels, MaskScore& score,
+               const std::vector<FilterBox>& boxes = {}) const;
 
   private:
     std::string folder_;
