@@ -135,7 +135,12 @@ int main(int argc, char** argv) {
     }
     try {
         cv::setNumThreads(threads);
-        auto cfg = core::loadIni(config);
+        // A SLAM INI names its filter INI ([run] filter_config, filter_overrides).
+        auto cfg = core::loadFilterIni(*core::loadIni(config), config);
+        if (!cfg->sectionExists("detector") && !cfg->sectionExists("dynamic_filter"))
+            throw std::invalid_argument("--config " + config +
+                                        ": no [detector] or [dynamic_filter] section, and no "
+                                        "[run] filter_config naming an INI that has them");
         std::optional<dynamic::MaskMode> mode_override;
         if (!mode.empty()) mode_override = dynamic::parseMaskMode(mode);
         auto filter = dynamic::makeFilterFromConfig(*cfg, mode_override);

@@ -98,15 +98,9 @@ struct Loaded {
     bool async_filter = false;
 };
 
-/// Applies "section.key=value" overrides to an INI held in memory.
+/// Applies --set "section.key=value" overrides to an INI held in memory.
 void applySets(mrpt::config::CConfigFileMemory& cfg, const std::vector<std::string>& sets) {
-    for (const auto& s : sets) {
-        const auto dot = s.find('.'), eq = s.find('=');
-        if (dot == std::string::npos || eq == std::string::npos || dot > eq || dot == 0 ||
-            eq == dot + 1)
-            throw std::invalid_argument("--set '" + s + "': expected SECTION.KEY=VALUE");
-        cfg.write(s.substr(0, dot), s.substr(dot + 1, eq - dot - 1), s.substr(eq + 1));
-    }
+    core::applyOverrides(cfg, sets, "--set");
 }
 
 Loaded loadConfig(const Args& a, const std::vector<std::string>& extra_sets = {}) {
@@ -118,20 +112,9 @@ Loaded loadConfig(const Args& a, const std::vector<std::string>& extra_sets = {}
                            {"mode", "filter_config", "filter_overrides", "async_filter"}, a.config);
     l.async_filter = l.cfg->read_bool("run", "async_filter", false);
     l.mode = a.mode.empty() ? l.cfg->read_string("run", "mode", "dynamic") : a.mode;
-    const std::string fc = l.cfg->read_string("run", "filter_config", "");
-    if (!fc.empty()) {
-        const fs::path p =
-            fs::path(fc).is_absolute() ? fs::path(fc) : fs::path(a.config).parent_path() / fc;
-        l.filter_cfg = core::loadIni(p.string());
-    } else {
-        l.filter_cfg = core::loadIni(a.config);
-    }
-    // [run] filter_overrides: "section.key=value ..." applied to the filter's INI (so a SLAM
-    // config can pick e.g. the detection interval without copying the filter's file).
-    std::vector<std::string> overrides;
-    std::istringstream ov(l.cfg->read_string("run", "filter_overrides", ""));
-    for (std::string item; ov >> item;) overrides.push_back(item);
-    applySets(*l.filter_cfg, overrides);
+    // [run] filter_config / filter_overrides: the filter's INI, with "section.key=value ..."
+    // overrides (so a SLAM config can pick e.g. the detection interval without copying it).
+    l.filter_cfg = core::loadFilterIni(*l.cfg, a.config);
     applySets(*l.filter_cfg, a.sets);
     applySets(*l.filter_cfg, extra_sets);
     l.reader.loadFromConfig(*l.cfg, "dataset");

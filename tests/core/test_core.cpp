@@ -7,6 +7,8 @@
 
 #include <gtest/gtest.h>
 
+#include <fstream>
+
 #include <cmath>
 
 using namespace devslam::core;
@@ -63,6 +65,38 @@ TEST(Config, UnknownKeyIsNamed) {
         EXPECT_STREQ(e.what(), "test.ini [a]: unknown key 'y' (known: x)");
     }
     EXPECT_THROW((void)loadIni("/nonexistent/file.ini"), std::runtime_error);
+}
+
+TEST(Config, FilterIniFollowsRunFilterConfigWithOverrides) {
+    // The shipped SLAM INI names dynamic_filter.ini and overrides its detection interval.
+    const std::string slam_ini = std::string(DEVSLAM_SOURCE_DIR) + "/config_ini/slam_tum_fr1.ini";
+    const auto f = loadFilterIni(*loadIni(slam_ini), slam_ini);
+    EXPECT_TRUE(f->sectionExists("detector"));
+    EXPECT_EQ(f->read_int("dynamic_filter", "detect_every", 0), 3);
+    // Without [run] filter_config the INI is its own filter INI; overrides still apply.
+    const std::string dir = ::testing::TempDir();
+    const std::string own = dir + "/own.ini";
+    std::ofstream(own) << "[run]\nfilter_overrides = dynamic_filter.mask_margin=3\n"
+                          "[dynamic_filter]\nmask_margin = 10\n";
+    EXPECT_EQ(loadFilterIni(*loadIni(own), own)->read_int("dynamic_filter", "mask_margin", 0), 3);
+    // A malformed override names the file and the item; a missing filter INI names its path.
+    const std::string bad = dir + "/bad.ini";
+    std::ofstream(bad) << "[run]\nfilter_overrides = detect_every=3\n";
+    try {
+        (void)loadFilterIni(*loadIni(bad), bad);
+        FAIL();
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find(bad), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("'detect_every=3'"), std::string::npos) << e.what();
+    }
+    const std::string missing = dir + "/missing.ini";
+    std::ofstream(missing) << "[run]\nfilter_config = nowhere.ini\n";
+    try {
+        (void)loadFilterIni(*loadIni(missing), missing);
+        FAIL();
+    } catch (const std::runtime_error& e) {
+        EXPECT_NE(std::string(e.what()).find("nowhere.ini"), std::string::npos) << e.what();
+    }
 }
 
 TEST(Association, NearestPairsNeverReused) {

@@ -10,6 +10,7 @@
 #include <devslam/slam/PoseGraph.h>
 #include <devslam/slam/PoseSolver.h>
 #include <devslam/slam/Slam.h>
+#include <devslam/slam/Tracker.h>
 
 #include <gtest/gtest.h>
 #include <mrpt/config/CConfigFileMemory.h>
@@ -355,6 +356,25 @@ TEST(LoopDetector, MeasuresFromTheKeyframesAndRejectsImplausibleCorrections) {
                 << "0.5 m correction > max_correction " << lo.max_correction;
         }
     }
+}
+
+TEST(Tracker, RelocalizationCannotJumpFarAfterAShortLoss) {
+    // Bound: 0.1 m + 1 m/s x time since the last tracked frame, 10 deg + 90 deg/s x that time.
+    TrackerOptions o;
+    Tracker tr(o);
+    const Eigen::Isometry3d T0 = makePose(1, 2, 0.5, 0.1, -0.2, 0.3);
+    tr.initialize(T0, 100.0);
+    auto moved = [&](double dx, double yaw_deg) {
+        return T0 * makePose(dx, 0, 0, 0, yaw_deg * M_PI / 180.0, 0);
+    };
+    EXPECT_TRUE(tr.relocPlausible(moved(0.05, 2), 100.033));
+    // The bad relocalization seen on walking_halfsphere: 0.9 m after 0.27 s lost.
+    EXPECT_FALSE(tr.relocPlausible(moved(0.9, 0), 100.27));
+    EXPECT_FALSE(tr.relocPlausible(moved(0.05, 40), 100.1)) << "rotation bounded too";
+    // After a long loss anything within reach is accepted again.
+    EXPECT_TRUE(tr.relocPlausible(moved(0.9, 40), 101.0));
+    o.reloc_max_speed = 0;  // no bound
+    EXPECT_TRUE(Tracker(o).relocPlausible(moved(5, 90), 100.0));
 }
 
 TEST(Matching, HammingAndBruteForce) {

@@ -1,6 +1,7 @@
 #include <devslam/core/Config.h>
 
 #include <algorithm>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -14,6 +15,32 @@ std::unique_ptr<mrpt::config::CConfigFileMemory> loadIni(const std::string& path
     ss << in.rdbuf();
     if (in.bad()) throw std::runtime_error("cannot read INI file '" + path + "'");
     return std::make_unique<mrpt::config::CConfigFileMemory>(ss.str());
+}
+
+void applyOverrides(mrpt::config::CConfigFileMemory& cfg, const std::vector<std::string>& items,
+                    const std::string& what) {
+    for (const auto& s : items) {
+        const auto dot = s.find('.'), eq = s.find('=');
+        if (dot == std::string::npos || eq == std::string::npos || dot > eq || dot == 0 ||
+            eq == dot + 1)
+            throw std::invalid_argument(what + " '" + s + "': expected SECTION.KEY=VALUE");
+        cfg.write(s.substr(0, dot), s.substr(dot + 1, eq - dot - 1), s.substr(eq + 1));
+    }
+}
+
+std::unique_ptr<mrpt::config::CConfigFileMemory> loadFilterIni(
+    const mrpt::config::CConfigFileBase& cfg, const std::string& path) {
+    namespace fs = std::filesystem;
+    const std::string fc = cfg.read_string("run", "filter_config", "");
+    auto out = loadIni(fc.empty() ? path
+                       : fs::path(fc).is_absolute()
+                           ? fc
+                           : (fs::path(path).parent_path() / fc).string());
+    std::vector<std::string> items;
+    std::istringstream ov(cfg.read_string("run", "filter_overrides", ""));
+    for (std::string item; ov >> item;) items.push_back(item);
+    applyOverrides(*out, items, path + " [run] filter_overrides item");
+    return out;
 }
 
 std::vector<std::string> unknownKeys(const mrpt::config::CConfigFileBase& cfg,

@@ -32,7 +32,9 @@ void TrackerOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, cons
                                   "min_matches",        "min_inliers",
                                   "local_keyframes",    "max_motion_dt",
                                   "reloc_keyframes",    "reloc_min_inliers",
-                                  "reloc_max_hamming",  "reloc_ratio"});
+                                  "reloc_max_hamming",  "reloc_ratio",
+                                  "reloc_max_jump",     "reloc_max_speed",
+                                  "reloc_max_jump_deg", "reloc_max_rate_deg"});
     projection.radius = c.read_double(s, "search_radius", projection.radius);
     fine_radius = c.read_double(s, "fine_radius", fine_radius);
     wide_radius_factor = c.read_double(s, "wide_radius_factor", wide_radius_factor);
@@ -53,6 +55,10 @@ void TrackerOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, cons
     reloc_min_inliers = c.read_int(s, "reloc_min_inliers", reloc_min_inliers);
     reloc_max_hamming = c.read_int(s, "reloc_max_hamming", reloc_max_hamming);
     reloc_ratio = c.read_double(s, "reloc_ratio", reloc_ratio);
+    reloc_max_jump = c.read_double(s, "reloc_max_jump", reloc_max_jump);
+    reloc_max_speed = c.read_double(s, "reloc_max_speed", reloc_max_speed);
+    reloc_max_jump_deg = c.read_double(s, "reloc_max_jump_deg", reloc_max_jump_deg);
+    reloc_max_rate_deg = c.read_double(s, "reloc_max_rate_deg", reloc_max_rate_deg);
     core::requireValue(projection.radius > 0 && fine_radius > 0, s, "search_radius/fine_radius",
                        "must be > 0");
     core::requireValue(projection.max_hamming > 0 && projection.max_hamming <= 256, s,
@@ -65,6 +71,8 @@ void TrackerOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, cons
     core::requireValue(min_inliers >= 6, s, "min_inliers", "must be >= 6");
     core::requireValue(local_keyframes >= 1, s, "local_keyframes", "must be >= 1");
     core::requireValue(reloc_keyframes >= 1, s, "reloc_keyframes", "must be >= 1");
+    core::requireValue(reloc_max_jump >= 0 && reloc_max_jump_deg >= 0 && reloc_max_rate_deg >= 0,
+                       s, "reloc_max_jump/reloc_max_jump_deg/reloc_max_rate_deg", "must be >= 0");
 }
 
 void TrackerOptions::saveToConfig(mrpt::config::CConfigFileBase& c, const std::string& s) const {
@@ -88,6 +96,10 @@ void TrackerOptions::saveToConfig(mrpt::config::CConfigFileBase& c, const std::s
     c.write(s, "reloc_min_inliers", reloc_min_inliers);
     c.write(s, "reloc_max_hamming", reloc_max_hamming);
     c.write(s, "reloc_ratio", reloc_ratio);
+    c.write(s, "reloc_max_jump", reloc_max_jump);
+    c.write(s, "reloc_max_speed", reloc_max_speed);
+    c.write(s, "reloc_max_jump_deg", reloc_max_jump_deg);
+    c.write(s, "reloc_max_rate_deg", reloc_max_rate_deg);
 }
 
 void Tracker::initialize(const Eigen::Isometry3d& T_wc, double timestamp) {
@@ -188,9 +200,19 @@ std::optional<PoseRefineResult> Tracker::trackWithMap(const FrameFeatures& f, Ma
     return refined2;
 }
 
+bool Tracker::relocPlausible(const Eigen::Isometry3d& T_wc, double timestamp) const {
+    if (opts_.reloc_max_speed <= 0) return true;
+    const double lost_s = std::max(0.0, timestamp - last_t_);
+    const Eigen::Isometry3d d = last_T_wc_.inverse() * T_wc;
+    const double deg = Eigen::AngleAxisd(d.linear()).angle() * 180.0 / M_PI;
+    return d.translation().norm() <= opts_.reloc_max_jump + opts_.reloc_max_speed * lost_s &&
+           deg <= opts_.reloc_max_jump_deg + opts_.reloc_max_rate_deg * lost_s;
+}
+
 std::optional<Eigen::Isometry3d> Tracker::relocalize(const FrameFeatures& f, const Map& map,
                                                      const core::CameraIntrinsics& K,
-                                                     unsigned long long seed) const {
+                                                     unsigned long long seed,
+                                                     double timestamp) const {
     // Candidates: the newest keyframes and the ones nearest to the last pose.
     std::vector<std::pair<double, KeyframeId>> by_dist;
     for (const auto& [id, kf] : map.keyframes())
@@ -231,7 +253,8 @@ std::optional<Eigen::Isometry3d> Tracker::relocalize(const FrameFeatures& f, con
         const auto pnp = solvePnpRansac(obs, K, pnp_opts);
         if (!pnp) continue;
         const auto refined = refinePose(obs, pnp->T_wc, K, opts_.refine);
-        if (refined.n_inliers >= opts_.reloc_min_inliers && refined.n_inliers > best_inliers) {
+        if (refined.n_inliers >= opts_.reloc_min_inliers && refined.n_inliers > best_inliers &&
+            relocPlausible(refined.T_wc, timestamp)) {
             best_inliers = refined.n_inliers;
             best = refined.T_wc;
         }
@@ -260,9 +283,12 @@ TrackResult Tracker::track(const TrackInput& in, Map& map, const core::CameraInt
     if (!ok && f.size() > 0) {
         // Relocalize against keyframes, then track the local map from that pose.
         TrackResult reloc_res;
-        if (const auto T = relocalize(f, map, K, seed)) {
+        if (const auto T = relocalize(f, map, K, seed, in.timestamp)) {
             auto near = map.landmarksOf(map.lastKeyframes(opts_.local_keyframes));
             ok = trackWithMap(f, map, K, *T, near, seed + 1, reloc_res);
+            // The local map may pull the pose away again (its newest keyframes can be the
+            // bad poses that lost the track): the bound holds for the final pose too.
+            if (ok && !relocPlausible(ok->T_wc, in.timestamp)) ok.reset();
             if (ok) {
                 const std::string why = res.reason;
                 res = reloc_res;

@@ -29,6 +29,18 @@ namespace devslam::core {
 void requireKnownKeys(const mrpt::config::CConfigFileBase& cfg, const std::string& section,
                       const std::vector<std::string>& known, const std::string& source = "INI");
 
+/// Applies "section.key=value" items to an INI held in memory. Throws std::invalid_argument
+/// naming `what` and the item when one is malformed.
+void applyOverrides(mrpt::config::CConfigFileMemory& cfg, const std::vector<std::string>& items,
+                    const std::string& what = "override");
+
+/// The INI holding [detector] and [dynamic_filter] for the config `cfg` read from `path`:
+/// the file its [run] `filter_config` names (relative to `path`), or `path` itself when
+/// there is none, with the [run] `filter_overrides` ("section.key=value ..." items)
+/// applied. Throws naming the file when it cannot be read or an override is malformed.
+[[nodiscard]] std::unique_ptr<mrpt::config::CConfigFileMemory> loadFilterIni(
+    const mrpt::config::CConfigFileBase& cfg, const std::string& path);
+
 /// Throws std::invalid_argument naming section and key when `ok` is false.
 void requireValue(bool ok, const std::string& section, const std::string& key,
                   const std::string& what);

@@ -42,6 +42,15 @@ struct TrackerOptions {
     int reloc_min_inliers = 25;   ///< PnP inliers needed to relocalize
     int reloc_max_hamming = 64;   ///< brute-force matching threshold
     double reloc_ratio = 0.8;     ///< brute-force ratio test
+    /// A relocalized pose must lie within reloc_max_jump + reloc_max_speed * (time since the
+    /// last tracked frame) of the last tracked pose, and its rotation within
+    /// reloc_max_jump_deg + reloc_max_rate_deg * that time: after a short loss, a pose far
+    /// away is a false match (repeated textures), and it would break the trajectory. After
+    /// a long loss the bound grows and anything goes. reloc_max_speed <= 0: no bound.
+    double reloc_max_jump = 0.1;       ///< [m]
+    double reloc_max_speed = 1.0;      ///< [m/s]
+    double reloc_max_jump_deg = 10.0;  ///< [deg]
+    double reloc_max_rate_deg = 90.0;  ///< [deg/s]
     double scale_factor = 1.3;    ///< ORB pyramid scale for level sigmas (copied from [orb])
 
     void loadFromConfig(const mrpt::config::CConfigFileBase& cfg,
@@ -92,15 +101,20 @@ class Tracker {
     [[nodiscard]] const Eigen::Isometry3d& lastPose() const { return last_T_wc_; }
     [[nodiscard]] double lastTimestamp() const { return last_t_; }
 
+    /// Whether a relocalized pose at `timestamp` is within the jump bound (reloc_max_jump,
+    /// reloc_max_speed, ...) of the last tracked pose.
+    [[nodiscard]] bool relocPlausible(const Eigen::Isometry3d& T_wc, double timestamp) const;
+
   private:
     std::optional<PoseRefineResult> trackWithMap(const FrameFeatures& f, Map& map,
                                                  const core::CameraIntrinsics& K,
                                                  const Eigen::Isometry3d& pred,
                                                  const std::vector<LandmarkId>& local,
                                                  unsigned long long seed, TrackResult& res) const;
+    /// `timestamp`: of the frame, for the jump bound.
     std::optional<Eigen::Isometry3d> relocalize(const FrameFeatures& f, const Map& map,
                                                 const core::CameraIntrinsics& K,
-                                                unsigned long long seed) const;
+                                                unsigned long long seed, double timestamp) const;
 
     TrackerOptions opts_;
     TrackingState state_ = TrackingState::NotInitialized;
