@@ -7,6 +7,7 @@
 #include <devslam/core/Progress.h>
 #include <devslam/core/Results.h>
 #include <devslam/core/Stats.h>
+#include <devslam/nav/BenchFixtures.h>
 #include <devslam/nav/CHolonomicVFHPlus.h>
 #include <devslam/nav/GridPlanner.h>
 #include <devslam/nav/VfhPlus.h>
@@ -80,17 +81,11 @@ std::string shortName(const std::string& m) {
 /// Median wall time of vfhPlusStep on synthetic 121-sector fields.
 double timeVfhStep() {
     std::mt19937 g(3);
-    std::uniform_real_distribution<double> u(0.05, 1.0);
     devslam::nav::VfhPlusOptions o;
     devslam::nav::VfhState st;
     std::vector<double> t;
     for (int i = 0; i < 2000; i++) {
-        devslam::nav::VfhInput in;
-        in.obstacles.resize(121);
-        for (auto& d : in.obstacles) d = u(g);
-        in.target_x = 0.6;
-        in.target_y = 0.2;
-        in.ref_distance = 2.5;
+        const devslam::nav::VfhInput in = devslam::nav::randomVfhInput(g);
         const double t0 = cpuMs();
         const auto out = devslam::nav::vfhPlusStep(in, st, o);
         t.push_back(cpuMs() - t0);
@@ -101,15 +96,7 @@ double timeVfhStep() {
 
 /// Median A* time on a 400x400 grid (20 m x 20 m at 5 cm) with random boxes, corner to corner.
 double timeAStar400(double* length) {
-    mrpt::maps::COccupancyGridMap2D grid;
-    grid.setSize(0, 20, 0, 20, 0.05f, 1.0f);
-    std::mt19937 g(5);
-    std::uniform_real_distribution<double> u(2.0, 18.0);
-    for (int k = 0; k < 60; k++) {
-        const double cx = u(g), cy = u(g);
-        for (double y = cy - 0.5; y <= cy + 0.5; y += 0.05)
-            for (double x = cx - 0.5; x <= cx + 0.5; x += 0.05) grid.setPos(x, y, 0.0f);
-    }
+    const auto grid = devslam::nav::clutteredGrid400();
     devslam::nav::GridPlanner planner;
     planner.setMap(grid);
     std::vector<double> t;
