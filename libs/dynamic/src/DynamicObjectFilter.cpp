@@ -238,6 +238,10 @@ struct DynamicObjectFilter::Impl {
         TrackedBox tb;
         int quiet = 0;   ///< consecutive frames without moving evidence
         int missed = 0;  ///< detector runs without a matching detection
+        /// the person's depth (personDepth) in this step's box and depth image, when the
+        /// band or the silhouette mask needs it; the next step's corners use it as the
+        /// previous frame's
+        std::optional<float> depth;
     };
     cv::Mat prev_work, prev_depth;
     std::vector<cv::Mat> prev_pyr;
@@ -303,19 +307,17 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
                     cv::Rect(0, 0, work.cols, work.rows);
                 if (roi.width < 8 || roi.height < 8) continue;
                 cv::Mat fg;  // the person's depth band in the ROI (empty: whole ROI)
-                if (opts_.fg_depth_band > 0) {
-                    if (const auto zp = personDepth(im.prev_depth, t.tb.box, opts_.max_depth)) {
-                        const float h = depthBand(opts_.fg_depth_band, *zp);
-                        const cv::Rect full =
-                            cv::Rect(cv::Rect2f(static_cast<float>(roi.x / sc),
-                                                static_cast<float>(roi.y / sc),
-                                                static_cast<float>(roi.width / sc),
-                                                static_cast<float>(roi.height / sc))) &
-                            cv::Rect(0, 0, im.prev_depth.cols, im.prev_depth.rows);
-                        cv::Mat band;
-                        cv::inRange(im.prev_depth(full), *zp - h, *zp + h, band);
-                        cv::resize(band, fg, roi.size(), 0, 0, cv::INTER_NEAREST);
-                    }
+                if (opts_.fg_depth_band > 0 && t.depth) {  // t.depth: the previous step's
+                    const float zp = *t.depth, h = depthBand(opts_.fg_depth_band, zp);
+                    const cv::Rect full =
+                        cv::Rect(cv::Rect2f(static_cast<float>(roi.x / sc),
+                                            static_cast<float>(roi.y / sc),
+                                            static_cast<float>(roi.width / sc),
+                                            static_cast<float>(roi.height / sc))) &
+                        cv::Rect(0, 0, im.prev_depth.cols, im.prev_depth.rows);
+                    cv::Mat band;
+                    cv::inRange(im.prev_depth(full), zp - h, zp + h, band);
+                    cv::resize(band, fg, roi.size(), 0, 0, cv::INTER_NEAREST);
                 }
                 std::vector<cv::Point2f> pts;
                 cv::goodFeaturesToTrack(im.prev_work(roi), pts, opts_.max_corners_per_box,
@@ -415,6 +417,10 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
     im.tracks.erase(std::remove_if(im.tracks.begin(), im.tracks.end(),
                                    [](const Impl::Track& t) { return t.tb.box.area() < 16.f; }),
                     im.tracks.end());
+    // The boxes are final for this step: the person's depth in each, once.
+    const bool need_depth = opts_.fg_depth_band > 0 || opts_.mask_silhouette;
+    for (auto& t : im.tracks)
+        t.depth = need_depth ? personDepth(frame.depth, t.tb.box, opts_.max_depth) : std::nullopt;
 
     std::vector<std::optional<Eigen::Vector3d>> X;  // 3D of each point in the previous frame
     // 4. Ego-motion: 3D of each point from the previous depth; relative pose refined with
@@ -532,15 +538,15 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
                 local_thr = std::max(local_thr, opts_.background_factor * static_cast<double>(*k));
             }
         }
-        std::optional<float> zp;
-        if (opts_.fg_depth_band > 0) zp = personDepth(frame.depth, t.tb.box, opts_.max_depth);
+        const bool use_band = opts_.fg_depth_band > 0 && t.depth.has_value();
+        const float zp = t.depth.value_or(0.f);
         int n = 0, n_dyn = 0;
         for (std::size_t i = 0; i < out.flow.size(); ++i) {
             auto& fp = out.flow[i];
             if (fp.residual < 0.f || !inner.contains(fp.cur)) continue;
             // (a point with a residual has a depth: X[i] is set)
-            if (zp && std::abs(static_cast<float>(X[i]->z()) - *zp) >
-                          depthBand(opts_.fg_depth_band, *zp))
+            if (use_band && std::abs(static_cast<float>(X[i]->z()) - zp) >
+                                depthBand(opts_.fg_depth_band, zp))
                 continue;  // background or foreground clutter seen inside the box
             fp.in_box = true;
             fp.dynamic = fp.residual > local_thr;
@@ -579,21 +585,18 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
         if (y1 > H - snap) y1 = H;
         const cv::Rect r =
             cv::Rect(cv::Rect2f(x0, y0, x1 - x0, y1 - y0)) & cv::Rect(0, 0, gray.cols, gray.rows);
-        const auto zp = opts_.mask_silhouette
-                            ? personDepth(frame.depth, t.tb.box, opts_.max_depth)
-                            : std::nullopt;
-        if (!zp) {
+        if (!opts_.mask_silhouette || !t.depth) {
             out.mask(r).setTo(255);
             continue;
         }
         // Silhouette: the box's pixels in the person's depth band or without depth (the
         // holes along a person's outline), dilated by the margin.
-        const float h = depthBand(opts_.fg_depth_band > 0 ? opts_.fg_depth_band : 0.5, *zp);
-        const cv::Rect inner =
-            cv::Rect(t.tb.box) & cv::Rect(0, 0, gray.cols, gray.rows);
+        const float zp = *t.depth;
+        const float h = depthBand(opts_.fg_depth_band > 0 ? opts_.fg_depth_band : 0.5, zp);
+        const cv::Rect inner = cv::Rect(t.tb.box) & cv::Rect(0, 0, gray.cols, gray.rows);
         if (inner.empty()) continue;
         cv::Mat sil, holes;
-        cv::inRange(frame.depth(inner), *zp - h, *zp + h, sil);
+        cv::inRange(frame.depth(inner), zp - h, zp + h, sil);
         cv::compare(frame.depth(inner), 0.f, holes, cv::CMP_LE);
         sil |= holes;
         cv::Mat big = cv::Mat::zeros(r.size(), CV_8UC1);
