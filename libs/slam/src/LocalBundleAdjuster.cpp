@@ -7,6 +7,7 @@
 #include <Eigen/Cholesky>
 
 #include <cmath>
+#include <optional>
 #include <unordered_map>
 
 namespace devslam::slam {
@@ -110,38 +111,40 @@ LocalBaResult localBundleAdjust(Map& map, KeyframeId newest, const core::CameraI
     // Huber kernel bounds an outlier's pull but does not remove it; people at the mask
     // borders give many such outliers that pull together).
     std::vector<char> active(obs.size(), 1);
-    auto robustCost = [&](const std::vector<Eigen::Isometry3d>& T,
-                          const std::vector<Eigen::Vector3d>& Xs) {
-        double cost = 0;
+    // An observation's scaled squared error e2 and its chi2 bound d2 (stereo or mono) at a
+    // pose and point; nullopt when the point is behind the camera.
+    struct Chi2 {
+        double e2, d2;
+    };
+    auto chi2 = [&](const Obs& o, const Eigen::Isometry3d& T,
+                    const Eigen::Vector3d& Xl) -> std::optional<Chi2> {
         Eigen::Vector3d r;
         Eigen::Matrix<double, 3, 6> Jp;
         Eigen::Matrix3d Jl;
         int rows;
+        if (!observationJacobians(T, Xl, o.uv, o.depth, K, opts.bf, r, Jp, Jl, rows))
+            return std::nullopt;
+        return Chi2{r.squaredNorm() * o.inv_sigma2, rows == 3 ? opts.chi2_stereo : opts.chi2_mono};
+    };
+    auto robustCost = [&](const std::vector<Eigen::Isometry3d>& T,
+                          const std::vector<Eigen::Vector3d>& Xs) {
+        double cost = 0;
         for (std::size_t k = 0; k < obs.size(); ++k) {
             if (!active[k]) continue;
             const auto& o = obs[k];
-            if (!observationJacobians(T[o.pose], Xs[o.landmark], o.uv, o.depth, K, opts.bf, r, Jp,
-                                      Jl, rows)) {
+            const auto c = chi2(o, T[o.pose], Xs[o.landmark]);
+            if (!c)
                 cost += 100.0;
-                continue;
-            }
-            const double e2 = r.squaredNorm() * o.inv_sigma2;
-            const double d2 = rows == 3 ? opts.chi2_stereo : opts.chi2_mono;
-            cost += e2 <= d2 ? e2 : 2 * std::sqrt(e2 * d2) - d2;
+            else
+                cost += c->e2 <= c->d2 ? c->e2 : 2 * std::sqrt(c->e2 * c->d2) - c->d2;
         }
         return cost;
     };
 
     // Outside chi2 (or behind the camera) at the current estimate.
     auto isOutlier = [&](const Obs& o) {
-        Eigen::Vector3d r;
-        Eigen::Matrix<double, 3, 6> Jp;
-        Eigen::Matrix3d Jl;
-        int rows;
-        if (!observationJacobians(T_cw[o.pose], X[o.landmark], o.uv, o.depth, K, opts.bf, r, Jp, Jl,
-                                  rows))
-            return true;
-        return r.squaredNorm() * o.inv_sigma2 > (rows == 3 ? opts.chi2_stereo : opts.chi2_mono);
+        const auto c = chi2(o, T_cw[o.pose], X[o.landmark]);
+        return !c || c->e2 > c->d2;
     };
 
     const int L = static_cast<int>(lm_ids.size());
