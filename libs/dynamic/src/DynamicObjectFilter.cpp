@@ -11,7 +11,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <deque>
 #include <stdexcept>
+#include <tuple>
 
 namespace devslam::dynamic {
 
@@ -49,7 +51,10 @@ const std::vector<std::string> kKeys{"mode",
                                      "mask_unknown",
                                      "mask_border_snap",
                                      "fg_depth_band",
-                                     "mask_silhouette"};
+                                     "mask_silhouette",
+                                     "slow_frames",
+                                     "slow_threshold",
+                                     "new_track_score"};
 
 cv::Rect2f shrink(const cv::Rect2f& b, double f) {
     const auto dx = static_cast<float>(f * b.width), dy = static_cast<float>(f * b.height);
@@ -166,6 +171,9 @@ void DynamicObjectFilter::Options::loadFromConfig(const mrpt::config::CConfigFil
     box_shrink = c.read_double(s, "box_shrink", box_shrink);
     fg_depth_band = c.read_double(s, "fg_depth_band", fg_depth_band);
     mask_silhouette = c.read_bool(s, "mask_silhouette", mask_silhouette);
+    slow_frames = c.read_int(s, "slow_frames", slow_frames);
+    slow_threshold = c.read_double(s, "slow_threshold", slow_threshold);
+    new_track_score = c.read_double(s, "new_track_score", new_track_score);
     iou_match = c.read_double(s, "iou_match", iou_match);
     release_frames = c.read_int(s, "release_frames", release_frames);
     max_missed_detections = c.read_int(s, "max_missed_detections", max_missed_detections);
@@ -195,6 +203,10 @@ void DynamicObjectFilter::Options::loadFromConfig(const mrpt::config::CConfigFil
     core::requireValue(min_points >= 1, s, "min_points", "must be >= 1");
     core::requireValue(box_shrink >= 0 && box_shrink < 0.5, s, "box_shrink", "must be in [0, 0.5)");
     core::requireValue(fg_depth_band >= 0, s, "fg_depth_band", "must be >= 0 (0 = off)");
+    core::requireValue(slow_frames >= 0, s, "slow_frames", "must be >= 0 (0 = off)");
+    core::requireValue(slow_threshold > 0, s, "slow_threshold", "must be > 0");
+    core::requireValue(new_track_score >= 0 && new_track_score <= 1, s, "new_track_score",
+                       "must be in [0, 1]");
     core::requireValue(iou_match > 0 && iou_match <= 1, s, "iou_match", "must be in (0, 1]");
     core::requireValue(release_frames >= 1, s, "release_frames", "must be >= 1");
     core::requireValue(max_missed_detections >= 0, s, "max_missed_detections", "must be >= 0");
@@ -225,6 +237,9 @@ void DynamicObjectFilter::Options::saveToConfig(mrpt::config::CConfigFileBase& c
     c.write(s, "box_shrink", box_shrink);
     c.write(s, "fg_depth_band", fg_depth_band);
     c.write(s, "mask_silhouette", mask_silhouette);
+    c.write(s, "slow_frames", slow_frames);
+    c.write(s, "slow_threshold", slow_threshold);
+    c.write(s, "new_track_score", new_track_score);
     c.write(s, "iou_match", iou_match);
     c.write(s, "release_frames", release_frames);
     c.write(s, "max_missed_detections", max_missed_detections);
@@ -242,6 +257,9 @@ struct DynamicObjectFilter::Impl {
         /// band or the silhouette mask needs it; the next step's corners use it as the
         /// previous frame's
         std::optional<float> depth;
+        /// the median residual flow vector of the box's points in its last steps with
+        /// evidence (at most slow_frames, newest last)
+        std::deque<cv::Point2f> slow_history;
     };
     cv::Mat prev_work, prev_depth;
     std::vector<cv::Mat> prev_pyr;
@@ -375,7 +393,15 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
         detect_ms = msSince(t_det0);
         out.detector_ran = true;
         std::vector<bool> used_det(dets.size(), false), used_trk(im.tracks.size(), false);
+        // Detections scoring under new_track_score only continue tracks (and are
+        // matched after the confident ones): a person the detector grows unsure of (cut
+        // by the image border, half hidden) stays tracked without weak boxes starting
+        // tracks of their own.
+        const auto confident = [&](std::size_t d) {
+            return dets[d].score >= opts_.new_track_score;
+        };
         struct Pair {
+            bool confident;
             float iou;
             std::size_t d, t;
         };
@@ -383,10 +409,10 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
         for (std::size_t d = 0; d < dets.size(); ++d)
             for (std::size_t t = 0; t < im.tracks.size(); ++t) {
                 const float v = detect::iou(dets[d].box, im.tracks[t].tb.box);
-                if (v >= opts_.iou_match) pairs.push_back({v, d, t});
+                if (v >= opts_.iou_match) pairs.push_back({confident(d), v, d, t});
             }
         std::sort(pairs.begin(), pairs.end(), [](const Pair& a, const Pair& b) {
-            return a.iou > b.iou || (a.iou == b.iou && (a.d < b.d || (a.d == b.d && a.t < b.t)));
+            return std::tie(a.confident, a.iou, b.d, b.t) > std::tie(b.confident, b.iou, a.d, a.t);
         });
         for (const auto& p : pairs) {
             if (used_det[p.d] || used_trk[p.t]) continue;
@@ -405,7 +431,7 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
                                        }),
                         im.tracks.end());
         for (std::size_t d = 0; d < dets.size(); ++d) {
-            if (used_det[d]) continue;
+            if (used_det[d] || !confident(d)) continue;
             Impl::Track t;
             t.tb.id = im.next_id++;
             t.tb.box = dets[d].box;
@@ -423,6 +449,7 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
         t.depth = need_depth ? personDepth(frame.depth, t.tb.box, opts_.max_depth) : std::nullopt;
 
     std::vector<std::optional<Eigen::Vector3d>> X;  // 3D of each point in the previous frame
+    std::vector<cv::Point2f> res_vec;  // residual flow vector of each point (observed - predicted)
     // 4. Ego-motion: 3D of each point from the previous depth; relative pose refined with
     //    PnP-RANSAC on points outside every person box.
     if (have_prev && !p0.empty()) {
@@ -491,13 +518,16 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
         //    90th percentile of the background residuals).
         const Eigen::Isometry3d T_cur_prev = T_prev_cur.inverse();
         out.flow.reserve(p0.size());
+        res_vec.assign(p0.size(), cv::Point2f(0.f, 0.f));
         std::vector<float> bg_res;
         for (std::size_t i = 0; i < p0.size(); ++i) {
             FilterOutput::FlowPoint fp{p0[i], p1[i], -1.f, false, false};
             if (X[i]) {
-                if (const auto uv = core::project(T_cur_prev * *X[i], Kc))
-                    fp.residual =
-                        static_cast<float>(std::hypot(p1[i].x - uv->x(), p1[i].y - uv->y()));
+                if (const auto uv = core::project(T_cur_prev * *X[i], Kc)) {
+                    res_vec[i] = {p1[i].x - static_cast<float>(uv->x()),
+                                  p1[i].y - static_cast<float>(uv->y())};
+                    fp.residual = static_cast<float>(std::hypot(res_vec[i].x, res_vec[i].y));
+                }
             }
             if (fp.residual >= 0.f && !inAnyBox(p0[i], p1[i])) bg_res.push_back(fp.residual);
             out.flow.push_back(fp);
@@ -541,6 +571,7 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
         const bool use_band = opts_.fg_depth_band > 0 && t.depth.has_value();
         const float zp = t.depth.value_or(0.f);
         int n = 0, n_dyn = 0;
+        std::vector<float> rx, ry;  // residual vectors of the box's points (slow walkers)
         for (std::size_t i = 0; i < out.flow.size(); ++i) {
             auto& fp = out.flow[i];
             if (fp.residual < 0.f || !inner.contains(fp.cur)) continue;
@@ -552,12 +583,33 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
             fp.dynamic = fp.residual > local_thr;
             ++n;
             if (fp.dynamic) ++n_dyn;
+            if (opts_.slow_frames > 0) {
+                rx.push_back(res_vec[i].x);
+                ry.push_back(res_vec[i].y);
+            }
         }
         t.tb.n_points = n;
         t.tb.n_dynamic_points = n_dyn;
         if (n < opts_.min_points) continue;  // no evidence: keep the state
-        const bool moving = n_dyn >= opts_.threshold2_count &&
-                            n_dyn >= opts_.threshold2_fraction * static_cast<double>(n);
+        bool moving = n_dyn >= opts_.threshold2_count &&
+                      n_dyn >= opts_.threshold2_fraction * static_cast<double>(n);
+        if (opts_.slow_frames > 0) {
+            // Slow walkers: the mean of the box's per-step median residual vectors. A
+            // walker who stops keeps it above the threshold for up to slow_frames - 1
+            // steps, which delay the release by as many.
+            const auto mid = rx.size() / 2;
+            std::nth_element(rx.begin(), rx.begin() + static_cast<std::ptrdiff_t>(mid), rx.end());
+            std::nth_element(ry.begin(), ry.begin() + static_cast<std::ptrdiff_t>(mid), ry.end());
+            t.slow_history.emplace_back(rx[mid], ry[mid]);
+            if (t.slow_history.size() > static_cast<std::size_t>(opts_.slow_frames))
+                t.slow_history.pop_front();
+            if (t.slow_history.size() == static_cast<std::size_t>(opts_.slow_frames)) {
+                cv::Point2f sum(0.f, 0.f);
+                for (const auto& r : t.slow_history) sum += r;
+                const double mean = cv::norm(sum) / opts_.slow_frames;
+                moving |= mean > std::max(opts_.slow_threshold, 0.5 * local_thr);
+            }
+        }
         if (moving) {
             t.tb.state = BoxState::Moving;  // caught at once
             t.quiet = 0;

@@ -113,11 +113,24 @@ class DynamicObjectFilter {
         /// corners to the background seen inside the box, which votes "static".
         /// 0 = every point in the box counts.
         double fg_depth_band = 0.0;
+        /// Slow walkers: a box is also moving when the mean, over its last slow_frames
+        /// steps with evidence, of its points' median residual flow vector exceeds
+        /// max(slow_threshold, local threshold / 2) [px per frame]. A person walking at
+        /// 0.5 m/s 4 m away moves under 2 px a frame, below threshold1 for every single
+        /// point, but the same way in every frame, while noise averages out. A walker who
+        /// stops is released up to slow_frames - 1 steps later (the window still holds
+        /// their walk). 0 = off (per-frame evidence only).
+        int slow_frames = 0;
+        double slow_threshold = 1.0;  ///< [px per frame]
 
         // Tracking and hysteresis
         double iou_match = 0.3;         ///< min IoU to associate a detection with a track
         int release_frames = 5;         ///< quiet frames before a Moving box becomes Static
         int max_missed_detections = 2;  ///< detector runs without a match before a track is dropped
+        /// detections scoring below this only continue existing tracks (matched after the
+        /// confident ones) and never start one; with the detector's conf_threshold below
+        /// it, a person the detector grows unsure of stays tracked. 0 = every detection.
+        double new_track_score = 0.0;
 
         // Mask
         int mask_margin = 10;  ///< [px] dilation of each masked box
