@@ -536,3 +536,49 @@ TEST(DynamicFilter, WeakDetectionsContinueTracksButStartNone) {
         }
     }
 }
+
+TEST(DynamicFilter, MovingTracksOutliveDetectorMisses) {
+    // The detector loses the person after frame 5 (as it does for walkers cut by the image
+    // border). A walker's track is kept while its points move, carried by their flow, and
+    // its mask stays on them; a standing person's track is dropped after
+    // max_missed_detections + 1 detector runs without a match.
+    for (auto motion : {dynamic::PersonMotion::Walking, dynamic::PersonMotion::Static}) {
+        dynamic::SyntheticOptions so;
+        so.person = motion;
+        so.n_frames = kFrames;
+        if (motion == dynamic::PersonMotion::Static) so.person_x0 = 0.3;
+        const auto& seq = sequence(so);
+        const auto fo = testOptions();
+        auto det = std::make_unique<ScriptedDetector>();
+        ScriptedDetector* script = det.get();
+        DynamicObjectFilter filter(fo, std::move(det));
+        constexpr int kLastDetection = 5;
+        int covered = 0, frames = 0, tracked = 0;
+        for (const auto& s : seq) {
+            script->next.clear();
+            if (s.person_box && static_cast<int>(s.frame.index) <= kLastDetection)
+                script->next.push_back({*s.person_box, 0, "person", 0.9f});
+            const auto out = filter.step(s.frame, s.T_prev_cur);
+            if (static_cast<int>(s.frame.index) <= kLastDetection + fo.max_missed_detections + 1)
+                continue;
+            ++frames;
+            tracked += !out.boxes.empty();
+            if (s.person_box) {
+                const cv::Rect p = cv::Rect(*s.person_box) & cv::Rect(0, 0, 640, 480);
+                covered += cv::countNonZero(out.mask(p)) >= 0.5 * p.area();
+            }
+        }
+        std::printf("%s person, no detections after frame %d: tracked in %d/%d later frames, "
+                    "mask on them in %d\n",
+                    motion == dynamic::PersonMotion::Walking ? "walking" : "standing",
+                    kLastDetection, tracked, frames, covered);
+        ASSERT_GT(frames, 5);
+        if (motion == dynamic::PersonMotion::Walking) {
+            EXPECT_EQ(tracked, frames);
+            EXPECT_GE(covered, frames - 1);
+        } else {
+            EXPECT_EQ(tracked, 0);
+            EXPECT_EQ(covered, 0);
+        }
+    }
+}

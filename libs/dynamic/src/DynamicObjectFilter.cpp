@@ -425,9 +425,16 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
         }
         for (std::size_t t = 0; t < im.tracks.size(); ++t)
             if (!used_trk[t]) ++im.tracks[t].missed;
+        // A track whose last step showed motion is kept without detections, carried by
+        // its points' flow: the detector loses walkers cut by the image border, half
+        // hidden or filling the view, and the corners seeded in their box would otherwise
+        // join the background of the next ego-motion fit. Dropped once quiet and unmatched.
         im.tracks.erase(std::remove_if(im.tracks.begin(), im.tracks.end(),
                                        [&](const Impl::Track& t) {
-                                           return t.missed > opts_.max_missed_detections;
+                                           const bool moving_now =
+                                               t.tb.state == BoxState::Moving && t.quiet == 0;
+                                           return t.missed > opts_.max_missed_detections &&
+                                                  !moving_now;
                                        }),
                         im.tracks.end());
         for (std::size_t d = 0; d < dets.size(); ++d) {
