@@ -47,6 +47,19 @@ cv::Mat personSprite() {
     return m(cv::Rect(180, 90, 105, 295)).clone();  // the person with a little margin
 }
 
+/// One frame of the wall photo at a constant 2 m depth (no motion: tests of the tracks).
+core::Frame flatWallFrame() {
+    core::Frame f;
+    f.bgr = wallTexture();
+    f.depth = cv::Mat(f.bgr.size(), CV_32FC1, cv::Scalar(2.0f));
+    f.K.fx = f.K.fy = 525;
+    f.K.cx = 319.5;
+    f.K.cy = 239.5;
+    f.K.width = f.bgr.cols;
+    f.K.height = f.bgr.rows;
+    return f;
+}
+
 DynamicObjectFilter::Options testOptions() {
     auto cfg = core::loadIni(kRoot + "/config_ini/dynamic_filter.ini");
     DynamicObjectFilter::Options o;
@@ -394,14 +407,7 @@ TEST(DynamicConfig, BadValuesAreRejected) {
 TEST(DynamicFilter, UnknownBoxesAreMaskedUntilThereIsEvidence) {
     // Frame 0 has no flow yet: with mask_unknown the new person box is masked (a walker is
     // not mapped while the filter waits for evidence); without it, nothing is masked.
-    core::Frame f;
-    f.bgr = wallTexture();
-    f.depth = cv::Mat(f.bgr.size(), CV_32FC1, cv::Scalar(2.0f));
-    f.K.fx = f.K.fy = 525;
-    f.K.cx = 319.5;
-    f.K.cy = 239.5;
-    f.K.width = f.bgr.cols;
-    f.K.height = f.bgr.rows;
+    core::Frame f = flatWallFrame();
     const cv::Rect2f box(300, 100, 80, 200);
     for (bool mask_unknown : {true, false}) {
         auto o = testOptions();
@@ -500,14 +506,7 @@ TEST(DynamicFilter, SlowWalkerIsCaughtByItsMeanResidualFlow) {
 TEST(DynamicFilter, WeakDetectionsContinueTracksButStartNone) {
     // new_track_score: a detection scoring under it continues the track it overlaps (the
     // detector grows unsure of a person cut by the border) but never starts a track.
-    core::Frame f;
-    f.bgr = wallTexture();
-    f.depth = cv::Mat(f.bgr.size(), CV_32FC1, cv::Scalar(2.0f));
-    f.K.fx = f.K.fy = 525;
-    f.K.cx = 319.5;
-    f.K.cy = 239.5;
-    f.K.width = f.bgr.cols;
-    f.K.height = f.bgr.rows;
+    core::Frame f = flatWallFrame();
     const cv::Rect2f person(300, 100, 80, 200), elsewhere(60, 120, 70, 180);
     for (double new_track_score : {0.35, 0.0}) {
         auto o = testOptions();
