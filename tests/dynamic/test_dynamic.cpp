@@ -184,41 +184,45 @@ TEST(DynamicFilter, HysteresisReleasesAfterQuietFrames) {
     dynamic::SyntheticOptions so;
     so.person = dynamic::PersonMotion::Walking;
     so.n_frames = kFrames;
-    auto fo = testOptions();
     const auto& seq = sequence(so);  // the first 12 frames are used
     dynamic::SyntheticOptions stand = so;
     stand.person = dynamic::PersonMotion::Static;
     stand.person_x0 = so.person_x0 + so.person_speed * 11 / so.fps;
     stand.n_frames = 24;
     const auto& seq2 = sequence(stand);
-    // Continue the camera path: frames 12..23 of the standing sequence.
-    auto det = std::make_unique<ScriptedDetector>();
-    ScriptedDetector* script = det.get();
-    DynamicObjectFilter filter(fo, std::move(det));
-    std::vector<BoxState> states;
-    for (int k = 0; k < 24; ++k) {
-        const auto& s = k < 12 ? seq[k] : seq2[k];
-        script->next = {{*s.person_box, 0, "person", 0.9f}};
-        const auto out = filter.step(s.frame, s.T_prev_cur);
-        ASSERT_EQ(out.boxes.size(), 1u);
-        states.push_back(out.boxes[0].state);
+    // Per-frame evidence alone (slow_frames 0), then with the shipped slow-walker window.
+    for (int slow_frames : {0, testOptions().slow_frames}) {
+        auto fo = testOptions();
+        fo.slow_frames = slow_frames;
+        // Continue the camera path: frames 12..23 of the standing sequence.
+        auto det = std::make_unique<ScriptedDetector>();
+        ScriptedDetector* script = det.get();
+        DynamicObjectFilter filter(fo, std::move(det));
+        std::vector<BoxState> states;
+        for (int k = 0; k < 24; ++k) {
+            const auto& s = k < 12 ? seq[k] : seq2[k];
+            script->next = {{*s.person_box, 0, "person", 0.9f}};
+            const auto out = filter.step(s.frame, s.T_prev_cur);
+            ASSERT_EQ(out.boxes.size(), 1u);
+            states.push_back(out.boxes[0].state);
+        }
+        EXPECT_EQ(states[1], BoxState::Moving) << "caught at once";
+        EXPECT_EQ(states[11], BoxState::Moving);
+        // From frame 12 on the person stands still: quiet frames 12, 13, ... release it
+        // after release_frames of them (one frame of slack for the last walking step's
+        // flow). The slow-walker window still holds the walk for up to slow_frames - 1 of
+        // the first standing steps, which are not quiet yet.
+        const int release = fo.release_frames;
+        const int window = std::max(slow_frames - 1, 0);
+        int released = -1;
+        for (int k = 12; k < 24 && released < 0; ++k)
+            if (states[k] == BoxState::Static) released = k;
+        std::printf("walked 12 frames, then stood: released at frame %d (release_frames %d, "
+                    "slow_frames %d)\n", released, release, slow_frames);
+        ASSERT_GE(released, 12 + release - 1) << "not released too early (-1: never)";
+        EXPECT_LE(released, 12 + release + window) << "released after quiet frames";
+        for (int k = released; k < 24; ++k) EXPECT_EQ(states[k], BoxState::Static) << k;
     }
-    EXPECT_EQ(states[1], BoxState::Moving) << "caught at once";
-    EXPECT_EQ(states[11], BoxState::Moving);
-    // From frame 12 on the person stands still: quiet frames 12, 13, ... release it after
-    // release_frames of them (one frame of slack for the last walking step's flow). The
-    // slow-walker window (slow_frames) still holds the walk for up to slow_frames - 1 of
-    // the first standing steps, which are not quiet yet.
-    const int release = fo.release_frames;
-    const int window = std::max(fo.slow_frames - 1, 0);
-    int released = -1;
-    for (int k = 12; k < 24 && released < 0; ++k)
-        if (states[k] == BoxState::Static) released = k;
-    std::printf("walked 12 frames, then stood: released at frame %d (release_frames %d, "
-                "slow_frames %d)\n", released, release, fo.slow_frames);
-    ASSERT_GE(released, 12 + release - 1) << "not released too early (-1: never)";
-    EXPECT_LE(released, 12 + release + window) << "released after quiet frames";
-    for (int k = released; k < 24; ++k) EXPECT_EQ(states[k], BoxState::Static) << k;
 }
 
 TEST(DynamicFilter, DetectEveryKCarriesBoxes) {
