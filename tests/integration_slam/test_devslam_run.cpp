@@ -87,3 +87,28 @@ TEST(DevslamRun, BadInputIsReported) {
     EXPECT_EQ(r.rc, 1);
     EXPECT_NE(r.out.find("usage"), std::string::npos);
 }
+
+// The filter one frame ahead in a second thread (async_filter, the shipped setting) must
+// give the sequential run's result: its ego-motion prior is the constant-velocity
+// prediction instead of the tracker's, which on these slow real frames changes nothing.
+TEST(DevslamRun, FilterInASecondThreadKeepsTheSequentialAccuracy) {
+    auto ate = [](const std::string& out) {
+        const auto at = out.find("ATE        : RMSE ");
+        return at == std::string::npos ? -1.0 : std::stod(out.substr(at + 18));
+    };
+    const auto seq = run("--mode dynamic --quiet --out '' --set run.async_filter=false");
+    const auto par = run("--mode dynamic --quiet --out '' --set run.async_filter=true");
+    ASSERT_EQ(seq.rc, 0) << seq.out;
+    ASSERT_EQ(par.rc, 0) << par.out;
+    EXPECT_EQ(seq.out.find("second thread"), std::string::npos) << seq.out;
+    EXPECT_NE(par.out.find("filter one frame ahead in a second thread"), std::string::npos)
+        << par.out;
+    for (const auto* r : {&seq, &par}) {
+        EXPECT_NE(r->out.find("frames     : 32"), std::string::npos) << r->out;
+        EXPECT_NE(r->out.find("lost frames: 0"), std::string::npos) << r->out;
+    }
+    ASSERT_GT(ate(seq.out), 0.0) << seq.out;
+    ASSERT_GT(ate(par.out), 0.0) << par.out;
+    EXPECT_LT(ate(par.out), 0.01);
+    EXPECT_NEAR(ate(par.out), ate(seq.out), 0.001);
+}
