@@ -167,8 +167,10 @@ int main(int argc, char** argv) {
               ">= 0.5 in the "
            << sweep_frames.size()
            << " frames of the walking and standing sequences):\n\n"
-              "| input (w x h) | median ms | median thread-CPU ms | person.jpg IoU | dog.jpg "
-              "persons | synthetic person found | mean IoU |\n|---|---|---|---|---|---|---|\n";
+              "| input (w x h) | median ms | median thread-CPU ms | median ms, "
+           << all_threads
+           << " OpenCV threads | person.jpg IoU | dog.jpg persons | synthetic person found | "
+              "mean IoU |\n|---|---|---|---|---|---|---|---|\n";
         for (const auto& [w, h] : std::vector<std::pair<int, int>>{
                  {320, 320}, {320, 256}, {288, 224}, {256, 192}, {224, 160}}) {
             auto dcfg = core::loadIni(kRoot + "/config_ini/detector_yolo_fastest.ini");
@@ -176,6 +178,9 @@ int main(int argc, char** argv) {
             dcfg->write("detector", "input_height", h);
             auto det = detect::makeDetector(*dcfg);
             const auto t = timeDetector(*det, tum);
+            cv::setNumThreads(all_threads);
+            const auto t_all = timeDetector(*det, tum);
+            cv::setNumThreads(threads);
             double best = 0;
             for (const auto& d : det->detect(person_jpg))
                 best = std::max(best, static_cast<double>(detect::iou(d.box, person_box)));
@@ -190,7 +195,8 @@ int main(int argc, char** argv) {
                 iou_sum += b;
             }
             md << "| " << w << " x " << h << " | " << fmt(core::median(t.ms)) << " | "
-               << fmt(core::median(t.cpu)) << " | " << fmt(best, 2) << " | " << dog << " | "
+               << fmt(core::median(t.cpu)) << " | " << fmt(core::median(t_all.ms)) << " | "
+               << fmt(best, 2) << " | " << dog << " | "
                << found << "/" << sweep_frames.size() << " | "
                << fmt(sweep_frames.empty() ? 0.0 : iou_sum / sweep_frames.size(), 2) << " |\n";
         }
@@ -201,41 +207,56 @@ int main(int argc, char** argv) {
         fo.loadFromConfig(*cfg);
 
         md << "\n| filter stage (detector excluded) | sequence | median ms | mean ms | median "
-              "thread-CPU ms | frames |\n|---|---|---|---|---|---|\n";
+              "thread-CPU ms | frames | median ms, "
+           << all_threads << " OpenCV threads |\n|---|---|---|---|---|---|---|\n";
         {
             // Five passes over the sequence (a fresh filter each): a median over ~150 steps,
             // since single 29-step medians moved by +-25 % between runs on this VM.
-            std::vector<double> ms, cpu;
-            for (int pass = 0; pass < 5; ++pass) {
-                auto det = std::make_unique<TruthDetector>();
-                TruthDetector* truth = det.get();
-                dynamic::DynamicObjectFilter filter(fo, std::move(det));
-                for (const auto& s : walking) {
-                    truth->next = {{*s.person_box, 0, "person", 0.9f}};
-                    const double c0 = threadCpuMs();
-                    const auto out = filter.step(s.frame, s.T_prev_cur);
-                    if (s.frame.index == 0) continue;
-                    cpu.push_back(threadCpuMs() - c0);
-                    ms.push_back(out.filter_ms);
+            auto passes = [&](std::vector<double>& ms, std::vector<double>& cpu) {
+                for (int pass = 0; pass < 5; ++pass) {
+                    auto det = std::make_unique<TruthDetector>();
+                    TruthDetector* truth = det.get();
+                    dynamic::DynamicObjectFilter filter(fo, std::move(det));
+                    for (const auto& s : walking) {
+                        truth->next = {{*s.person_box, 0, "person", 0.9f}};
+                        const double c0 = threadCpuMs();
+                        const auto out = filter.step(s.frame, s.T_prev_cur);
+                        if (s.frame.index == 0) continue;
+                        cpu.push_back(threadCpuMs() - c0);
+                        ms.push_back(out.filter_ms);
+                    }
                 }
-            }
+            };
+            std::vector<double> ms, cpu, ms_all, cpu_all;
+            passes(ms, cpu);
+            cv::setNumThreads(all_threads);
+            passes(ms_all, cpu_all);
+            cv::setNumThreads(threads);
             const auto st = core::summarize(ms);
             md << "| DynamicObjectFilter::step | synthetic walking person (true box) | "
                << fmt(st.median, 2) << " | " << fmt(st.mean, 2) << " | "
-               << fmt(core::median(cpu), 2) << " | " << ms.size() << " |\n";
+               << fmt(core::median(cpu), 2) << " | " << ms.size() << " | "
+               << fmt(core::median(ms_all), 2) << " |\n";
         }
         {
-            std::vector<double> ms;
-            for (int pass = 0; pass < 5; ++pass) {
-                auto filter = dynamic::makeFilterFromConfig(*cfg);
-                for (const auto& f : tum) {
-                    const auto out = filter->step(f, std::nullopt);
-                    if (f.index > 0) ms.push_back(out.filter_ms);
+            auto passes = [&](std::vector<double>& ms) {
+                for (int pass = 0; pass < 5; ++pass) {
+                    auto filter = dynamic::makeFilterFromConfig(*cfg);
+                    for (const auto& f : tum) {
+                        const auto out = filter->step(f, std::nullopt);
+                        if (f.index > 0) ms.push_back(out.filter_ms);
+                    }
                 }
-            }
+            };
+            std::vector<double> ms, ms_all;
+            passes(ms);
+            cv::setNumThreads(all_threads);
+            passes(ms_all);
+            cv::setNumThreads(threads);
             const auto st = core::summarize(ms);
             md << "| DynamicObjectFilter::step | fr1_xyz_first37 (YOLO, no person) | "
-               << fmt(st.median, 2) << " | " << fmt(st.mean, 2) << " | - | " << ms.size() << " |\n";
+               << fmt(st.median, 2) << " | " << fmt(st.mean, 2) << " | - | " << ms.size() << " | "
+               << fmt(core::median(ms_all), 2) << " |\n";
         }
 
         // 3. detect_every trade-off with the real detector.
