@@ -45,6 +45,18 @@ std::string fmt(double v, int prec = 1) {
     return b;
 }
 
+/// Runs `f` with OpenCV at `n` threads, then restores the previous setting.
+template <class F>
+auto withThreads(int n, F&& f) {
+    const int before = cv::getNumThreads();
+    cv::setNumThreads(n);
+    struct Restore {
+        int n;
+        ~Restore() { cv::setNumThreads(n); }
+    } restore{before};
+    return f();
+}
+
 /// Detector that returns the true box (times the filter alone on synthetic data).
 class TruthDetector : public detect::PersonDetector {
   public:
@@ -128,9 +140,7 @@ int main(int argc, char** argv) {
             core::ProgressBar bar("detector " + det->name(), tum.size());
             const auto t = timeDetector(*det, tum, &bar);
             bar.finish();
-            cv::setNumThreads(all_threads);
-            const auto t_all = timeDetector(*det, tum);
-            cv::setNumThreads(threads);
+            const auto t_all = withThreads(all_threads, [&] { return timeDetector(*det, tum); });
             const auto s = core::summarize(t.ms);
             md << "| " << det->name() << " | " << ini << " | " << fmt(s.median) << " | "
                << fmt(s.mean) << " | " << fmt(core::median(t.cpu)) << " | " << t.ms.size()
@@ -178,9 +188,7 @@ int main(int argc, char** argv) {
             dcfg->write("detector", "input_height", h);
             auto det = detect::makeDetector(*dcfg);
             const auto t = timeDetector(*det, tum);
-            cv::setNumThreads(all_threads);
-            const auto t_all = timeDetector(*det, tum);
-            cv::setNumThreads(threads);
+            const auto t_all = withThreads(all_threads, [&] { return timeDetector(*det, tum); });
             double best = 0;
             for (const auto& d : det->detect(person_jpg))
                 best = std::max(best, static_cast<double>(detect::iou(d.box, person_box)));
@@ -212,7 +220,8 @@ int main(int argc, char** argv) {
         {
             // Five passes over the sequence (a fresh filter each): a median over ~150 steps,
             // since single 29-step medians moved by +-25 % between runs on this VM.
-            auto passes = [&](std::vector<double>& ms, std::vector<double>& cpu) {
+            auto passes = [&] {
+                std::vector<double> ms, cpu;
                 for (int pass = 0; pass < 5; ++pass) {
                     auto det = std::make_unique<TruthDetector>();
                     TruthDetector* truth = det.get();
@@ -226,12 +235,10 @@ int main(int argc, char** argv) {
                         ms.push_back(out.filter_ms);
                     }
                 }
+                return std::pair{ms, cpu};
             };
-            std::vector<double> ms, cpu, ms_all, cpu_all;
-            passes(ms, cpu);
-            cv::setNumThreads(all_threads);
-            passes(ms_all, cpu_all);
-            cv::setNumThreads(threads);
+            const auto [ms, cpu] = passes();
+            const auto ms_all = withThreads(all_threads, passes).first;
             const auto st = core::summarize(ms);
             md << "| DynamicObjectFilter::step | synthetic walking person (true box) | "
                << fmt(st.median, 2) << " | " << fmt(st.mean, 2) << " | "
@@ -239,7 +246,8 @@ int main(int argc, char** argv) {
                << fmt(core::median(ms_all), 2) << " |\n";
         }
         {
-            auto passes = [&](std::vector<double>& ms) {
+            auto passes = [&] {
+                std::vector<double> ms;
                 for (int pass = 0; pass < 5; ++pass) {
                     auto filter = dynamic::makeFilterFromConfig(*cfg);
                     for (const auto& f : tum) {
@@ -247,12 +255,10 @@ int main(int argc, char** argv) {
                         if (f.index > 0) ms.push_back(out.filter_ms);
                     }
                 }
+                return ms;
             };
-            std::vector<double> ms, ms_all;
-            passes(ms);
-            cv::setNumThreads(all_threads);
-            passes(ms_all);
-            cv::setNumThreads(threads);
+            const auto ms = passes();
+            const auto ms_all = withThreads(all_threads, passes);
             const auto st = core::summarize(ms);
             md << "| DynamicObjectFilter::step | fr1_xyz_first37 (YOLO, no person) | "
                << fmt(st.median, 2) << " | " << fmt(st.mean, 2) << " | - | " << ms.size() << " | "
