@@ -93,8 +93,9 @@ TEST(DevslamRun, BadInputIsReported) {
 // prediction instead of the tracker's, which on these slow real frames changes nothing.
 TEST(DevslamRun, FilterInASecondThreadKeepsTheSequentialAccuracy) {
     auto ate = [](const std::string& out) {
-        const auto at = out.find("ATE        : RMSE ");
-        return at == std::string::npos ? -1.0 : std::stod(out.substr(at + 18));
+        const std::string key = "ATE        : RMSE ";
+        const auto at = out.find(key);
+        return at == std::string::npos ? -1.0 : std::stod(out.substr(at + key.size()));
     };
     const auto seq = run("--mode dynamic --quiet --out '' --set run.async_filter=false");
     const auto par = run("--mode dynamic --quiet --out '' --set run.async_filter=true");
