@@ -1,6 +1,7 @@
 #include "MaskSource.h"
 
 #include <stdexcept>
+#include <utility>
 
 #ifdef DEVSLAM_HAVE_DYNAMIC
 #include <devslam/dynamic/DynamicObjectFilter.h>
@@ -9,6 +10,25 @@
 namespace devslam::run {
 
 namespace {
+class TruthMask final : public MaskSource {
+  public:
+    TruthMask(eval::PersonTruth truth, int margin) : truth_(std::move(truth)), margin_(margin) {}
+    MaskStep step(const core::Frame& frame, const std::optional<Eigen::Isometry3d>&) override {
+        MaskStep s;
+        s.mask = truth_.walkerMask(frame.timestamp, margin_);
+        return s;
+    }
+    void reset() override {}
+    std::string describe() const override {
+        return "renderer truth: walking people's pixels dilated by " + std::to_string(margin_) +
+               " px (diagnostic)";
+    }
+
+  private:
+    eval::PersonTruth truth_;
+    int margin_;
+};
+
 #ifndef DEVSLAM_HAVE_DYNAMIC
 class NoMask final : public MaskSource {
   public:
@@ -52,10 +72,24 @@ class FilterMask final : public MaskSource {
 }  // namespace
 
 std::unique_ptr<MaskSource> makeMaskSource(const std::string& mode,
-                                           const mrpt::config::CConfigFileBase& cfg) {
-    if (mode != "none" && mode != "all_persons" && mode != "dynamic")
+                                           const mrpt::config::CConfigFileBase& cfg,
+                                           const std::string& input) {
+    if (mode != "none" && mode != "all_persons" && mode != "dynamic" && mode != "truth")
         throw std::invalid_argument("unknown mode '" + mode +
-                                    "' (known: none, all_persons, dynamic)");
+                                    "' (known: none, all_persons, dynamic, truth)");
+    if (mode == "truth") {
+        auto truth = eval::PersonTruth::open(input);
+        if (!truth)
+            throw std::invalid_argument(
+                "mode 'truth' needs the renderer's person truth (persons.txt and labels/), "
+                "which '" +
+                input + "' does not have");
+        const int margin = cfg.read_int("dynamic_filter", "mask_margin", 10);
+        if (margin < 0)
+            throw std::invalid_argument("[dynamic_filter] mask_margin: must be >= 0, got " +
+                                        std::to_string(margin));
+        return std::make_unique<TruthMask>(std::move(*truth), margin);
+    }
 #ifdef DEVSLAM_HAVE_DYNAMIC
     auto filter = dynamic::makeFilterFromConfig(cfg, dynamic::parseMaskMode(mode));
     return std::make_unique<FilterMask>(std::move(filter));

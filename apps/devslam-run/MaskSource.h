@@ -34,8 +34,12 @@ class MaskSource {
     [[nodiscard]] virtual std::string describe() const = 0;
 };
 
-/// mode: "none" | "all_persons" | "dynamic". `cfg` holds [detector] and [dynamic_filter].
+/// mode: "none" | "all_persons" | "dynamic" | "truth". `cfg` holds [detector] and
+/// [dynamic_filter]. "truth" is a diagnostic: the renderer's walker pixels of `input` (a
+/// devslam-synth folder) dilated by [dynamic_filter] mask_margin, i.e. a perfect filter's
+/// silhouette mask; it throws when `input` has no person truth.
 [[nodiscard]] std::unique_ptr<MaskSource> makeMaskSource(const std::string& mode,
-                                                         const mrpt::config::CConfigFileBase& cfg);
+                                                         const mrpt::config::CConfigFileBase& cfg,
+                                                         const std::string& input);
 
 }  // namespace devslam::run

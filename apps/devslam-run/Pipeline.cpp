@@ -75,7 +75,7 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
     const auto slam_opts = slam::SlamOptions::fromConfig(cfg);
     slam::GridMapOptions grid_opts;
     grid_opts.loadFromConfig(cfg, "grid_map");
-    auto masks = makeMaskSource(rc.mode, filter_cfg);
+    auto masks = makeMaskSource(rc.mode, filter_cfg, rc.input);
     slam::Slam slam(slam_opts);
 
     RunReport rep;
@@ -289,8 +289,8 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
                 while (frame + 1 < rep.log.size() && rep.log[frame].t < e.timestamp - 1e-6) ++frame;
                 mf << num(e.timestamp, 6) << "," << frame << "," << e.person_id << ","
                    << (e.moving ? "moving" : "static") << "," << e.visible_pixels << ","
-                   << num(e.masked_fraction, 3) << "," << e.filter_box << ","
-                   << num(e.box_cover, 2) << "\n";
+                   << num(e.masked_fraction, 3) << "," << e.filter_box << "," << num(e.box_cover, 2)
+                   << "\n";
             }
         }
         rep.peak_rss_mb = peakRssMb();

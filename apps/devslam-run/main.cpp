@@ -2,7 +2,7 @@
 // or an MRPT rawlog; prints a summary and writes trajectories, maps and plots.
 //
 //   devslam-run                                   # data/tum/fr1_xyz_first37, dynamic mode
-//   devslam-run --input DIR|FILE.rawlog --mode none|all_persons|dynamic
+//   devslam-run --input DIR|FILE.rawlog --mode none|all_persons|dynamic|truth
 //               --config config_ini/slam_tum_fr1.ini --out DIR
 //   devslam-run --bench 5                         # all modes x 5 runs -> docs/RESULTS.md
 #include "Pipeline.h"
@@ -24,7 +24,7 @@ using namespace devslam;
 namespace {
 
 const char* kUsage =
-    "usage: devslam-run [--input PATH] [--mode none|all_persons|dynamic] [--config INI]\n"
+    "usage: devslam-run [--input PATH] [--mode none|all_persons|dynamic|truth] [--config INI]\n"
     "                   [--out DIR] [--max-frames N] [--quiet] [--set SECTION.KEY=VALUE]...\n"
     "                   [--replay N]  (play the input forward/backward N times)\n"
     "       devslam-run --bench N [--input PATH] [--config INI] [--results FILE]\n"
@@ -33,7 +33,9 @@ const char* kUsage =
     "/data/tum/fr1_xyz_first37\n"
     "          --config " DEVSLAM_SOURCE_DIR
     "/config_ini/slam_tum_fr1.ini\n"
-    "          --mode from the INI's [run] mode (dynamic), --out ./out/devslam-run\n";
+    "          --mode from the INI's [run] mode (dynamic), --out ./out/devslam-run\n"
+    "mode truth (diagnostic, devslam-synth folders only): the mask is the renderer's\n"
+    "walking people, dilated by [dynamic_filter] mask_margin - a perfect filter.\n";
 
 struct Args {
     std::string input = std::string(DEVSLAM_SOURCE_DIR) + "/data/tum/fr1_xyz_first37";

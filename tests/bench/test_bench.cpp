@@ -1,6 +1,7 @@
 // Two-frame smoke test of the whole devslam-bench command: renders a synthetic sequence,
-// runs devslam-run in the three modes on it and on the shipped TUM frames, scores the
-// filter against the person truth, and writes the tables and the RESULTS section.
+// runs devslam-run in the three modes on it and on the shipped TUM frames (plus the
+// diagnostic truth mask on the synthetic one), scores the filter against the person truth,
+// and writes the tables and the RESULTS section.
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -35,12 +36,15 @@ TEST(DevslamBench, TwoFrameSmokeRunOfTheWholeCommand) {
         fs::temp_directory_path() / ("devslam_bench_smoke_" + std::to_string(::getpid()));
     fs::remove_all(tmp);
     fs::create_directories(tmp);
-    std::ofstream(tmp / "bench.ini") << "[bench]\nrepeats = 1\nslam_config = " << root
-                                     << "/config_ini/slam_synthetic.ini\n"
-                                        "[sequence_short]\nscenario = short_walking\n"
-                                        "[sequence_fr1]\npath = "
-                                     << root << "/data/tum/fr1_xyz_first37\nslam_config = " << root
-                                     << "/config_ini/slam_tum_fr1.ini\n";
+    std::ofstream(tmp / "bench.ini")
+        << "[bench]\nrepeats = 1\nmodes = none all_persons dynamic truth\n"
+           "slam_config = "
+        << root
+        << "/config_ini/slam_synthetic.ini\n"
+           "[sequence_short]\nscenario = short_walking\n"
+           "[sequence_fr1]\npath = "
+        << root << "/data/tum/fr1_xyz_first37\nslam_config = " << root
+        << "/config_ini/slam_tum_fr1.ini\n";
     std::ofstream(tmp / "RESULTS.md") << "# Results\n";
     const std::string cmd =
         "'" + bin + "/devslam-bench' --config '" + (tmp / "bench.ini").string() +
@@ -50,11 +54,14 @@ TEST(DevslamBench, TwoFrameSmokeRunOfTheWholeCommand) {
     // The synthetic sequence was rendered (2 frames) with its person truth.
     EXPECT_TRUE(fs::exists(tmp / "out/synth/short/groundtruth.txt"));
     EXPECT_EQ(countLines(readFile(tmp / "out/synth/short/groundtruth.txt")), 2u);
-    // 2 sequences x 3 modes x 1 repeat, every run succeeded.
+    // 4 modes on the synthetic sequence, 3 on fr1 (no person truth for mode truth), 1 repeat,
+    // every run succeeded.
     const std::string runs = readFile(tmp / "out/runs.csv");
-    EXPECT_EQ(countLines(runs), 1u + 6u) << runs;
+    EXPECT_EQ(countLines(runs), 1u + 7u) << runs;
+    EXPECT_NE(runs.find("short,truth,0,"), std::string::npos) << runs;
+    EXPECT_EQ(runs.find("fr1,truth"), std::string::npos) << runs;
     const std::string ate = readFile(tmp / "out/table2_ate.csv");
-    EXPECT_EQ(countLines(ate), 1u + 6u);
+    EXPECT_EQ(countLines(ate), 1u + 7u);
     std::istringstream lines(ate);
     std::string line;
     std::getline(lines, line);  // header

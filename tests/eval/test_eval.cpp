@@ -304,6 +304,44 @@ TEST(MaskScore, PersonTruthOfAFolder) {
     EXPECT_EQ(s.moving_instances, 1u);
     EXPECT_EQ(s.moving_masked, 0u);
     EXPECT_THROW(truth->score(cv::Mat(), 2.0, 1, s), std::runtime_error);  // no entry
+    EXPECT_THROW((void)truth->walkerMask(2.0, 0), std::runtime_error);
+    fs::remove_all(dir);
+}
+
+// devslam-run's diagnostic mode `truth`: the walkers' pixels, dilated, never a static person.
+TEST(MaskScore, WalkerMaskIsTheWalkersPixelsDilated) {
+    namespace fs = std::filesystem;
+    const fs::path dir = fs::temp_directory_path() / "devslam_test_walker_mask";
+    fs::remove_all(dir);
+    fs::create_directories(dir / "labels");
+    std::ofstream(dir / "persons.txt") << "1.000000 1 walker moving 2 2 4 4 16\n"
+                                          "1.000000 2 sitter static 12 12 4 4 16\n";
+    cv::Mat labels(20, 20, CV_8UC1, cv::Scalar(0));
+    labels(cv::Rect(2, 2, 4, 4)).setTo(1);
+    labels(cv::Rect(12, 12, 4, 4)).setTo(2);
+    cv::imwrite((dir / "labels" / "1.000000.png").string(), labels);
+    const auto truth = eval::PersonTruth::open(dir.string());
+    ASSERT_TRUE(truth.has_value());
+    const cv::Mat exact = truth->walkerMask(1.0, 0);
+    ASSERT_EQ(exact.type(), CV_8UC1);
+    EXPECT_EQ(cv::countNonZero(exact), 16);
+    EXPECT_EQ(cv::countNonZero(exact(cv::Rect(2, 2, 4, 4))), 16);
+    const cv::Mat grown = truth->walkerMask(1.0, 2);
+    EXPECT_EQ(cv::countNonZero(grown), 8 * 8);  // 4x4 grown by 2 px on every side
+    EXPECT_EQ(cv::countNonZero(grown(cv::Rect(12, 12, 4, 4))), 0);  // the sitter stays
+    // Scored against the same truth, it masks every walker and no static person.
+    eval::MaskScore s;
+    truth->score(grown, 1.0, 1, s);
+    EXPECT_EQ(s.movingRecall(), 1.0);
+    EXPECT_EQ(s.staticMasked(), 0.0);
+    fs::remove_all(dir);
+}
+
+TEST(MaskScore, MalformedPersonsTxtIsRejected) {
+    namespace fs = std::filesystem;
+    const fs::path dir = fs::temp_directory_path() / "devslam_test_person_truth_bad";
+    fs::remove_all(dir);
+    fs::create_directories(dir / "labels");
     {
         std::ofstream p(dir / "persons.txt");
         p << "1.0 1 p walking 0 0 10 10 100\n";  // bad state

@@ -83,6 +83,11 @@ TEST(DevslamRun, BadInputIsReported) {
     EXPECT_EQ(r.rc, 1);
     EXPECT_NE(r.out.find("fine_raduis"), std::string::npos) << r.out;
     fs::remove(ini);
+    // the diagnostic truth mask needs a rendered folder's person truth
+    r = run("--mode truth --quiet --out ''");
+    EXPECT_EQ(r.rc, 1);
+    EXPECT_NE(r.out.find("needs the renderer's person truth"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("fr1_xyz_first37"), std::string::npos) << r.out;
     r = run("--frobnicate");
     EXPECT_EQ(r.rc, 1);
     EXPECT_NE(r.out.find("usage"), std::string::npos);

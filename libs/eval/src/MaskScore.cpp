@@ -2,6 +2,7 @@
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include <cstdio>
 #include <filesystem>
@@ -105,17 +106,38 @@ std::optional<PersonTruth> PersonTruth::open(const std::string& folder) {
     return t;
 }
 
-void PersonTruth::score(const cv::Mat& mask, double timestamp, int min_pixels,
-                        MaskScore& score, const std::vector<FilterBox>& boxes) const {
+PersonTruth::FrameTruth PersonTruth::frame(double timestamp) const {
     char stamp[64];
     std::snprintf(stamp, sizeof stamp, "%.6f", timestamp);
     const auto it = persons_.find(stamp);
     if (it == persons_.end())
         throw std::runtime_error(folder_ + "/persons.txt: no entry for frame " + stamp);
     const std::string label_path = folder_ + "/labels/" + stamp + ".png";
-    const cv::Mat labels = cv::imread(label_path, cv::IMREAD_UNCHANGED);
-    if (labels.empty()) throw std::runtime_error("cannot read person labels '" + label_path + "'");
-    score.add(mask, labels, it->second, min_pixels, timestamp, boxes);
+    FrameTruth f;
+    f.labels = cv::imread(label_path, cv::IMREAD_UNCHANGED);
+    if (f.labels.empty() || f.labels.type() != CV_8UC1)
+        throw std::runtime_error("cannot read person labels '" + label_path +
+                                 "' (expected an 8-bit one-channel PNG)");
+    f.persons = &it->second;
+    return f;
+}
+
+void PersonTruth::score(const cv::Mat& mask, double timestamp, int min_pixels, MaskScore& score,
+                        const std::vector<FilterBox>& boxes) const {
+    const auto f = frame(timestamp);
+    score.add(mask, f.labels, *f.persons, min_pixels, timestamp, boxes);
+}
+
+cv::Mat PersonTruth::walkerMask(double timestamp, int margin) const {
+    const auto f = frame(timestamp);
+    cv::Mat mask = cv::Mat::zeros(f.labels.size(), CV_8UC1);
+    for (const auto& p : *f.persons)
+        if (p.moving) mask |= f.labels == p.id;
+    if (margin > 0)
+        cv::dilate(
+            mask, mask,
+            cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * margin + 1, 2 * margin + 1)));
+    return mask;
 }
 
 }  // namespace devslam::eval

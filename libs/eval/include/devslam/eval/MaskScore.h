@@ -79,8 +79,18 @@ class PersonTruth {
     /// no truth (a missing label image or persons.txt entry).
     void score(const cv::Mat& mask, double timestamp, int min_pixels, MaskScore& score,
                const std::vector<FilterBox>& boxes = {}) const;
+    /// The ideal dynamic mask of the frame at `timestamp`: every visible pixel of the
+    /// walking people, dilated by `margin` px (CV_8UC1, 255 = dynamic). devslam-run's
+    /// diagnostic mode `truth` feeds it to the SLAM: the bound the filter can approach.
+    /// Throws like score().
+    [[nodiscard]] cv::Mat walkerMask(double timestamp, int margin) const;
 
   private:
+    struct FrameTruth {
+        cv::Mat labels;
+        const std::vector<PersonEntry>* persons = nullptr;
+    };
+    [[nodiscard]] FrameTruth frame(double timestamp) const;
     std::string folder_;
     std::map<std::string, std::vector<PersonEntry>> persons_;
 };
