@@ -484,6 +484,58 @@ TEST(DynamicFilter, DepthBandFindsAWalkerInABoxOfBackground) {
     EXPECT_LT(masked, 0.6) << "and leaves the wall in the box";
 }
 
+TEST(DynamicFilter, NarrowSilhouetteBandKeepsTheWallRightBehindAPerson) {
+    // The wall 0.6 m behind the person falls inside fg_depth_band's band (0.4 m + 10 % of
+    // 2.2 m), so a silhouette with that band masks the wall seen in a wide box as well;
+    // silhouette_depth_band = 0.1 (0.32 m at 2.2 m) masks the person alone. all_persons
+    // masks every box whatever its state, so only the mask's shape is compared.
+    dynamic::SyntheticOptions so;
+    so.person = dynamic::PersonMotion::Static;
+    so.person_x0 = 0.3;
+    so.n_frames = 6;
+    so.wall_depth = 2.8;
+    so.wall_tilt_deg = 0.0;
+    const auto seq = dynamic::makeSyntheticSequence(so, wallTexture(), personSprite());
+    auto run = [&](double silhouette_band, double* person_cover, double* box_masked) {
+        auto fo = testOptions();
+        fo.mode = MaskMode::AllPersons;
+        fo.fg_depth_band = 0.4;
+        fo.mask_silhouette = true;
+        fo.silhouette_depth_band = silhouette_band;
+        auto det = std::make_unique<ScriptedDetector>();
+        ScriptedDetector* script = det.get();
+        DynamicObjectFilter filter(fo, std::move(det));
+        int frames = 0;
+        double cover = 0, masked = 0;
+        for (const auto& s : seq) {
+            ASSERT_TRUE(s.person_box.has_value());
+            const cv::Rect2f p = *s.person_box;
+            const cv::Rect2f wide =
+                cv::Rect2f(p.x - p.width, p.y, 3 * p.width, p.height) & cv::Rect2f(0, 0, 640, 480);
+            script->next = {{wide, 0, "person", 0.9f}};
+            const auto out = filter.step(s.frame, s.T_prev_cur);
+            ASSERT_FALSE(out.mask.empty());
+            const cv::Rect pr = cv::Rect(p) & cv::Rect(0, 0, 640, 480);
+            const cv::Rect wr = cv::Rect(wide) & cv::Rect(0, 0, 640, 480);
+            cover += cv::countNonZero(out.mask(pr)) / static_cast<double>(pr.area());
+            masked += cv::countNonZero(out.mask(wr)) / static_cast<double>(wr.area());
+            ++frames;
+        }
+        *person_cover = cover / frames;
+        *box_masked = masked / frames;
+        std::printf("wall 0.6 m behind, silhouette_depth_band %.1f: person covered %.2f, box "
+                    "masked %.2f\n",
+                    silhouette_band, *person_cover, *box_masked);
+    };
+    double cover_wide = 0, masked_wide = 0, cover_narrow = 0, masked_narrow = 0;
+    run(0.0, &cover_wide, &masked_wide);  // 0: fg_depth_band's band
+    run(0.1, &cover_narrow, &masked_narrow);
+    EXPECT_GT(cover_wide, 0.95);
+    EXPECT_GT(masked_wide, 0.9) << "the wall is inside the wide band";
+    EXPECT_GT(cover_narrow, 0.95) << "the narrow band still covers the person";
+    EXPECT_LT(masked_narrow, 0.6) << "and leaves the wall in the box";
+}
+
 TEST(DynamicFilter, SlowWalkerIsCaughtByItsMeanResidualFlow) {
     // A person walking at 0.2 m/s 2.2 m away moves about 1.6 px a frame after ego-motion
     // compensation: under threshold1 (2 px) for nearly every point, so per-frame evidence

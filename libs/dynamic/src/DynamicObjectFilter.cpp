@@ -52,6 +52,7 @@ const std::vector<std::string> kKeys{"mode",
                                      "mask_border_snap",
                                      "fg_depth_band",
                                      "mask_silhouette",
+                                     "silhouette_depth_band",
                                      "slow_frames",
                                      "slow_threshold",
                                      "new_track_score"};
@@ -171,6 +172,7 @@ void DynamicObjectFilter::Options::loadFromConfig(const mrpt::config::CConfigFil
     box_shrink = c.read_double(s, "box_shrink", box_shrink);
     fg_depth_band = c.read_double(s, "fg_depth_band", fg_depth_band);
     mask_silhouette = c.read_bool(s, "mask_silhouette", mask_silhouette);
+    silhouette_depth_band = c.read_double(s, "silhouette_depth_band", silhouette_depth_band);
     slow_frames = c.read_int(s, "slow_frames", slow_frames);
     slow_threshold = c.read_double(s, "slow_threshold", slow_threshold);
     new_track_score = c.read_double(s, "new_track_score", new_track_score);
@@ -203,6 +205,8 @@ void DynamicObjectFilter::Options::loadFromConfig(const mrpt::config::CConfigFil
     core::requireValue(min_points >= 1, s, "min_points", "must be >= 1");
     core::requireValue(box_shrink >= 0 && box_shrink < 0.5, s, "box_shrink", "must be in [0, 0.5)");
     core::requireValue(fg_depth_band >= 0, s, "fg_depth_band", "must be >= 0 (0 = off)");
+    core::requireValue(silhouette_depth_band >= 0, s, "silhouette_depth_band",
+                       "must be >= 0 (0 = fg_depth_band's)");
     core::requireValue(slow_frames >= 0, s, "slow_frames", "must be >= 0 (0 = off)");
     core::requireValue(slow_threshold > 0, s, "slow_threshold", "must be > 0");
     core::requireValue(new_track_score >= 0 && new_track_score <= 1, s, "new_track_score",
@@ -237,6 +241,7 @@ void DynamicObjectFilter::Options::saveToConfig(mrpt::config::CConfigFileBase& c
     c.write(s, "box_shrink", box_shrink);
     c.write(s, "fg_depth_band", fg_depth_band);
     c.write(s, "mask_silhouette", mask_silhouette);
+    c.write(s, "silhouette_depth_band", silhouette_depth_band);
     c.write(s, "slow_frames", slow_frames);
     c.write(s, "slow_threshold", slow_threshold);
     c.write(s, "new_track_score", new_track_score);
@@ -651,7 +656,10 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
         // Silhouette: the box's pixels in the person's depth band or without depth (the
         // holes along a person's outline), dilated by the margin.
         const float zp = *t.depth;
-        const float h = depthBand(opts_.fg_depth_band > 0 ? opts_.fg_depth_band : 0.5, zp);
+        const double band = opts_.silhouette_depth_band > 0 ? opts_.silhouette_depth_band
+                            : opts_.fg_depth_band > 0       ? opts_.fg_depth_band
+                                                            : 0.5;
+        const float h = depthBand(band, zp);
         const cv::Rect inner = cv::Rect(t.tb.box) & cv::Rect(0, 0, gray.cols, gray.rows);
         if (inner.empty()) continue;
         cv::Mat sil, holes;

@@ -143,10 +143,15 @@ class DynamicObjectFilter {
         /// leaving a strip of the person unmasked.
         int mask_border_snap = 0;
         /// false: the whole (dilated) box is masked, as in the paper. true: only the box's
-        /// pixels within the person's depth band (see fg_depth_band; 0.5 m when that is 0)
-        /// or without depth, dilated by mask_margin: the background seen inside the box
-        /// stays usable. Falls back to the whole box when the torso has no depth.
+        /// pixels within the person's depth band (silhouette_depth_band, else fg_depth_band,
+        /// else 0.5 m) or without depth, dilated by mask_margin: the background seen inside
+        /// the box stays usable. Falls back to the whole box when the torso has no depth.
         bool mask_silhouette = false;
+        /// [m] the silhouette's depth band (+ 10 % of the person's depth) when > 0;
+        /// 0 = fg_depth_band's. The evidence band wants to be wide (a near person's
+        /// arms and back), the mask's narrow (the background right behind a person
+        /// keeps its features).
+        double silhouette_depth_band = 0.0;
 
         /// Reads `[section]`; unknown keys throw std::invalid_argument naming them.
         void loadFromConfig(const mrpt::config::CConfigFileBase& cfg,
