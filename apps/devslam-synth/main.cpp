@@ -14,8 +14,10 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <cstdint>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -26,6 +28,7 @@ namespace {
 
 const char* kUsage =
     "usage: devslam-synth SCENARIO [-o DIR] [--rawlog FILE] [--frames N] [--no-labels]\n"
+    "                     [--seed N]  (another render of the scenario: noise, panel crops)\n"
     "       devslam-synth --list\n"
     "       devslam-synth --cut-texture IMAGE X,Y,W,H OUT.png\n"
     "SCENARIO: a name from sim_worlds/synth/ (e.g. walking_xyz) or an INI file.\n"
@@ -102,6 +105,7 @@ int run(int argc, char** argv) {
 
     std::string scenario_arg, out_dir, rawlog;
     std::size_t frames = 0;
+    std::optional<std::uint64_t> seed;
     bool labels = true;
     for (std::size_t i = 0; i < a.size(); ++i) {
         const auto value = [&]() -> std::string {
@@ -116,6 +120,20 @@ int run(int argc, char** argv) {
             frames = std::size_t(std::stoul(value()));
         else if (a[i] == "--no-labels")
             labels = false;
+        else if (a[i] == "--seed") {
+            const std::string v = value();
+            std::size_t used = 0;
+            unsigned long long n = 0;
+            try {
+                n = std::stoull(v, &used);
+            } catch (const std::exception&) {
+                used = 0;
+            }
+            if (used != v.size() || v.empty() || v[0] == '-')
+                throw std::invalid_argument("--seed: expected a non-negative integer, got '" + v +
+                                            "'");
+            seed = n;
+        }
         else if (!a[i].empty() && a[i][0] == '-')
             throw std::invalid_argument("unknown option '" + a[i] + "'\n" + kUsage);
         else if (scenario_arg.empty())
@@ -126,7 +144,10 @@ int run(int argc, char** argv) {
     }
     if (scenario_arg.empty())
         throw std::invalid_argument(std::string("no scenario given\n") + kUsage);
-    const auto sc = render::loadScenario(resolveScenario(scenario_arg));
+    auto sc = render::loadScenario(resolveScenario(scenario_arg));
+    // The same scene and motion, other noise and panel crops: renders to tell a setting's
+    // effect from the SLAM's sensitivity to small changes (docs/render.md).
+    if (seed) sc.seed = *seed;
     if (out_dir.empty()) out_dir = "out/synth/" + sc.name;
 
     render::WriteOptions o;
