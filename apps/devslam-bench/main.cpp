@@ -12,6 +12,7 @@
 #include <devslam/core/Results.h>
 #include <devslam/core/Stats.h>
 #include <devslam/dynamic/DynamicObjectFilter.h>
+#include <devslam/eval/MaskScore.h>
 #include <devslam/io/RgbdReader.h>
 
 #include <opencv2/imgcodecs.hpp>
@@ -118,8 +119,7 @@ Bench loadBench(const std::string& path) {
 /// devslam-run's diagnostic mode `truth` (the renderer's walkers as the mask) needs the
 /// person truth that devslam-synth writes; sequences without it skip that mode.
 bool runsMode(const Sequence& q, const std::string& mode) {
-    return mode != "truth" || (fs::exists(fs::path(q.path) / "persons.txt") &&
-                               fs::is_directory(fs::path(q.path) / "labels"));
+    return mode != "truth" || eval::PersonTruth::available(q.path);
 }
 
 /// The number after "key": inside the object that follows "object": (or at top level).

@@ -93,16 +93,18 @@ double MaskScore::precision() const {
     return masked_px > 0 ? moving_px_masked / masked_px : 0.0;
 }
 
-std::optional<PersonTruth> PersonTruth::open(const std::string& folder) {
+bool PersonTruth::available(const std::string& folder) {
     namespace fs = std::filesystem;
-    const fs::path p = fs::path(folder) / "persons.txt";
     // Both parts of the truth are needed (devslam-synth --no-labels writes persons.txt only).
-    if (!fs::is_directory(folder) || !fs::exists(p) ||
-        !fs::is_directory(fs::path(folder) / "labels"))
-        return std::nullopt;
+    return fs::is_directory(folder) && fs::exists(fs::path(folder) / "persons.txt") &&
+           fs::is_directory(fs::path(folder) / "labels");
+}
+
+std::optional<PersonTruth> PersonTruth::open(const std::string& folder) {
+    if (!available(folder)) return std::nullopt;
     PersonTruth t;
     t.folder_ = folder;
-    t.persons_ = readPersons(p.string());
+    t.persons_ = readPersons((std::filesystem::path(folder) / "persons.txt").string());
     return t;
 }
 

@@ -75,6 +75,9 @@ class PersonTruth {
     /// nullopt when `folder` lacks persons.txt or labels/ (real data, or rendered with
     /// --no-labels); throws on a malformed persons.txt.
     [[nodiscard]] static std::optional<PersonTruth> open(const std::string& folder);
+    /// Whether `folder` has both parts of the truth (persons.txt and labels/), without
+    /// reading them: what open() checks first.
+    [[nodiscard]] static bool available(const std::string& folder);
     /// Adds the frame at `timestamp` to `score`. Throws naming the file when the frame has
     /// no truth (a missing label image or persons.txt entry).
     void score(const cv::Mat& mask, double timestamp, int min_pixels, MaskScore& score,
