@@ -1,4 +1,5 @@
 #include <devslam/dynamic/DynamicObjectFilter.h>
+#include <devslam/dynamic/ShiTomasi.h>
 
 #include <devslam/core/Config.h>
 
@@ -309,8 +310,11 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
     const double sc = opts_.flow_scale;
     if (sc != 1.0) cv::resize(gray, work, cv::Size(), sc, sc, cv::INTER_AREA);
     const cv::Size win(opts_.lk_window, opts_.lk_window);
+    // With the Scharr derivatives stored in the pyramid, calcOpticalFlowPyrLK does not
+    // recompute them for each of the two calls that start from this frame (this step's
+    // backward check and the next step's forward flow); the flow is bit-identical.
     std::vector<cv::Mat> pyr;
-    cv::buildOpticalFlowPyramid(work, pyr, win, opts_.lk_levels, false);
+    cv::buildOpticalFlowPyramid(work, pyr, win, opts_.lk_levels, true);
     const cv::Rect2f image(0.f, 0.f, static_cast<float>(gray.cols), static_cast<float>(gray.rows));
     const bool have_prev = !im.prev_work.empty() && im.prev_work.size() == work.size() &&
                            im.prev_depth.size() == gray.size();
@@ -318,8 +322,10 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
     // 1. Flow of Shi-Tomasi corners of the previous frame (global + inside each box).
     std::vector<cv::Point2f> p0, p1;
     if (have_prev) {
-        cv::goodFeaturesToTrack(im.prev_work, p0, opts_.max_corners, opts_.corner_quality,
-                                opts_.corner_min_distance);
+        // One eigenvalue map for the image and every box (see ShiTomasi.h).
+        const ShiTomasiMap corners = ShiTomasiMap::compute(im.prev_work);
+        p0 = selectShiTomasi(corners, cv::Rect(0, 0, work.cols, work.rows), opts_.max_corners,
+                             opts_.corner_quality, opts_.corner_min_distance);
         if (opts_.max_corners_per_box > 0) {
             for (const auto& t : im.tracks) {
                 const cv::Rect2f b = shrink(t.tb.box, opts_.box_shrink);
@@ -342,10 +348,10 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
                     cv::inRange(im.prev_depth(full), zp - h, zp + h, band);
                     cv::resize(band, fg, roi.size(), 0, 0, cv::INTER_NEAREST);
                 }
-                std::vector<cv::Point2f> pts;
-                cv::goodFeaturesToTrack(im.prev_work(roi), pts, opts_.max_corners_per_box,
-                                        opts_.corner_quality, opts_.corner_min_distance * 0.5, fg);
-                for (auto& p : pts) p0.emplace_back(p.x + roi.x, p.y + roi.y);
+                const auto pts = selectShiTomasi(corners, roi, opts_.max_corners_per_box,
+                                                 opts_.corner_quality,
+                                                 opts_.corner_min_distance * 0.5, fg);
+                p0.insert(p0.end(), pts.begin(), pts.end());
             }
         }
         if (!p0.empty()) {

@@ -1,0 +1,94 @@
+#include <devslam/dynamic/ShiTomasi.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <stdexcept>
+#include <tuple>
+
+namespace devslam::dynamic {
+
+ShiTomasiMap ShiTomasiMap::compute(const cv::Mat& gray) {
+    if (gray.type() != CV_8UC1 || gray.empty())
+        throw std::invalid_argument("Shi-Tomasi map: needs a non-empty CV_8UC1 image");
+    ShiTomasiMap m;
+    cv::cornerMinEigenVal(gray, m.eig, 3, 3);
+    // A pixel above the quality threshold is a local maximum of the thresholded map (what
+    // goodFeaturesToTrack dilates) exactly when it is one of the raw map: its 3x3 maximum is
+    // at least its own value, so above the threshold too. One dilation serves every region.
+    cv::dilate(m.eig, m.eig_max, cv::Mat());
+    return m;
+}
+
+std::vector<cv::Point2f> selectShiTomasi(const ShiTomasiMap& map, const cv::Rect& roi,
+                                         int max_corners, double quality, double min_distance,
+                                         const cv::Mat& mask) {
+    if (map.empty() || (roi & cv::Rect(0, 0, map.eig.cols, map.eig.rows)) != roi)
+        throw std::invalid_argument("Shi-Tomasi selection: region outside the map");
+    if (!mask.empty() && (mask.type() != CV_8UC1 || mask.size() != roi.size()))
+        throw std::invalid_argument(
+            "Shi-Tomasi selection: mask must be CV_8U of the region's size");
+    std::vector<cv::Point2f> corners;
+    if (roi.empty()) return corners;
+    const cv::Mat eig = map.eig(roi), eig_max = map.eig_max(roi);
+    double max_val = 0;
+    cv::minMaxLoc(eig, nullptr, &max_val, nullptr, nullptr, mask);
+    const auto thr = static_cast<float>(max_val * quality);
+
+    struct Candidate {
+        float v;
+        int y, x;  // region coordinates
+    };
+    std::vector<Candidate> cand;
+    for (int y = 1; y < roi.height - 1; ++y) {
+        const float* e = eig.ptr<float>(y);
+        const float* d = eig_max.ptr<float>(y);
+        const uchar* mk = mask.empty() ? nullptr : mask.ptr<uchar>(y);
+        for (int x = 1; x < roi.width - 1; ++x)
+            if (e[x] > thr && e[x] == d[x] && (!mk || mk[x])) cand.push_back({e[x], y, x});
+    }
+    // Strongest first; ties go to the later pixel, as goodFeaturesToTrack orders them.
+    std::sort(cand.begin(), cand.end(), [](const Candidate& a, const Candidate& b) {
+        return a.v != b.v ? a.v > b.v : std::tie(a.y, a.x) > std::tie(b.y, b.x);
+    });
+
+    const auto full = [&] {
+        return max_corners > 0 && static_cast<int>(corners.size()) >= max_corners;
+    };
+    const cv::Point2f offset(static_cast<float>(roi.x), static_cast<float>(roi.y));
+    if (min_distance < 1) {
+        for (const auto& c : cand) {
+            if (full()) break;
+            corners.emplace_back(cv::Point2f(static_cast<float>(c.x), static_cast<float>(c.y)) +
+                                 offset);
+        }
+        return corners;
+    }
+    // Grid of min_distance cells: a new corner is checked against the 3x3 cells around it.
+    const int cell = cvRound(min_distance);
+    const int gw = (roi.width + cell - 1) / cell, gh = (roi.height + cell - 1) / cell;
+    std::vector<std::vector<cv::Point2f>> grid(static_cast<std::size_t>(gw) * gh);
+    const auto d2 = static_cast<float>(min_distance * min_distance);
+    for (const auto& c : cand) {
+        const int cx = c.x / cell, cy = c.y / cell;
+        bool good = true;
+        for (int yy = std::max(0, cy - 1); good && yy <= std::min(gh - 1, cy + 1); ++yy)
+            for (int xx = std::max(0, cx - 1); good && xx <= std::min(gw - 1, cx + 1); ++xx)
+                for (const auto& q : grid[static_cast<std::size_t>(yy) * gw + xx]) {
+                    const float dx = static_cast<float>(c.x) - q.x,
+                                dy = static_cast<float>(c.y) - q.y;
+                    if (dx * dx + dy * dy < d2) {
+                        good = false;
+                        break;
+                    }
+                }
+        if (!good) continue;
+        const cv::Point2f p(static_cast<float>(c.x), static_cast<float>(c.y));
+        grid[static_cast<std::size_t>(cy) * gw + cx].push_back(p);
+        corners.push_back(p + offset);
+        if (full()) break;
+    }
+    return corners;
+}
+
+}  // namespace devslam::dynamic

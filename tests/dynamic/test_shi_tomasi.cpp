@@ -1,0 +1,76 @@
+// The filter's Shi-Tomasi selection from a shared eigenvalue map against OpenCV's own
+// goodFeaturesToTrack, on a real TUM frame at the filter's working scale.
+#include <devslam/dynamic/ShiTomasi.h>
+
+#include <gtest/gtest.h>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <filesystem>
+
+using namespace devslam;
+
+namespace {
+const std::string kRoot = DEVSLAM_SOURCE_DIR;
+
+cv::Mat workImage() {
+    const auto dir = std::filesystem::path(kRoot) / "data/tum/fr1_xyz_first37/rgb";
+    std::vector<std::filesystem::path> files;
+    for (const auto& e : std::filesystem::directory_iterator(dir)) files.push_back(e.path());
+    std::sort(files.begin(), files.end());
+    const cv::Mat gray = cv::imread(files.at(10).string(), cv::IMREAD_GRAYSCALE);
+    cv::Mat work;
+    cv::resize(gray, work, cv::Size(), 0.5, 0.5, cv::INTER_AREA);
+    return work;
+}
+}  // namespace
+
+TEST(ShiTomasi, WholeImageSelectionIsGoodFeaturesToTrack) {
+    const cv::Mat work = workImage();
+    ASSERT_EQ(work.size(), cv::Size(320, 240));
+    const auto map = dynamic::ShiTomasiMap::compute(work);
+    // The filter's settings (200, 0.01, 5), a denser one, and no distance / no limit.
+    for (const auto& [n, q, d] :
+         {std::tuple{200, 0.01, 5.0}, std::tuple{500, 0.001, 2.5}, std::tuple{0, 0.05, 0.0}}) {
+        std::vector<cv::Point2f> expected;
+        cv::goodFeaturesToTrack(work, expected, n, q, d);
+        const auto got =
+            dynamic::selectShiTomasi(map, cv::Rect(0, 0, work.cols, work.rows), n, q, d);
+        ASSERT_GT(expected.size(), 50u);
+        EXPECT_EQ(got, expected) << "max_corners " << n << ", quality " << q << ", distance " << d;
+    }
+}
+
+TEST(ShiTomasi, RegionWithMaskMatchesGoodFeaturesToTrackOnTheRegion) {
+    // goodFeaturesToTrack on a region sees no pixels outside it for its local-maximum test;
+    // the shared map does, so the two may differ on the region's border rows and columns.
+    // Everywhere else they agree, and every corner respects the mask and the region.
+    const cv::Mat work = workImage();
+    const auto map = dynamic::ShiTomasiMap::compute(work);
+    const cv::Rect roi(100, 60, 90, 120);
+    cv::Mat mask = cv::Mat::zeros(roi.size(), CV_8UC1);
+    cv::circle(mask, {45, 60}, 40, 255, cv::FILLED);
+    std::vector<cv::Point2f> expected;
+    cv::goodFeaturesToTrack(work(roi), expected, 40, 0.01, 2.5, mask);
+    const auto got = dynamic::selectShiTomasi(map, roi, 40, 0.01, 2.5, mask);
+    ASSERT_GT(expected.size(), 10u);
+    ASSERT_LE(got.size(), 40u);
+    std::size_t same = 0;
+    for (const auto& p : got) {
+        const cv::Point local(cvRound(p.x) - roi.x, cvRound(p.y) - roi.y);
+        EXPECT_TRUE(cv::Rect({}, roi.size()).contains(local));
+        EXPECT_NE(mask.at<uchar>(local), 0);
+        for (const auto& e : expected) same += e + cv::Point2f(roi.tl()) == p;
+    }
+    EXPECT_GE(same, got.size() * 9 / 10) << got.size() << " corners, " << same << " shared";
+}
+
+TEST(ShiTomasi, BadArgumentsAreRejected) {
+    const auto map = dynamic::ShiTomasiMap::compute(workImage());
+    EXPECT_THROW((void)dynamic::selectShiTomasi(map, cv::Rect(300, 0, 40, 40), 10, 0.01, 5),
+                 std::invalid_argument);
+    EXPECT_THROW((void)dynamic::selectShiTomasi(map, cv::Rect(0, 0, 40, 40), 10, 0.01, 5,
+                                                cv::Mat::zeros(20, 20, CV_8UC1)),
+                 std::invalid_argument);
+    EXPECT_THROW((void)dynamic::ShiTomasiMap::compute(cv::Mat()), std::invalid_argument);
+}
