@@ -73,4 +73,8 @@ TEST(ShiTomasi, BadArgumentsAreRejected) {
                                                 cv::Mat::zeros(20, 20, CV_8UC1)),
                  std::invalid_argument);
     EXPECT_THROW((void)dynamic::ShiTomasiMap::compute(cv::Mat()), std::invalid_argument);
+    EXPECT_THROW((void)dynamic::selectShiTomasi({}, cv::Rect(0, 0, 4, 4), 10, 0.01, 5),
+                 std::invalid_argument);
+    // An empty region inside the map has no corners (and is no error).
+    EXPECT_TRUE(dynamic::selectShiTomasi(map, cv::Rect(50, 50, 0, 0), 10, 0.01, 5).empty());
 }

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <stdexcept>
+#include <string>
 #include <tuple>
 
 namespace devslam::dynamic {
@@ -23,8 +24,14 @@ ShiTomasiMap ShiTomasiMap::compute(const cv::Mat& gray) {
 std::vector<cv::Point2f> selectShiTomasi(const ShiTomasiMap& map, const cv::Rect& roi,
                                          int max_corners, double quality, double min_distance,
                                          const cv::Mat& mask) {
-    if (map.empty() || (roi & cv::Rect(0, 0, map.eig.cols, map.eig.rows)) != roi)
-        throw std::invalid_argument("Shi-Tomasi selection: region outside the map");
+    if (map.empty()) throw std::invalid_argument("Shi-Tomasi selection: empty map");
+    const cv::Rect whole(0, 0, map.eig.cols, map.eig.rows);
+    if (roi.width < 0 || roi.height < 0 || (!roi.empty() && (roi & whole) != roi))
+        throw std::invalid_argument("Shi-Tomasi selection: region (" + std::to_string(roi.x) +
+                                    ", " + std::to_string(roi.y) + ", " +
+                                    std::to_string(roi.width) + " x " + std::to_string(roi.height) +
+                                    ") outside the " + std::to_string(whole.width) + " x " +
+                                    std::to_string(whole.height) + " map");
     if (!mask.empty() && (mask.type() != CV_8UC1 || mask.size() != roi.size()))
         throw std::invalid_argument(
             "Shi-Tomasi selection: mask must be CV_8U of the region's size");
