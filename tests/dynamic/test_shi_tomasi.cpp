@@ -6,7 +6,10 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
 #include <filesystem>
+#include <tuple>
+#include <vector>
 
 using namespace devslam;
 
@@ -58,7 +61,7 @@ TEST(ShiTomasi, RegionWithMaskMatchesGoodFeaturesToTrackOnTheRegion) {
     std::size_t same = 0;
     for (const auto& p : got) {
         const cv::Point local(cvRound(p.x) - roi.x, cvRound(p.y) - roi.y);
-        EXPECT_TRUE(cv::Rect({}, roi.size()).contains(local));
+        ASSERT_TRUE(cv::Rect({}, roi.size()).contains(local));
         EXPECT_NE(mask.at<uchar>(local), 0);
         for (const auto& e : expected) same += e + cv::Point2f(roi.tl()) == p;
     }

@@ -19,9 +19,9 @@ namespace devslam::dynamic {
 /// exactly what cv::goodFeaturesToTrack returns (tests/dynamic checks this); inside a
 /// region, a corner must also be a local maximum over the region's outside neighbours.
 ///
-///   cv::Mat eig;  cv::cornerMinEigenVal(gray, eig, 3, 3);
-///   cv::Mat eig_max;  cv::dilate(eig, eig_max, cv::Mat());
-///   auto pts = selectShiTomasi(eig, eig_max, roi, 40, 0.01, 2.5, fg_mask);
+///   const auto map = ShiTomasiMap::compute(gray);  // once per frame
+///   auto all = selectShiTomasi(map, cv::Rect(0, 0, gray.cols, gray.rows), 200, 0.01, 5);
+///   auto box = selectShiTomasi(map, roi, 40, 0.01, 2.5, fg_mask);  // per box, same map
 struct ShiTomasiMap {
     cv::Mat eig;      ///< CV_32F minimum eigenvalue of the gradient covariance per pixel
     cv::Mat eig_max;  ///< CV_32F 3x3 dilation of eig (local-maximum test)
