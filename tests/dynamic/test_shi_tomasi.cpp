@@ -1,13 +1,13 @@
 // The filter's Shi-Tomasi selection from a shared eigenvalue map against OpenCV's own
 // goodFeaturesToTrack, on a real TUM frame at the filter's working scale.
 #include <devslam/dynamic/ShiTomasi.h>
+#include <devslam/io/RgbdReader.h>
 
 #include <gtest/gtest.h>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include <algorithm>
-#include <filesystem>
+#include <optional>
+#include <stdexcept>
 #include <tuple>
 #include <vector>
 
@@ -16,13 +16,14 @@ using namespace devslam;
 namespace {
 const std::string kRoot = DEVSLAM_SOURCE_DIR;
 
+/// A real frame as the filter sees it: gray, at its default flow_scale of 0.5.
 cv::Mat workImage() {
-    const auto dir = std::filesystem::path(kRoot) / "data/tum/fr1_xyz_first37/rgb";
-    std::vector<std::filesystem::path> files;
-    for (const auto& e : std::filesystem::directory_iterator(dir)) files.push_back(e.path());
-    std::sort(files.begin(), files.end());
-    const cv::Mat gray = cv::imread(files.at(10).string(), cv::IMREAD_GRAYSCALE);
-    cv::Mat work;
+    auto reader = io::openRgbd(kRoot + "/data/tum/fr1_xyz_first37", {});
+    std::optional<core::Frame> f;
+    for (int i = 0; i <= 10; ++i) f = reader->next();
+    if (!f) throw std::runtime_error("fr1_xyz_first37 has fewer than 11 frames");
+    cv::Mat gray, work;
+    cv::cvtColor(f->bgr, gray, cv::COLOR_BGR2GRAY);
     cv::resize(gray, work, cv::Size(), 0.5, 0.5, cv::INTER_AREA);
     return work;
 }
