@@ -9,6 +9,7 @@
 //   devslam-bench --config INI [--repeats N] [--max-frames N] [--out DIR] [--results FILE]
 
 #include <devslam/core/Config.h>
+#include <devslam/core/Parse.h>
 #include <devslam/core/Results.h>
 #include <devslam/core/Stats.h>
 #include <devslam/dynamic/DynamicObjectFilter.h>
@@ -86,8 +87,8 @@ Bench loadBench(const std::string& path) {
             b.modes.push_back(m);
         }
     }
-    b.repeats = cfg->read_int("bench", "repeats", b.repeats);
-    b.max_frames = std::size_t(cfg->read_int("bench", "max_frames", 0));
+    b.repeats = core::readInt(*cfg, "bench", "repeats", b.repeats);
+    b.max_frames = std::size_t(core::readInt(*cfg, "bench", "max_frames", 0));
     b.out_dir = cfg->read_string("bench", "out_dir", b.out_dir);
     b.slam_config = resolve(cfg->read_string("bench", "slam_config", b.slam_config), base);
     core::requireValue(b.repeats >= 1 && b.repeats <= 100, path + " [bench]", "repeats",
@@ -212,9 +213,9 @@ int run(int argc, char** argv) {
         if (k == "--config")
             config = value();
         else if (k == "--repeats")
-            repeats = std::stoi(value());
+            repeats = int(core::parseInteger(value(), "--repeats", 1, 100));
         else if (k == "--max-frames")
-            max_frames = std::stoul(value());
+            max_frames = std::size_t(core::parseInteger(value(), "--max-frames", 0));
         else if (k == "--out")
             out_override = value();
         else if (k == "--results")

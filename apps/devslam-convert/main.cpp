@@ -1,6 +1,7 @@
 // devslam-convert: TUM RGB-D folder <-> MRPT rawlog of CObservation3DRangeScan.
 // Depth keeps the source's raw 16-bit units and colour is stored losslessly, so a
 // TUM -> rawlog -> TUM round trip is bit-exact in both images.
+#include <devslam/core/Parse.h>
 #include <devslam/core/Progress.h>
 #include <devslam/io/Rawlog.h>
 #include <devslam/io/RgbdReader.h>
@@ -54,11 +55,11 @@ int main(int argc, char** argv) {
             else if (a == "--external")
                 wo.external_images = true;
             else if (a == "--compression")
-                wo.compression = std::stoi(value());
+                wo.compression = int(devslam::core::parseInteger(value(), "--compression", 0, 9));
             else if (a == "--label")
                 wo.sensor_label = value();
             else if (a == "--max-frames")
-                max_frames = std::stoul(value());
+                max_frames = std::size_t(devslam::core::parseInteger(value(), "--max-frames", 0));
             else if (!a.empty() && a[0] == '-')
                 throw std::invalid_argument("unknown option " + a);
             else

@@ -5,6 +5,7 @@
 //   devslam-filter-bench                      # defaults below, writes docs/RESULTS.md
 //   devslam-filter-bench --threads 1 --frames 30 --results FILE|none
 #include <devslam/core/Config.h>
+#include <devslam/core/Parse.h>
 #include <devslam/core/Progress.h>
 #include <devslam/core/Results.h>
 #include <devslam/core/Stats.h>
@@ -97,21 +98,26 @@ int main(int argc, char** argv) {
     int threads = 1, n_frames = 30;
     std::string results = kRoot + "/docs/RESULTS.md";
     std::string filter_ini = kRoot + "/config_ini/dynamic_filter.ini";
-    for (int i = 1; i < argc; ++i) {
-        const std::string a = argv[i];
-        if (i + 1 < argc && a == "--threads")
-            threads = std::stoi(argv[++i]);
-        else if (i + 1 < argc && a == "--frames")
-            n_frames = std::stoi(argv[++i]);
-        else if (i + 1 < argc && a == "--results")
-            results = argv[++i];
-        else if (i + 1 < argc && a == "--config")
-            filter_ini = argv[++i];
-        else {
-            std::cerr << "usage: devslam-filter-bench [--threads N] [--frames N] "
-                         "[--config INI] [--results FILE|none]\n";
-            return 2;
+    try {
+        for (int i = 1; i < argc; ++i) {
+            const std::string a = argv[i];
+            if (i + 1 < argc && a == "--threads")
+                threads = int(devslam::core::parseInteger(argv[++i], "--threads", 1, 256));
+            else if (i + 1 < argc && a == "--frames")
+                n_frames = int(devslam::core::parseInteger(argv[++i], "--frames", 2, 100000));
+            else if (i + 1 < argc && a == "--results")
+                results = argv[++i];
+            else if (i + 1 < argc && a == "--config")
+                filter_ini = argv[++i];
+            else {
+                std::cerr << "usage: devslam-filter-bench [--threads N] [--frames N] "
+                             "[--config INI] [--results FILE|none]\n";
+                return 2;
+            }
         }
+    } catch (const std::invalid_argument& e) {
+        std::cerr << "devslam-filter-bench: " << e.what() << "\n";
+        return 2;
     }
     try {
         cv::setNumThreads(threads);

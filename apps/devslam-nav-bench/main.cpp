@@ -4,6 +4,7 @@
 // VFH+ step and A* on a 400x400 grid. --quick: a smoke test (2 worlds per category, no
 // RESULTS.md unless --results is given).
 #include <devslam/core/Config.h>
+#include <devslam/core/Parse.h>
 #include <devslam/core/Progress.h>
 #include <devslam/core/Results.h>
 #include <devslam/core/Stats.h>
@@ -162,7 +163,8 @@ int main(int argc, char** argv) {
                 return argv[++i];
             };
             if (s == "--per-category")
-                a.per_category = std::stoi(next());
+                a.per_category =
+                    int(devslam::core::parseInteger(next(), "--per-category", 1, 100000));
             else if (s == "--quick")
                 a.quick = true;
             else if (s == "--config")
@@ -173,7 +175,8 @@ int main(int argc, char** argv) {
             } else if (s == "--png-dir")
                 a.png_dir = next();
             else if (s == "--seed")
-                a.seed = static_cast<uint32_t>(std::stoul(next()));
+                a.seed = static_cast<uint32_t>(
+                    devslam::core::parseInteger(next(), "--seed", 0, UINT32_MAX));
             else if (s == "--methods") {
                 a.methods.clear();
                 std::stringstream ss(next());

@@ -2,6 +2,7 @@
 // Prints one result line, writes a PNG (map, A* path, trajectory, people tracks) and,
 // with --navlog, MRPT's .reactivenavlog (open it with MRPT's navlog-viewer).
 #include <devslam/core/Config.h>
+#include <devslam/core/Parse.h>
 #include <devslam/nav/CHolonomicVFHPlus.h>
 #include <devslam/sim/Episode.h>
 #include <devslam/sim/RandomWorlds.h>
@@ -22,7 +23,9 @@ devslam::sim::WorldSpec loadOrGenerate(const std::string& spec) {
     for (auto c : devslam::sim::allCategories())
         if (cat == devslam::sim::toString(c))
             return devslam::sim::randomWorld(
-                c, static_cast<uint32_t>(std::stoul(spec.substr(colon + 1))));
+                c,
+                static_cast<uint32_t>(devslam::core::parseInteger(
+                    spec.substr(colon + 1), "random world seed in '" + spec + "'", 0, UINT32_MAX)));
     throw std::invalid_argument(
         "unknown random world category '" + cat +
         "' (known: open_clutter, corridor_people, office, obstacle_near_goal)");

@@ -9,6 +9,7 @@
 //                   [--config config_ini/dynamic_filter.ini] [--mode none|all_persons|dynamic]
 //                   [--every N] [--threads N] [--no-prior]
 #include <devslam/core/Config.h>
+#include <devslam/core/Parse.h>
 #include <devslam/core/Progress.h>
 #include <devslam/dynamic/DynamicObjectFilter.h>
 #include <devslam/dynamic/SyntheticSequence.h>
@@ -112,11 +113,11 @@ int main(int argc, char** argv) {
             else if (a == "--mode")
                 mode = next();
             else if (a == "--every")
-                every = std::stoi(next());
+                every = int(devslam::core::parseInteger(next(), "--every", 1, 1000000));
             else if (a == "--frames")
-                frames = std::stoi(next());
+                frames = int(devslam::core::parseInteger(next(), "--frames", 0, 100000000));
             else if (a == "--threads")
-                threads = std::stoi(next());
+                threads = int(devslam::core::parseInteger(next(), "--threads", 1, 256));
             else if (a == "--no-prior")
                 use_prior = false;
             else if (a == "-h" || a == "--help") {

@@ -3,6 +3,8 @@
 #include <stdexcept>
 #include <utility>
 
+#include <devslam/core/Config.h>
+
 #ifdef DEVSLAM_HAVE_DYNAMIC
 #include <devslam/dynamic/DynamicObjectFilter.h>
 #endif
@@ -84,7 +86,7 @@ std::unique_ptr<MaskSource> makeMaskSource(const std::string& mode,
                 "mode 'truth' needs the renderer's person truth (persons.txt and labels/), "
                 "which '" +
                 input + "' does not have");
-        const int margin = cfg.read_int("dynamic_filter", "mask_margin", 10);
+        const int margin = core::readInt(cfg, "dynamic_filter", "mask_margin", 10);
         if (margin < 0)
             throw std::invalid_argument("[dynamic_filter] mask_margin: must be >= 0, got " +
                                         std::to_string(margin));

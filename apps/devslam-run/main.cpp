@@ -9,6 +9,7 @@
 #include "ReplayReader.h"
 
 #include <devslam/core/Config.h>
+#include <devslam/core/Parse.h>
 #include <devslam/core/Results.h>
 #include <devslam/core/Stats.h>
 
@@ -71,9 +72,9 @@ Args parse(int argc, char** argv) {
         else if (k == "--results")
             a.results = value(i);
         else if (k == "--max-frames")
-            a.max_frames = std::stoul(value(i));
+            a.max_frames = std::size_t(core::parseInteger(value(i), "--max-frames", 0));
         else if (k == "--bench")
-            a.bench = std::stoi(value(i));
+            a.bench = int(core::parseInteger(value(i), "--bench", 1, 1000));
         else if (k == "--quiet")
             a.quiet = true;
         else if (k == "--section")
@@ -81,7 +82,7 @@ Args parse(int argc, char** argv) {
         else if (k == "--modes-only")
             a.modes_only = true;
         else if (k == "--replay")
-            a.replay = std::stoi(value(i));
+            a.replay = int(core::parseInteger(value(i), "--replay", 1, 1000));
         else if (k == "--set")
             a.sets.push_back(value(i));
         else if (k == "-h" || k == "--help") {
@@ -112,7 +113,7 @@ Loaded loadConfig(const Args& a, const std::vector<std::string>& extra_sets = {}
     applySets(*l.cfg, extra_sets);
     core::requireKnownKeys(*l.cfg, "run",
                            {"mode", "filter_config", "filter_overrides", "async_filter"}, a.config);
-    l.async_filter = l.cfg->read_bool("run", "async_filter", false);
+    l.async_filter = core::readBool(*l.cfg, "run", "async_filter", false);
     l.mode = a.mode.empty() ? l.cfg->read_string("run", "mode", "dynamic") : a.mode;
     // [run] filter_config / filter_overrides: the filter's INI, with "section.key=value ..."
     // overrides (so a SLAM config can pick e.g. the detection interval without copying it).

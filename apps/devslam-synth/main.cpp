@@ -4,6 +4,7 @@
 //   out/synth/walking_xyz devslam-synth path/to/scenario.ini -o DIR [--rawlog FILE] [--frames N]
 //   [--no-labels] devslam-synth --list                           # the shipped scenarios
 //   devslam-synth --cut-texture IMAGE X,Y,W,H OUT.png   # person photo -> RGBA texture (GrabCut)
+#include <devslam/core/Parse.h>
 #include <devslam/core/Progress.h>
 #include <devslam/render/PersonTexture.h>
 #include <devslam/render/Scenario.h>
@@ -117,23 +118,11 @@ int run(int argc, char** argv) {
         else if (a[i] == "--rawlog")
             rawlog = value();
         else if (a[i] == "--frames")
-            frames = std::size_t(std::stoul(value()));
+            frames = std::size_t(devslam::core::parseInteger(value(), "--frames", 1));
         else if (a[i] == "--no-labels")
             labels = false;
-        else if (a[i] == "--seed") {
-            const std::string v = value();
-            std::size_t used = 0;
-            unsigned long long n = 0;
-            try {
-                n = std::stoull(v, &used);
-            } catch (const std::exception&) {
-                used = 0;
-            }
-            if (used != v.size() || v.empty() || v[0] == '-')
-                throw std::invalid_argument("--seed: expected a non-negative integer, got '" + v +
-                                            "'");
-            seed = n;
-        }
+        else if (a[i] == "--seed")
+            seed = std::uint64_t(devslam::core::parseInteger(value(), "--seed", 0));
         else if (!a[i].empty() && a[i][0] == '-')
             throw std::invalid_argument("unknown option '" + a[i] + "'\n" + kUsage);
         else if (scenario_arg.empty())

@@ -2,12 +2,14 @@
 #include <devslam/core/Camera.h>
 #include <devslam/core/Config.h>
 #include <devslam/core/Frame.h>
+#include <devslam/core/Parse.h>
 #include <devslam/core/Pose.h>
 #include <devslam/core/Stats.h>
 
 #include <gtest/gtest.h>
 
 #include <fstream>
+#include <limits>
 
 #include <cmath>
 
@@ -97,6 +99,101 @@ TEST(Config, FilterIniFollowsRunFilterConfigWithOverrides) {
     } catch (const std::runtime_error& e) {
         EXPECT_NE(std::string(e.what()).find("nowhere.ini"), std::string::npos) << e.what();
     }
+}
+
+/// The message of the std::invalid_argument `f` throws ("" when it throws none).
+template <class F>
+std::string invalidArgument(F&& f) {
+    try {
+        f();
+    } catch (const std::invalid_argument& e) {
+        return e.what();
+    }
+    return "";
+}
+
+TEST(Parse, NumbersAreReadInFullOrRejected) {
+    EXPECT_DOUBLE_EQ(parseNumber("0.5", "x"), 0.5);
+    EXPECT_DOUBLE_EQ(parseNumber(" -1e-3\t", "x"), -1e-3);
+    EXPECT_DOUBLE_EQ(parseNumber("3.000000e+01", "x"), 30.0);  // MRPT's $eval{} output
+    EXPECT_EQ(invalidArgument([] { (void)parseNumber("0.5m", "[a] k"); }),
+              "[a] k: expected a number, got '0.5m'");
+    for (const char* bad : {"", "  ", "abc", "1,5", "nan", "inf", "1e999", "2 3"})
+        EXPECT_NE(invalidArgument([&] { (void)parseNumber(bad, "x"); }), "") << bad;
+}
+
+TEST(Parse, IntegersAreWholeAndInRange) {
+    EXPECT_EQ(parseInteger("42", "x"), 42);
+    EXPECT_EQ(parseInteger("+7", "x"), 7);
+    EXPECT_EQ(parseInteger("1e3", "x"), 1000);  // atoi reads 1
+    EXPECT_EQ(parseInteger("3.000000e+01", "x"), 30);
+    EXPECT_EQ(parseInteger("18446744073709551", "x"), 18446744073709551LL);  // past 2^53
+    EXPECT_EQ(parseInteger("-5", "x", -5, 5), -5);
+    EXPECT_EQ(invalidArgument([] { (void)parseInteger("7x", "--frames", 1); }),
+              "--frames: expected an integer, got '7x'");
+    EXPECT_EQ(invalidArgument([] { (void)parseInteger("-5", "--frames", 0); }),
+              "--frames: expected an integer >= 0, got '-5'");
+    EXPECT_EQ(invalidArgument([] { (void)parseInteger("9", "--k", 1, 8); }),
+              "--k: expected an integer in [1, 8], got '9'");
+    EXPECT_EQ(invalidArgument(
+                  [] { (void)parseInteger("9", "--k", std::numeric_limits<long long>::min(), 8); }),
+              "--k: expected an integer <= 8, got '9'");
+    for (const char* bad : {"", "2.5", "1e-3", "abc", "99999999999999999999", "1e30", "0.1e1x"})
+        EXPECT_NE(invalidArgument([&] { (void)parseInteger(bad, "x"); }), "") << bad;
+}
+
+TEST(Parse, BooleansAreSpelledOut) {
+    for (const char* t : {"true", "TRUE", "Yes", "on", "1", " true "})
+        EXPECT_TRUE(parseBool(t, "x")) << t;
+    for (const char* f : {"false", "False", "no", "OFF", "0"}) EXPECT_FALSE(parseBool(f, "x")) << f;
+    EXPECT_EQ(invalidArgument([] { (void)parseBool("ture", "[local_ba] enabled"); }),
+              "[local_ba] enabled: expected true or false, got 'ture'");
+    EXPECT_NE(invalidArgument([] { (void)parseBool("", "x"); }), "");
+}
+
+TEST(Config, StrictReadsNameSectionKeyAndValue) {
+    mrpt::config::CConfigFileMemory mem(
+        "[a]\nn = 12 // a trailing comment is stripped\nbig = 1e3\nx = 0.25\non = yes\n"
+        "typo_int = 12x\ntypo_num = 0.5.1\ntypo_bool = ture\nempty =\nseed = 12345678901\n"
+        "neg_seed = -1\nhuge = 3000000000\n");
+    EXPECT_EQ(readInt(mem, "a", "n", 0), 12);
+    EXPECT_EQ(readInt(mem, "a", "big", 0), 1000);  // MRPT's read_int gives 1
+    EXPECT_DOUBLE_EQ(readDouble(mem, "a", "x", 0.0), 0.25);
+    EXPECT_TRUE(readBool(mem, "a", "on", false));
+    EXPECT_EQ(readUint64(mem, "a", "seed", 0), 12345678901ULL);
+    // Absent keys give the default, or an error naming them when required.
+    EXPECT_EQ(readInt(mem, "a", "absent", 7), 7);
+    EXPECT_DOUBLE_EQ(readDouble(mem, "b", "absent", 1.5), 1.5);
+    EXPECT_FALSE(readBool(mem, "a", "absent", false));
+    EXPECT_EQ(invalidArgument([&] { (void)readDouble(mem, "a", "absent", 0.0, true); }),
+              "[a] absent: missing");
+    // Malformed values name section, key and text (MRPT reads 12, 0.5 and false).
+    EXPECT_EQ(invalidArgument([&] { (void)readInt(mem, "a", "typo_int", 0); }),
+              "[a] typo_int: expected an integer, got '12x'");
+    EXPECT_EQ(invalidArgument([&] { (void)readDouble(mem, "a", "typo_num", 0.0); }),
+              "[a] typo_num: expected a number, got '0.5.1'");
+    EXPECT_EQ(invalidArgument([&] { (void)readBool(mem, "a", "typo_bool", true); }),
+              "[a] typo_bool: expected true or false, got 'ture'");
+    EXPECT_NE(invalidArgument([&] { (void)readInt(mem, "a", "empty", 3); }), "");
+    EXPECT_NE(invalidArgument([&] { (void)readUint64(mem, "a", "neg_seed", 0); }), "");
+    EXPECT_NE(invalidArgument([&] { (void)readInt(mem, "a", "huge", 0); }), "");  // > int
+    EXPECT_EQ(invalidArgument([&] { (void)readInt(mem, "a", "x", 0); }),
+              "[a] x: expected an integer, got '0.25'");
+}
+
+TEST(Config, NamingSourcePrefixesFieldOnlyErrors) {
+    EXPECT_EQ(namingSource("f.ini", [] { return 5; }), 5);
+    mrpt::config::CConfigFileMemory mem("[a]\nn = 3y\n");
+    EXPECT_EQ(invalidArgument(
+                  [&] { (void)namingSource("f.ini", [&] { return readInt(mem, "a", "n", 0); }); }),
+              "f.ini [a] n: expected an integer, got '3y'");
+    // A message that already names its source, and other exception types, pass unchanged.
+    EXPECT_EQ(invalidArgument([] {
+                  namingSource("f.ini", [] { throw std::invalid_argument("room.ini [room]: x"); });
+              }),
+              "room.ini [room]: x");
+    EXPECT_THROW(namingSource("f.ini", [] { throw std::runtime_error("[a] io"); }),
+                 std::runtime_error);
 }
 
 TEST(Association, NearestPairsNeverReused) {

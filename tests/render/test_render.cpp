@@ -397,6 +397,10 @@ TEST(Scenario, ShippedFilesLoadAndTyposAreReported) {
                 withEdit(text, "path    = [2.4 1.6  2.4 4.4]", "path = [2.4 1.6 x 4.4]"));
         },
         "[person_1] path: 'x' is not a number");
+    // Numbers are read in full, and the error names the file (MRPT's reader gives 60).
+    expectMessage(
+        [&] { (void)loadScenario(withEdit(text, "n_frames        = 60", "n_frames = 60x")); },
+        tmp.str("s.ini") + " [scenario] n_frames: expected an integer, got '60x'");
 }
 
 TEST(PersonTexture, GrabCutCutsThePhotoAndCellsFollowAlpha) {

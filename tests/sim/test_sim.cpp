@@ -78,6 +78,16 @@ TEST(World, BadEntriesNameTheKey) {
         "[world]\nx_min=0\nx_max=5\ny_min=0\ny_max=5\nspeed=3\n[robot]\nstart_x=1\n"
         "start_y=1\n[goal]\nx=4\ny=4\n");
     EXPECT_THROW((void)parseWorld(c, "w.ini"), std::invalid_argument);  // unknown key 'speed'
+    // A number with a typo is an error naming file, key and text (MRPT's reader gives 12).
+    const mrpt::config::CConfigFileMemory typo(
+        "[world]\nx_min=0\nx_max=5\ny_min=0\ny_max=5\ntimeout = 12x\n[robot]\nstart_x=1\n"
+        "start_y=1\n[goal]\nx=4\ny=4\n");
+    try {
+        (void)parseWorld(typo, "w.ini");
+        FAIL() << "timeout = 12x was accepted";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_STREQ(e.what(), "w.ini [world] timeout: expected a number, got '12x'");
+    }
 }
 
 TEST(World, DistanceToRotatedBox) {

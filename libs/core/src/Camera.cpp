@@ -61,12 +61,12 @@ CameraIntrinsics CameraIntrinsics::fromConfig(const mrpt::config::CConfigFileBas
     const std::string preset = c.read_string(s, "preset", "");
     const bool has_preset = !preset.empty();
     if (has_preset) K = fromPreset(preset);
-    K.fx = c.read_double(s, "fx", K.fx, !has_preset);
-    K.fy = c.read_double(s, "fy", K.fy, !has_preset);
-    K.cx = c.read_double(s, "cx", K.cx, !has_preset);
-    K.cy = c.read_double(s, "cy", K.cy, !has_preset);
-    K.width = c.read_int(s, "width", K.width);
-    K.height = c.read_int(s, "height", K.height);
+    K.fx = core::readDouble(c, s, "fx", K.fx, !has_preset);
+    K.fy = core::readDouble(c, s, "fy", K.fy, !has_preset);
+    K.cx = core::readDouble(c, s, "cx", K.cx, !has_preset);
+    K.cy = core::readDouble(c, s, "cy", K.cy, !has_preset);
+    K.width = core::readInt(c, s, "width", K.width);
+    K.height = core::readInt(c, s, "height", K.height);
     std::vector<double> d(K.dist.begin(), K.dist.end());
     c.read_vector(s, "dist", d, d);
     requireValue(d.size() == 5, s, "dist", "must have 5 values k1 k2 p1 p2 k3");

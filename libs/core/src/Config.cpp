@@ -1,8 +1,10 @@
 #include <devslam/core/Config.h>
+#include <devslam/core/Parse.h>
 
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -61,6 +63,54 @@ void requireKnownKeys(const mrpt::config::CConfigFileBase& cfg, const std::strin
     for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
     throw std::invalid_argument(source + " [" + section + "]: unknown key '" + unknown.front() +
                                 "' (known: " + list + ")");
+}
+
+namespace {
+
+/// The key's text, or nothing when it is absent (and not required).
+bool readText(const mrpt::config::CConfigFileBase& cfg, const std::string& section,
+              const std::string& key, bool required, std::string& text) {
+    if (!cfg.keyExists(section, key)) {
+        if (required) throw std::invalid_argument("[" + section + "] " + key + ": missing");
+        return false;
+    }
+    text = cfg.read_string(section, key, "");
+    return true;
+}
+
+std::string field(const std::string& section, const std::string& key) {
+    return "[" + section + "] " + key;
+}
+
+}  // namespace
+
+int readInt(const mrpt::config::CConfigFileBase& cfg, const std::string& section,
+            const std::string& key, int def, bool required) {
+    std::string t;
+    if (!readText(cfg, section, key, required, t)) return def;
+    return static_cast<int>(parseInteger(t, field(section, key), std::numeric_limits<int>::min(),
+                                         std::numeric_limits<int>::max()));
+}
+
+std::uint64_t readUint64(const mrpt::config::CConfigFileBase& cfg, const std::string& section,
+                         const std::string& key, std::uint64_t def, bool required) {
+    std::string t;
+    if (!readText(cfg, section, key, required, t)) return def;
+    return static_cast<std::uint64_t>(parseInteger(t, field(section, key), 0));
+}
+
+double readDouble(const mrpt::config::CConfigFileBase& cfg, const std::string& section,
+                  const std::string& key, double def, bool required) {
+    std::string t;
+    if (!readText(cfg, section, key, required, t)) return def;
+    return parseNumber(t, field(section, key));
+}
+
+bool readBool(const mrpt::config::CConfigFileBase& cfg, const std::string& section,
+              const std::string& key, bool def, bool required) {
+    std::string t;
+    if (!readText(cfg, section, key, required, t)) return def;
+    return parseBool(t, field(section, key));
 }
 
 void requireValue(bool ok, const std::string& section, const std::string& key,

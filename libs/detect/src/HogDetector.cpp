@@ -16,12 +16,12 @@ void HogDetector::Options::loadFromConfig(const mrpt::config::CConfigFileBase& c
     core::requireKnownKeys(c, s,
                            {"detector", "hit_threshold", "win_stride", "scale", "group_threshold",
                             "min_score", "resize"});
-    hit_threshold = c.read_double(s, "hit_threshold", hit_threshold);
-    win_stride = c.read_int(s, "win_stride", win_stride);
-    scale = c.read_double(s, "scale", scale);
-    group_threshold = c.read_int(s, "group_threshold", group_threshold);
-    min_score = c.read_double(s, "min_score", min_score);
-    resize = c.read_double(s, "resize", resize);
+    hit_threshold = core::readDouble(c, s, "hit_threshold", hit_threshold);
+    win_stride = core::readInt(c, s, "win_stride", win_stride);
+    scale = core::readDouble(c, s, "scale", scale);
+    group_threshold = core::readInt(c, s, "group_threshold", group_threshold);
+    min_score = core::readDouble(c, s, "min_score", min_score);
+    resize = core::readDouble(c, s, "resize", resize);
     core::requireValue(win_stride > 0 && win_stride % 8 == 0, s, "win_stride",
                        "must be a positive multiple of 8 (HOG cell size)");
     core::requireValue(scale > 1.0, s, "scale", "must be > 1");

@@ -91,12 +91,12 @@ void YoloDetector::Options::loadFromConfig(const mrpt::config::CConfigFileBase& 
     model = c.read_string(s, "model", model);
     weights = c.read_string(s, "weights", weights);
     names = c.read_string(s, "names", names);
-    input_width = c.read_int(s, "input_width", input_width);
-    input_height = c.read_int(s, "input_height", input_height);
-    conf_threshold = c.read_float(s, "conf_threshold", conf_threshold);
-    nms_threshold = c.read_float(s, "nms_threshold", nms_threshold);
+    input_width = core::readInt(c, s, "input_width", input_width);
+    input_height = core::readInt(c, s, "input_height", input_height);
+    conf_threshold = static_cast<float>(core::readDouble(c, s, "conf_threshold", conf_threshold));
+    nms_threshold = static_cast<float>(core::readDouble(c, s, "nms_threshold", nms_threshold));
     if (c.keyExists(s, "classes")) classes = splitList(c.read_string(s, "classes", ""));
-    validate_on_load = c.read_bool(s, "validate_on_load", validate_on_load);
+    validate_on_load = core::readBool(c, s, "validate_on_load", validate_on_load);
     core::requireValue(input_width > 0 && input_width % 32 == 0, s, "input_width",
                        "must be a positive multiple of 32");
     core::requireValue(input_height > 0 && input_height % 32 == 0, s, "input_height",

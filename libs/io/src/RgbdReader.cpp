@@ -17,8 +17,8 @@ void ReaderOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, const
     core::requireKnownKeys(c, s, {"camera", "max_dt", "tum_depth_scale", "sensor_label"},
                            "dataset");
     camera = c.read_string(s, "camera", camera);
-    max_dt = c.read_double(s, "max_dt", max_dt);
-    tum_depth_scale = c.read_double(s, "tum_depth_scale", tum_depth_scale);
+    max_dt = core::readDouble(c, s, "max_dt", max_dt);
+    tum_depth_scale = core::readDouble(c, s, "tum_depth_scale", tum_depth_scale);
     sensor_label = c.read_string(s, "sensor_label", sensor_label);
     core::requireValue(max_dt > 0, s, "max_dt", "must be > 0 s");
     core::requireValue(tum_depth_scale > 0, s, "tum_depth_scale", "must be > 0");

@@ -29,13 +29,13 @@ void GridPlannerOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase&
         {"robot_radius", "inflation_margin", "inflation_penalty", "clearance_distance",
          "clearance_weight", "occupied_threshold", "waypoint_spacing"},
         source);
-    robot_radius = c.read_double(s, "robot_radius", robot_radius);
-    inflation_margin = c.read_double(s, "inflation_margin", inflation_margin);
-    inflation_penalty = c.read_double(s, "inflation_penalty", inflation_penalty);
-    clearance_distance = c.read_double(s, "clearance_distance", clearance_distance);
-    clearance_weight = c.read_double(s, "clearance_weight", clearance_weight);
-    occupied_threshold = c.read_double(s, "occupied_threshold", occupied_threshold);
-    waypoint_spacing = c.read_double(s, "waypoint_spacing", waypoint_spacing);
+    robot_radius = core::readDouble(c, s, "robot_radius", robot_radius);
+    inflation_margin = core::readDouble(c, s, "inflation_margin", inflation_margin);
+    inflation_penalty = core::readDouble(c, s, "inflation_penalty", inflation_penalty);
+    clearance_distance = core::readDouble(c, s, "clearance_distance", clearance_distance);
+    clearance_weight = core::readDouble(c, s, "clearance_weight", clearance_weight);
+    occupied_threshold = core::readDouble(c, s, "occupied_threshold", occupied_threshold);
+    waypoint_spacing = core::readDouble(c, s, "waypoint_spacing", waypoint_spacing);
     validate();
 }
 

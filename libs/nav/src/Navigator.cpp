@@ -61,12 +61,12 @@ NavigatorOptions NavigatorOptions::fromConfig(const mrpt::config::CConfigFileBas
                            {"nav_period", "waypoint_allowed_distance", "holonomic_method",
                             "robot_radius", "log_file", "log_directory"},
                            source);
-    o.nav_period = c.read_double(s, "nav_period", o.nav_period);
+    o.nav_period = core::readDouble(c, s, "nav_period", o.nav_period);
     o.waypoint_allowed_distance =
-        c.read_double(s, "waypoint_allowed_distance", o.waypoint_allowed_distance);
+        core::readDouble(c, s, "waypoint_allowed_distance", o.waypoint_allowed_distance);
     o.holonomic_method = c.read_string(s, "holonomic_method", o.holonomic_method);
-    o.robot_radius = c.read_double(s, "robot_radius", o.robot_radius);
-    o.log_file = c.read_bool(s, "log_file", o.log_file);
+    o.robot_radius = core::readDouble(c, s, "robot_radius", o.robot_radius);
+    o.log_file = core::readBool(c, s, "log_file", o.log_file);
     o.log_directory = c.read_string(s, "log_directory", o.log_directory);
     core::requireValue(o.nav_period > 0, s, "nav_period", "must be > 0 s");
     core::requireValue(o.robot_radius > 0, s, "robot_radius", "must be > 0 m");
@@ -101,7 +101,7 @@ Navigator::Navigator(mrpt::nav::CRobot2NavInterface& robot,
         throw std::invalid_argument("Navigator: the navigation INI lacks [" + sec_ptg + "] or [" +
                                     sec_rns + "]");
     cfg.write(sec_ptg, "holonomic_method", opts_.holonomic_method);
-    ref_distance_ = cfg.read_double(sec_ptg, "ref_distance", 0.0, true);
+    ref_distance_ = core::readDouble(cfg, sec_ptg, "ref_distance", 0.0, true);
     // robot polygon: 16-gon circumscribing the robot circle
     std::vector<double> xs, ys;
     const int nv = 16;

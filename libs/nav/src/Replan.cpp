@@ -14,13 +14,13 @@ void ReplanOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, c
         {"density_threshold", "density_time", "min_interval", "blocked_lookahead", "blocked_margin",
          "obstacle_inflation", "sensed_range"},
         source);
-    density_threshold = c.read_double(s, "density_threshold", density_threshold);
-    density_time = c.read_double(s, "density_time", density_time);
-    min_interval = c.read_double(s, "min_interval", min_interval);
-    blocked_lookahead = c.read_double(s, "blocked_lookahead", blocked_lookahead);
-    blocked_margin = c.read_double(s, "blocked_margin", blocked_margin);
-    obstacle_inflation = c.read_double(s, "obstacle_inflation", obstacle_inflation);
-    sensed_range = c.read_double(s, "sensed_range", sensed_range);
+    density_threshold = core::readDouble(c, s, "density_threshold", density_threshold);
+    density_time = core::readDouble(c, s, "density_time", density_time);
+    min_interval = core::readDouble(c, s, "min_interval", min_interval);
+    blocked_lookahead = core::readDouble(c, s, "blocked_lookahead", blocked_lookahead);
+    blocked_margin = core::readDouble(c, s, "blocked_margin", blocked_margin);
+    obstacle_inflation = core::readDouble(c, s, "obstacle_inflation", obstacle_inflation);
+    sensed_range = core::readDouble(c, s, "sensed_range", sensed_range);
     core::requireValue(density_time >= 0, s, "density_time", "must be >= 0 s");
     core::requireValue(min_interval >= 0, s, "min_interval", "must be >= 0 s");
     core::requireValue(blocked_lookahead > 0, s, "blocked_lookahead", "must be > 0 m");

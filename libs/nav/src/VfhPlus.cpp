@@ -31,21 +31,21 @@ void VfhPlusOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c,
                                         const std::string& s, const std::string& source) {
     core::requireKnownKeys(c, s, std::vector<std::string>(std::begin(kKeys), std::end(kKeys)),
                            source);
-    window = c.read_double(s, "window", window);
-    certainty = c.read_double(s, "certainty", certainty);
-    enlargement_radius = c.read_double(s, "enlargement_radius", enlargement_radius);
-    tau_low = c.read_double(s, "tau_low", tau_low);
-    tau_high = c.read_double(s, "tau_high", tau_high);
-    min_free_distance = c.read_double(s, "min_free_distance", min_free_distance);
-    mask_distance = c.read_double(s, "mask_distance", mask_distance);
-    wide_valley_sectors = c.read_int(s, "wide_valley_sectors", wide_valley_sectors);
-    mu1 = c.read_double(s, "mu1", mu1);
-    mu2 = c.read_double(s, "mu2", mu2);
-    mu3 = c.read_double(s, "mu3", mu3);
-    hm = c.read_double(s, "hm", hm);
-    min_speed_ratio = c.read_double(s, "min_speed_ratio", min_speed_ratio);
+    window = core::readDouble(c, s, "window", window);
+    certainty = core::readDouble(c, s, "certainty", certainty);
+    enlargement_radius = core::readDouble(c, s, "enlargement_radius", enlargement_radius);
+    tau_low = core::readDouble(c, s, "tau_low", tau_low);
+    tau_high = core::readDouble(c, s, "tau_high", tau_high);
+    min_free_distance = core::readDouble(c, s, "min_free_distance", min_free_distance);
+    mask_distance = core::readDouble(c, s, "mask_distance", mask_distance);
+    wide_valley_sectors = core::readInt(c, s, "wide_valley_sectors", wide_valley_sectors);
+    mu1 = core::readDouble(c, s, "mu1", mu1);
+    mu2 = core::readDouble(c, s, "mu2", mu2);
+    mu3 = core::readDouble(c, s, "mu3", mu3);
+    hm = core::readDouble(c, s, "hm", hm);
+    min_speed_ratio = core::readDouble(c, s, "min_speed_ratio", min_speed_ratio);
     target_slowdown_distance =
-        c.read_double(s, "target_slowdown_distance", target_slowdown_distance);
+        core::readDouble(c, s, "target_slowdown_distance", target_slowdown_distance);
     validate();
 }
 

@@ -111,11 +111,12 @@ void TrajectoryOptions::loadFromConfig(const mrpt::config::CConfigFileBase& cfg,
     period = readVec3(cfg, s, "period", period);
     rot_amplitude_deg = readVec3(cfg, s, "rot_amplitude_deg", rot_amplitude_deg);
     rot_period = readVec3(cfg, s, "rot_period", rot_period);
-    azimuth_amplitude_deg = cfg.read_double(s, "azimuth_amplitude_deg", azimuth_amplitude_deg);
+    azimuth_amplitude_deg =
+        core::readDouble(cfg, s, "azimuth_amplitude_deg", azimuth_amplitude_deg);
     elevation_amplitude_deg =
-        cfg.read_double(s, "elevation_amplitude_deg", elevation_amplitude_deg);
-    azimuth_period = cfg.read_double(s, "azimuth_period", azimuth_period);
-    elevation_period = cfg.read_double(s, "elevation_period", elevation_period);
+        core::readDouble(cfg, s, "elevation_amplitude_deg", elevation_amplitude_deg);
+    azimuth_period = core::readDouble(cfg, s, "azimuth_period", azimuth_period);
+    elevation_period = core::readDouble(cfg, s, "elevation_period", elevation_period);
     for (int i = 0; i < 3; ++i) {
         core::requireValue(period[i] > 0, s, "period", "must be > 0 [s]");
         core::requireValue(rot_period[i] > 0, s, "rot_period", "must be > 0 [s]");

@@ -16,16 +16,16 @@ void DepthNoiseOptions::loadFromConfig(const mrpt::config::CConfigFileBase& cfg,
                            {"enabled", "min_range", "max_range", "sigma_a", "sigma_b", "baseline",
                             "disparity_step", "edge_jump", "edge_dilate", "dropout"},
                            "depth_noise");
-    enabled = cfg.read_bool(s, "enabled", enabled);
-    min_range = cfg.read_double(s, "min_range", min_range);
-    max_range = cfg.read_double(s, "max_range", max_range);
-    sigma_a = cfg.read_double(s, "sigma_a", sigma_a);
-    sigma_b = cfg.read_double(s, "sigma_b", sigma_b);
-    baseline = cfg.read_double(s, "baseline", baseline);
-    disparity_step = cfg.read_double(s, "disparity_step", disparity_step);
-    edge_jump = cfg.read_double(s, "edge_jump", edge_jump);
-    edge_dilate = cfg.read_int(s, "edge_dilate", edge_dilate);
-    dropout = cfg.read_double(s, "dropout", dropout);
+    enabled = core::readBool(cfg, s, "enabled", enabled);
+    min_range = core::readDouble(cfg, s, "min_range", min_range);
+    max_range = core::readDouble(cfg, s, "max_range", max_range);
+    sigma_a = core::readDouble(cfg, s, "sigma_a", sigma_a);
+    sigma_b = core::readDouble(cfg, s, "sigma_b", sigma_b);
+    baseline = core::readDouble(cfg, s, "baseline", baseline);
+    disparity_step = core::readDouble(cfg, s, "disparity_step", disparity_step);
+    edge_jump = core::readDouble(cfg, s, "edge_jump", edge_jump);
+    edge_dilate = core::readInt(cfg, s, "edge_dilate", edge_dilate);
+    dropout = core::readDouble(cfg, s, "dropout", dropout);
     core::requireValue(min_range >= 0 && max_range > min_range, s, "max_range",
                        "need 0 <= min_range < max_range [m]");
     core::requireValue(sigma_a >= 0 && sigma_b >= 0, s, "sigma_a", "must be >= 0");

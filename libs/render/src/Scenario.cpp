@@ -72,15 +72,15 @@ std::vector<std::string> sectionsWithPrefix(const mrpt::config::CConfigFileBase&
     return out;
 }
 
-void loadRoom(const std::string& path, RoomSpec& room) {
+void readRoom(const std::string& path, RoomSpec& room) {
     const auto cfg = core::loadIni(path);
     const std::string base = dirOf(path);
     const std::string s = "room";
     core::requireKnownKeys(
         *cfg, s, {"size", "panel_width", "panel_height", "wall_textures", "floor_textures"}, path);
     room.size = vec3(*cfg, s, "size", path, true);
-    room.panel_width = cfg->read_double(s, "panel_width", room.panel_width);
-    room.panel_height = cfg->read_double(s, "panel_height", room.panel_height);
+    room.panel_width = core::readDouble(*cfg, s, "panel_width", room.panel_width);
+    room.panel_height = core::readDouble(*cfg, s, "panel_height", room.panel_height);
     core::requireValue(room.size.minCoeff() > 0.5, path + " [room]", "size", "each side > 0.5 [m]");
     core::requireValue(room.panel_width > 0.05 && room.panel_height > 0.05, path + " [room]",
                        "panel_width", "panels must be > 0.05 m");
@@ -96,11 +96,15 @@ void loadRoom(const std::string& path, RoomSpec& room) {
         box.size = vec3(*cfg, b, "size", path, true);
         core::requireValue(box.size.minCoeff() > 0, path + " [" + b + "]", "size",
                            "must be > 0 [m]");
-        box.yaw = cfg->read_double(b, "yaw_deg", 0.0) * kPi / 180.0;
+        box.yaw = core::readDouble(*cfg, b, "yaw_deg", 0.0) * kPi / 180.0;
         box.textures = resolveImages(cfg->read_string(b, "textures", "", true), base,
                                      path + " [" + b + "] textures");
         room.boxes.push_back(std::move(box));
     }
+}
+
+void loadRoom(const std::string& path, RoomSpec& room) {
+    core::namingSource(path, [&] { readRoom(path, room); });
 }
 
 PersonSpec loadPerson(const mrpt::config::CConfigFileBase& cfg, const std::string& s,
@@ -117,13 +121,13 @@ PersonSpec loadPerson(const mrpt::config::CConfigFileBase& cfg, const std::strin
         resolveImages(cfg.read_string(s, "texture", "", true), dirOf(path), where + " texture");
     if (tex.size() != 1) throw std::invalid_argument(where + " texture: need exactly one file");
     p.texture = tex.front();
-    p.height = cfg.read_double(s, "height", p.height);
-    p.speed = cfg.read_double(s, "speed", p.speed);
-    p.start_offset = cfg.read_double(s, "start_offset", p.start_offset);
-    p.base_z = cfg.read_double(s, "base_z", p.base_z);
-    p.sway_deg = cfg.read_double(s, "sway_deg", p.sway_deg);
-    p.sway_period = cfg.read_double(s, "sway_period", p.sway_period);
-    p.bob = cfg.read_double(s, "bob", p.bob);
+    p.height = core::readDouble(cfg, s, "height", p.height);
+    p.speed = core::readDouble(cfg, s, "speed", p.speed);
+    p.start_offset = core::readDouble(cfg, s, "start_offset", p.start_offset);
+    p.base_z = core::readDouble(cfg, s, "base_z", p.base_z);
+    p.sway_deg = core::readDouble(cfg, s, "sway_deg", p.sway_deg);
+    p.sway_period = core::readDouble(cfg, s, "sway_period", p.sway_period);
+    p.bob = core::readDouble(cfg, s, "bob", p.bob);
     const auto xy = parseNumberList(cfg.read_string(s, "path", "", true), where + " path");
     if (xy.size() < 2 || xy.size() % 2)
         throw std::invalid_argument(where + " path: need x y pairs");
@@ -177,7 +181,9 @@ core::CameraIntrinsics scaleIntrinsics(const core::CameraIntrinsics& K, double s
     return o;
 }
 
-Scenario loadScenario(const std::string& path) {
+namespace {
+
+Scenario readScenario(const std::string& path) {
     const auto cfg = core::loadIni(path);
     Scenario sc;
     sc.source = path;
@@ -187,20 +193,20 @@ Scenario loadScenario(const std::string& path) {
                             "rgb_noise_sigma", "near_clip", "far_clip"},
                            path);
     sc.name = cfg->read_string(s, "name", fs::path(path).stem().string());
-    sc.rate_hz = cfg->read_double(s, "rate_hz", sc.rate_hz);
+    sc.rate_hz = core::readDouble(*cfg, s, "rate_hz", sc.rate_hz);
     core::requireValue(sc.rate_hz > 0 && sc.rate_hz <= 1000, path + " [scenario]", "rate_hz",
                        "must be in (0, 1000] [Hz]");
-    const double duration = cfg->read_double(s, "duration", 0.0);
-    const int n = cfg->read_int(s, "n_frames", 0);
+    const double duration = core::readDouble(*cfg, s, "duration", 0.0);
+    const int n = core::readInt(*cfg, s, "n_frames", 0);
     if ((duration > 0) == (n > 0))
         throw std::invalid_argument(
             path + " [scenario]: give exactly one of 'duration' [s] or 'n_frames'");
     sc.n_frames = n > 0 ? std::size_t(n) : std::size_t(std::lround(duration * sc.rate_hz));
-    sc.t0 = cfg->read_double(s, "t0", sc.t0);
-    sc.seed = std::uint64_t(cfg->read_uint64_t(s, "seed", sc.seed));
-    sc.rgb_noise_sigma = cfg->read_double(s, "rgb_noise_sigma", sc.rgb_noise_sigma);
-    sc.near_clip = cfg->read_double(s, "near_clip", sc.near_clip);
-    sc.far_clip = cfg->read_double(s, "far_clip", sc.far_clip);
+    sc.t0 = core::readDouble(*cfg, s, "t0", sc.t0);
+    sc.seed = std::uint64_t(core::readUint64(*cfg, s, "seed", sc.seed));
+    sc.rgb_noise_sigma = core::readDouble(*cfg, s, "rgb_noise_sigma", sc.rgb_noise_sigma);
+    sc.near_clip = core::readDouble(*cfg, s, "near_clip", sc.near_clip);
+    sc.far_clip = core::readDouble(*cfg, s, "far_clip", sc.far_clip);
     core::requireValue(sc.rgb_noise_sigma >= 0, path + " [scenario]", "rgb_noise_sigma",
                        "must be >= 0");
     core::requireValue(sc.near_clip > 0 && sc.far_clip > sc.near_clip, path + " [scenario]",
@@ -234,6 +240,12 @@ Scenario loadScenario(const std::string& path) {
                 "] (known: scenario, camera, trajectory, depth_noise, person_*)");
     }
     return sc;
+}
+
+}  // namespace
+
+Scenario loadScenario(const std::string& path) {
+    return core::namingSource(path, [&] { return readScenario(path); });
 }
 
 }  // namespace devslam::render

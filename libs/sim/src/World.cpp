@@ -45,7 +45,7 @@ std::vector<double> parseNumbers(const std::vector<std::string>& words, size_t f
 double readRequired(const mrpt::config::CConfigFileBase& c, const std::string& source,
                     const std::string& s, const std::string& k) {
     if (!c.keyExists(s, k)) fail(source, s, k, "required key is missing");
-    return c.read_double(s, k, 0.0);
+    return core::readDouble(c, s, k, 0.0);
 }
 }  // namespace
 
@@ -54,7 +54,9 @@ WorldSpec loadWorld(const std::string& path) {
     return parseWorld(*cfg, path);
 }
 
-WorldSpec parseWorld(const mrpt::config::CConfigFileBase& c, const std::string& source) {
+namespace {
+
+WorldSpec parseWorldFields(const mrpt::config::CConfigFileBase& c, const std::string& source) {
     WorldSpec w;
     w.source = source;
     for (const char* s : {"world", "robot", "goal"})
@@ -70,12 +72,12 @@ WorldSpec parseWorld(const mrpt::config::CConfigFileBase& c, const std::string& 
     w.x_max = readRequired(c, source, s, "x_max");
     w.y_min = readRequired(c, source, s, "y_min");
     w.y_max = readRequired(c, source, s, "y_max");
-    w.boundary_walls = c.read_bool(s, "boundary_walls", w.boundary_walls);
-    w.grid_resolution = c.read_double(s, "grid_resolution", w.grid_resolution);
-    w.time_step = c.read_double(s, "time_step", w.time_step);
-    w.timeout = c.read_double(s, "timeout", w.timeout);
-    w.seed = static_cast<uint32_t>(c.read_uint64_t(s, "seed", w.seed));
-    w.pedestrians_yield = c.read_bool(s, "pedestrians_yield", w.pedestrians_yield);
+    w.boundary_walls = core::readBool(c, s, "boundary_walls", w.boundary_walls);
+    w.grid_resolution = core::readDouble(c, s, "grid_resolution", w.grid_resolution);
+    w.time_step = core::readDouble(c, s, "time_step", w.time_step);
+    w.timeout = core::readDouble(c, s, "timeout", w.timeout);
+    w.seed = static_cast<uint32_t>(core::readUint64(c, s, "seed", w.seed));
+    w.pedestrians_yield = core::readBool(c, s, "pedestrians_yield", w.pedestrians_yield);
 
     s = "robot";
     core::requireKnownKeys(c, s,
@@ -84,31 +86,32 @@ WorldSpec parseWorld(const mrpt::config::CConfigFileBase& c, const std::string& 
                            source);
     w.robot.start.x = readRequired(c, source, s, "start_x");
     w.robot.start.y = readRequired(c, source, s, "start_y");
-    w.robot.start.phi = mrpt::DEG2RAD(c.read_double(s, "start_yaw_deg", 0.0));
-    w.robot.radius = c.read_double(s, "radius", w.robot.radius);
-    w.robot.max_v = c.read_double(s, "max_v", w.robot.max_v);
-    w.robot.max_w = mrpt::DEG2RAD(c.read_double(s, "max_w_deg", mrpt::RAD2DEG(w.robot.max_w)));
-    w.robot.max_acc = c.read_double(s, "max_acc", w.robot.max_acc);
-    w.robot.max_ang_acc =
-        mrpt::DEG2RAD(c.read_double(s, "max_ang_acc_deg", mrpt::RAD2DEG(w.robot.max_ang_acc)));
+    w.robot.start.phi = mrpt::DEG2RAD(core::readDouble(c, s, "start_yaw_deg", 0.0));
+    w.robot.radius = core::readDouble(c, s, "radius", w.robot.radius);
+    w.robot.max_v = core::readDouble(c, s, "max_v", w.robot.max_v);
+    w.robot.max_w =
+        mrpt::DEG2RAD(core::readDouble(c, s, "max_w_deg", mrpt::RAD2DEG(w.robot.max_w)));
+    w.robot.max_acc = core::readDouble(c, s, "max_acc", w.robot.max_acc);
+    w.robot.max_ang_acc = mrpt::DEG2RAD(
+        core::readDouble(c, s, "max_ang_acc_deg", mrpt::RAD2DEG(w.robot.max_ang_acc)));
 
     s = "goal";
     core::requireKnownKeys(c, s, {"x", "y", "tolerance"}, source);
     w.goal.x = readRequired(c, source, s, "x");
     w.goal.y = readRequired(c, source, s, "y");
-    w.goal_tolerance = c.read_double(s, "tolerance", w.goal_tolerance);
+    w.goal_tolerance = core::readDouble(c, s, "tolerance", w.goal_tolerance);
 
     s = "laser";
     core::requireKnownKeys(
         c, s, {"range", "rays", "fov_deg", "noise_std", "rate_hz", "height", "detect_people"},
         source);
-    w.laser.range = c.read_double(s, "range", w.laser.range);
-    w.laser.rays = c.read_int(s, "rays", w.laser.rays);
-    w.laser.fov = mrpt::DEG2RAD(c.read_double(s, "fov_deg", mrpt::RAD2DEG(w.laser.fov)));
-    w.laser.noise_std = c.read_double(s, "noise_std", w.laser.noise_std);
-    w.laser.rate = c.read_double(s, "rate_hz", w.laser.rate);
-    w.laser.height = c.read_double(s, "height", w.laser.height);
-    w.laser.detect_people = c.read_bool(s, "detect_people", w.laser.detect_people);
+    w.laser.range = core::readDouble(c, s, "range", w.laser.range);
+    w.laser.rays = core::readInt(c, s, "rays", w.laser.rays);
+    w.laser.fov = mrpt::DEG2RAD(core::readDouble(c, s, "fov_deg", mrpt::RAD2DEG(w.laser.fov)));
+    w.laser.noise_std = core::readDouble(c, s, "noise_std", w.laser.noise_std);
+    w.laser.rate = core::readDouble(c, s, "rate_hz", w.laser.rate);
+    w.laser.height = core::readDouble(c, s, "height", w.laser.height);
+    w.laser.detect_people = core::readBool(c, s, "detect_people", w.laser.detect_people);
 
     std::vector<std::string> keys;
     s = "obstacles";
@@ -177,6 +180,12 @@ WorldSpec parseWorld(const mrpt::config::CConfigFileBase& c, const std::string& 
     }
     validateWorld(w);
     return w;
+}
+
+}  // namespace
+
+WorldSpec parseWorld(const mrpt::config::CConfigFileBase& c, const std::string& source) {
+    return core::namingSource(source, [&] { return parseWorldFields(c, source); });
 }
 
 void validateWorld(const WorldSpec& w) {

@@ -11,14 +11,14 @@ void KeyframeSelectorOptions::loadFromConfig(const mrpt::config::CConfigFileBase
         c, s,
         {"min_frames", "max_frames", "min_tracked_ratio", "min_tracked", "close_tracked_below",
          "close_untracked_above", "max_translation", "max_rotation_deg"});
-    min_frames = c.read_int(s, "min_frames", min_frames);
-    max_frames = c.read_int(s, "max_frames", max_frames);
-    min_tracked_ratio = c.read_double(s, "min_tracked_ratio", min_tracked_ratio);
-    min_tracked = c.read_int(s, "min_tracked", min_tracked);
-    close_tracked_below = c.read_int(s, "close_tracked_below", close_tracked_below);
-    close_untracked_above = c.read_int(s, "close_untracked_above", close_untracked_above);
-    max_translation = c.read_double(s, "max_translation", max_translation);
-    max_rotation_deg = c.read_double(s, "max_rotation_deg", max_rotation_deg);
+    min_frames = core::readInt(c, s, "min_frames", min_frames);
+    max_frames = core::readInt(c, s, "max_frames", max_frames);
+    min_tracked_ratio = core::readDouble(c, s, "min_tracked_ratio", min_tracked_ratio);
+    min_tracked = core::readInt(c, s, "min_tracked", min_tracked);
+    close_tracked_below = core::readInt(c, s, "close_tracked_below", close_tracked_below);
+    close_untracked_above = core::readInt(c, s, "close_untracked_above", close_untracked_above);
+    max_translation = core::readDouble(c, s, "max_translation", max_translation);
+    max_rotation_deg = core::readDouble(c, s, "max_rotation_deg", max_rotation_deg);
     core::requireValue(max_frames >= 1, s, "max_frames", "must be >= 1");
     core::requireValue(min_frames >= 0 && min_frames <= max_frames, s, "min_frames",
                        "must be in [0, max_frames]");

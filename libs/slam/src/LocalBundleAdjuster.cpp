@@ -16,15 +16,15 @@ void LocalBaOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, cons
     core::requireKnownKeys(
         c, s,
         {"enabled", "window", "iterations", "bf", "chi2_mono", "chi2_stereo", "outlier_rounds"});
-    enabled = c.read_bool(s, "enabled", enabled);
-    window = c.read_int(s, "window", window);
-    outlier_rounds = c.read_int(s, "outlier_rounds", outlier_rounds);
+    enabled = core::readBool(c, s, "enabled", enabled);
+    window = core::readInt(c, s, "window", window);
+    outlier_rounds = core::readInt(c, s, "outlier_rounds", outlier_rounds);
     core::requireValue(outlier_rounds >= 0 && outlier_rounds <= 5, s, "outlier_rounds",
                        "must be in [0, 5]");
-    iterations = c.read_int(s, "iterations", iterations);
-    bf = c.read_double(s, "bf", bf);
-    chi2_mono = c.read_double(s, "chi2_mono", chi2_mono);
-    chi2_stereo = c.read_double(s, "chi2_stereo", chi2_stereo);
+    iterations = core::readInt(c, s, "iterations", iterations);
+    bf = core::readDouble(c, s, "bf", bf);
+    chi2_mono = core::readDouble(c, s, "chi2_mono", chi2_mono);
+    chi2_stereo = core::readDouble(c, s, "chi2_stereo", chi2_stereo);
     core::requireValue(window >= 1 && window <= 30, s, "window", "must be in [1, 30]");
     core::requireValue(iterations >= 0, s, "iterations", "must be >= 0");
     core::requireValue(bf > 0, s, "bf", "must be > 0");

@@ -14,18 +14,18 @@ void LoopOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, const s
                            {"enabled", "min_keyframe_gap", "cooldown_keyframes", "max_distance",
                             "max_candidates", "max_hamming", "ratio", "min_inliers", "sigma_t",
                             "sigma_r_deg", "max_correction", "max_correction_deg"});
-    enabled = c.read_bool(s, "enabled", enabled);
-    min_keyframe_gap = c.read_int(s, "min_keyframe_gap", min_keyframe_gap);
-    cooldown_keyframes = c.read_int(s, "cooldown_keyframes", cooldown_keyframes);
-    max_distance = c.read_double(s, "max_distance", max_distance);
-    max_candidates = c.read_int(s, "max_candidates", max_candidates);
-    max_hamming = c.read_int(s, "max_hamming", max_hamming);
-    ratio = c.read_double(s, "ratio", ratio);
-    min_inliers = c.read_int(s, "min_inliers", min_inliers);
-    max_correction = c.read_double(s, "max_correction", max_correction);
-    max_correction_deg = c.read_double(s, "max_correction_deg", max_correction_deg);
-    sigma_t = c.read_double(s, "sigma_t", sigma_t);
-    sigma_r_deg = c.read_double(s, "sigma_r_deg", sigma_r_deg);
+    enabled = core::readBool(c, s, "enabled", enabled);
+    min_keyframe_gap = core::readInt(c, s, "min_keyframe_gap", min_keyframe_gap);
+    cooldown_keyframes = core::readInt(c, s, "cooldown_keyframes", cooldown_keyframes);
+    max_distance = core::readDouble(c, s, "max_distance", max_distance);
+    max_candidates = core::readInt(c, s, "max_candidates", max_candidates);
+    max_hamming = core::readInt(c, s, "max_hamming", max_hamming);
+    ratio = core::readDouble(c, s, "ratio", ratio);
+    min_inliers = core::readInt(c, s, "min_inliers", min_inliers);
+    max_correction = core::readDouble(c, s, "max_correction", max_correction);
+    max_correction_deg = core::readDouble(c, s, "max_correction_deg", max_correction_deg);
+    sigma_t = core::readDouble(c, s, "sigma_t", sigma_t);
+    sigma_r_deg = core::readDouble(c, s, "sigma_r_deg", sigma_r_deg);
     core::requireValue(min_keyframe_gap >= 1, s, "min_keyframe_gap", "must be >= 1");
     core::requireValue(max_distance > 0, s, "max_distance", "must be > 0");
     core::requireValue(min_inliers >= 6, s, "min_inliers", "must be >= 6");

@@ -92,11 +92,11 @@ void write3DScene(const std::string& path, const Map& map, const core::Trajector
 
 void GridMapOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, const std::string& s) {
     core::requireKnownKeys(c, s, {"resolution", "min_height", "max_height", "margin", "max_range"});
-    resolution = c.read_double(s, "resolution", resolution);
-    min_height = c.read_double(s, "min_height", min_height);
-    max_height = c.read_double(s, "max_height", max_height);
-    margin = c.read_double(s, "margin", margin);
-    max_range = c.read_double(s, "max_range", max_range);
+    resolution = core::readDouble(c, s, "resolution", resolution);
+    min_height = core::readDouble(c, s, "min_height", min_height);
+    max_height = core::readDouble(c, s, "max_height", max_height);
+    margin = core::readDouble(c, s, "margin", margin);
+    max_range = core::readDouble(c, s, "max_range", max_range);
     core::requireValue(resolution > 0, s, "resolution", "must be > 0");
     core::requireValue(max_height > min_height, s, "min_height/max_height",
                        "need min_height < max_height");

@@ -18,20 +18,20 @@ void OrbExtractor::Options::loadFromConfig(const mrpt::config::CConfigFileBase& 
         {"n_features", "scale_factor", "n_levels", "fast_threshold", "min_fast_threshold",
          "oversample", "grid_cols", "grid_rows", "min_depth", "max_depth", "depth_factor",
          "detect_outside_mask", "depth_edge_threshold"});
-    n_features = c.read_int(s, "n_features", n_features);
-    scale_factor = c.read_double(s, "scale_factor", scale_factor);
-    n_levels = c.read_int(s, "n_levels", n_levels);
-    fast_threshold = c.read_int(s, "fast_threshold", fast_threshold);
-    min_fast_threshold = c.read_int(s, "min_fast_threshold", min_fast_threshold);
-    oversample = c.read_double(s, "oversample", oversample);
-    detect_outside_mask = c.read_bool(s, "detect_outside_mask", detect_outside_mask);
-    depth_edge_threshold = c.read_double(s, "depth_edge_threshold", depth_edge_threshold);
+    n_features = core::readInt(c, s, "n_features", n_features);
+    scale_factor = core::readDouble(c, s, "scale_factor", scale_factor);
+    n_levels = core::readInt(c, s, "n_levels", n_levels);
+    fast_threshold = core::readInt(c, s, "fast_threshold", fast_threshold);
+    min_fast_threshold = core::readInt(c, s, "min_fast_threshold", min_fast_threshold);
+    oversample = core::readDouble(c, s, "oversample", oversample);
+    detect_outside_mask = core::readBool(c, s, "detect_outside_mask", detect_outside_mask);
+    depth_edge_threshold = core::readDouble(c, s, "depth_edge_threshold", depth_edge_threshold);
     core::requireValue(depth_edge_threshold >= 0, s, "depth_edge_threshold", "must be >= 0");
-    grid_cols = c.read_int(s, "grid_cols", grid_cols);
-    grid_rows = c.read_int(s, "grid_rows", grid_rows);
-    min_depth = c.read_double(s, "min_depth", min_depth);
-    max_depth = c.read_double(s, "max_depth", max_depth);
-    depth_factor = c.read_double(s, "depth_factor", depth_factor);
+    grid_cols = core::readInt(c, s, "grid_cols", grid_cols);
+    grid_rows = core::readInt(c, s, "grid_rows", grid_rows);
+    min_depth = core::readDouble(c, s, "min_depth", min_depth);
+    max_depth = core::readDouble(c, s, "max_depth", max_depth);
+    depth_factor = core::readDouble(c, s, "depth_factor", depth_factor);
     core::requireValue(depth_factor > 0.5 && depth_factor < 2.0, s, "depth_factor",
                        "must be in (0.5, 2)");
     core::requireValue(n_features > 0, s, "n_features", "must be > 0");

@@ -15,14 +15,15 @@ void MappingOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, cons
         c, s,
         {"min_init_points", "cull_min_found_ratio", "cull_min_visible", "cull_keyframe_age",
          "odometry_sigma_t", "odometry_sigma_r_deg", "depth_time_compensation", "refine_frames"});
-    depth_time_compensation = c.read_bool(s, "depth_time_compensation", depth_time_compensation);
-    refine_frames = c.read_bool(s, "refine_frames", refine_frames);
-    min_init_points = c.read_int(s, "min_init_points", min_init_points);
-    cull_min_found_ratio = c.read_double(s, "cull_min_found_ratio", cull_min_found_ratio);
-    cull_min_visible = c.read_int(s, "cull_min_visible", cull_min_visible);
-    cull_keyframe_age = c.read_int(s, "cull_keyframe_age", cull_keyframe_age);
-    odometry_sigma_t = c.read_double(s, "odometry_sigma_t", odometry_sigma_t);
-    odometry_sigma_r_deg = c.read_double(s, "odometry_sigma_r_deg", odometry_sigma_r_deg);
+    depth_time_compensation =
+        core::readBool(c, s, "depth_time_compensation", depth_time_compensation);
+    refine_frames = core::readBool(c, s, "refine_frames", refine_frames);
+    min_init_points = core::readInt(c, s, "min_init_points", min_init_points);
+    cull_min_found_ratio = core::readDouble(c, s, "cull_min_found_ratio", cull_min_found_ratio);
+    cull_min_visible = core::readInt(c, s, "cull_min_visible", cull_min_visible);
+    cull_keyframe_age = core::readInt(c, s, "cull_keyframe_age", cull_keyframe_age);
+    odometry_sigma_t = core::readDouble(c, s, "odometry_sigma_t", odometry_sigma_t);
+    odometry_sigma_r_deg = core::readDouble(c, s, "odometry_sigma_r_deg", odometry_sigma_r_deg);
     core::requireValue(min_init_points >= 10, s, "min_init_points", "must be >= 10");
     core::requireValue(cull_min_found_ratio >= 0 && cull_min_found_ratio < 1, s,
                        "cull_min_found_ratio", "must be in [0, 1)");
@@ -76,8 +77,8 @@ SlamOptions SlamOptions::fromConfig(const mrpt::config::CConfigFileBase& cfg) {
     o.local_ba.loadFromConfig(cfg, "local_ba");
     o.loop.loadFromConfig(cfg, "loop_closure");
     core::requireKnownKeys(cfg, "pose_graph", {"max_iterations", "seed"});
-    o.pose_graph.max_iterations = cfg.read_int("pose_graph", "max_iterations", 100);
-    o.seed = static_cast<unsigned long long>(cfg.read_uint64_t("pose_graph", "seed", o.seed));
+    o.pose_graph.max_iterations = core::readInt(cfg, "pose_graph", "max_iterations", 100);
+    o.seed = static_cast<unsigned long long>(core::readUint64(cfg, "pose_graph", "seed", o.seed));
     core::requireValue(o.pose_graph.max_iterations > 0, "pose_graph", "max_iterations",
                        "must be > 0");
     // The level sigmas of tracking and BA follow the ORB pyramid.

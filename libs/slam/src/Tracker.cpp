@@ -35,30 +35,30 @@ void TrackerOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, cons
                                   "reloc_max_hamming",  "reloc_ratio",
                                   "reloc_max_jump",     "reloc_max_speed",
                                   "reloc_max_jump_deg", "reloc_max_rate_deg"});
-    projection.radius = c.read_double(s, "search_radius", projection.radius);
-    fine_radius = c.read_double(s, "fine_radius", fine_radius);
-    wide_radius_factor = c.read_double(s, "wide_radius_factor", wide_radius_factor);
-    projection.max_hamming = c.read_int(s, "max_hamming", projection.max_hamming);
-    projection.ratio = c.read_double(s, "match_ratio", projection.ratio);
-    projection.max_depth = c.read_double(s, "max_depth", projection.max_depth);
-    pnp.iterations = c.read_int(s, "pnp_iterations", pnp.iterations);
-    pnp.reprojection_px = c.read_double(s, "pnp_reprojection_px", pnp.reprojection_px);
-    pnp.confidence = c.read_double(s, "pnp_confidence", pnp.confidence);
-    refine.bf = c.read_double(s, "bf", refine.bf);
-    refine.rounds = c.read_int(s, "refine_rounds", refine.rounds);
-    refine.iterations = c.read_int(s, "refine_iterations", refine.iterations);
-    min_matches = c.read_int(s, "min_matches", min_matches);
-    min_inliers = c.read_int(s, "min_inliers", min_inliers);
-    local_keyframes = c.read_int(s, "local_keyframes", local_keyframes);
-    max_motion_dt = c.read_double(s, "max_motion_dt", max_motion_dt);
-    reloc_keyframes = c.read_int(s, "reloc_keyframes", reloc_keyframes);
-    reloc_min_inliers = c.read_int(s, "reloc_min_inliers", reloc_min_inliers);
-    reloc_max_hamming = c.read_int(s, "reloc_max_hamming", reloc_max_hamming);
-    reloc_ratio = c.read_double(s, "reloc_ratio", reloc_ratio);
-    reloc_max_jump = c.read_double(s, "reloc_max_jump", reloc_max_jump);
-    reloc_max_speed = c.read_double(s, "reloc_max_speed", reloc_max_speed);
-    reloc_max_jump_deg = c.read_double(s, "reloc_max_jump_deg", reloc_max_jump_deg);
-    reloc_max_rate_deg = c.read_double(s, "reloc_max_rate_deg", reloc_max_rate_deg);
+    projection.radius = core::readDouble(c, s, "search_radius", projection.radius);
+    fine_radius = core::readDouble(c, s, "fine_radius", fine_radius);
+    wide_radius_factor = core::readDouble(c, s, "wide_radius_factor", wide_radius_factor);
+    projection.max_hamming = core::readInt(c, s, "max_hamming", projection.max_hamming);
+    projection.ratio = core::readDouble(c, s, "match_ratio", projection.ratio);
+    projection.max_depth = core::readDouble(c, s, "max_depth", projection.max_depth);
+    pnp.iterations = core::readInt(c, s, "pnp_iterations", pnp.iterations);
+    pnp.reprojection_px = core::readDouble(c, s, "pnp_reprojection_px", pnp.reprojection_px);
+    pnp.confidence = core::readDouble(c, s, "pnp_confidence", pnp.confidence);
+    refine.bf = core::readDouble(c, s, "bf", refine.bf);
+    refine.rounds = core::readInt(c, s, "refine_rounds", refine.rounds);
+    refine.iterations = core::readInt(c, s, "refine_iterations", refine.iterations);
+    min_matches = core::readInt(c, s, "min_matches", min_matches);
+    min_inliers = core::readInt(c, s, "min_inliers", min_inliers);
+    local_keyframes = core::readInt(c, s, "local_keyframes", local_keyframes);
+    max_motion_dt = core::readDouble(c, s, "max_motion_dt", max_motion_dt);
+    reloc_keyframes = core::readInt(c, s, "reloc_keyframes", reloc_keyframes);
+    reloc_min_inliers = core::readInt(c, s, "reloc_min_inliers", reloc_min_inliers);
+    reloc_max_hamming = core::readInt(c, s, "reloc_max_hamming", reloc_max_hamming);
+    reloc_ratio = core::readDouble(c, s, "reloc_ratio", reloc_ratio);
+    reloc_max_jump = core::readDouble(c, s, "reloc_max_jump", reloc_max_jump);
+    reloc_max_speed = core::readDouble(c, s, "reloc_max_speed", reloc_max_speed);
+    reloc_max_jump_deg = core::readDouble(c, s, "reloc_max_jump_deg", reloc_max_jump_deg);
+    reloc_max_rate_deg = core::readDouble(c, s, "reloc_max_rate_deg", reloc_max_rate_deg);
     core::requireValue(projection.radius > 0 && fine_radius > 0, s, "search_radius/fine_radius",
                        "must be > 0");
     core::requireValue(projection.max_hamming > 0 && projection.max_hamming <= 256, s,

@@ -6,10 +6,13 @@
 ///   auto cfg = devslam::core::loadIni("config_ini/tum_fr1.ini");
 ///   opts.loadFromConfigFile(*cfg, "tracking");
 ///   devslam::core::requireKnownKeys(*cfg, "tracking", {"n_features", "scale_factor"}, path);
+///   n_features = devslam::core::readInt(*cfg, "orb", "n_features", n_features);
 
 #include <mrpt/config/CConfigFileMemory.h>
 
+#include <cstdint>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -40,6 +43,36 @@ void applyOverrides(mrpt::config::CConfigFileMemory& cfg, const std::vector<std:
 /// applied. Throws naming the file when it cannot be read or an override is malformed.
 [[nodiscard]] std::unique_ptr<mrpt::config::CConfigFileMemory> loadFilterIni(
     const mrpt::config::CConfigFileBase& cfg, const std::string& path);
+
+/// Strict typed reads of one key (core/Parse.h rules; MRPT strips a trailing `//` comment
+/// first). A missing key gives `def`, or throws when `required`; a value that does not
+/// parse in full throws std::invalid_argument "[section] key: expected an integer, got
+/// '12x'". Use these instead of MRPT's read_int/read_double/read_bool, which take "12x"
+/// as 12, "1e3" as 1 and "ture" as false without a word.
+[[nodiscard]] int readInt(const mrpt::config::CConfigFileBase& cfg, const std::string& section,
+                          const std::string& key, int def, bool required = false);
+[[nodiscard]] std::uint64_t readUint64(const mrpt::config::CConfigFileBase& cfg,
+                                       const std::string& section, const std::string& key,
+                                       std::uint64_t def, bool required = false);
+[[nodiscard]] double readDouble(const mrpt::config::CConfigFileBase& cfg,
+                                const std::string& section, const std::string& key, double def,
+                                bool required = false);
+[[nodiscard]] bool readBool(const mrpt::config::CConfigFileBase& cfg, const std::string& section,
+                            const std::string& key, bool def, bool required = false);
+
+/// Runs `load()` and returns what it returns. A std::invalid_argument whose message names
+/// only the field ("[section] key: ...", as the reads above and requireValue throw) comes
+/// back as "<source> [section] key: ...", so a loader that reads one file can name it.
+template <class Load>
+decltype(auto) namingSource(const std::string& source, Load&& load) {
+    try {
+        return load();
+    } catch (const std::invalid_argument& e) {
+        const std::string msg = e.what();
+        if (msg.empty() || msg.front() != '[') throw;
+        throw std::invalid_argument(source + " " + msg);
+    }
+}
 
 /// Throws std::invalid_argument naming section and key when `ok` is false.
 void requireValue(bool ok, const std::string& section, const std::string& key,

@@ -1,0 +1,34 @@
+#pragma once
+/// Whole-text number parsing for command-line options and INI values. The C and MRPT
+/// readers stop at the first character they cannot use: atoi("7x") is 7, atoi("1e3") is 1,
+/// std::stoul("-5") wraps to a huge count, and MRPT's read_bool takes "ture" as false.
+/// These parse the whole text or throw std::invalid_argument naming `what` and the text.
+///
+/// Usage:
+///   frames = devslam::core::parseInteger(argv[i], "--frames", 1);        // "7x" throws
+///   ratio = devslam::core::parseNumber(value, "[tracker] match_ratio");
+///   on = devslam::core::parseBool(value, "[local_ba] enabled");
+
+#include <cstdint>
+#include <limits>
+#include <string>
+
+namespace devslam::core {
+
+/// A finite number written in full ("0.5", "-3", "1e-3", and MRPT's $eval{} output
+/// "3.000000e+01"); surrounding blanks are ignored. Throws std::invalid_argument
+/// "<what>: expected a number, got '<text>'".
+[[nodiscard]] double parseNumber(const std::string& text, const std::string& what);
+
+/// An integer in [min, max]. Written in full as parseNumber accepts it, with an integral
+/// value ("1e3" is 1000, "2.5" is an error). Throws std::invalid_argument naming `what`,
+/// the text and, when it is outside them, the bounds.
+[[nodiscard]] long long parseInteger(const std::string& text, const std::string& what,
+                                     long long min = std::numeric_limits<long long>::min(),
+                                     long long max = std::numeric_limits<long long>::max());
+
+/// true/yes/on/1 or false/no/off/0, in any letter case. Throws std::invalid_argument
+/// "<what>: expected true or false, got '<text>'".
+[[nodiscard]] bool parseBool(const std::string& text, const std::string& what);
+
+}  // namespace devslam::core

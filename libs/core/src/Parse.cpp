@@ -1,0 +1,76 @@
+#include <devslam/core/Parse.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <stdexcept>
+
+namespace devslam::core {
+namespace {
+
+std::string trimmed(const std::string& s) {
+    const auto blank = [](unsigned char c) { return std::isspace(c) != 0; };
+    const auto b = std::find_if_not(s.begin(), s.end(), blank);
+    const auto e = std::find_if_not(s.rbegin(), s.rend(), blank).base();
+    return b < e ? std::string(b, e) : std::string();
+}
+
+[[noreturn]] void fail(const std::string& what, const std::string& expected,
+                       const std::string& text) {
+    throw std::invalid_argument(what + ": expected " + expected + ", got '" + text + "'");
+}
+
+}  // namespace
+
+double parseNumber(const std::string& text, const std::string& what) {
+    const std::string t = trimmed(text);
+    if (t.empty()) fail(what, "a number", text);
+    char* end = nullptr;
+    errno = 0;
+    const double v = std::strtod(t.c_str(), &end);
+    if (end != t.c_str() + t.size() || errno == ERANGE || !std::isfinite(v))
+        fail(what, "a number", text);
+    return v;
+}
+
+long long parseInteger(const std::string& text, const std::string& what, long long min,
+                       long long max) {
+    const std::string t = trimmed(text);
+    if (t.empty()) fail(what, "an integer", text);
+    // Plain digits go through strtoll, exact over the whole 64-bit range; other spellings
+    // (exponents, $eval{} output) through strtod, which is exact up to 2^53.
+    char* end = nullptr;
+    errno = 0;
+    long long v = std::strtoll(t.c_str(), &end, 10);
+    if (end != t.c_str() + t.size() || errno == ERANGE) {
+        errno = 0;
+        const double d = std::strtod(t.c_str(), &end);
+        if (end != t.c_str() + t.size() || errno == ERANGE || !std::isfinite(d) ||
+            d != std::floor(d) || std::fabs(d) > 9007199254740992.0)
+            fail(what, "an integer", text);
+        v = static_cast<long long>(d);
+    }
+    if (v < min || v > max) {
+        const bool no_min = min == std::numeric_limits<long long>::min();
+        const bool no_max = max == std::numeric_limits<long long>::max();
+        fail(what,
+             no_max   ? "an integer >= " + std::to_string(min)
+             : no_min ? "an integer <= " + std::to_string(max)
+                      : "an integer in [" + std::to_string(min) + ", " + std::to_string(max) + "]",
+             text);
+    }
+    return v;
+}
+
+bool parseBool(const std::string& text, const std::string& what) {
+    std::string t = trimmed(text);
+    std::transform(t.begin(), t.end(), t.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    if (t == "true" || t == "yes" || t == "on" || t == "1") return true;
+    if (t == "false" || t == "no" || t == "off" || t == "0") return false;
+    fail(what, "true or false", text);
+}
+
+}  // namespace devslam::core
