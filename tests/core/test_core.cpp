@@ -4,6 +4,7 @@
 #include <devslam/core/Frame.h>
 #include <devslam/core/Parse.h>
 #include <devslam/core/Pose.h>
+#include <devslam/core/Results.h>
 #include <devslam/core/Stats.h>
 
 #include <gtest/gtest.h>
@@ -194,6 +195,16 @@ TEST(Config, NamingSourcePrefixesFieldOnlyErrors) {
               "room.ini [room]: x");
     EXPECT_THROW(namingSource("f.ini", [] { throw std::runtime_error("[a] io"); }),
                  std::runtime_error);
+}
+
+TEST(Results, MeasuredOnLineNamesTheHostAndItsSimdLevel) {
+    const std::string line = measuredOnLine();
+    EXPECT_NE(line.find(" UTC, "), std::string::npos) << line;
+    EXPECT_NE(line.find(" hardware threads, "), std::string::npos) << line;
+    const bool simd = line.find("OpenCV SIMD AVX2") != std::string::npos ||
+                      line.find("OpenCV SIMD AVX-512") != std::string::npos ||
+                      line.find("OpenCV SIMD SSE/AVX") != std::string::npos;
+    EXPECT_TRUE(simd) << line;
 }
 
 TEST(Association, NearestPairsNeverReused) {

@@ -1,5 +1,7 @@
 #include <devslam/core/Results.h>
 
+#include <opencv2/core/utility.hpp>
+
 #include <chrono>
 #include <ctime>
 #include <fstream>
@@ -47,15 +49,25 @@ std::string measuredOnLine() {
     const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
     char date[64];
     std::strftime(date, sizeof date, "%Y-%m-%d %H:%M UTC", std::gmtime(&now));
-    std::string cpu = "unknown CPU";
+    std::string cpu = "unknown CPU", family, model;
     std::ifstream info("/proc/cpuinfo");
-    for (std::string line; std::getline(info, line);)
-        if (line.rfind("model name", 0) == 0) {
-            cpu = line.substr(line.find(':') + 2);
-            break;
-        }
+    const auto value = [](const std::string& line) {
+        const auto colon = line.find(':');
+        return colon == std::string::npos ? std::string() : line.substr(colon + 2);
+    };
+    for (std::string line; std::getline(info, line) && line != "";) {  // the first CPU
+        if (line.rfind("model name", 0) == 0) cpu = value(line);
+        if (line.rfind("cpu family", 0) == 0) family = value(line);
+        if (line.rfind("model\t", 0) == 0) model = value(line);
+    }
+    if (!family.empty() && !model.empty()) cpu += " (family " + family + " model " + model + ")";
+    // OpenCV picks its SIMD kernels at run time, and floating-point results (detector
+    // scores, hence boxes and SLAM trajectories) differ between them (docs/bench.md).
+    const char* simd = cv::checkHardwareSupport(CV_CPU_AVX512_SKX) ? "AVX-512"
+                       : cv::checkHardwareSupport(CV_CPU_AVX2)     ? "AVX2"
+                                                                   : "SSE/AVX";
     return std::string(date) + ", " + std::to_string(std::thread::hardware_concurrency()) +
-           " hardware threads, " + cpu;
+           " hardware threads, " + cpu + ", OpenCV SIMD " + simd;
 }
 
 }  // namespace devslam::core

@@ -17,8 +17,9 @@ namespace devslam::core {
 void replaceResultsSection(const std::string& path, const std::string& name,
                            const std::string& markdown);
 
-/// The current UTC date-time and host facts ("2026-11-21 06:00 UTC, 2 cores, <cpu model>")
-/// for a "measured on" line under each table.
+/// The current UTC date-time and host facts ("2026-11-21 06:00 UTC, 2 hardware threads,
+/// AMD EPYC (family 25 model 1), OpenCV SIMD AVX2") for a "measured on" line under each
+/// table. The SIMD level matters: OpenCV's kernels round differently on AVX2 and AVX-512.
 [[nodiscard]] std::string measuredOnLine();
 
 }  // namespace devslam::core
