@@ -125,8 +125,9 @@ int main(int argc, char** argv) {
         md << "## Person detection and dynamic-object filter (`devslam-filter-bench`)\n\n"
            << "Command: `devslam-filter-bench --threads " << threads << " --frames " << n_frames
            << "` (OpenCV threads = " << threads
-           << "). Times are per-frame medians of wall time at 640x480. The machine was shared "
-              "with other builds while measuring, so the figures are upper bounds.\n\n";
+           << "). Times are per-frame medians of wall time at 640x480. This 2-core VM's speed "
+              "drifts by 20 % and more within minutes (docs/detect.md), so a single figure moves "
+              "by that much; compare figures measured side by side.\n\n";
 
         // Real frames, 640x480.
         std::vector<core::Frame> tum;

@@ -278,8 +278,8 @@ int runBench(const Args& a) {
     }
     md << stages.str() << (a.modes_only ? std::string() : abl.str()) << mem.str()
        << "\nPeak RSS is per run (VmHWM reset before each run). Wall-clock FPS depends on the load "
-          "of this shared 2-core machine (other builds ran at the same time); the CPU time per "
-          "frame (all threads) is printed by `devslam-run` beside it. Measured on "
+          "and the drifting speed of this 2-core VM; the CPU time per frame (all threads) is "
+          "printed by `devslam-run` beside it. Measured on "
        << core::measuredOnLine() << ".\n";
     core::replaceResultsSection(a.results, a.section, md.str());
     std::cout << md.str();

@@ -88,6 +88,11 @@ TEST(World, BadEntriesNameTheKey) {
     } catch (const std::invalid_argument& e) {
         EXPECT_STREQ(e.what(), "w.ini [world] timeout: expected a number, got '12x'");
     }
+    // The simulator's seed is 32 bits: a larger one is an error, not silently cut.
+    const mrpt::config::CConfigFileMemory big(
+        "[world]\nx_min=0\nx_max=5\ny_min=0\ny_max=5\nseed = 4294967296\n[robot]\nstart_x=1\n"
+        "start_y=1\n[goal]\nx=4\ny=4\n");
+    EXPECT_THROW((void)parseWorld(big, "w.ini"), std::invalid_argument);
 }
 
 TEST(World, DistanceToRotatedBox) {

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <sstream>
 #include <stdexcept>
 
@@ -76,7 +77,9 @@ WorldSpec parseWorldFields(const mrpt::config::CConfigFileBase& c, const std::st
     w.grid_resolution = core::readDouble(c, s, "grid_resolution", w.grid_resolution);
     w.time_step = core::readDouble(c, s, "time_step", w.time_step);
     w.timeout = core::readDouble(c, s, "timeout", w.timeout);
-    w.seed = static_cast<uint32_t>(core::readUint64(c, s, "seed", w.seed));
+    const std::uint64_t seed = core::readUint64(c, s, "seed", w.seed);
+    if (seed > UINT32_MAX) fail(source, s, "seed", "must be < 2^32, got " + std::to_string(seed));
+    w.seed = static_cast<uint32_t>(seed);
     w.pedestrians_yield = core::readBool(c, s, "pedestrians_yield", w.pedestrians_yield);
 
     s = "robot";
