@@ -9,7 +9,6 @@
 ///   ratio = devslam::core::parseNumber(value, "[tracker] match_ratio");
 ///   on = devslam::core::parseBool(value, "[local_ba] enabled");
 
-#include <cstdint>
 #include <limits>
 #include <string>
 

@@ -19,7 +19,8 @@ void replaceResultsSection(const std::string& path, const std::string& name,
 
 /// The current UTC date-time and host facts ("2026-11-21 06:00 UTC, 2 hardware threads,
 /// AMD EPYC (family 25 model 1), OpenCV SIMD AVX2") for a "measured on" line under each
-/// table. The SIMD level matters: OpenCV's kernels round differently on AVX2 and AVX-512.
+/// table. The SIMD level matters: OpenCV picks its kernels by it at run time, and the same
+/// code gives other trajectories with other kernels (docs/bench.md, "Limits").
 [[nodiscard]] std::string measuredOnLine();
 
 }  // namespace devslam::core
