@@ -167,7 +167,7 @@ TEST(Config, StrictReadsNameSectionKeyAndValue) {
     EXPECT_DOUBLE_EQ(readDouble(mem, "b", "absent", 1.5), 1.5);
     EXPECT_FALSE(readBool(mem, "a", "absent", false));
     EXPECT_EQ(invalidArgument([&] { (void)readDouble(mem, "a", "absent", 0.0, true); }),
-              "[a] absent: missing");
+              "[a] absent: required key is missing");
     // Malformed values name section, key and text (MRPT reads 12, 0.5 and false).
     EXPECT_EQ(invalidArgument([&] { (void)readInt(mem, "a", "typo_int", 0); }),
               "[a] typo_int: expected an integer, got '12x'");

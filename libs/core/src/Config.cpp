@@ -71,7 +71,8 @@ namespace {
 bool readText(const mrpt::config::CConfigFileBase& cfg, const std::string& section,
               const std::string& key, bool required, std::string& text) {
     if (!cfg.keyExists(section, key)) {
-        if (required) throw std::invalid_argument("[" + section + "] " + key + ": missing");
+        if (required)
+            throw std::invalid_argument("[" + section + "] " + key + ": required key is missing");
         return false;
     }
     text = cfg.read_string(section, key, "");

@@ -203,7 +203,7 @@ Scenario readScenario(const std::string& path) {
             path + " [scenario]: give exactly one of 'duration' [s] or 'n_frames'");
     sc.n_frames = n > 0 ? std::size_t(n) : std::size_t(std::lround(duration * sc.rate_hz));
     sc.t0 = core::readDouble(*cfg, s, "t0", sc.t0);
-    sc.seed = std::uint64_t(core::readUint64(*cfg, s, "seed", sc.seed));
+    sc.seed = core::readUint64(*cfg, s, "seed", sc.seed);
     sc.rgb_noise_sigma = core::readDouble(*cfg, s, "rgb_noise_sigma", sc.rgb_noise_sigma);
     sc.near_clip = core::readDouble(*cfg, s, "near_clip", sc.near_clip);
     sc.far_clip = core::readDouble(*cfg, s, "far_clip", sc.far_clip);

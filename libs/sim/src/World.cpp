@@ -43,11 +43,6 @@ std::vector<double> parseNumbers(const std::vector<std::string>& words, size_t f
     return v;
 }
 
-double readRequired(const mrpt::config::CConfigFileBase& c, const std::string& source,
-                    const std::string& s, const std::string& k) {
-    if (!c.keyExists(s, k)) fail(source, s, k, "required key is missing");
-    return core::readDouble(c, s, k, 0.0);
-}
 }  // namespace
 
 WorldSpec loadWorld(const std::string& path) {
@@ -69,10 +64,10 @@ WorldSpec parseWorldFields(const mrpt::config::CConfigFileBase& c, const std::st
                             "grid_resolution", "time_step", "timeout", "seed", "pedestrians_yield"},
                            source);
     w.name = c.read_string(s, "name", w.name);
-    w.x_min = readRequired(c, source, s, "x_min");
-    w.x_max = readRequired(c, source, s, "x_max");
-    w.y_min = readRequired(c, source, s, "y_min");
-    w.y_max = readRequired(c, source, s, "y_max");
+    w.x_min = core::readDouble(c, s, "x_min", 0.0, true);
+    w.x_max = core::readDouble(c, s, "x_max", 0.0, true);
+    w.y_min = core::readDouble(c, s, "y_min", 0.0, true);
+    w.y_max = core::readDouble(c, s, "y_max", 0.0, true);
     w.boundary_walls = core::readBool(c, s, "boundary_walls", w.boundary_walls);
     w.grid_resolution = core::readDouble(c, s, "grid_resolution", w.grid_resolution);
     w.time_step = core::readDouble(c, s, "time_step", w.time_step);
@@ -87,8 +82,8 @@ WorldSpec parseWorldFields(const mrpt::config::CConfigFileBase& c, const std::st
                            {"start_x", "start_y", "start_yaw_deg", "radius", "max_v", "max_w_deg",
                             "max_acc", "max_ang_acc_deg"},
                            source);
-    w.robot.start.x = readRequired(c, source, s, "start_x");
-    w.robot.start.y = readRequired(c, source, s, "start_y");
+    w.robot.start.x = core::readDouble(c, s, "start_x", 0.0, true);
+    w.robot.start.y = core::readDouble(c, s, "start_y", 0.0, true);
     w.robot.start.phi = mrpt::DEG2RAD(core::readDouble(c, s, "start_yaw_deg", 0.0));
     w.robot.radius = core::readDouble(c, s, "radius", w.robot.radius);
     w.robot.max_v = core::readDouble(c, s, "max_v", w.robot.max_v);
@@ -100,8 +95,8 @@ WorldSpec parseWorldFields(const mrpt::config::CConfigFileBase& c, const std::st
 
     s = "goal";
     core::requireKnownKeys(c, s, {"x", "y", "tolerance"}, source);
-    w.goal.x = readRequired(c, source, s, "x");
-    w.goal.y = readRequired(c, source, s, "y");
+    w.goal.x = core::readDouble(c, s, "x", 0.0, true);
+    w.goal.y = core::readDouble(c, s, "y", 0.0, true);
     w.goal_tolerance = core::readDouble(c, s, "tolerance", w.goal_tolerance);
 
     s = "laser";
