@@ -190,7 +190,6 @@ int main(int argc, char** argv) {
                 throw std::invalid_argument("unknown option " + s);
         }
         if (a.quick) a.per_category = 2;
-        if (a.per_category < 1) throw std::invalid_argument("--per-category must be >= 1");
         if (a.methods.empty()) throw std::invalid_argument("--methods is empty");
     } catch (const std::exception& e) {
         std::cerr << "devslam-nav-bench: " << e.what() << "\n";

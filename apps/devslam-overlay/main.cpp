@@ -130,7 +130,7 @@ int main(int argc, char** argv) {
             return 2;
         }
     }
-    if (input.empty() || out_dir.empty() || every < 1 || frames < 0) {
+    if (input.empty() || out_dir.empty()) {
         std::cerr << kUsage;
         return 2;
     }
