@@ -1,7 +1,7 @@
-// Two-frame smoke test of the whole devslam-bench command: renders a synthetic sequence,
-// runs devslam-run in the three modes on it and on the shipped TUM frames (plus the
-// diagnostic truth mask on the synthetic one), scores the filter against the person truth,
-// and writes the tables and the RESULTS section.
+// Two-frame smoke test of the whole devslam-bench command: renders a synthetic sequence in
+// two seeds, runs devslam-run in the three modes on both renders and on the shipped TUM
+// frames (plus the diagnostic truth mask on the synthetic one), scores the filter against
+// the person truth, and writes the tables and the RESULTS section.
 #include <gtest/gtest.h>
 
 #include <cstdlib>
@@ -42,7 +42,7 @@ TEST(DevslamBench, TwoFrameSmokeRunOfTheWholeCommand) {
            "slam_config = "
         << root
         << "/config_ini/slam_synthetic.ini\n"
-           "[sequence_short]\nscenario = short_walking\n"
+           "[sequence_short]\nscenario = short_walking\nseeds = 5 6\n"
            "[sequence_fr1]\npath = "
         << root << "/data/tum/fr1_xyz_first37\nslam_config = " << root
         << "/config_ini/slam_tum_fr1.ini\n";
@@ -52,21 +52,32 @@ TEST(DevslamBench, TwoFrameSmokeRunOfTheWholeCommand) {
         "' --max-frames 2 --out '" + (tmp / "out").string() + "' --results '" +
         (tmp / "RESULTS.md").string() + "' > '" + (tmp / "log.txt").string() + "' 2>&1";
     ASSERT_EQ(std::system(cmd.c_str()), 0) << readFile(tmp / "log.txt");
-    // The synthetic sequence was rendered (2 frames) with its person truth.
-    EXPECT_TRUE(fs::exists(tmp / "out/synth/short/groundtruth.txt"));
-    EXPECT_EQ(countLines(readFile(tmp / "out/synth/short/groundtruth.txt")), 2u);
-    // 4 modes on the synthetic sequence, 3 on fr1 (no person truth for mode truth), 1 repeat,
-    // every run succeeded.
+    // The synthetic sequence was rendered (2 frames) with its person truth, once per seed:
+    // the same camera path, other noise.
+    for (const char* render : {"out/synth/short_seed5", "out/synth/short_seed6"}) {
+        EXPECT_TRUE(fs::exists(tmp / render / "persons.txt")) << render;
+        EXPECT_EQ(countLines(readFile(tmp / render / "groundtruth.txt")), 2u) << render;
+    }
+    EXPECT_EQ(readFile(tmp / "out/synth/short_seed5/groundtruth.txt"),
+              readFile(tmp / "out/synth/short_seed6/groundtruth.txt"));
+    EXPECT_NE(readFile(tmp / "out/synth/short_seed5/depth/1700000400.000000.png"),
+              readFile(tmp / "out/synth/short_seed6/depth/1700000400.000000.png"));
+    // 4 modes on each render of the synthetic sequence, 3 on fr1 (no person truth for mode
+    // truth), 1 repeat, every run succeeded.
     const std::string runs = readFile(tmp / "out/runs.csv");
-    EXPECT_EQ(countLines(runs), 1u + 7u) << runs;
-    EXPECT_NE(runs.find("short,truth,0,"), std::string::npos) << runs;
+    EXPECT_EQ(countLines(runs), 1u + 8u + 3u) << runs;
+    EXPECT_NE(runs.find("short,truth,5,0,"), std::string::npos) << runs;
+    EXPECT_NE(runs.find("short,truth,6,0,"), std::string::npos) << runs;
+    EXPECT_NE(runs.find("fr1,dynamic,,0,"), std::string::npos) << runs;
     EXPECT_EQ(runs.find("fr1,truth"), std::string::npos) << runs;
     const std::string ate = readFile(tmp / "out/table2_ate.csv");
     EXPECT_EQ(countLines(ate), 1u + 7u);
     std::istringstream lines(ate);
     std::string line;
     std::getline(lines, line);  // header
-    while (std::getline(lines, line)) EXPECT_EQ(line.substr(line.rfind(',') + 1), "1") << line;
+    while (std::getline(lines, line))
+        EXPECT_EQ(line.substr(line.rfind(',') + 1), line.rfind("short,", 0) == 0 ? "2" : "1")
+            << line;
     for (const char* f : {"table1_rpe.csv", "table3_fps.csv", "filter_truth.csv", "tables.md"})
         EXPECT_TRUE(fs::exists(tmp / "out" / f)) << f;
     EXPECT_EQ(countLines(readFile(tmp / "out/filter_truth.csv")),
@@ -75,6 +86,50 @@ TEST(DevslamBench, TwoFrameSmokeRunOfTheWholeCommand) {
     EXPECT_NE(results.find("Table 1: RPE"), std::string::npos);
     EXPECT_NE(results.find("Table 2: ATE"), std::string::npos);
     EXPECT_NE(results.find("Table 3: speed"), std::string::npos);
+    EXPECT_NE(results.find("fr1 1 run, short 2 renders (seed 5 6) x 1 run per mode"),
+              std::string::npos)
+        << results;
+    EXPECT_NE(results.find("| short | dynamic | "), std::string::npos);
+    EXPECT_NE(results.find("ATE RMSE (m) per render"), std::string::npos);
+    EXPECT_NE(results.find(" (seed 5), "), std::string::npos) << results;
+    fs::remove_all(tmp);
+}
+
+// A bad bench INI stops the bench before anything runs, naming the file, section and key.
+TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
+    const std::string root = DEVSLAM_SOURCE_DIR, bin = DEVSLAM_BIN_DIR;
+    const fs::path tmp =
+        fs::temp_directory_path() / ("devslam_bench_bad_" + std::to_string(::getpid()));
+    fs::remove_all(tmp);
+    fs::create_directories(tmp);
+    const auto refused = [&](const std::string& ini) {
+        std::ofstream(tmp / "bench.ini") << ini;
+        const std::string cmd =
+            "'" + bin + "/devslam-bench' --config '" + (tmp / "bench.ini").string() + "' --out '" +
+            (tmp / "out").string() + "' --results '" + (tmp / "RESULTS.md").string() + "' > '" +
+            (tmp / "log.txt").string() + "' 2>&1";
+        EXPECT_NE(std::system(cmd.c_str()), 0) << ini;
+        EXPECT_FALSE(fs::exists(tmp / "out/runs.csv")) << ini << ": nothing may run";
+        return readFile(tmp / "log.txt");
+    };
+    const std::string fr1 = "path = " + root + "/data/tum/fr1_xyz_first37\n";
+    EXPECT_NE(refused("[sequence_a]\nscenario = short_walking\nseeds = 5 x\n")
+                  .find("[sequence_a] seeds: expected an integer"),
+              std::string::npos)
+        << readFile(tmp / "log.txt");
+    EXPECT_NE(refused("[sequence_a]\nscenario = short_walking\nseeds = 5 6 5\n")
+                  .find("seed 5 is listed twice"),
+              std::string::npos)
+        << readFile(tmp / "log.txt");
+    EXPECT_NE(refused("[sequence_a]\n" + fr1 + "seeds = 5\n")
+                  .find("[sequence_a] seeds: only a synthetic sequence"),
+              std::string::npos)
+        << readFile(tmp / "log.txt");
+    EXPECT_NE(refused("[sequence_a]\n" + fr1 + "repeats = 0x\n").find("[sequence_a] repeats"),
+              std::string::npos)
+        << readFile(tmp / "log.txt");
+    EXPECT_NE(refused("[sequence_a]\n" + fr1 + "seed = 5\n").find("seed"), std::string::npos)
+        << readFile(tmp / "log.txt");
     fs::remove_all(tmp);
 }
 
