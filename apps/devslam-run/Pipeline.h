@@ -24,7 +24,7 @@ struct RunConfig {
     std::size_t max_frames = 0;  ///< 0 = all
     /// Run the dynamic filter for frame k+1 in a second thread while the SLAM processes
     /// frame k (INI [run] async_filter). Results do not depend on timing.
-    bool async_filter = false;
+    bool async_filter = true;
     /// Score each frame's mask against the renderer's person truth when the input folder
     /// has one (persons.txt + labels/, written by devslam-synth). Off for replayed inputs.
     bool score_masks = true;

@@ -98,7 +98,7 @@ struct Loaded {
     std::unique_ptr<mrpt::config::CConfigFileMemory> cfg, filter_cfg;
     io::ReaderOptions reader;
     std::string mode;
-    bool async_filter = false;
+    bool async_filter = true;
 };
 
 /// Applies --set "section.key=value" overrides to an INI held in memory.
@@ -113,7 +113,7 @@ Loaded loadConfig(const Args& a, const std::vector<std::string>& extra_sets = {}
     applySets(*l.cfg, extra_sets);
     core::requireKnownKeys(*l.cfg, "run",
                            {"mode", "filter_config", "filter_overrides", "async_filter"}, a.config);
-    l.async_filter = core::readBool(*l.cfg, "run", "async_filter", false);
+    l.async_filter = core::readBool(*l.cfg, "run", "async_filter", true);
     l.mode = a.mode.empty() ? l.cfg->read_string("run", "mode", "dynamic") : a.mode;
     // [run] filter_config / filter_overrides: the filter's INI, with "section.key=value ..."
     // overrides (so a SLAM config can pick e.g. the detection interval without copying it).
