@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <sstream>
 
 using namespace devslam;
 using dynamic::BoxState;
@@ -70,9 +71,11 @@ DynamicObjectFilter::Options testOptions() {
 /// Rendered sequences, cached across tests (rendering dominates the run time).
 const std::vector<dynamic::SyntheticFrame>& sequence(const dynamic::SyntheticOptions& so) {
     static std::map<std::string, std::vector<dynamic::SyntheticFrame>> cache;
-    const std::string key = std::to_string(static_cast<int>(so.person)) + "/" +
-                            std::to_string(so.person_x0) + "/" + std::to_string(so.n_frames) +
-                            "/" + std::to_string(so.person_speed);
+    std::ostringstream k;  // every option a test changes
+    k << static_cast<int>(so.person) << "/" << so.person_x0 << "/" << so.n_frames << "/"
+      << so.person_speed << "/" << so.person_depth << "/" << so.person_direction.transpose() << "/"
+      << so.cam_velocity.transpose() << "/" << so.cam_rate_deg.transpose();
+    const std::string key = k.str();
     auto it = cache.find(key);
     if (it == cache.end())
         it = cache.emplace(key, dynamic::makeSyntheticSequence(so, wallTexture(), personSprite()))
@@ -406,6 +409,18 @@ TEST(DynamicConfig, BadValuesAreRejected) {
     }
     EXPECT_EQ(dynamic::parseMaskMode("all_persons"), MaskMode::AllPersons);
     EXPECT_THROW((void)dynamic::parseMaskMode("dyn"), std::invalid_argument);
+    for (const auto& [key, value] : std::vector<std::pair<std::string, std::string>>{
+             {"depth_frames", "-1"}, {"depth_rate_threshold", "0"}, {"depth_noise_z2", "-0.1"}}) {
+        mrpt::config::CConfigFileMemory c;
+        c.write("dynamic_filter", key, value);
+        try {
+            DynamicObjectFilter::Options fresh;
+            fresh.loadFromConfig(c);
+            ADD_FAILURE() << key << " = " << value << " was accepted";
+        } catch (const std::invalid_argument& e) {
+            EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+        }
+    }
 }
 
 TEST(DynamicFilter, UnknownBoxesAreMaskedUntilThereIsEvidence) {
@@ -557,6 +572,40 @@ TEST(DynamicFilter, SlowWalkerIsCaughtByItsMeanResidualFlow) {
     EXPECT_LE(a.moving, a.frames / 3) << "the walker is too fast for this test";
     // the mean needs slow_frames steps with evidence (the first has no flow)
     EXPECT_GE(b.moving, b.frames - slow.slow_frames);
+}
+
+TEST(DynamicFilter, PersonWalkingTowardsTheCameraIsCaughtByTheirDepth) {
+    // A person 3.2 m away walks straight at the moving camera at 0.45 m/s: their image only
+    // grows (a point 100 px from the box centre moves ~0.5 px a frame), so the flow leaves
+    // them Static. Their depth falls 1.5 cm a frame more than the camera's motion explains;
+    // over depth_frames steps that is far above the depth camera's noise.
+    dynamic::SyntheticOptions so;
+    so.person = dynamic::PersonMotion::Walking;
+    so.person_speed = 0.45;
+    so.person_direction = {0.0, 0.0, -1.0};
+    so.person_depth = 3.2;
+    so.person_x0 = 0.0;
+    so.cam_velocity = {0.1, -0.02, 0.05};
+    so.cam_rate_deg = {0.3, 4.0, 0.5};
+    so.n_frames = 40;
+    auto flow_only = testOptions();
+    flow_only.depth_frames = 0;
+    const auto with_depth = testOptions();
+    ASSERT_GT(with_depth.depth_frames, 0) << "dynamic_filter.ini ships the depth test";
+    const RunStats a = runSynthetic(so, flow_only, true);
+    const RunStats b = runSynthetic(so, with_depth, true);
+    std::printf(
+        "walking towards the camera: moving in %d/%d frames by flow, %d/%d with "
+        "depth_frames %d\n",
+        a.moving, a.frames, b.moving, b.frames, with_depth.depth_frames);
+    EXPECT_LE(a.moving, a.frames / 3) << "the flow alone already sees this walker";
+    // the window needs depth_frames steps with evidence (the first frame has no flow)
+    EXPECT_GE(b.moving, b.frames - with_depth.depth_frames - 1);
+    // The same person standing still is not flagged by the depth test.
+    so.person = dynamic::PersonMotion::Static;
+    const RunStats c = runSynthetic(so, with_depth, true);
+    EXPECT_EQ(c.moving, 0);
+    EXPECT_GE(c.statics, c.frames - 1);
 }
 
 TEST(DynamicFilter, WeakDetectionsContinueTracksButStartNone) {

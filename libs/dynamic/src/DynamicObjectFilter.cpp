@@ -13,6 +13,7 @@
 #include <chrono>
 #include <cmath>
 #include <deque>
+#include <limits>
 #include <stdexcept>
 #include <tuple>
 
@@ -56,6 +57,9 @@ const std::vector<std::string> kKeys{"mode",
                                      "silhouette_depth_band",
                                      "slow_frames",
                                      "slow_threshold",
+                                     "depth_frames",
+                                     "depth_rate_threshold",
+                                     "depth_noise_z2",
                                      "new_track_score"};
 
 cv::Rect2f shrink(const cv::Rect2f& b, double f) {
@@ -176,6 +180,9 @@ void DynamicObjectFilter::Options::loadFromConfig(const mrpt::config::CConfigFil
     silhouette_depth_band = core::readDouble(c, s, "silhouette_depth_band", silhouette_depth_band);
     slow_frames = core::readInt(c, s, "slow_frames", slow_frames);
     slow_threshold = core::readDouble(c, s, "slow_threshold", slow_threshold);
+    depth_frames = core::readInt(c, s, "depth_frames", depth_frames);
+    depth_rate_threshold = core::readDouble(c, s, "depth_rate_threshold", depth_rate_threshold);
+    depth_noise_z2 = core::readDouble(c, s, "depth_noise_z2", depth_noise_z2);
     new_track_score = core::readDouble(c, s, "new_track_score", new_track_score);
     iou_match = core::readDouble(c, s, "iou_match", iou_match);
     release_frames = core::readInt(c, s, "release_frames", release_frames);
@@ -210,6 +217,9 @@ void DynamicObjectFilter::Options::loadFromConfig(const mrpt::config::CConfigFil
                        "must be >= 0 (0 = fg_depth_band's)");
     core::requireValue(slow_frames >= 0, s, "slow_frames", "must be >= 0 (0 = off)");
     core::requireValue(slow_threshold > 0, s, "slow_threshold", "must be > 0");
+    core::requireValue(depth_frames >= 0, s, "depth_frames", "must be >= 0 (0 = off)");
+    core::requireValue(depth_rate_threshold > 0, s, "depth_rate_threshold", "must be > 0");
+    core::requireValue(depth_noise_z2 >= 0, s, "depth_noise_z2", "must be >= 0");
     core::requireValue(new_track_score >= 0 && new_track_score <= 1, s, "new_track_score",
                        "must be in [0, 1]");
     core::requireValue(iou_match > 0 && iou_match <= 1, s, "iou_match", "must be in (0, 1]");
@@ -245,6 +255,9 @@ void DynamicObjectFilter::Options::saveToConfig(mrpt::config::CConfigFileBase& c
     c.write(s, "silhouette_depth_band", silhouette_depth_band);
     c.write(s, "slow_frames", slow_frames);
     c.write(s, "slow_threshold", slow_threshold);
+    c.write(s, "depth_frames", depth_frames);
+    c.write(s, "depth_rate_threshold", depth_rate_threshold);
+    c.write(s, "depth_noise_z2", depth_noise_z2);
     c.write(s, "new_track_score", new_track_score);
     c.write(s, "iou_match", iou_match);
     c.write(s, "release_frames", release_frames);
@@ -266,6 +279,8 @@ struct DynamicObjectFilter::Impl {
         /// the median residual flow vector of the box's points in its last steps with
         /// evidence (at most slow_frames, newest last)
         std::deque<cv::Point2f> slow_history;
+        /// the median depth residual [m] of the box's points in the same steps
+        std::deque<float> depth_history;
     };
     cv::Mat prev_work, prev_depth;
     std::vector<cv::Mat> prev_pyr;
@@ -462,12 +477,16 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
                                    [](const Impl::Track& t) { return t.tb.box.area() < 16.f; }),
                     im.tracks.end());
     // The boxes are final for this step: the person's depth in each, once.
-    const bool need_depth = opts_.fg_depth_band > 0 || opts_.mask_silhouette;
+    const bool need_depth =
+        opts_.fg_depth_band > 0 || opts_.mask_silhouette || opts_.depth_frames > 0;
     for (auto& t : im.tracks)
         t.depth = need_depth ? personDepth(frame.depth, t.tb.box, opts_.max_depth) : std::nullopt;
 
     std::vector<std::optional<Eigen::Vector3d>> X;  // 3D of each point in the previous frame
     std::vector<cv::Point2f> res_vec;  // residual flow vector of each point (observed - predicted)
+    // depth residual of each point [m]: measured depth at its new position - the depth
+    // ego-motion predicts, less the background's median (NaN: no stable depth)
+    std::vector<float> res_z;
     // 4. Ego-motion: 3D of each point from the previous depth; relative pose refined with
     //    PnP-RANSAC on points outside every person box.
     if (have_prev && !p0.empty()) {
@@ -537,18 +556,33 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
         const Eigen::Isometry3d T_cur_prev = T_prev_cur.inverse();
         out.flow.reserve(p0.size());
         res_vec.assign(p0.size(), cv::Point2f(0.f, 0.f));
-        std::vector<float> bg_res;
+        const bool want_z = opts_.depth_frames > 0;
+        res_z.assign(p0.size(), std::numeric_limits<float>::quiet_NaN());
+        std::vector<float> bg_res, bg_z;
         for (std::size_t i = 0; i < p0.size(); ++i) {
             FilterOutput::FlowPoint fp{p0[i], p1[i], -1.f, false, false};
             if (X[i]) {
-                if (const auto uv = core::project(T_cur_prev * *X[i], Kc)) {
+                const Eigen::Vector3d Xc = T_cur_prev * *X[i];
+                if (const auto uv = core::project(Xc, Kc)) {
                     res_vec[i] = {p1[i].x - static_cast<float>(uv->x()),
                                   p1[i].y - static_cast<float>(uv->y())};
                     fp.residual = static_cast<float>(std::hypot(res_vec[i].x, res_vec[i].y));
+                    if (want_z)
+                        if (const auto z = stableDepth(frame.depth, p1[i], opts_.max_depth))
+                            res_z[i] = *z - static_cast<float>(Xc.z());
                 }
             }
-            if (fp.residual >= 0.f && !inAnyBox(p0[i], p1[i])) bg_res.push_back(fp.residual);
+            if (fp.residual >= 0.f && !inAnyBox(p0[i], p1[i])) {
+                bg_res.push_back(fp.residual);
+                if (!std::isnan(res_z[i])) bg_z.push_back(res_z[i]);
+            }
             out.flow.push_back(fp);
+        }
+        // An ego-motion error along the optical axis shifts every depth residual alike.
+        if (bg_z.size() >= static_cast<std::size_t>(opts_.min_background_points)) {
+            const auto k = bg_z.begin() + static_cast<std::ptrdiff_t>(bg_z.size() / 2);
+            std::nth_element(bg_z.begin(), k, bg_z.end());
+            for (auto& z : res_z) z -= *k;
         }
         double thr = opts_.threshold1;
         if (bg_res.size() >= static_cast<std::size_t>(opts_.min_background_points)) {
@@ -590,6 +624,7 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
         const float zp = t.depth.value_or(0.f);
         int n = 0, n_dyn = 0;
         std::vector<float> rx, ry;  // residual vectors of the box's points (slow walkers)
+        std::vector<float> rz;      // their depth residuals (walkers towards the camera)
         for (std::size_t i = 0; i < out.flow.size(); ++i) {
             auto& fp = out.flow[i];
             if (fp.residual < 0.f || !inner.contains(fp.cur)) continue;
@@ -605,6 +640,7 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
                 rx.push_back(res_vec[i].x);
                 ry.push_back(res_vec[i].y);
             }
+            if (!res_z.empty() && !std::isnan(res_z[i])) rz.push_back(res_z[i]);
         }
         t.tb.n_points = n;
         t.tb.n_dynamic_points = n_dyn;
@@ -626,6 +662,24 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
                 for (const auto& r : t.slow_history) sum += r;
                 const double mean = cv::norm(sum) / opts_.slow_frames;
                 moving |= mean > std::max(opts_.slow_threshold, 0.5 * local_thr);
+            }
+        }
+        if (opts_.depth_frames > 0) {
+            // A step whose box has too few points with depth adds no sample (the window
+            // then spans more steps).
+            if (rz.size() >= static_cast<std::size_t>(opts_.min_points)) {
+                const auto mid = rz.begin() + static_cast<std::ptrdiff_t>(rz.size() / 2);
+                std::nth_element(rz.begin(), mid, rz.end());
+                t.depth_history.push_back(*mid);
+                if (t.depth_history.size() > static_cast<std::size_t>(opts_.depth_frames))
+                    t.depth_history.pop_front();
+            }
+            if (t.depth_history.size() == static_cast<std::size_t>(opts_.depth_frames) && t.depth) {
+                double sum = 0;
+                for (const float z : t.depth_history) sum += z;
+                const double z = *t.depth;
+                moving |= std::abs(sum) > std::max(opts_.depth_rate_threshold * opts_.depth_frames,
+                                                   opts_.depth_noise_z2 * z * z);
             }
         }
         if (moving) {

@@ -65,9 +65,9 @@ std::vector<SyntheticFrame> makeSyntheticSequence(const SyntheticOptions& o,
                             .toRotationMatrix();
         T_wc.translation() = o.cam_velocity * t;
         const bool has_person = o.person != PersonMotion::None;
-        person.origin = {
-            o.person_x0 + (o.person == PersonMotion::Walking ? o.person_speed * t : 0.0), 0.1,
-            o.person_depth};
+        const double walked = o.person == PersonMotion::Walking ? o.person_speed * t : 0.0;
+        const Eigen::Vector3d dir = o.person_direction.normalized();
+        person.origin = {o.person_x0 + walked * dir.x(), 0.1, o.person_depth + walked * dir.z()};
 
         cv::Mat depth(K.height, K.width, CV_32FC1, cv::Scalar(0.f));
         cv::Mat person_hit(K.height, K.width, CV_8UC1, cv::Scalar(0));

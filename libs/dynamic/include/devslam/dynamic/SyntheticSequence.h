@@ -23,7 +23,10 @@ enum class PersonMotion { None, Static, Walking };
 struct SyntheticOptions {
     int n_frames = 30;
     PersonMotion person = PersonMotion::Walking;
-    double person_speed = 1.2;    ///< [m/s] walking speed along the world x axis
+    double person_speed = 1.2;  ///< [m/s] walking speed along person_direction
+    /// walking direction in the world (= first camera) frame: x right, z forward; only its
+    /// x and z are used (the billboard stays upright and faces the camera)
+    Eigen::Vector3d person_direction{1.0, 0.0, 0.0};
     double person_height = 1.7;   ///< [m] billboard height (width from the photo's aspect)
     double person_depth = 2.2;    ///< [m] billboard distance from the first camera
     double person_x0 = -0.9;      ///< [m] billboard centre x at frame 0 (world = first camera)
