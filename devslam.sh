@@ -14,7 +14,7 @@ JOBS=${JOBS:-2}
 
 # Everything comes from Debian's archive; nothing is downloaded at build or run time.
 PACKAGES=(build-essential cmake pkg-config
-  libmrpt-dev mrpt-apps mrpt-common libopencv-dev libbullet-dev libeigen3-dev zlib1g-dev
+  libmrpt-dev mrpt-apps mrpt-common libopencv-dev opencv-doc libbullet-dev libeigen3-dev zlib1g-dev
   libgtest-dev libgmock-dev libbenchmark-dev)
 
 setup() {

@@ -47,6 +47,8 @@ const std::vector<std::string> kKeys{"mode",
                                      "iou_match",
                                      "release_frames",
                                      "max_missed_detections",
+                                     "hide_unseen_frames",
+                                     "forget_unseen_frames",
                                      "mask_margin",
                                      "background_factor",
                                      "flow_scale",
@@ -187,6 +189,8 @@ void DynamicObjectFilter::Options::loadFromConfig(const mrpt::config::CConfigFil
     iou_match = core::readDouble(c, s, "iou_match", iou_match);
     release_frames = core::readInt(c, s, "release_frames", release_frames);
     max_missed_detections = core::readInt(c, s, "max_missed_detections", max_missed_detections);
+    hide_unseen_frames = core::readInt(c, s, "hide_unseen_frames", hide_unseen_frames);
+    forget_unseen_frames = core::readInt(c, s, "forget_unseen_frames", forget_unseen_frames);
     mask_margin = core::readInt(c, s, "mask_margin", mask_margin);
     mask_unknown = core::readBool(c, s, "mask_unknown", mask_unknown);
     mask_border_snap = core::readInt(c, s, "mask_border_snap", mask_border_snap);
@@ -225,6 +229,9 @@ void DynamicObjectFilter::Options::loadFromConfig(const mrpt::config::CConfigFil
     core::requireValue(iou_match > 0 && iou_match <= 1, s, "iou_match", "must be in (0, 1]");
     core::requireValue(release_frames >= 1, s, "release_frames", "must be >= 1");
     core::requireValue(max_missed_detections >= 0, s, "max_missed_detections", "must be >= 0");
+    core::requireValue(hide_unseen_frames >= 0, s, "hide_unseen_frames", "must be >= 0");
+    core::requireValue(forget_unseen_frames >= hide_unseen_frames, s, "forget_unseen_frames",
+                       "must be >= hide_unseen_frames");
     core::requireValue(mask_margin >= 0, s, "mask_margin", "must be >= 0");
 }
 
@@ -262,6 +269,8 @@ void DynamicObjectFilter::Options::saveToConfig(mrpt::config::CConfigFileBase& c
     c.write(s, "iou_match", iou_match);
     c.write(s, "release_frames", release_frames);
     c.write(s, "max_missed_detections", max_missed_detections);
+    c.write(s, "hide_unseen_frames", hide_unseen_frames);
+    c.write(s, "forget_unseen_frames", forget_unseen_frames);
     c.write(s, "mask_margin", mask_margin);
     c.write(s, "mask_unknown", mask_unknown);
     c.write(s, "mask_border_snap", mask_border_snap);
@@ -272,6 +281,12 @@ struct DynamicObjectFilter::Impl {
         TrackedBox tb;
         int quiet = 0;   ///< consecutive frames without moving evidence
         int missed = 0;  ///< detector runs without a matching detection
+        /// consecutive steps unmatched at the last detector run and with fewer than
+        /// min_points points in the box: nothing shows the person is still there
+        int unseen = 0;
+        [[nodiscard]] bool hidden(const Options& o) const {
+            return o.hide_unseen_frames > 0 && unseen >= o.hide_unseen_frames;
+        }
         /// the person's depth (personDepth) in this step's box and depth image, when the
         /// band or the silhouette mask needs it; the next step's corners use it as the
         /// previous frame's
@@ -644,7 +659,14 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
         }
         t.tb.n_points = n;
         t.tb.n_dynamic_points = n_dyn;
-        if (n < opts_.min_points) continue;  // no evidence: keep the state
+        if (n < opts_.min_points) {  // no evidence: keep the state
+            if (t.missed > 0)
+                ++t.unseen;  // and no detection either
+            else
+                t.unseen = 0;
+            continue;
+        }
+        t.unseen = 0;
         bool moving = n_dyn >= opts_.threshold2_count &&
                       n_dyn >= opts_.threshold2_fraction * static_cast<double>(n);
         if (opts_.slow_frames > 0) {
@@ -692,8 +714,20 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
         }
     }
 
+    // A track nothing has shown for forget_unseen_frames steps is gone for good; before
+    // that, from hide_unseen_frames on, it is kept out of the boxes and the mask but
+    // remembered, so that a walker who comes back (through the border they left by, from
+    // behind someone) is matched and masked at once instead of collecting evidence anew.
+    if (opts_.hide_unseen_frames > 0)
+        im.tracks.erase(std::remove_if(im.tracks.begin(), im.tracks.end(),
+                                       [&](const Impl::Track& t) {
+                                           return t.unseen > opts_.forget_unseen_frames;
+                                       }),
+                        im.tracks.end());
+
     // 7. Mask: whole boxes, dilated by the margin.
     for (const auto& t : im.tracks) {
+        if (t.hidden(opts_)) continue;
         out.boxes.push_back(t.tb);
         const bool masked = opts_.mode == MaskMode::AllPersons || t.tb.state == BoxState::Moving ||
                             (opts_.mask_unknown && t.tb.state == BoxState::Unknown);

@@ -141,6 +141,15 @@ class DynamicObjectFilter {
         double iou_match = 0.3;         ///< min IoU to associate a detection with a track
         int release_frames = 5;         ///< quiet frames before a Moving box becomes Static
         int max_missed_detections = 2;  ///< detector runs without a match before a track is dropped
+        /// A Moving track outlives detector misses (walkers cut by the border, half hidden),
+        /// carried by its points' flow. When neither the detector (unmatched at its last
+        /// run) nor the box's points (fewer than min_points) have shown it for
+        /// hide_unseen_frames steps, it leaves the boxes and the mask: a walker who left
+        /// the view, or a box over a textureless floor, would otherwise be masked forever.
+        /// It is remembered until forget_unseen_frames such steps, so a walker who comes
+        /// back is matched and masked at once. 0 = never hidden or forgotten.
+        int hide_unseen_frames = 5;
+        int forget_unseen_frames = 30;  ///< must be >= hide_unseen_frames
         /// detections scoring below this only continue existing tracks (matched after the
         /// confident ones) and never start one; with the detector's conf_threshold below
         /// it, a person the detector grows unsure of stays tracked. 0 = every detection.
