@@ -85,10 +85,11 @@ TEST(DynamicRealPeople, WalkersAreMovingAndAStandingManOftenStaticInVtest) {
             standing_states += letter(s);
         }
     }
-    std::printf("vtest.avi: walkers Moving %d/%d (%s), the standing man Static in %d/%d frames "
-                "(%s; M moving, s static, u unknown, . no box)\n",
-                walkers_moving, walkers, walker_states.c_str(), standing_static, standing,
-                standing_states.c_str());
+    std::printf(
+        "vtest.avi: walkers Moving %d/%d (%s), the standing man Static in %d/%d frames "
+        "(%s; M moving, s static, u unknown, . no box)\n",
+        walkers_moving, walkers, walker_states.c_str(), standing_static, standing,
+        standing_states.c_str());
     ASSERT_EQ(walkers, static_cast<int>(kWalkers.size())) << "video shorter than expected";
     ASSERT_EQ(standing, kStandingTo - kStandingFrom + 1);
     // Measured (session 10): walkers 11/12 (one without a box), standing man Static in 31/56

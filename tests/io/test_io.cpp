@@ -4,6 +4,7 @@
 #include <devslam/io/TrajectoryIO.h>
 #include <devslam/io/TumReader.h>
 #include <devslam/io/TumWriter.h>
+#include <devslam/io/VideoReader.h>
 
 #include <gtest/gtest.h>
 #include <opencv2/core.hpp>
@@ -12,6 +13,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <regex>
 
 namespace fs = std::filesystem;
@@ -314,4 +316,45 @@ TEST(Rawlog, RejectsFramesThatCannotBeWritten) {
     io::RawlogWriterOptions bad;
     bad.compression = 11;
     EXPECT_THROW(io::RawlogWriter(d.str("y.rawlog"), bad), std::invalid_argument);
+}
+
+TEST(VideoReader, ReadsVtestAsFixedCameraFramesWithAPlaneOfDepth) {
+    const std::string vtest = "/usr/share/doc/opencv-doc/examples/data/vtest.avi";  // opencv-doc
+    ASSERT_TRUE(fs::exists(vtest)) << "installed by Debian's opencv-doc (./devslam.sh setup)";
+    io::VideoReader video(vtest, {3.0, 0.0});
+    ASSERT_EQ(video.size(), std::optional<std::size_t>(795));
+    EXPECT_EQ(video.intrinsics().width, 768);
+    EXPECT_EQ(video.intrinsics().height, 576);
+    EXPECT_DOUBLE_EQ(video.intrinsics().fx, 768.0);
+    std::size_t n = 0;
+    while (auto f = video.next()) {
+        EXPECT_EQ(f->index, n);
+        EXPECT_DOUBLE_EQ(f->timestamp, static_cast<double>(n) / 10.0);  // a 10 Hz file
+        if (n == 0 || n == 794) {
+            core::validateFrame(*f, f->rgb_source);
+            double lo = 0, hi = 0;
+            cv::minMaxLoc(f->depth, &lo, &hi);
+            EXPECT_EQ(lo, 3.0);
+            EXPECT_EQ(hi, 3.0);
+        }
+        ++n;
+    }
+    EXPECT_EQ(n, 795u);
+}
+
+TEST(VideoReader, BadFilesAndOptionsNameTheFile) {
+    TempDir tmp;
+    const auto expectError = [](const std::function<void()>& f, const std::string& what) {
+        try {
+            f();
+            ADD_FAILURE() << "no error for " << what;
+        } catch (const std::exception& e) {
+            EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+        }
+    };
+    expectError([&] { io::VideoReader v(tmp.str("missing.avi"), {}); }, "missing.avi: no such");
+    { std::ofstream(tmp.str("text.avi")) << "not a video\n"; }
+    expectError([&] { io::VideoReader v(tmp.str("text.avi"), {}); }, "text.avi");
+    expectError([&] { io::VideoReader v(kTum + "/rgb.txt", {0.0, 0.0}); }, "plane_depth");
+    expectError([&] { io::VideoReader v(kTum + "/rgb.txt", {2.0, -1.0}); }, "focal");
 }

@@ -16,8 +16,11 @@ VideoReader::VideoReader(std::string path, Options opts)
     if (!(opts_.focal >= 0)) throw std::invalid_argument(path_ + ": focal must be >= 0 px");
     if (!std::filesystem::is_regular_file(path_))
         throw std::runtime_error(path_ + ": no such video file");
-    if (!cap_->open(path_, cv::CAP_ANY) || !cap_->isOpened())
-        throw std::runtime_error(path_ + ": cannot open as a video (no OpenCV backend decodes it)");
+    // FFmpeg only: CAP_ANY would also try the image-sequence backend, which reports any
+    // file that is not a video with a confusing exception of its own on stderr.
+    if (!cap_->open(path_, cv::CAP_FFMPEG) || !cap_->isOpened())
+        throw std::runtime_error(
+            path_ + ": cannot open as a video (OpenCV's FFmpeg backend does not decode it)");
     const double fps = cap_->get(cv::CAP_PROP_FPS);
     if (fps > 0) fps_ = fps;
     const double count = cap_->get(cv::CAP_PROP_FRAME_COUNT);
@@ -51,9 +54,8 @@ std::optional<core::Frame> VideoReader::readFrame() {
         K_.cx = (img.cols - 1) / 2.0;
         K_.cy = (img.rows - 1) / 2.0;
     } else if (img.cols != K_.width || img.rows != K_.height) {
-        throw std::runtime_error(path_ + " frame " + std::to_string(index_) +
-                                 ": size changed to " + std::to_string(img.cols) + "x" +
-                                 std::to_string(img.rows));
+        throw std::runtime_error(path_ + " frame " + std::to_string(index_) + ": size changed to " +
+                                 std::to_string(img.cols) + "x" + std::to_string(img.rows));
     }
     core::Frame f;
     f.index = index_;
@@ -70,8 +72,8 @@ std::optional<core::Frame> VideoReader::readFrame() {
 
 std::string VideoReader::describe() const {
     std::ostringstream s;
-    s << "video " << path_ << " (fixed camera, " << K_.width << "x" << K_.height << ", "
-      << fps_ << " Hz, depth a plane at " << opts_.plane_depth << " m)";
+    s << "video " << path_ << " (fixed camera, " << K_.width << "x" << K_.height << ", " << fps_
+      << " Hz, depth a plane at " << opts_.plane_depth << " m)";
     return s.str();
 }
 
