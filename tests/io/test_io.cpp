@@ -357,4 +357,7 @@ TEST(VideoReader, BadFilesAndOptionsNameTheFile) {
     expectError([&] { io::VideoReader v(tmp.str("text.avi"), {}); }, "text.avi");
     expectError([&] { io::VideoReader v(kTum + "/rgb.txt", {0.0, 0.0}); }, "plane_depth");
     expectError([&] { io::VideoReader v(kTum + "/rgb.txt", {2.0, -1.0}); }, "focal");
+    // openRgbd does not take videos for RGB-D input, and says where they can go.
+    expectError([&] { (void)io::openRgbd(tmp.str("text.avi")); },
+                "text.avi: a video has no depth");
 }

@@ -6,6 +6,8 @@
 
 #include <mrpt/config/CConfigFileBase.h>
 
+#include <algorithm>
+#include <cctype>
 #include <filesystem>
 #include <stdexcept>
 
@@ -31,7 +33,17 @@ std::unique_ptr<RgbdReader> openRgbd(const std::string& path, const ReaderOption
             throw std::runtime_error(path + ": folder has no rgb.txt (not a TUM RGB-D folder)");
         return std::make_unique<TumReader>(path, opts);
     }
-    if (fs::is_regular_file(path)) return std::make_unique<RawlogReader>(path, opts);
+    if (fs::is_regular_file(path)) {
+        std::string ext = fs::path(path).extension().string();
+        std::transform(ext.begin(), ext.end(), ext.begin(),
+                       [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+        if (ext == ".avi" || ext == ".mp4" || ext == ".mkv" || ext == ".mov")
+            throw std::runtime_error(path +
+                                     ": a video has no depth, so it is no RGB-D input (for the "
+                                     "dynamic-object filter on a fixed camera's video: "
+                                     "devslam-overlay --input video:FILE)");
+        return std::make_unique<RawlogReader>(path, opts);
+    }
     throw std::runtime_error(path + ": no such TUM folder or rawlog file");
 }
 
