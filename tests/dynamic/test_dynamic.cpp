@@ -410,7 +410,11 @@ TEST(DynamicConfig, BadValuesAreRejected) {
     EXPECT_EQ(dynamic::parseMaskMode("all_persons"), MaskMode::AllPersons);
     EXPECT_THROW((void)dynamic::parseMaskMode("dyn"), std::invalid_argument);
     for (const auto& [key, value] : std::vector<std::pair<std::string, std::string>>{
-             {"depth_frames", "-1"}, {"depth_rate_threshold", "0"}, {"depth_noise_z2", "-0.1"}}) {
+             {"depth_frames", "-1"},
+             {"depth_rate_threshold", "0"},
+             {"depth_noise_z2", "-0.1"},
+             {"hide_unseen_frames", "-1"},
+             {"forget_unseen_frames", "4"}}) {  // under the default hide_unseen_frames 5
         mrpt::config::CConfigFileMemory c;
         c.write("dynamic_filter", key, value);
         try {
