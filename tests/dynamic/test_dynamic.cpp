@@ -699,7 +699,8 @@ TEST(DynamicFilter, TracksNothingShowsLeaveTheMaskButAreRemembered) {
     // footage (vtest.avi). Nothing shows them any more, so after hide_unseen_frames steps
     // the box leaves the boxes and the mask; the detector finding them at the spot again
     // within forget_unseen_frames steps hands the new box the remembered Moving state at
-    // once, and after that a detection there starts a new track, Unknown.
+    // once, and after that a detection there starts a new track, Unknown. A box reaching
+    // the left or right image border (keep_border_tracks) is kept, as before.
     dynamic::SyntheticOptions so;
     so.n_frames = 24;
     so.person = dynamic::PersonMotion::Walking;
@@ -707,26 +708,39 @@ TEST(DynamicFilter, TracksNothingShowsLeaveTheMaskButAreRemembered) {
     so.person = dynamic::PersonMotion::None;
     const auto& empty = sequence(so);
     constexpr int kLast = 7, kBack = 13, kNew = 22;
-    const cv::Rect2f gone = *walking[kLast].person_box;
-    const cv::Rect patch = cv::Rect(gone.x - 20, gone.y - 20, gone.width + 40, gone.height + 40) &
-                           cv::Rect(0, 0, 640, 480);
-    auto frameAt = [&](int i) {
-        if (i <= kLast) return walking[i].frame;
-        core::Frame f = empty[i].frame;
-        f.bgr = f.bgr.clone();
-        f.bgr(patch).setTo(cv::Scalar(128, 128, 128));
-        return f;
+    struct Case {
+        int hide;
+        bool at_border;  // the detections moved left until they touch the image border
     };
-    const auto masked = [&](const dynamic::FilterOutput& out) {
-        const cv::Rect r = cv::Rect(gone) & cv::Rect(0, 0, 640, 480);
-        return cv::countNonZero(out.mask(r)) >= 0.9 * r.area();
-    };
-
-    for (const int hide : {0, 3}) {
+    for (const Case c : {Case{0, false}, Case{3, false}, Case{3, true}}) {
+        const float shift = c.at_border ? -walking[kLast].person_box->x : 0.f;
+        auto detection = [&](int i) {
+            cv::Rect2f b = *walking[i].person_box;
+            b.x += shift;
+            return b;
+        };
+        const cv::Rect2f gone = detection(kLast);
+        ASSERT_EQ(c.at_border, gone.x <= 10.f) << "the walker's box and the border";
+        const cv::Rect patch =
+            cv::Rect(gone.x - 20, gone.y - 20, gone.width + 40, gone.height + 40) &
+            cv::Rect(0, 0, 640, 480);
+        auto frameAt = [&](int i) {
+            if (i <= kLast) return walking[i].frame;
+            core::Frame f = empty[i].frame;
+            f.bgr = f.bgr.clone();
+            f.bgr(patch).setTo(cv::Scalar(128, 128, 128));
+            return f;
+        };
+        const auto masked = [&](const dynamic::FilterOutput& out) {
+            const cv::Rect r = cv::Rect(gone) & cv::Rect(0, 0, 640, 480);
+            return cv::countNonZero(out.mask(r)) >= 0.9 * r.area();
+        };
+        const bool hides = c.hide > 0 && !c.at_border;
         auto fo = testOptions();
         ASSERT_EQ(fo.detect_every, 1);
-        fo.hide_unseen_frames = hide;
-        fo.forget_unseen_frames = hide > 0 ? 6 : 0;
+        ASSERT_TRUE(fo.keep_border_tracks);
+        fo.hide_unseen_frames = c.hide;
+        fo.forget_unseen_frames = c.hide > 0 ? 6 : 0;
         auto det = std::make_unique<ScriptedDetector>();
         ScriptedDetector* script = det.get();
         DynamicObjectFilter filter(fo, std::move(det));
@@ -735,8 +749,8 @@ TEST(DynamicFilter, TracksNothingShowsLeaveTheMaskButAreRemembered) {
         for (int i = 0; i < so.n_frames; ++i) {
             script->next.clear();
             if (i <= kLast) {
-                script->next.push_back({*walking[i].person_box, 0, "person", 0.9f});
-            } else if (hide > 0 && (i == kBack || i == kNew)) {
+                script->next.push_back({detection(i), 0, "person", 0.9f});
+            } else if (hides && (i == kBack || i == kNew)) {
                 script->next.push_back({gone, 0, "person", 0.9f});
             }
             const auto out = filter.step(frameAt(i), walking[i].T_prev_cur);
@@ -746,8 +760,8 @@ TEST(DynamicFilter, TracksNothingShowsLeaveTheMaskButAreRemembered) {
                 ASSERT_EQ(out.boxes[0].state, BoxState::Moving) << "the walker before leaving";
                 walker_id = out.boxes[0].id;
             }
-            if (hide == 0) {
-                // Without hiding, the walker's box stays Moving and masked for good.
+            if (!hides) {
+                // Without hiding, or at the border, the box stays Moving and masked.
                 if (i > kLast) {
                     EXPECT_TRUE(masked(out)) << "frame " << i;
                 }
@@ -755,7 +769,7 @@ TEST(DynamicFilter, TracksNothingShowsLeaveTheMaskButAreRemembered) {
             }
             // One step of slack: the LK points of frame kLast that landed in the grey patch
             // may still give evidence in the first frame without the walker.
-            if (i > kLast + hide + 1 && i < kBack) {
+            if (i > kLast + c.hide + 1 && i < kBack) {
                 EXPECT_FALSE(masked(out)) << "frame " << i;
                 EXPECT_TRUE(out.boxes.empty()) << "frame " << i;
             }
@@ -771,7 +785,7 @@ TEST(DynamicFilter, TracksNothingShowsLeaveTheMaskButAreRemembered) {
                 EXPECT_EQ(out.boxes[0].state, BoxState::Unknown);
             }
         }
-        std::printf("hide_unseen_frames %d: walker's box masked per frame %s\n", hide,
-                    timeline.c_str());
+        std::printf("hide_unseen_frames %d, box %s: walker's box masked per frame %s\n", c.hide,
+                    c.at_border ? "at the border" : "inside the image", timeline.c_str());
     }
 }

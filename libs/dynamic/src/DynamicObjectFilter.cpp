@@ -49,6 +49,7 @@ const std::vector<std::string> kKeys{"mode",
                                      "max_missed_detections",
                                      "hide_unseen_frames",
                                      "forget_unseen_frames",
+                                     "keep_border_tracks",
                                      "mask_margin",
                                      "background_factor",
                                      "flow_scale",
@@ -191,6 +192,7 @@ void DynamicObjectFilter::Options::loadFromConfig(const mrpt::config::CConfigFil
     max_missed_detections = core::readInt(c, s, "max_missed_detections", max_missed_detections);
     hide_unseen_frames = core::readInt(c, s, "hide_unseen_frames", hide_unseen_frames);
     forget_unseen_frames = core::readInt(c, s, "forget_unseen_frames", forget_unseen_frames);
+    keep_border_tracks = core::readBool(c, s, "keep_border_tracks", keep_border_tracks);
     mask_margin = core::readInt(c, s, "mask_margin", mask_margin);
     mask_unknown = core::readBool(c, s, "mask_unknown", mask_unknown);
     mask_border_snap = core::readInt(c, s, "mask_border_snap", mask_border_snap);
@@ -271,6 +273,7 @@ void DynamicObjectFilter::Options::saveToConfig(mrpt::config::CConfigFileBase& c
     c.write(s, "max_missed_detections", max_missed_detections);
     c.write(s, "hide_unseen_frames", hide_unseen_frames);
     c.write(s, "forget_unseen_frames", forget_unseen_frames);
+    c.write(s, "keep_border_tracks", keep_border_tracks);
     c.write(s, "mask_margin", mask_margin);
     c.write(s, "mask_unknown", mask_unknown);
     c.write(s, "mask_border_snap", mask_border_snap);
@@ -660,8 +663,15 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
         t.tb.n_points = n;
         t.tb.n_dynamic_points = n_dyn;
         if (n < opts_.min_points) {  // no evidence: keep the state
-            if (t.missed > 0)
-                ++t.unseen;  // and no detection either
+            // and no detection either: unseen, unless the box reaches the image's left or
+            // right border, where walkers leave and come back, and where one cut by the
+            // border is often both undetected and without points (the bottom border cuts
+            // every near person's box, so it does not count)
+            const auto m = static_cast<float>(opts_.mask_margin);
+            const bool at_border =
+                t.tb.box.x <= m || t.tb.box.br().x >= static_cast<float>(gray.cols) - m;
+            if (t.missed > 0 && !(opts_.keep_border_tracks && at_border))
+                ++t.unseen;
             else
                 t.unseen = 0;
             continue;

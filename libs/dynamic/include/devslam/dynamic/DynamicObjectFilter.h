@@ -150,6 +150,10 @@ class DynamicObjectFilter {
         /// back is matched and masked at once. 0 = never hidden or forgotten.
         int hide_unseen_frames = 5;
         int forget_unseen_frames = 30;  ///< must be >= hide_unseen_frames
+        /// boxes within mask_margin of the left or right image border are never unseen:
+        /// walkers leave and come back there, and one cut by the border is often both
+        /// undetected and without points (the bottom border cuts every near person's box)
+        bool keep_border_tracks = true;
         /// detections scoring below this only continue existing tracks (matched after the
         /// confident ones) and never start one; with the detector's conf_threshold below
         /// it, a person the detector grows unsure of stays tracked. 0 = every detection.
