@@ -1,8 +1,9 @@
 // devslam-overlay: runs the dynamic-object filter over a TUM folder, an MRPT rawlog, a
-// synthetic sequence or a video from a fixed camera (real walking people, no depth) and writes overlay PNGs like the DEV-SLAM paper's Fig. 2/3: person
-// boxes coloured by state (red moving, green static, yellow unknown; thin = carried by the
-// flow), flow vectors (red = residual above the threshold), and the ORB keypoints the mask
-// drops (magenta crosses) over the masked area (tinted).
+// synthetic sequence or a video from a fixed camera (real walking people, no depth) and
+// writes overlay PNGs like the DEV-SLAM paper's Fig. 2/3: person boxes coloured by state
+// (red moving, green static, yellow unknown; thin = carried by the flow), flow vectors (red =
+// residual above the threshold), and the ORB keypoints the mask drops (magenta crosses) over
+// the masked area (tinted).
 //
 //   devslam-overlay --input data/tum/fr1_xyz_first37 --out /tmp/ov
 //   devslam-overlay --input synthetic:walking|synthetic:static [--frames 30] --out DIR
