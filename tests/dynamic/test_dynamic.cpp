@@ -326,9 +326,9 @@ TEST(DynamicFilter, RealTumFramesHaveNoMovingRegion) {
         const auto a = yolo_filter->step(*f, std::nullopt);
         const auto b = box_filter.step(*f, std::nullopt);
         ++frames;
-        // Frame 0 masks the boxes whose state is still Unknown (mask_unknown); afterwards
-        // nothing may be masked.
-        if (f->index > 0) masked += cv::countNonZero(a.mask) > 0 || cv::countNonZero(b.mask) > 0;
+        // Nothing may be masked: frame 0, where every box is Unknown, included
+        // (mask_unknown_first_frame is off).
+        masked += cv::countNonZero(a.mask) > 0 || cv::countNonZero(b.mask) > 0;
         for (const auto& box : b.boxes) {
             flagged += box.state == BoxState::Moving;
             if (f->index > 0) {
@@ -428,29 +428,38 @@ TEST(DynamicConfig, BadValuesAreRejected) {
 }
 
 TEST(DynamicFilter, UnknownBoxesAreMaskedUntilThereIsEvidence) {
-    // Frame 0 has no flow yet: with mask_unknown the new person box is masked (a walker is
-    // not mapped while the filter waits for evidence); without it, nothing is masked.
+    // A box over a uniform patch of the wall gets no points, so its state stays Unknown.
+    // From the second frame on, mask_unknown masks it (a walker who has just appeared is
+    // not mapped while the filter waits for evidence). In a frame with no previous one,
+    // every box is Unknown (seated people too), and it is masked only with
+    // mask_unknown_first_frame.
     core::Frame f = flatWallFrame();
     const cv::Rect2f box(300, 100, 80, 200);
-    for (bool mask_unknown : {true, false}) {
-        auto o = testOptions();
-        o.mode = MaskMode::Dynamic;
-        o.mask_unknown = mask_unknown;
-        auto det = std::make_unique<ScriptedDetector>();
-        det->next = {{box, 0, "person", 0.9f}};
-        DynamicObjectFilter filter(o, std::move(det));
-        const auto out = filter.step(f, std::nullopt);
-        ASSERT_EQ(out.boxes.size(), 1u);
-        EXPECT_EQ(out.boxes[0].state, BoxState::Unknown);
-        const int masked = cv::countNonZero(out.mask);
-        if (mask_unknown) {
+    f.bgr(cv::Rect(280, 80, 120, 240)).setTo(cv::Scalar(128, 128, 128));
+    for (bool mask_unknown : {true, false})
+        for (bool first_frame : {true, false}) {
+            SCOPED_TRACE("mask_unknown " + std::to_string(mask_unknown) + ", first_frame " +
+                         std::to_string(first_frame));
+            auto o = testOptions();
+            o.mode = MaskMode::Dynamic;
+            o.mask_unknown = mask_unknown;
+            o.mask_unknown_first_frame = first_frame;
+            auto det = std::make_unique<ScriptedDetector>();
+            det->next = {{box, 0, "person", 0.9f}};
+            DynamicObjectFilter filter(o, std::move(det));
             // the box dilated by mask_margin on each side
-            const int m = o.mask_margin;
-            EXPECT_EQ(masked, (80 + 2 * m) * (200 + 2 * m));
-        } else {
-            EXPECT_EQ(masked, 0);
+            const int m = o.mask_margin, box_area = (80 + 2 * m) * (200 + 2 * m);
+            for (int k = 0; k < 2; ++k) {
+                f.index = static_cast<std::size_t>(k);
+                const auto out = filter.step(f, Eigen::Isometry3d::Identity());
+                ASSERT_EQ(out.boxes.size(), 1u);
+                EXPECT_EQ(out.boxes[0].state, BoxState::Unknown) << "frame " << k;
+                EXPECT_LT(out.boxes[0].n_points, o.min_points) << "frame " << k;
+                const bool expect_masked = mask_unknown && (k > 0 || first_frame);
+                EXPECT_EQ(cv::countNonZero(out.mask), expect_masked ? box_area : 0)
+                    << "frame " << k;
+            }
         }
-    }
 }
 
 TEST(DynamicFilter, DepthBandFindsAWalkerInABoxOfBackground) {

@@ -54,6 +54,7 @@ const std::vector<std::string> kKeys{"mode",
                                      "background_factor",
                                      "flow_scale",
                                      "mask_unknown",
+                                     "mask_unknown_first_frame",
                                      "mask_border_snap",
                                      "fg_depth_band",
                                      "mask_silhouette",
@@ -195,6 +196,8 @@ void DynamicObjectFilter::Options::loadFromConfig(const mrpt::config::CConfigFil
     keep_border_tracks = core::readBool(c, s, "keep_border_tracks", keep_border_tracks);
     mask_margin = core::readInt(c, s, "mask_margin", mask_margin);
     mask_unknown = core::readBool(c, s, "mask_unknown", mask_unknown);
+    mask_unknown_first_frame =
+        core::readBool(c, s, "mask_unknown_first_frame", mask_unknown_first_frame);
     mask_border_snap = core::readInt(c, s, "mask_border_snap", mask_border_snap);
     core::requireValue(mask_border_snap >= 0, s, "mask_border_snap", "must be >= 0");
     core::requireValue(detect_every >= 1, s, "detect_every", "must be >= 1");
@@ -276,6 +279,7 @@ void DynamicObjectFilter::Options::saveToConfig(mrpt::config::CConfigFileBase& c
     c.write(s, "keep_border_tracks", keep_border_tracks);
     c.write(s, "mask_margin", mask_margin);
     c.write(s, "mask_unknown", mask_unknown);
+    c.write(s, "mask_unknown_first_frame", mask_unknown_first_frame);
     c.write(s, "mask_border_snap", mask_border_snap);
 }
 
@@ -735,12 +739,15 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
                                        }),
                         im.tracks.end());
 
-    // 7. Mask: whole boxes, dilated by the margin.
+    // 7. Mask: whole boxes, dilated by the margin. On a frame with no previous one every
+    //    box is Unknown, walkers and sitters alike: masking them all there would be
+    //    all_persons for that frame (mask_unknown_first_frame).
+    const bool mask_unknown = opts_.mask_unknown && (have_prev || opts_.mask_unknown_first_frame);
     for (const auto& t : im.tracks) {
         if (t.hidden(opts_)) continue;
         out.boxes.push_back(t.tb);
         const bool masked = opts_.mode == MaskMode::AllPersons || t.tb.state == BoxState::Moving ||
-                            (opts_.mask_unknown && t.tb.state == BoxState::Unknown);
+                            (mask_unknown && t.tb.state == BoxState::Unknown);
         if (!masked) continue;
         const auto m = static_cast<float>(opts_.mask_margin);
         const auto snap = static_cast<float>(opts_.mask_border_snap);

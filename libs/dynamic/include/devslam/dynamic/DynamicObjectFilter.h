@@ -165,6 +165,11 @@ class DynamicObjectFilter {
         /// no flow evidence yet). Unmasked, such a person enters the map for the frames the
         /// evidence takes (always the first frame) and corrupts it if they walk.
         bool mask_unknown = true;
+        /// with mask_unknown, also mask the Unknown boxes of a frame with no previous frame
+        /// (the first, and the first after reset()). No box can have evidence there, so
+        /// this masks every person, seated ones too, in the frame the SLAM builds its
+        /// first keyframe from. Off by default (docs/dynamic.md, session 11).
+        bool mask_unknown_first_frame = false;
         /// [px] a masked box edge this close to the image border is extended to it: a
         /// person cut off by the border is detected with a box that stops short of it,
         /// leaving a strip of the person unmasked.
