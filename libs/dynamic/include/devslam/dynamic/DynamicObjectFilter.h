@@ -163,7 +163,7 @@ class DynamicObjectFilter {
         int mask_margin = 10;  ///< [px] dilation of each masked box
         /// mode dynamic: also mask boxes whose state is still Unknown (a person first seen,
         /// no flow evidence yet). Unmasked, such a person enters the map for the frames the
-        /// evidence takes (always the first frame) and corrupts it if they walk.
+        /// evidence takes and corrupts it if they walk.
         bool mask_unknown = true;
         /// with mask_unknown, also mask the Unknown boxes of a frame with no previous frame
         /// (the first, and the first after reset()). No box can have evidence there, so
