@@ -16,18 +16,47 @@ using namespace devslam;
 namespace {
 const std::string kRoot = DEVSLAM_SOURCE_DIR;
 
-/// A real frame as the filter sees it: gray, at its default flow_scale of 0.5.
-cv::Mat workImage() {
+/// The real frames as the filter sees them: gray, at its default flow_scale of 0.5.
+std::vector<cv::Mat> workImages() {
     auto reader = io::openRgbd(kRoot + "/data/tum/fr1_xyz_first37", {});
-    std::optional<core::Frame> f;
-    for (int i = 0; i <= 10; ++i) f = reader->next();
-    if (!f) throw std::runtime_error("fr1_xyz_first37 has fewer than 11 frames");
-    cv::Mat gray, work;
-    cv::cvtColor(f->bgr, gray, cv::COLOR_BGR2GRAY);
-    cv::resize(gray, work, cv::Size(), 0.5, 0.5, cv::INTER_AREA);
-    return work;
+    std::vector<cv::Mat> images;
+    while (const auto f = reader->next()) {
+        cv::Mat gray, work;
+        cv::cvtColor(f->bgr, gray, cv::COLOR_BGR2GRAY);
+        cv::resize(gray, work, cv::Size(), 0.5, 0.5, cv::INTER_AREA);
+        images.push_back(work);
+    }
+    return images;
+}
+
+/// Frame 10 of them.
+cv::Mat workImage() {
+    const auto images = workImages();
+    if (images.size() < 11) throw std::runtime_error("fr1_xyz_first37 has fewer than 11 frames");
+    return images[10];
 }
 }  // namespace
+
+TEST(ShiTomasi, MapIsCornerMinEigenVal) {
+    // compute() builds cv::cornerMinEigenVal's map from faster OpenCV primitives: the values
+    // must agree to float rounding, everywhere including the image border, on a real frame
+    // and on a synthetic one with corners right at the border.
+    cv::Mat synthetic(240, 320, CV_8UC1, cv::Scalar(90));
+    cv::rectangle(synthetic, {0, 0, 40, 30}, cv::Scalar(250), cv::FILLED);
+    cv::rectangle(synthetic, {150, 100, 60, 50}, cv::Scalar(10), cv::FILLED);
+    cv::circle(synthetic, {319, 239}, 25, cv::Scalar(200), cv::FILLED);
+    for (const cv::Mat& image : {workImage(), synthetic}) {
+        const auto map = dynamic::ShiTomasiMap::compute(image);
+        cv::Mat expected;
+        cv::cornerMinEigenVal(image, expected, 3, 3);
+        double max_val = 0;
+        cv::minMaxLoc(expected, nullptr, &max_val);
+        ASSERT_GT(max_val, 0.0);
+        ASSERT_EQ(map.eig.size(), expected.size());
+        ASSERT_EQ(map.eig.type(), CV_32FC1);
+        EXPECT_LE(cv::norm(map.eig, expected, cv::NORM_INF), 1e-5 * max_val);
+    }
+}
 
 TEST(ShiTomasi, WholeImageSelectionIsGoodFeaturesToTrack) {
     const cv::Mat work = workImage();
@@ -43,6 +72,18 @@ TEST(ShiTomasi, WholeImageSelectionIsGoodFeaturesToTrack) {
         ASSERT_GT(expected.size(), 50u);
         EXPECT_EQ(got, expected) << "max_corners " << n << ", quality " << q << ", distance " << d;
     }
+    // The filter's settings on every frame.
+    int frame = 0;
+    for (const cv::Mat& image : workImages()) {
+        std::vector<cv::Point2f> expected;
+        cv::goodFeaturesToTrack(image, expected, 200, 0.01, 5.0);
+        const auto got = dynamic::selectShiTomasi(dynamic::ShiTomasiMap::compute(image),
+                                                  cv::Rect(0, 0, image.cols, image.rows), 200,
+                                                  0.01, 5.0);
+        EXPECT_EQ(got, expected) << "frame " << frame;
+        ++frame;
+    }
+    EXPECT_GE(frame, 30);  // the frames with an associated depth image
 }
 
 TEST(ShiTomasi, RegionWithMaskMatchesGoodFeaturesToTrackOnTheRegion) {

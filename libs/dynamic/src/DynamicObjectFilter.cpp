@@ -306,6 +306,11 @@ struct DynamicObjectFilter::Impl {
     };
     cv::Mat prev_work, prev_depth;
     std::vector<cv::Mat> prev_pyr;
+    /// this step's images (swapped into prev_* at its end), the full-size grey image, and
+    /// the eigenvalue map of prev_work: buffers reused from step to step
+    cv::Mat work, gray;
+    std::vector<cv::Mat> pyr;
+    ShiTomasiMap corner_map;
     core::CameraIntrinsics prev_K;
     std::vector<Track> tracks;
     int next_id = 0;
@@ -339,28 +344,36 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
     Impl& im = *impl_;
     const auto t_filter0 = Clock::now();
     double detect_ms = 0;
-    cv::Mat gray;
-    cv::cvtColor(frame.bgr, gray, cv::COLOR_BGR2GRAY);
-    // Corners and flow run on a downscaled image (flow_scale) for speed; all coordinates
-    // below are full-resolution pixels.
-    cv::Mat work = gray;
+    const cv::Size size = frame.bgr.size();
+    // Corners and flow run on a downscaled grey image (flow_scale) for speed; all
+    // coordinates below are full-resolution pixels. The images a step builds go into
+    // buffers kept in Impl (this step's become the next step's previous ones by swapping):
+    // images this large get fresh pages from the kernel, and page faults, when allocated anew.
     const double sc = opts_.flow_scale;
-    if (sc != 1.0) cv::resize(gray, work, cv::Size(), sc, sc, cv::INTER_AREA);
+    cv::Mat& work = im.work;
+    if (sc != 1.0) {
+        cv::cvtColor(frame.bgr, im.gray, cv::COLOR_BGR2GRAY);
+        cv::resize(im.gray, work, cv::Size(), sc, sc, cv::INTER_AREA);
+    } else {
+        cv::cvtColor(frame.bgr, work, cv::COLOR_BGR2GRAY);
+    }
     const cv::Size win(opts_.lk_window, opts_.lk_window);
     // With the Scharr derivatives stored in the pyramid, calcOpticalFlowPyrLK does not
     // recompute them for each of the two calls that start from this frame (this step's
     // backward check and the next step's forward flow); the flow is bit-identical.
-    std::vector<cv::Mat> pyr;
+    std::vector<cv::Mat>& pyr = im.pyr;
     cv::buildOpticalFlowPyramid(work, pyr, win, opts_.lk_levels, true);
-    const cv::Rect2f image(0.f, 0.f, static_cast<float>(gray.cols), static_cast<float>(gray.rows));
+    const cv::Rect2f image(0.f, 0.f, static_cast<float>(size.width),
+                           static_cast<float>(size.height));
     const bool have_prev = !im.prev_work.empty() && im.prev_work.size() == work.size() &&
-                           im.prev_depth.size() == gray.size();
+                           im.prev_depth.size() == size;
 
     // 1. Flow of Shi-Tomasi corners of the previous frame (global + inside each box).
     std::vector<cv::Point2f> p0, p1;
     if (have_prev) {
         // One eigenvalue map for the image and every box (see ShiTomasi.h).
-        const ShiTomasiMap corners = ShiTomasiMap::compute(im.prev_work);
+        im.corner_map.update(im.prev_work);
+        const ShiTomasiMap& corners = im.corner_map;
         p0 = selectShiTomasi(corners, cv::Rect(0, 0, work.cols, work.rows), opts_.max_corners,
                              opts_.corner_quality, opts_.corner_min_distance);
         if (opts_.max_corners_per_box > 0) {
@@ -673,7 +686,7 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
             // every near person's box, so it does not count)
             const auto m = static_cast<float>(opts_.mask_margin);
             const bool at_border =
-                t.tb.box.x <= m || t.tb.box.br().x >= static_cast<float>(gray.cols) - m;
+                t.tb.box.x <= m || t.tb.box.br().x >= static_cast<float>(size.width) - m;
             if (t.missed > 0 && !(opts_.keep_border_tracks && at_border))
                 ++t.unseen;
             else
@@ -751,7 +764,7 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
         if (!masked) continue;
         const auto m = static_cast<float>(opts_.mask_margin);
         const auto snap = static_cast<float>(opts_.mask_border_snap);
-        const auto W = static_cast<float>(gray.cols), H = static_cast<float>(gray.rows);
+        const auto W = static_cast<float>(size.width), H = static_cast<float>(size.height);
         float x0 = t.tb.box.x - m, y0 = t.tb.box.y - m;
         float x1 = t.tb.box.br().x + m, y1 = t.tb.box.br().y + m;
         if (x0 < snap) x0 = 0.f;
@@ -759,7 +772,7 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
         if (x1 > W - snap) x1 = W;
         if (y1 > H - snap) y1 = H;
         const cv::Rect r =
-            cv::Rect(cv::Rect2f(x0, y0, x1 - x0, y1 - y0)) & cv::Rect(0, 0, gray.cols, gray.rows);
+            cv::Rect(cv::Rect2f(x0, y0, x1 - x0, y1 - y0)) & cv::Rect({}, size);
         if (!opts_.mask_silhouette || !t.depth) {
             out.mask(r).setTo(255);
             continue;
@@ -771,7 +784,7 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
                             : opts_.fg_depth_band > 0       ? opts_.fg_depth_band
                                                             : 0.5;
         const float h = depthBand(band, zp);
-        const cv::Rect inner = cv::Rect(t.tb.box) & cv::Rect(0, 0, gray.cols, gray.rows);
+        const cv::Rect inner = cv::Rect(t.tb.box) & cv::Rect({}, size);
         if (inner.empty()) continue;
         cv::Mat sil, holes;
         cv::inRange(frame.depth(inner), zp - h, zp + h, sil);
@@ -787,9 +800,9 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
         out.mask(r) |= big;
     }
 
-    im.prev_work = work;
-    im.prev_pyr = std::move(pyr);
-    im.prev_depth = frame.depth.clone();
+    std::swap(im.prev_work, im.work);
+    std::swap(im.prev_pyr, im.pyr);
+    frame.depth.copyTo(im.prev_depth);
     im.prev_K = frame.K;
     ++im.frame_count;
     out.detect_ms = detect_ms;

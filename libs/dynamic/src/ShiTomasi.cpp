@@ -10,15 +10,44 @@
 namespace devslam::dynamic {
 
 ShiTomasiMap ShiTomasiMap::compute(const cv::Mat& gray) {
+    ShiTomasiMap m;
+    m.update(gray);
+    return m;
+}
+
+void ShiTomasiMap::update(const cv::Mat& gray) {
     if (gray.type() != CV_8UC1 || gray.empty())
         throw std::invalid_argument("Shi-Tomasi map: needs a non-empty CV_8UC1 image");
-    ShiTomasiMap m;
-    cv::cornerMinEigenVal(gray, m.eig, 3, 3);
+    // cv::cornerMinEigenVal(gray, eig, 3, 3), composed from OpenCV's own primitives, which
+    // Debian's OpenCV 4.6 runs in 0.62x its time at 320x240 (devslam-filter-bench, the
+    // `detect` section of docs/RESULTS.md): its 3x3 sums, a boxFilter on a 3-channel float
+    // image, are the slow part, and a separable filter of ones computes the same sums. The
+    // steps write into buffers kept from call to call. Same scale, border and formula: the
+    // values agree to float rounding, and the corners selected are goodFeaturesToTrack's
+    // (tests ShiTomasi.MapIsCornerMinEigenVal, WholeImageSelectionIsGoodFeaturesToTrack).
+    const double scale = 1.0 / (4 * 3 * 255.0);  // 1 / ((1 << (aperture - 1)) * block * 255)
+    const auto border = cv::BORDER_REFLECT_101;
+    cv::Sobel(gray, a_, CV_32F, 1, 0, 3, scale, 0, border);  // a_ = gx
+    cv::Sobel(gray, b_, CV_32F, 0, 1, 3, scale, 0, border);  // b_ = gy
+    cv::multiply(a_, a_, c_);                                // gx^2
+    cv::multiply(a_, b_, d_);                                // gx gy
+    cv::multiply(b_, b_, e_);                                // gy^2
+    const cv::Mat ones = cv::Mat::ones(1, 3, CV_32F);        // unnormalised 3x3 block sums
+    cv::sepFilter2D(c_, a_, CV_32F, ones, ones, cv::Point(-1, -1), 0, border);  // a_ = Sxx
+    cv::sepFilter2D(e_, b_, CV_32F, ones, ones, cv::Point(-1, -1), 0, border);  // b_ = Syy
+    cv::sepFilter2D(d_, c_, CV_32F, ones, ones, cv::Point(-1, -1), 0, border);  // c_ = Sxy
+    // Smaller eigenvalue of [[Sxx, Sxy], [Sxy, Syy]], as cornerMinEigenVal computes it:
+    // (p + q) - sqrt((p - q)^2 + Sxy^2) with p = Sxx / 2, q = Syy / 2.
+    a_ *= 0.5;
+    b_ *= 0.5;
+    cv::subtract(a_, b_, d_);
+    cv::magnitude(d_, c_, e_);
+    cv::add(a_, b_, eig);
+    cv::subtract(eig, e_, eig);
     // A pixel above the quality threshold is a local maximum of the thresholded map (what
     // goodFeaturesToTrack dilates) exactly when it is one of the raw map: its 3x3 maximum is
     // at least its own value, so above the threshold too. One dilation serves every region.
-    cv::dilate(m.eig, m.eig_max, cv::Mat());
-    return m;
+    cv::dilate(eig, eig_max, cv::Mat());
 }
 
 std::vector<cv::Point2f> selectShiTomasi(const ShiTomasiMap& map, const cv::Rect& roi,

@@ -18,18 +18,25 @@ namespace devslam::dynamic {
 /// min_distance apart, at most max_corners. On the whole image with no mask it returns
 /// exactly what cv::goodFeaturesToTrack returns (tests/dynamic checks this); inside a
 /// region, a corner must also be a local maximum over the region's outside neighbours.
+/// The map itself is cv::cornerMinEigenVal's, computed from faster OpenCV primitives
+/// (ShiTomasi.cpp says why).
 ///
-///   const auto map = ShiTomasiMap::compute(gray);  // once per frame
+///   const auto map = ShiTomasiMap::compute(gray);  // once per frame (or map.update(gray))
 ///   auto all = selectShiTomasi(map, cv::Rect(0, 0, gray.cols, gray.rows), 200, 0.01, 5);
 ///   auto box = selectShiTomasi(map, roi, 40, 0.01, 2.5, fg_mask);  // per box, same map
 struct ShiTomasiMap {
     cv::Mat eig;      ///< CV_32F minimum eigenvalue of the gradient covariance per pixel
     cv::Mat eig_max;  ///< CV_32F 3x3 dilation of eig (local-maximum test)
-
     /// Computes the map of a CV_8U image (blockSize 3, Sobel aperture 3, as the filter's
     /// former goodFeaturesToTrack calls).
     [[nodiscard]] static ShiTomasiMap compute(const cv::Mat& gray);
+    /// The same, in place: a map kept from frame to frame reuses its images and scratch
+    /// buffers (no allocation once the image size is fixed).
+    void update(const cv::Mat& gray);
     [[nodiscard]] bool empty() const { return eig.empty(); }
+
+  private:
+    cv::Mat a_, b_, c_, d_, e_;  // scratch (gradients, their products and sums)
 };
 
 /// Corners in `roi` of the map (coordinates of the whole image). mask: empty, or CV_8U of
