@@ -6,6 +6,8 @@
 #include <gtest/gtest.h>
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
+#include <cstdio>
 #include <optional>
 #include <stdexcept>
 #include <tuple>
@@ -59,31 +61,37 @@ TEST(ShiTomasi, MapIsCornerMinEigenVal) {
 }
 
 TEST(ShiTomasi, WholeImageSelectionIsGoodFeaturesToTrack) {
+    // The map is cornerMinEigenVal's to float rounding, not to the bit (it is computed from
+    // other primitives), so a corner whose response ties another's to the last bit could
+    // swap places on another CPU. On this project's machines the selections are identical
+    // on every frame; the test allows 1 % of the corners to differ.
+    int frames = 0, identical = 0;
+    const auto check = [&](const cv::Mat& image, int n, double q, double d) {
+        std::vector<cv::Point2f> expected;
+        cv::goodFeaturesToTrack(image, expected, n, q, d);
+        const auto got = dynamic::selectShiTomasi(dynamic::ShiTomasiMap::compute(image),
+                                                  cv::Rect(0, 0, image.cols, image.rows), n, q, d);
+        ASSERT_GT(expected.size(), 50u);
+        std::size_t same = 0;
+        for (std::size_t i = 0; i < std::min(got.size(), expected.size()); ++i)
+            same += got[i] == expected[i];
+        EXPECT_GE(same * 100, expected.size() * 99)
+            << "max_corners " << n << ", quality " << q << ", distance " << d << ": " << same
+            << " of " << expected.size() << " corners in the same place";
+        EXPECT_LE(got.size(), expected.size() + expected.size() / 100 + 1);
+        ++frames;
+        identical += got == expected;
+    };
     const cv::Mat work = workImage();
     ASSERT_EQ(work.size(), cv::Size(320, 240));
-    const auto map = dynamic::ShiTomasiMap::compute(work);
     // The filter's settings (200, 0.01, 5), a denser one, and no distance / no limit.
     for (const auto& [n, q, d] :
-         {std::tuple{200, 0.01, 5.0}, std::tuple{500, 0.001, 2.5}, std::tuple{0, 0.05, 0.0}}) {
-        std::vector<cv::Point2f> expected;
-        cv::goodFeaturesToTrack(work, expected, n, q, d);
-        const auto got =
-            dynamic::selectShiTomasi(map, cv::Rect(0, 0, work.cols, work.rows), n, q, d);
-        ASSERT_GT(expected.size(), 50u);
-        EXPECT_EQ(got, expected) << "max_corners " << n << ", quality " << q << ", distance " << d;
-    }
-    // The filter's settings on every frame.
-    int frame = 0;
-    for (const cv::Mat& image : workImages()) {
-        std::vector<cv::Point2f> expected;
-        cv::goodFeaturesToTrack(image, expected, 200, 0.01, 5.0);
-        const auto got = dynamic::selectShiTomasi(dynamic::ShiTomasiMap::compute(image),
-                                                  cv::Rect(0, 0, image.cols, image.rows), 200,
-                                                  0.01, 5.0);
-        EXPECT_EQ(got, expected) << "frame " << frame;
-        ++frame;
-    }
-    EXPECT_GE(frame, 30);  // the frames with an associated depth image
+         {std::tuple{200, 0.01, 5.0}, std::tuple{500, 0.001, 2.5}, std::tuple{0, 0.05, 0.0}})
+        check(work, n, q, d);
+    // The filter's settings on every frame with an associated depth image.
+    for (const cv::Mat& image : workImages()) check(image, 200, 0.01, 5.0);
+    EXPECT_GE(frames, 33);
+    std::printf("identical to goodFeaturesToTrack: %d of %d selections\n", identical, frames);
 }
 
 TEST(ShiTomasi, RegionWithMaskMatchesGoodFeaturesToTrackOnTheRegion) {

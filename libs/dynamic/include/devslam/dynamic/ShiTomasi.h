@@ -27,11 +27,13 @@ namespace devslam::dynamic {
 struct ShiTomasiMap {
     cv::Mat eig;      ///< CV_32F minimum eigenvalue of the gradient covariance per pixel
     cv::Mat eig_max;  ///< CV_32F 3x3 dilation of eig (local-maximum test)
+
     /// Computes the map of a CV_8U image (blockSize 3, Sobel aperture 3, as the filter's
     /// former goodFeaturesToTrack calls).
     [[nodiscard]] static ShiTomasiMap compute(const cv::Mat& gray);
     /// The same, in place: a map kept from frame to frame reuses its images and scratch
-    /// buffers (no allocation once the image size is fixed).
+    /// buffers (no allocation once the image size is fixed). eig and eig_max are
+    /// overwritten, so headers copied from them earlier see the new map.
     void update(const cv::Mat& gray);
     [[nodiscard]] bool empty() const { return eig.empty(); }
 
