@@ -269,7 +269,7 @@ int main(int argc, char** argv) {
             const auto ms = passes();
             const auto ms_all = withThreads(all_threads, passes);
             const auto st = core::summarize(ms);
-            md << "| DynamicObjectFilter::step | fr1_xyz_first37 (YOLO, no person) | "
+            md << "| DynamicObjectFilter::step | fr1_xyz_first37 (YOLO; one seated person, frames 0-3) | "
                << fmt(st.median, 2) << " | " << fmt(st.mean, 2) << " | - | " << ms.size() << " | "
                << fmt(core::median(ms_all), 2) << " |\n";
         }
