@@ -19,7 +19,7 @@ void ShiTomasiMap::update(const cv::Mat& gray) {
     if (gray.type() != CV_8UC1 || gray.empty())
         throw std::invalid_argument("Shi-Tomasi map: needs a non-empty CV_8UC1 image");
     // cv::cornerMinEigenVal(gray, eig, 3, 3), composed from OpenCV's own primitives, which
-    // Debian's OpenCV 4.6 runs in about 0.6x its time at 320x240 (devslam-filter-bench, the
+    // Debian's OpenCV 4.6 runs in 0.6-0.7x its time at 320x240 (devslam-filter-bench, the
     // `detect` section of docs/RESULTS.md): its 3x3 sums, a boxFilter on a 3-channel float
     // image, are the slow part, and a separable filter of ones computes the same sums. The
     // steps write into buffers kept from call to call. Same scale, border and formula: the
