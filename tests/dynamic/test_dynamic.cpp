@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <mrpt/config/CConfigFileMemory.h>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include <algorithm>
 #include <cstdio>
@@ -252,6 +253,39 @@ TEST(DynamicFilter, DetectEveryKCarriesBoxes) {
     EXPECT_EQ(script->calls, (kFrames + 2) / 3);
     EXPECT_GE(moving, kFrames - 2);
     EXPECT_GE(good_iou, kFrames - 2) << "boxes carried by the flow stay on the person";
+}
+
+TEST(DynamicFilter, FrameOfAnotherSizeStartsAfresh) {
+    // The filter keeps its images from step to step (buffers reused). A frame of another
+    // size has no previous frame to flow from: it is handled as a first frame, and the
+    // steps after it flow again, at the new size.
+    dynamic::SyntheticOptions so;
+    so.person = dynamic::PersonMotion::Walking;
+    so.n_frames = kFrames;
+    const auto& seq = sequence(so);
+    ASSERT_GE(seq.size(), 6u);
+    DynamicObjectFilter filter(testOptions(), std::make_unique<ScriptedDetector>());
+    for (std::size_t i = 0; i < 6; ++i) {
+        core::Frame f = seq[i].frame;
+        if (i >= 3) {  // the same view at half the resolution
+            cv::resize(seq[i].frame.bgr, f.bgr, cv::Size(), 0.5, 0.5, cv::INTER_AREA);
+            cv::resize(seq[i].frame.depth, f.depth, cv::Size(), 0.5, 0.5, cv::INTER_NEAREST);
+            f.K.fx *= 0.5;
+            f.K.fy *= 0.5;
+            f.K.cx *= 0.5;
+            f.K.cy *= 0.5;
+            f.K.width /= 2;
+            f.K.height /= 2;
+        }
+        const auto out = filter.step(f, seq[i].T_prev_cur);
+        EXPECT_EQ(out.mask.size(), f.bgr.size()) << "frame " << i;
+        EXPECT_EQ(out.flow.empty(), i == 0 || i == 3) << "frame " << i;
+        for (const auto& fp : out.flow)
+            ASSERT_TRUE(cv::Rect2f(0.f, 0.f, static_cast<float>(f.bgr.cols),
+                                   static_cast<float>(f.bgr.rows))
+                            .contains(fp.cur))
+                << "frame " << i;
+    }
 }
 
 TEST(DynamicFilter, ModesAndMask) {
