@@ -283,6 +283,32 @@ void DynamicObjectFilter::Options::saveToConfig(mrpt::config::CConfigFileBase& c
     c.write(s, "mask_border_snap", mask_border_snap);
 }
 
+namespace {
+
+using Options = DynamicObjectFilter::Options;
+
+/// Shi-Tomasi corners of the previous frame (p0) and where LK finds them in the current one
+/// (p1), in full-resolution pixels; only points that pass the forward-backward check and
+/// land in the image.
+struct PointFlow {
+    std::vector<cv::Point2f> p0, p1;
+};
+
+/// What ego-motion compensation says about each point of a PointFlow.
+struct Residuals {
+    /// 3D of the point in the previous camera frame (nullopt: no stable depth there)
+    std::vector<std::optional<Eigen::Vector3d>> X;
+    /// residual flow vector [px]: observed - predicted from ego-motion and depth
+    std::vector<cv::Point2f> vec;
+    /// depth residual [m]: measured depth at the point's new position - the depth
+    /// ego-motion predicts, less the background's median (NaN: no stable depth)
+    std::vector<float> z;
+};
+
+}  // namespace
+
+/// The filter's state between steps, and the stages of step(), numbered in the order
+/// step() calls them (the data flow diagram of docs/dynamic.md, top to bottom).
 struct DynamicObjectFilter::Impl {
     struct Track {
         TrackedBox tb;
@@ -315,6 +341,50 @@ struct DynamicObjectFilter::Impl {
     std::vector<Track> tracks;
     int next_id = 0;
     long frame_count = 0;
+
+    /// 0. This frame's grey image at flow_scale and its LK pyramid. Returns whether there
+    ///    is a previous frame of the same size to take the flow from.
+    bool prepareImages(const core::Frame& frame, const Options& o);
+    /// 1. Flow of the previous frame's Shi-Tomasi corners: over the whole image, and more
+    ///    inside each box, on the person's depth band when known.
+    PointFlow trackCorners(const Options& o, const cv::Rect2f& image);
+    /// 2. Carries each box with the median flow of its points (the prediction for the
+    ///    association, and the box itself on frames without detection).
+    void carryBoxes(const PointFlow& f, const cv::Rect2f& image);
+    /// 3. Greedy IoU association of this frame's detections with the tracks; drops tracks
+    ///    the detector lost (unless moving), starts tracks for confident new detections.
+    void associate(const std::vector<detect::Detection>& dets, const Options& o);
+    /// Drops degenerate boxes and measures the person's depth in each remaining one.
+    void measureBoxes(const cv::Mat& depth, const Options& o);
+    /// Whether a point (at a in the previous frame or b in this one) is near a box: within
+    /// mask_margin plus 20 % of the box's size (the detector's box may lag a walker's limbs).
+    [[nodiscard]] bool nearAnyBox(const cv::Point2f& a, const cv::Point2f& b,
+                                  const Options& o) const;
+    /// 4. Ego-motion: the 3D of each point from the previous depth (into r.X), and the
+    ///    relative pose p_prev = T * p_cur, the prior refined by PnP-RANSAC on the points
+    ///    near no box (also written to out.T_prev_cur_refined).
+    Eigen::Isometry3d egoMotion(const PointFlow& f, const core::CameraIntrinsics& Kc,
+                                const std::optional<Eigen::Isometry3d>& prior, const Options& o,
+                                Residuals& r, FilterOutput& out) const;
+    /// 5. Residual flow of each point (into r.vec, r.z and out.flow) and the image-wide
+    ///    threshold (out.threshold).
+    void residualFlow(const core::Frame& frame, const PointFlow& f,
+                      const Eigen::Isometry3d& T_prev_cur, const Options& o, Residuals& r,
+                      FilterOutput& out) const;
+    /// The threshold a box's points are judged by: out.threshold, raised where the box's
+    /// static surroundings fit ego-motion badly.
+    [[nodiscard]] double localThreshold(const cv::Rect2f& box, const FilterOutput& out,
+                                        const Options& o) const;
+    /// 6. Per-box evidence (Algorithm 1 with residual flow) and the state's hysteresis.
+    void classifyBoxes(const Residuals& r, const cv::Size& size, const Options& o,
+                       FilterOutput& out);
+    /// Forgets tracks unseen for more than forget_unseen_frames steps.
+    void forgetUnseen(const Options& o);
+    /// 7. The boxes to report and the mask (out.boxes, out.mask).
+    void drawMask(const core::Frame& frame, bool have_prev, const Options& o,
+                  FilterOutput& out) const;
+    /// This step's images become the previous ones.
+    void endStep(const core::Frame& frame);
 };
 
 DynamicObjectFilter::DynamicObjectFilter(const Options& opts,
@@ -345,97 +415,125 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
     const auto t_filter0 = Clock::now();
     double detect_ms = 0;
     const cv::Size size = frame.bgr.size();
+    const cv::Rect2f image(0.f, 0.f, static_cast<float>(size.width),
+                           static_cast<float>(size.height));
+
+    const bool have_prev = im.prepareImages(frame, opts_);
+    PointFlow flow;
+    if (have_prev) flow = im.trackCorners(opts_, image);
+    im.carryBoxes(flow, image);
+    if (im.frame_count % opts_.detect_every == 0) {
+        const auto t_det0 = Clock::now();
+        const auto dets = detector_->detect(frame.bgr);
+        detect_ms = msSince(t_det0);
+        out.detector_ran = true;
+        im.associate(dets, opts_);
+    }
+    im.measureBoxes(frame.depth, opts_);  // the boxes are final for this step
+    Residuals res;
+    if (have_prev && !flow.p0.empty()) {
+        const Eigen::Isometry3d T_prev_cur =
+            im.egoMotion(flow, frame.K, T_prev_cur_prior, opts_, res, out);
+        im.residualFlow(frame, flow, T_prev_cur, opts_, res, out);
+    }
+    im.classifyBoxes(res, size, opts_, out);
+    im.forgetUnseen(opts_);
+    im.drawMask(frame, have_prev, opts_, out);
+    im.endStep(frame);
+
+    out.detect_ms = detect_ms;
+    out.filter_ms = msSince(t_filter0) - detect_ms;
+    return out;
+}
+
+bool DynamicObjectFilter::Impl::prepareImages(const core::Frame& frame, const Options& o) {
     // Corners and flow run on a downscaled grey image (flow_scale) for speed; all
-    // coordinates below are full-resolution pixels. The images a step builds go into
-    // buffers kept in Impl (this step's become the next step's previous ones by swapping):
-    // images this large get fresh pages from the kernel, and page faults, when allocated anew.
-    const double sc = opts_.flow_scale;
-    cv::Mat& work = im.work;
+    // coordinates outside trackCorners are full-resolution pixels. The images a step
+    // builds go into buffers kept here (this step's become the next step's previous ones
+    // by swapping): images this large get fresh pages from the kernel, and page faults,
+    // when allocated anew.
+    const double sc = o.flow_scale;
     if (sc != 1.0) {
-        cv::cvtColor(frame.bgr, im.gray, cv::COLOR_BGR2GRAY);
-        cv::resize(im.gray, work, cv::Size(), sc, sc, cv::INTER_AREA);
+        cv::cvtColor(frame.bgr, gray, cv::COLOR_BGR2GRAY);
+        cv::resize(gray, work, cv::Size(), sc, sc, cv::INTER_AREA);
     } else {
         cv::cvtColor(frame.bgr, work, cv::COLOR_BGR2GRAY);
     }
-    const cv::Size win(opts_.lk_window, opts_.lk_window);
     // With the Scharr derivatives stored in the pyramid, calcOpticalFlowPyrLK does not
     // recompute them for each of the two calls that start from this frame (this step's
     // backward check and the next step's forward flow); the flow is bit-identical.
-    std::vector<cv::Mat>& pyr = im.pyr;
-    cv::buildOpticalFlowPyramid(work, pyr, win, opts_.lk_levels, true);
-    const cv::Rect2f image(0.f, 0.f, static_cast<float>(size.width),
-                           static_cast<float>(size.height));
-    const bool have_prev = !im.prev_work.empty() && im.prev_work.size() == work.size() &&
-                           im.prev_depth.size() == size;
+    cv::buildOpticalFlowPyramid(work, pyr, cv::Size(o.lk_window, o.lk_window), o.lk_levels, true);
+    return !prev_work.empty() && prev_work.size() == work.size() &&
+           prev_depth.size() == frame.bgr.size();
+}
 
-    // 1. Flow of Shi-Tomasi corners of the previous frame (global + inside each box).
-    std::vector<cv::Point2f> p0, p1;
-    if (have_prev) {
-        // One eigenvalue map for the image and every box (see ShiTomasi.h).
-        im.corner_map.update(im.prev_work);
-        const ShiTomasiMap& corners = im.corner_map;
-        p0 = selectShiTomasi(corners, cv::Rect(0, 0, work.cols, work.rows), opts_.max_corners,
-                             opts_.corner_quality, opts_.corner_min_distance);
-        if (opts_.max_corners_per_box > 0) {
-            for (const auto& t : im.tracks) {
-                const cv::Rect2f b = shrink(t.tb.box, opts_.box_shrink);
-                const cv::Rect roi =
-                    cv::Rect(cv::Rect2f(static_cast<float>(b.x * sc), static_cast<float>(b.y * sc),
-                                        static_cast<float>(b.width * sc),
-                                        static_cast<float>(b.height * sc))) &
-                    cv::Rect(0, 0, work.cols, work.rows);
-                if (roi.width < 8 || roi.height < 8) continue;
-                cv::Mat fg;  // the person's depth band in the ROI (empty: whole ROI)
-                if (opts_.fg_depth_band > 0 && t.depth) {  // t.depth: the previous step's
-                    const float zp = *t.depth, h = depthBand(opts_.fg_depth_band, zp);
-                    const cv::Rect full =
-                        cv::Rect(cv::Rect2f(static_cast<float>(roi.x / sc),
-                                            static_cast<float>(roi.y / sc),
-                                            static_cast<float>(roi.width / sc),
-                                            static_cast<float>(roi.height / sc))) &
-                        cv::Rect(0, 0, im.prev_depth.cols, im.prev_depth.rows);
-                    cv::Mat band;
-                    cv::inRange(im.prev_depth(full), zp - h, zp + h, band);
-                    cv::resize(band, fg, roi.size(), 0, 0, cv::INTER_NEAREST);
-                }
-                const auto pts = selectShiTomasi(corners, roi, opts_.max_corners_per_box,
-                                                 opts_.corner_quality,
-                                                 opts_.corner_min_distance * 0.5, fg);
-                p0.insert(p0.end(), pts.begin(), pts.end());
+PointFlow DynamicObjectFilter::Impl::trackCorners(const Options& o, const cv::Rect2f& image) {
+    const double sc = o.flow_scale;
+    PointFlow f;
+    std::vector<cv::Point2f>& p0 = f.p0;
+    std::vector<cv::Point2f>& p1 = f.p1;
+    // One eigenvalue map for the image and every box (see ShiTomasi.h).
+    corner_map.update(prev_work);
+    p0 = selectShiTomasi(corner_map, cv::Rect(0, 0, work.cols, work.rows), o.max_corners,
+                         o.corner_quality, o.corner_min_distance);
+    if (o.max_corners_per_box > 0) {
+        for (const auto& t : tracks) {
+            const cv::Rect2f b = shrink(t.tb.box, o.box_shrink);
+            const cv::Rect roi =
+                cv::Rect(cv::Rect2f(static_cast<float>(b.x * sc), static_cast<float>(b.y * sc),
+                                    static_cast<float>(b.width * sc),
+                                    static_cast<float>(b.height * sc))) &
+                cv::Rect(0, 0, work.cols, work.rows);
+            if (roi.width < 8 || roi.height < 8) continue;
+            cv::Mat fg;  // the person's depth band in the ROI (empty: whole ROI)
+            if (o.fg_depth_band > 0 && t.depth) {  // t.depth: the previous step's
+                const float zp = *t.depth, h = depthBand(o.fg_depth_band, zp);
+                const cv::Rect full =
+                    cv::Rect(cv::Rect2f(static_cast<float>(roi.x / sc),
+                                        static_cast<float>(roi.y / sc),
+                                        static_cast<float>(roi.width / sc),
+                                        static_cast<float>(roi.height / sc))) &
+                    cv::Rect(0, 0, prev_depth.cols, prev_depth.rows);
+                cv::Mat band;
+                cv::inRange(prev_depth(full), zp - h, zp + h, band);
+                cv::resize(band, fg, roi.size(), 0, 0, cv::INTER_NEAREST);
             }
-        }
-        if (!p0.empty()) {
-            std::vector<uchar> st, st_back;
-            std::vector<float> err;
-            const cv::TermCriteria term(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 10, 0.03);
-            cv::calcOpticalFlowPyrLK(im.prev_pyr, pyr, p0, p1, st, err, win, opts_.lk_levels, term);
-            std::vector<cv::Point2f> back = p0;
-            cv::calcOpticalFlowPyrLK(pyr, im.prev_pyr, p1, back, st_back, err, win, opts_.lk_levels,
-                                     term, cv::OPTFLOW_USE_INITIAL_FLOW);
-            std::size_t n = 0;
-            const auto inv = static_cast<float>(1.0 / sc);
-            for (std::size_t i = 0; i < p0.size(); ++i) {
-                const float fb = static_cast<float>(cv::norm(back[i] - p0[i])) * inv;
-                const cv::Point2f a = p0[i] * inv, b = p1[i] * inv;
-                if (!st[i] || !st_back[i] || fb > opts_.fb_max_error || !image.contains(b))
-                    continue;
-                p0[n] = a;
-                p1[n] = b;
-                ++n;
-            }
-            p0.resize(n);
-            p1.resize(n);
+            const auto pts = selectShiTomasi(corner_map, roi, o.max_corners_per_box,
+                                             o.corner_quality, o.corner_min_distance * 0.5, fg);
+            p0.insert(p0.end(), pts.begin(), pts.end());
         }
     }
+    if (p0.empty()) return f;
+    const cv::Size win(o.lk_window, o.lk_window);
+    std::vector<uchar> st, st_back;
+    std::vector<float> err;
+    const cv::TermCriteria term(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 10, 0.03);
+    cv::calcOpticalFlowPyrLK(prev_pyr, pyr, p0, p1, st, err, win, o.lk_levels, term);
+    std::vector<cv::Point2f> back = p0;
+    cv::calcOpticalFlowPyrLK(pyr, prev_pyr, p1, back, st_back, err, win, o.lk_levels, term,
+                             cv::OPTFLOW_USE_INITIAL_FLOW);
+    std::size_t n = 0;
+    const auto inv = static_cast<float>(1.0 / sc);
+    for (std::size_t i = 0; i < p0.size(); ++i) {
+        const float fb = static_cast<float>(cv::norm(back[i] - p0[i])) * inv;
+        const cv::Point2f a = p0[i] * inv, b = p1[i] * inv;
+        if (!st[i] || !st_back[i] || fb > o.fb_max_error || !image.contains(b)) continue;
+        p0[n] = a;
+        p1[n] = b;
+        ++n;
+    }
+    p0.resize(n);
+    p1.resize(n);
+    return f;
+}
 
-    // 2. Carry the boxes with the median flow of their points (prediction for association,
-    //    and the boxes themselves on frames without detection).
-    for (auto& t : im.tracks) {
+void DynamicObjectFilter::Impl::carryBoxes(const PointFlow& f, const cv::Rect2f& image) {
+    for (auto& t : tracks) {
         std::vector<float> dx, dy;
-        for (std::size_t i = 0; i < p0.size(); ++i)
-            if (t.tb.box.contains(p0[i])) {
-                dx.push_back(p1[i].x - p0[i].x);
-                dy.push_back(p1[i].y - p0[i].y);
+        for (std::size_t i = 0; i < f.p0.size(); ++i)
+            if (t.tb.box.contains(f.p0[i])) {
+                dx.push_back(f.p1[i].x - f.p0[i].x);
+                dy.push_back(f.p1[i].y - f.p0[i].y);
             }
         if (dx.size() >= 3) {
             std::nth_element(dx.begin(), dx.begin() + dx.size() / 2, dx.end());
@@ -446,216 +544,219 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
         t.tb.box &= image;
         t.tb.detected_this_frame = false;
     }
+}
 
-    // 3. Detection every k-th frame, greedy IoU association, new tracks.
-    if (im.frame_count % opts_.detect_every == 0) {
-        const auto t_det0 = Clock::now();
-        const auto dets = detector_->detect(frame.bgr);
-        detect_ms = msSince(t_det0);
-        out.detector_ran = true;
-        std::vector<bool> used_det(dets.size(), false), used_trk(im.tracks.size(), false);
-        // Detections scoring under new_track_score only continue tracks (and are
-        // matched after the confident ones): a person the detector grows unsure of (cut
-        // by the image border, half hidden) stays tracked without weak boxes starting
-        // tracks of their own.
-        const auto confident = [&](std::size_t d) {
-            return dets[d].score >= opts_.new_track_score;
-        };
-        struct Pair {
-            bool confident;
-            float iou;
-            std::size_t d, t;
-        };
-        std::vector<Pair> pairs;
-        for (std::size_t d = 0; d < dets.size(); ++d)
-            for (std::size_t t = 0; t < im.tracks.size(); ++t) {
-                const float v = detect::iou(dets[d].box, im.tracks[t].tb.box);
-                if (v >= opts_.iou_match) pairs.push_back({confident(d), v, d, t});
-            }
-        std::sort(pairs.begin(), pairs.end(), [](const Pair& a, const Pair& b) {
-            return std::tie(a.confident, a.iou, b.d, b.t) > std::tie(b.confident, b.iou, a.d, a.t);
-        });
-        for (const auto& p : pairs) {
-            if (used_det[p.d] || used_trk[p.t]) continue;
-            used_det[p.d] = used_trk[p.t] = true;
-            auto& t = im.tracks[p.t];
-            t.tb.box = dets[p.d].box;
-            t.tb.score = dets[p.d].score;
-            t.tb.detected_this_frame = true;
-            t.missed = 0;
+void DynamicObjectFilter::Impl::associate(const std::vector<detect::Detection>& dets,
+                                          const Options& o) {
+    std::vector<bool> used_det(dets.size(), false), used_trk(tracks.size(), false);
+    // Detections scoring under new_track_score only continue tracks (and are matched after
+    // the confident ones): a person the detector grows unsure of (cut by the image border,
+    // half hidden) stays tracked without weak boxes starting tracks of their own.
+    const auto confident = [&](std::size_t d) { return dets[d].score >= o.new_track_score; };
+    struct Pair {
+        bool confident;
+        float iou;
+        std::size_t d, t;
+    };
+    std::vector<Pair> pairs;
+    for (std::size_t d = 0; d < dets.size(); ++d)
+        for (std::size_t t = 0; t < tracks.size(); ++t) {
+            const float v = detect::iou(dets[d].box, tracks[t].tb.box);
+            if (v >= o.iou_match) pairs.push_back({confident(d), v, d, t});
         }
-        for (std::size_t t = 0; t < im.tracks.size(); ++t)
-            if (!used_trk[t]) ++im.tracks[t].missed;
-        // A track whose last step showed motion is kept without detections, carried by
-        // its points' flow: the detector loses walkers cut by the image border, half
-        // hidden or filling the view, and the corners seeded in their box would otherwise
-        // join the background of the next ego-motion fit. Dropped once quiet and unmatched.
-        im.tracks.erase(std::remove_if(im.tracks.begin(), im.tracks.end(),
-                                       [&](const Impl::Track& t) {
-                                           const bool moving_now =
-                                               t.tb.state == BoxState::Moving && t.quiet == 0;
-                                           return t.missed > opts_.max_missed_detections &&
-                                                  !moving_now;
-                                       }),
-                        im.tracks.end());
-        for (std::size_t d = 0; d < dets.size(); ++d) {
-            if (used_det[d] || !confident(d)) continue;
-            Impl::Track t;
-            t.tb.id = im.next_id++;
-            t.tb.box = dets[d].box;
-            t.tb.score = dets[d].score;
-            t.tb.detected_this_frame = true;
-            im.tracks.push_back(t);
+    std::sort(pairs.begin(), pairs.end(), [](const Pair& a, const Pair& b) {
+        return std::tie(a.confident, a.iou, b.d, b.t) > std::tie(b.confident, b.iou, a.d, a.t);
+    });
+    for (const auto& p : pairs) {
+        if (used_det[p.d] || used_trk[p.t]) continue;
+        used_det[p.d] = used_trk[p.t] = true;
+        auto& t = tracks[p.t];
+        t.tb.box = dets[p.d].box;
+        t.tb.score = dets[p.d].score;
+        t.tb.detected_this_frame = true;
+        t.missed = 0;
+    }
+    for (std::size_t t = 0; t < tracks.size(); ++t)
+        if (!used_trk[t]) ++tracks[t].missed;
+    // A track whose last step showed motion is kept without detections, carried by its
+    // points' flow: the detector loses walkers cut by the image border, half hidden or
+    // filling the view, and the corners seeded in their box would otherwise join the
+    // background of the next ego-motion fit. Dropped once quiet and unmatched.
+    tracks.erase(std::remove_if(tracks.begin(), tracks.end(),
+                                [&](const Track& t) {
+                                    const bool moving_now =
+                                        t.tb.state == BoxState::Moving && t.quiet == 0;
+                                    return t.missed > o.max_missed_detections && !moving_now;
+                                }),
+                 tracks.end());
+    for (std::size_t d = 0; d < dets.size(); ++d) {
+        if (used_det[d] || !confident(d)) continue;
+        Track t;
+        t.tb.id = next_id++;
+        t.tb.box = dets[d].box;
+        t.tb.score = dets[d].score;
+        t.tb.detected_this_frame = true;
+        tracks.push_back(t);
+    }
+}
+
+void DynamicObjectFilter::Impl::measureBoxes(const cv::Mat& depth, const Options& o) {
+    tracks.erase(std::remove_if(tracks.begin(), tracks.end(),
+                                [](const Track& t) { return t.tb.box.area() < 16.f; }),
+                 tracks.end());
+    const bool need_depth = o.fg_depth_band > 0 || o.mask_silhouette || o.depth_frames > 0;
+    for (auto& t : tracks)
+        t.depth = need_depth ? personDepth(depth, t.tb.box, o.max_depth) : std::nullopt;
+}
+
+bool DynamicObjectFilter::Impl::nearAnyBox(const cv::Point2f& a, const cv::Point2f& b,
+                                           const Options& o) const {
+    for (const auto& t : tracks) {
+        const float mx = o.mask_margin + 0.2f * t.tb.box.width;
+        const float my = o.mask_margin + 0.2f * t.tb.box.height;
+        const cv::Rect2f grown(t.tb.box.x - mx, t.tb.box.y - my, t.tb.box.width + 2 * mx,
+                               t.tb.box.height + 2 * my);
+        if (grown.contains(a) || grown.contains(b)) return true;
+    }
+    return false;
+}
+
+Eigen::Isometry3d DynamicObjectFilter::Impl::egoMotion(
+    const PointFlow& f, const core::CameraIntrinsics& Kc,
+    const std::optional<Eigen::Isometry3d>& prior, const Options& o, Residuals& r,
+    FilterOutput& out) const {
+    const std::vector<cv::Point2f>& p0 = f.p0;
+    const std::vector<cv::Point2f>& p1 = f.p1;
+    r.X.assign(p0.size(), std::nullopt);
+    std::vector<cv::Point3f> bg_obj;
+    std::vector<cv::Point2f> bg_img;
+    for (std::size_t i = 0; i < p0.size(); ++i) {
+        const auto z = stableDepth(prev_depth, p0[i], o.max_depth);
+        if (!z) continue;
+        r.X[i] = core::backproject(p0[i].x, p0[i].y, *z, prev_K);
+        if (!nearAnyBox(p0[i], p1[i], o)) {
+            bg_obj.emplace_back(static_cast<float>(r.X[i]->x()), static_cast<float>(r.X[i]->y()),
+                                static_cast<float>(r.X[i]->z()));
+            bg_img.push_back(p1[i]);
         }
     }
-    im.tracks.erase(std::remove_if(im.tracks.begin(), im.tracks.end(),
-                                   [](const Impl::Track& t) { return t.tb.box.area() < 16.f; }),
-                    im.tracks.end());
-    // The boxes are final for this step: the person's depth in each, once.
-    const bool need_depth =
-        opts_.fg_depth_band > 0 || opts_.mask_silhouette || opts_.depth_frames > 0;
-    for (auto& t : im.tracks)
-        t.depth = need_depth ? personDepth(frame.depth, t.tb.box, opts_.max_depth) : std::nullopt;
-
-    std::vector<std::optional<Eigen::Vector3d>> X;  // 3D of each point in the previous frame
-    std::vector<cv::Point2f> res_vec;  // residual flow vector of each point (observed - predicted)
-    // depth residual of each point [m]: measured depth at its new position - the depth
-    // ego-motion predicts, less the background's median (NaN: no stable depth)
-    std::vector<float> res_z;
-    // 4. Ego-motion: 3D of each point from the previous depth; relative pose refined with
-    //    PnP-RANSAC on points outside every person box.
-    if (have_prev && !p0.empty()) {
-        const core::CameraIntrinsics& Kp = im.prev_K;
-        const core::CameraIntrinsics& Kc = frame.K;
-        // Background = outside every box grown by mask_margin plus 20% of its size (the
-        // detector's box may lag a walking person's limbs).
-        auto inAnyBox = [&](const cv::Point2f& a, const cv::Point2f& b) {
-            for (const auto& t : im.tracks) {
-                const float mx = opts_.mask_margin + 0.2f * t.tb.box.width;
-                const float my = opts_.mask_margin + 0.2f * t.tb.box.height;
-                const cv::Rect2f grown(t.tb.box.x - mx, t.tb.box.y - my, t.tb.box.width + 2 * mx,
-                                       t.tb.box.height + 2 * my);
-                if (grown.contains(a) || grown.contains(b)) return true;
-            }
-            return false;
-        };
-        X.assign(p0.size(), std::nullopt);
-        std::vector<cv::Point3f> bg_obj;
-        std::vector<cv::Point2f> bg_img;
-        for (std::size_t i = 0; i < p0.size(); ++i) {
-            const auto z = stableDepth(im.prev_depth, p0[i], opts_.max_depth);
-            if (!z) continue;
-            X[i] = core::backproject(p0[i].x, p0[i].y, *z, Kp);
-            if (!inAnyBox(p0[i], p1[i])) {
-                bg_obj.emplace_back(static_cast<float>(X[i]->x()), static_cast<float>(X[i]->y()),
-                                    static_cast<float>(X[i]->z()));
-                bg_img.push_back(p1[i]);
-            }
-        }
-        Eigen::Isometry3d T_prev_cur = T_prev_cur_prior.value_or(Eigen::Isometry3d::Identity());
-        if (opts_.refine_ego_motion &&
-            static_cast<int>(bg_obj.size()) >= opts_.min_background_points) {
-            // solvePnP gives T_cur_prev (x_cur = R x_prev + t).
-            const Eigen::Isometry3d T_cp = T_prev_cur.inverse();
-            cv::Mat R_cv, rvec, tvec;
-            cv::eigen2cv(Eigen::Matrix3d(T_cp.linear()), R_cv);
-            cv::Rodrigues(R_cv, rvec);
-            cv::eigen2cv(Eigen::Vector3d(T_cp.translation()), tvec);
-            cv::Mat K_cv;
-            cv::eigen2cv(Kc.matrix(), K_cv);
-            std::vector<int> inliers;
-            // (OpenCV's RANSAC uses its own fixed-seed RNG: runs are repeatable.)
-            const bool ok =
-                cv::solvePnPRansac(bg_obj, bg_img, K_cv, cv::noArray(), rvec, tvec, true, 100,
-                                   static_cast<float>(opts_.ransac_reprojection), 0.99, inliers,
-                                   cv::SOLVEPNP_ITERATIVE);
-            if (ok && static_cast<int>(inliers.size()) >= opts_.min_background_points &&
-                inliers.size() * 2 >= bg_obj.size() / 2) {
-                cv::Mat R_new;
-                cv::Rodrigues(rvec, R_new);
-                Eigen::Matrix3d R;
-                Eigen::Vector3d t;
-                cv::cv2eigen(R_new, R);
-                cv::cv2eigen(tvec, t);
-                Eigen::Isometry3d T_cp_new = Eigen::Isometry3d::Identity();
-                T_cp_new.linear() = R;
-                T_cp_new.translation() = t;
-                T_prev_cur = T_cp_new.inverse();
-                out.T_prev_cur_refined = T_prev_cur;
-            }
-        }
-        // 5. Residual flow = observed - predicted from ego-motion and depth. The threshold
-        //    adapts to frames where even the background fits badly (rgb/depth time offset,
-        //    motion blur): a point is dynamic above max(threshold1, background_factor *
-        //    90th percentile of the background residuals).
-        const Eigen::Isometry3d T_cur_prev = T_prev_cur.inverse();
-        out.flow.reserve(p0.size());
-        res_vec.assign(p0.size(), cv::Point2f(0.f, 0.f));
-        const bool want_z = opts_.depth_frames > 0;
-        res_z.assign(p0.size(), std::numeric_limits<float>::quiet_NaN());
-        std::vector<float> bg_res, bg_z;
-        for (std::size_t i = 0; i < p0.size(); ++i) {
-            FilterOutput::FlowPoint fp{p0[i], p1[i], -1.f, false, false};
-            if (X[i]) {
-                const Eigen::Vector3d Xc = T_cur_prev * *X[i];
-                if (const auto uv = core::project(Xc, Kc)) {
-                    res_vec[i] = {p1[i].x - static_cast<float>(uv->x()),
-                                  p1[i].y - static_cast<float>(uv->y())};
-                    fp.residual = static_cast<float>(std::hypot(res_vec[i].x, res_vec[i].y));
-                    if (want_z)
-                        if (const auto z = stableDepth(frame.depth, p1[i], opts_.max_depth))
-                            res_z[i] = *z - static_cast<float>(Xc.z());
-                }
-            }
-            if (fp.residual >= 0.f && !inAnyBox(p0[i], p1[i])) {
-                bg_res.push_back(fp.residual);
-                if (!std::isnan(res_z[i])) bg_z.push_back(res_z[i]);
-            }
-            out.flow.push_back(fp);
-        }
-        // An ego-motion error along the optical axis shifts every depth residual alike.
-        if (bg_z.size() >= static_cast<std::size_t>(opts_.min_background_points)) {
-            const auto k = bg_z.begin() + static_cast<std::ptrdiff_t>(bg_z.size() / 2);
-            std::nth_element(bg_z.begin(), k, bg_z.end());
-            for (auto& z : res_z) z -= *k;
-        }
-        double thr = opts_.threshold1;
-        if (bg_res.size() >= static_cast<std::size_t>(opts_.min_background_points)) {
-            const auto k = bg_res.begin() + static_cast<std::ptrdiff_t>(bg_res.size() * 9 / 10);
-            std::nth_element(bg_res.begin(), k, bg_res.end());
-            thr = std::max(thr, opts_.background_factor * static_cast<double>(*k));
-        }
-        out.threshold = thr;
-        for (auto& fp : out.flow) fp.dynamic = fp.residual > thr;
+    Eigen::Isometry3d T_prev_cur = prior.value_or(Eigen::Isometry3d::Identity());
+    if (!o.refine_ego_motion || static_cast<int>(bg_obj.size()) < o.min_background_points)
+        return T_prev_cur;
+    // solvePnP gives T_cur_prev (x_cur = R x_prev + t).
+    const Eigen::Isometry3d T_cp = T_prev_cur.inverse();
+    cv::Mat R_cv, rvec, tvec;
+    cv::eigen2cv(Eigen::Matrix3d(T_cp.linear()), R_cv);
+    cv::Rodrigues(R_cv, rvec);
+    cv::eigen2cv(Eigen::Vector3d(T_cp.translation()), tvec);
+    cv::Mat K_cv;
+    cv::eigen2cv(Kc.matrix(), K_cv);
+    std::vector<int> inliers;
+    // (OpenCV's RANSAC uses its own fixed-seed RNG: runs are repeatable.)
+    const bool ok = cv::solvePnPRansac(bg_obj, bg_img, K_cv, cv::noArray(), rvec, tvec, true,
+                                       100, static_cast<float>(o.ransac_reprojection), 0.99,
+                                       inliers, cv::SOLVEPNP_ITERATIVE);
+    if (ok && static_cast<int>(inliers.size()) >= o.min_background_points &&
+        inliers.size() * 2 >= bg_obj.size() / 2) {
+        cv::Mat R_new;
+        cv::Rodrigues(rvec, R_new);
+        Eigen::Matrix3d R;
+        Eigen::Vector3d t;
+        cv::cv2eigen(R_new, R);
+        cv::cv2eigen(tvec, t);
+        Eigen::Isometry3d T_cp_new = Eigen::Isometry3d::Identity();
+        T_cp_new.linear() = R;
+        T_cp_new.translation() = t;
+        T_prev_cur = T_cp_new.inverse();
+        out.T_prev_cur_refined = T_prev_cur;
     }
+    return T_prev_cur;
+}
 
-    // 6. Per-box evidence (Algorithm 1 with residual flow) and hysteresis.
-    for (auto& t : im.tracks) {
-        const cv::Rect2f inner = shrink(t.tb.box, opts_.box_shrink);
-        // Local threshold: the residuals of the static surroundings (a ring from 20% to 70%
-        // of the box size around it, outside every box) say how well ego-motion fits there
-        // (depth errors of near objects, rgb/depth time offset, rolling shutter).
-        double local_thr = out.threshold;
-        if (opts_.background_factor > 0) {
-            auto grow = [&](float f) {
-                return cv::Rect2f(t.tb.box.x - f * t.tb.box.width, t.tb.box.y - f * t.tb.box.height,
-                                  t.tb.box.width * (1 + 2 * f), t.tb.box.height * (1 + 2 * f));
-            };
-            const cv::Rect2f near = grow(0.2f), far = grow(0.7f);
-            std::vector<float> ring;
-            for (const auto& fp : out.flow) {
-                if (fp.residual < 0.f || !far.contains(fp.cur) || near.contains(fp.cur)) continue;
-                bool in_other = false;
-                for (const auto& o : im.tracks) in_other |= o.tb.box.contains(fp.cur);
-                if (!in_other) ring.push_back(fp.residual);
-            }
-            if (ring.size() >= 8) {
-                const auto k = ring.begin() + static_cast<std::ptrdiff_t>(ring.size() * 3 / 4);
-                std::nth_element(ring.begin(), k, ring.end());
-                local_thr = std::max(local_thr, opts_.background_factor * static_cast<double>(*k));
+void DynamicObjectFilter::Impl::residualFlow(const core::Frame& frame, const PointFlow& f,
+                                             const Eigen::Isometry3d& T_prev_cur,
+                                             const Options& o, Residuals& r,
+                                             FilterOutput& out) const {
+    // The threshold adapts to frames where even the background fits badly (rgb/depth time
+    // offset, motion blur): a point is dynamic above max(threshold1, background_factor *
+    // 90th percentile of the background residuals).
+    const std::vector<cv::Point2f>& p0 = f.p0;
+    const std::vector<cv::Point2f>& p1 = f.p1;
+    const core::CameraIntrinsics& Kc = frame.K;
+    const Eigen::Isometry3d T_cur_prev = T_prev_cur.inverse();
+    out.flow.reserve(p0.size());
+    r.vec.assign(p0.size(), cv::Point2f(0.f, 0.f));
+    const bool want_z = o.depth_frames > 0;
+    r.z.assign(p0.size(), std::numeric_limits<float>::quiet_NaN());
+    std::vector<float> bg_res, bg_z;
+    for (std::size_t i = 0; i < p0.size(); ++i) {
+        FilterOutput::FlowPoint fp{p0[i], p1[i], -1.f, false, false};
+        if (r.X[i]) {
+            const Eigen::Vector3d Xc = T_cur_prev * *r.X[i];
+            if (const auto uv = core::project(Xc, Kc)) {
+                r.vec[i] = {p1[i].x - static_cast<float>(uv->x()),
+                            p1[i].y - static_cast<float>(uv->y())};
+                fp.residual = static_cast<float>(std::hypot(r.vec[i].x, r.vec[i].y));
+                if (want_z)
+                    if (const auto z = stableDepth(frame.depth, p1[i], o.max_depth))
+                        r.z[i] = *z - static_cast<float>(Xc.z());
             }
         }
-        const bool use_band = opts_.fg_depth_band > 0 && t.depth.has_value();
+        if (fp.residual >= 0.f && !nearAnyBox(p0[i], p1[i], o)) {
+            bg_res.push_back(fp.residual);
+            if (!std::isnan(r.z[i])) bg_z.push_back(r.z[i]);
+        }
+        out.flow.push_back(fp);
+    }
+    // An ego-motion error along the optical axis shifts every depth residual alike.
+    if (bg_z.size() >= static_cast<std::size_t>(o.min_background_points)) {
+        const auto k = bg_z.begin() + static_cast<std::ptrdiff_t>(bg_z.size() / 2);
+        std::nth_element(bg_z.begin(), k, bg_z.end());
+        for (auto& z : r.z) z -= *k;
+    }
+    double thr = o.threshold1;
+    if (bg_res.size() >= static_cast<std::size_t>(o.min_background_points)) {
+        const auto k = bg_res.begin() + static_cast<std::ptrdiff_t>(bg_res.size() * 9 / 10);
+        std::nth_element(bg_res.begin(), k, bg_res.end());
+        thr = std::max(thr, o.background_factor * static_cast<double>(*k));
+    }
+    out.threshold = thr;
+    for (auto& fp : out.flow) fp.dynamic = fp.residual > thr;
+}
+
+double DynamicObjectFilter::Impl::localThreshold(const cv::Rect2f& box, const FilterOutput& out,
+                                                 const Options& o) const {
+    // The residuals of the static surroundings (a ring from 20% to 70% of the box size
+    // around it, outside every box) say how well ego-motion fits there (depth errors of
+    // near objects, rgb/depth time offset, rolling shutter).
+    double local_thr = out.threshold;
+    if (o.background_factor <= 0) return local_thr;
+    auto grow = [&](float f) {
+        return cv::Rect2f(box.x - f * box.width, box.y - f * box.height, box.width * (1 + 2 * f),
+                          box.height * (1 + 2 * f));
+    };
+    const cv::Rect2f near = grow(0.2f), far = grow(0.7f);
+    std::vector<float> ring;
+    for (const auto& fp : out.flow) {
+        if (fp.residual < 0.f || !far.contains(fp.cur) || near.contains(fp.cur)) continue;
+        bool in_other = false;
+        for (const auto& t : tracks) in_other |= t.tb.box.contains(fp.cur);
+        if (!in_other) ring.push_back(fp.residual);
+    }
+    if (ring.size() >= 8) {
+        const auto k = ring.begin() + static_cast<std::ptrdiff_t>(ring.size() * 3 / 4);
+        std::nth_element(ring.begin(), k, ring.end());
+        local_thr = std::max(local_thr, o.background_factor * static_cast<double>(*k));
+    }
+    return local_thr;
+}
+
+void DynamicObjectFilter::Impl::classifyBoxes(const Residuals& r, const cv::Size& size,
+                                              const Options& o, FilterOutput& out) {
+    for (auto& t : tracks) {
+        const cv::Rect2f inner = shrink(t.tb.box, o.box_shrink);
+        const double local_thr = localThreshold(t.tb.box, out, o);
+        const bool use_band = o.fg_depth_band > 0 && t.depth.has_value();
         const float zp = t.depth.value_or(0.f);
         int n = 0, n_dyn = 0;
         std::vector<float> rx, ry;  // residual vectors of the box's points (slow walkers)
@@ -663,40 +764,40 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
         for (std::size_t i = 0; i < out.flow.size(); ++i) {
             auto& fp = out.flow[i];
             if (fp.residual < 0.f || !inner.contains(fp.cur)) continue;
-            // (a point with a residual has a depth: X[i] is set)
-            if (use_band && std::abs(static_cast<float>(X[i]->z()) - zp) >
-                                depthBand(opts_.fg_depth_band, zp))
+            // (a point with a residual has a depth: r.X[i] is set)
+            if (use_band &&
+                std::abs(static_cast<float>(r.X[i]->z()) - zp) > depthBand(o.fg_depth_band, zp))
                 continue;  // background or foreground clutter seen inside the box
             fp.in_box = true;
             fp.dynamic = fp.residual > local_thr;
             ++n;
             if (fp.dynamic) ++n_dyn;
-            if (opts_.slow_frames > 0) {
-                rx.push_back(res_vec[i].x);
-                ry.push_back(res_vec[i].y);
+            if (o.slow_frames > 0) {
+                rx.push_back(r.vec[i].x);
+                ry.push_back(r.vec[i].y);
             }
-            if (!res_z.empty() && !std::isnan(res_z[i])) rz.push_back(res_z[i]);
+            if (!r.z.empty() && !std::isnan(r.z[i])) rz.push_back(r.z[i]);
         }
         t.tb.n_points = n;
         t.tb.n_dynamic_points = n_dyn;
-        if (n < opts_.min_points) {  // no evidence: keep the state
+        if (n < o.min_points) {  // no evidence: keep the state
             // and no detection either: unseen, unless the box reaches the image's left or
             // right border, where walkers leave and come back, and where one cut by the
             // border is often both undetected and without points (the bottom border cuts
             // every near person's box, so it does not count)
-            const auto m = static_cast<float>(opts_.mask_margin);
+            const auto m = static_cast<float>(o.mask_margin);
             const bool at_border =
                 t.tb.box.x <= m || t.tb.box.br().x >= static_cast<float>(size.width) - m;
-            if (t.missed > 0 && !(opts_.keep_border_tracks && at_border))
+            if (t.missed > 0 && !(o.keep_border_tracks && at_border))
                 ++t.unseen;
             else
                 t.unseen = 0;
             continue;
         }
         t.unseen = 0;
-        bool moving = n_dyn >= opts_.threshold2_count &&
-                      n_dyn >= opts_.threshold2_fraction * static_cast<double>(n);
-        if (opts_.slow_frames > 0) {
+        bool moving = n_dyn >= o.threshold2_count &&
+                      n_dyn >= o.threshold2_fraction * static_cast<double>(n);
+        if (o.slow_frames > 0) {
             // Slow walkers: the mean of the box's per-step median residual vectors. A
             // walker who stops keeps it above the threshold for up to slow_frames - 1
             // steps, which delay the release by as many.
@@ -704,66 +805,72 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
             std::nth_element(rx.begin(), rx.begin() + static_cast<std::ptrdiff_t>(mid), rx.end());
             std::nth_element(ry.begin(), ry.begin() + static_cast<std::ptrdiff_t>(mid), ry.end());
             t.slow_history.emplace_back(rx[mid], ry[mid]);
-            if (t.slow_history.size() > static_cast<std::size_t>(opts_.slow_frames))
+            if (t.slow_history.size() > static_cast<std::size_t>(o.slow_frames))
                 t.slow_history.pop_front();
-            if (t.slow_history.size() == static_cast<std::size_t>(opts_.slow_frames)) {
+            if (t.slow_history.size() == static_cast<std::size_t>(o.slow_frames)) {
                 cv::Point2f sum(0.f, 0.f);
-                for (const auto& r : t.slow_history) sum += r;
-                const double mean = cv::norm(sum) / opts_.slow_frames;
-                moving |= mean > std::max(opts_.slow_threshold, 0.5 * local_thr);
+                for (const auto& v : t.slow_history) sum += v;
+                const double mean = cv::norm(sum) / o.slow_frames;
+                moving |= mean > std::max(o.slow_threshold, 0.5 * local_thr);
             }
         }
-        if (opts_.depth_frames > 0) {
+        if (o.depth_frames > 0) {
             // A step whose box has too few points with depth adds no sample (the window
             // then spans more steps).
-            if (rz.size() >= static_cast<std::size_t>(opts_.min_points)) {
+            if (rz.size() >= static_cast<std::size_t>(o.min_points)) {
                 const auto mid = rz.begin() + static_cast<std::ptrdiff_t>(rz.size() / 2);
                 std::nth_element(rz.begin(), mid, rz.end());
                 t.depth_history.push_back(*mid);
-                if (t.depth_history.size() > static_cast<std::size_t>(opts_.depth_frames))
+                if (t.depth_history.size() > static_cast<std::size_t>(o.depth_frames))
                     t.depth_history.pop_front();
             }
-            if (t.depth_history.size() == static_cast<std::size_t>(opts_.depth_frames) && t.depth) {
+            if (t.depth_history.size() == static_cast<std::size_t>(o.depth_frames) && t.depth) {
                 double sum = 0;
                 for (const float z : t.depth_history) sum += z;
                 const double z = *t.depth;
-                moving |= std::abs(sum) > std::max(opts_.depth_rate_threshold * opts_.depth_frames,
-                                                   opts_.depth_noise_z2 * z * z);
+                moving |= std::abs(sum) > std::max(o.depth_rate_threshold * o.depth_frames,
+                                                   o.depth_noise_z2 * z * z);
             }
         }
         if (moving) {
             t.tb.state = BoxState::Moving;  // caught at once
             t.quiet = 0;
         } else if (t.tb.state == BoxState::Moving) {
-            if (++t.quiet >= opts_.release_frames) t.tb.state = BoxState::Static;
+            if (++t.quiet >= o.release_frames) t.tb.state = BoxState::Static;
         } else {
             t.tb.state = BoxState::Static;
         }
     }
+}
 
+void DynamicObjectFilter::Impl::forgetUnseen(const Options& o) {
     // A track nothing has shown for forget_unseen_frames steps is gone for good; before
     // that, from hide_unseen_frames on, it is kept out of the boxes and the mask but
     // remembered, so that a walker who comes back (through the border they left by, from
     // behind someone) is matched and masked at once instead of collecting evidence anew.
-    if (opts_.hide_unseen_frames > 0)
-        im.tracks.erase(std::remove_if(im.tracks.begin(), im.tracks.end(),
-                                       [&](const Impl::Track& t) {
-                                           return t.unseen > opts_.forget_unseen_frames;
-                                       }),
-                        im.tracks.end());
+    if (o.hide_unseen_frames > 0)
+        tracks.erase(std::remove_if(tracks.begin(), tracks.end(),
+                                    [&](const Track& t) {
+                                        return t.unseen > o.forget_unseen_frames;
+                                    }),
+                     tracks.end());
+}
 
-    // 7. Mask: whole boxes, dilated by the margin. On a frame with no previous one every
-    //    box is Unknown, walkers and sitters alike: masking them all there would be
-    //    all_persons for that frame (mask_unknown_first_frame).
-    const bool mask_unknown = opts_.mask_unknown && (have_prev || opts_.mask_unknown_first_frame);
-    for (const auto& t : im.tracks) {
-        if (t.hidden(opts_)) continue;
+void DynamicObjectFilter::Impl::drawMask(const core::Frame& frame, bool have_prev,
+                                         const Options& o, FilterOutput& out) const {
+    // Whole boxes, dilated by the margin. On a frame with no previous one every box is
+    // Unknown, walkers and sitters alike: masking them all there would be all_persons for
+    // that frame (mask_unknown_first_frame).
+    const cv::Size size = frame.bgr.size();
+    const bool mask_unknown = o.mask_unknown && (have_prev || o.mask_unknown_first_frame);
+    for (const auto& t : tracks) {
+        if (t.hidden(o)) continue;
         out.boxes.push_back(t.tb);
-        const bool masked = opts_.mode == MaskMode::AllPersons || t.tb.state == BoxState::Moving ||
+        const bool masked = o.mode == MaskMode::AllPersons || t.tb.state == BoxState::Moving ||
                             (mask_unknown && t.tb.state == BoxState::Unknown);
         if (!masked) continue;
-        const auto m = static_cast<float>(opts_.mask_margin);
-        const auto snap = static_cast<float>(opts_.mask_border_snap);
+        const auto m = static_cast<float>(o.mask_margin);
+        const auto snap = static_cast<float>(o.mask_border_snap);
         const auto W = static_cast<float>(size.width), H = static_cast<float>(size.height);
         float x0 = t.tb.box.x - m, y0 = t.tb.box.y - m;
         float x1 = t.tb.box.br().x + m, y1 = t.tb.box.br().y + m;
@@ -771,18 +878,17 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
         if (y0 < snap) y0 = 0.f;
         if (x1 > W - snap) x1 = W;
         if (y1 > H - snap) y1 = H;
-        const cv::Rect r =
-            cv::Rect(cv::Rect2f(x0, y0, x1 - x0, y1 - y0)) & cv::Rect({}, size);
-        if (!opts_.mask_silhouette || !t.depth) {
+        const cv::Rect r = cv::Rect(cv::Rect2f(x0, y0, x1 - x0, y1 - y0)) & cv::Rect({}, size);
+        if (!o.mask_silhouette || !t.depth) {
             out.mask(r).setTo(255);
             continue;
         }
         // Silhouette: the box's pixels in the person's depth band or without depth (the
         // holes along a person's outline), dilated by the margin.
         const float zp = *t.depth;
-        const double band = opts_.silhouette_depth_band > 0 ? opts_.silhouette_depth_band
-                            : opts_.fg_depth_band > 0       ? opts_.fg_depth_band
-                                                            : 0.5;
+        const double band = o.silhouette_depth_band > 0 ? o.silhouette_depth_band
+                            : o.fg_depth_band > 0       ? o.fg_depth_band
+                                                        : 0.5;
         const float h = depthBand(band, zp);
         const cv::Rect inner = cv::Rect(t.tb.box) & cv::Rect({}, size);
         if (inner.empty()) continue;
@@ -792,22 +898,20 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
         sil |= holes;
         cv::Mat big = cv::Mat::zeros(r.size(), CV_8UC1);
         sil.copyTo(big(inner - r.tl()));
-        if (opts_.mask_margin > 0)
+        if (o.mask_margin > 0)
             cv::dilate(big, big,
-                       cv::getStructuringElement(cv::MORPH_RECT,
-                                                 cv::Size(2 * opts_.mask_margin + 1,
-                                                          2 * opts_.mask_margin + 1)));
+                       cv::getStructuringElement(
+                           cv::MORPH_RECT, cv::Size(2 * o.mask_margin + 1, 2 * o.mask_margin + 1)));
         out.mask(r) |= big;
     }
+}
 
-    std::swap(im.prev_work, im.work);
-    std::swap(im.prev_pyr, im.pyr);
-    frame.depth.copyTo(im.prev_depth);
-    im.prev_K = frame.K;
-    ++im.frame_count;
-    out.detect_ms = detect_ms;
-    out.filter_ms = msSince(t_filter0) - detect_ms;
-    return out;
+void DynamicObjectFilter::Impl::endStep(const core::Frame& frame) {
+    std::swap(prev_work, work);
+    std::swap(prev_pyr, pyr);
+    frame.depth.copyTo(prev_depth);
+    prev_K = frame.K;
+    ++frame_count;
 }
 
 std::unique_ptr<DynamicObjectFilter> makeFilterFromConfig(const mrpt::config::CConfigFileBase& cfg,
