@@ -22,8 +22,10 @@
 #include <cstdio>
 #include <ctime>
 #include <iostream>
+#include <iterator>
 #include <sstream>
 #include <string>
+#include <tuple>
 
 using namespace devslam;
 
@@ -59,6 +61,26 @@ auto withThreads(int n, F&& f) {
     } restore{before};
     return f();
 }
+
+/// The filter's per-stage times (FilterOutput::stage_ms) over many steps.
+struct StageSamples {
+    static constexpr const char* kNames[] = {
+        "images: grey, scaling, LK pyramid, kept for the next step",
+        "corners: Shi-Tomasi map and selection",
+        "flow: pyramidal LK, forward and back",
+        "boxes: carrying, association, person depths",
+        "ego-motion: 3D points, PnP-RANSAC",
+        "residual flow and threshold",
+        "per-box evidence and states",
+        "mask"};
+    std::vector<double> ms[std::size(kNames)];
+    void add(const dynamic::FilterOutput::StageTimes& t) {
+        const double v[] = {t.images,     t.corners,   t.flow,     t.boxes,
+                            t.ego_motion, t.residuals, t.evidence, t.mask};
+        static_assert(std::size(v) == std::size(kNames));
+        for (std::size_t i = 0; i < std::size(v); ++i) ms[i].push_back(v[i]);
+    }
+};
 
 /// Detector that returns the true box (times the filter alone on synthetic data).
 class TruthDetector : public detect::PersonDetector {
@@ -223,6 +245,7 @@ int main(int argc, char** argv) {
         dynamic::DynamicObjectFilter::Options fo;
         fo.loadFromConfig(*cfg);
 
+        StageSamples stages_synthetic, stages_tum;
         md << "\n| filter stage (detector excluded) | sequence | median ms | mean ms | median "
               "thread-CPU ms | frames | median ms, "
            << all_threads << " OpenCV threads |\n|---|---|---|---|---|---|---|\n";
@@ -231,6 +254,7 @@ int main(int argc, char** argv) {
             // since single 29-step medians moved by +-25 % between runs on this VM.
             auto passes = [&] {
                 std::vector<double> ms, cpu;
+                StageSamples stages;
                 for (int pass = 0; pass < 5; ++pass) {
                     auto det = std::make_unique<TruthDetector>();
                     TruthDetector* truth = det.get();
@@ -242,12 +266,14 @@ int main(int argc, char** argv) {
                         if (s.frame.index == 0) continue;
                         cpu.push_back(threadCpuMs() - c0);
                         ms.push_back(out.filter_ms);
+                        stages.add(out.stage_ms);
                     }
                 }
-                return std::pair{ms, cpu};
+                return std::tuple{ms, cpu, stages};
             };
-            const auto [ms, cpu] = passes();
-            const auto ms_all = withThreads(all_threads, passes).first;
+            const auto [ms, cpu, stages] = passes();
+            stages_synthetic = stages;
+            const auto ms_all = std::get<0>(withThreads(all_threads, passes));
             const auto st = core::summarize(ms);
             md << "| DynamicObjectFilter::step | synthetic walking person (true box) | "
                << fmt(st.median, 2) << " | " << fmt(st.mean, 2) << " | "
@@ -257,22 +283,34 @@ int main(int argc, char** argv) {
         {
             auto passes = [&] {
                 std::vector<double> ms;
+                StageSamples stages;
                 for (int pass = 0; pass < 5; ++pass) {
                     auto filter = dynamic::makeFilterFromConfig(*cfg);
                     for (const auto& f : tum) {
                         const auto out = filter->step(f, std::nullopt);
-                        if (f.index > 0) ms.push_back(out.filter_ms);
+                        if (f.index == 0) continue;
+                        ms.push_back(out.filter_ms);
+                        stages.add(out.stage_ms);
                     }
                 }
-                return ms;
+                return std::pair{ms, stages};
             };
-            const auto ms = passes();
-            const auto ms_all = withThreads(all_threads, passes);
+            const auto [ms, stages] = passes();
+            stages_tum = stages;
+            const auto ms_all = withThreads(all_threads, passes).first;
             const auto st = core::summarize(ms);
             md << "| DynamicObjectFilter::step | fr1_xyz_first37 (YOLO; one seated person, frames 0-3) | "
                << fmt(st.median, 2) << " | " << fmt(st.mean, 2) << " | - | " << ms.size() << " | "
                << fmt(core::median(ms_all), 2) << " |\n";
         }
+
+        md << "\n**Where the filter's time goes** (its stages, `FilterOutput::stage_ms`; "
+              "medians over the one-thread steps above):\n\n"
+              "| stage | synthetic walking person, ms | fr1_xyz_first37, ms |\n|---|---|---|\n";
+        for (std::size_t i = 0; i < std::size(StageSamples::kNames); ++i)
+            md << "| " << StageSamples::kNames[i] << " | "
+               << fmt(core::median(stages_synthetic.ms[i]), 3) << " | "
+               << fmt(core::median(stages_tum.ms[i]), 3) << " |\n";
 
         {
             // The filter's corner map, timed against what it replaces: the three ways are

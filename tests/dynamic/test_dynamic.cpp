@@ -288,6 +288,43 @@ TEST(DynamicFilter, FrameOfAnotherSizeStartsAfresh) {
     }
 }
 
+TEST(DynamicFilter, StageTimesAddUpToTheFilterTime) {
+    // stage_ms splits filter_ms (the detector excluded) into the stages devslam-filter-bench
+    // reports: they cover the step without overlap, and a first frame has no corners or
+    // flow to time.
+    dynamic::SyntheticOptions so;
+    so.person = dynamic::PersonMotion::Walking;
+    so.n_frames = kFrames;
+    const auto& seq = sequence(so);
+    auto det = std::make_unique<ScriptedDetector>();
+    ScriptedDetector* scripted = det.get();
+    DynamicObjectFilter filter(testOptions(), std::move(det));
+    for (std::size_t i = 0; i < 5; ++i) {
+        ASSERT_TRUE(seq[i].person_box.has_value()) << "frame " << i;
+        scripted->next = {{*seq[i].person_box, 0, "person", 0.9f}};
+        const auto out = filter.step(seq[i].frame, seq[i].T_prev_cur);
+        const auto& t = out.stage_ms;
+        const double stages[] = {t.images,     t.corners,   t.flow,     t.boxes,
+                                 t.ego_motion, t.residuals, t.evidence, t.mask};
+        double sum = 0;
+        for (const double ms : stages) {
+            EXPECT_GE(ms, 0.0) << "frame " << i;
+            sum += ms;
+        }
+        EXPECT_TRUE(out.detector_ran);
+        EXPECT_LE(sum, out.filter_ms + 1e-6) << "frame " << i;  // the detector is not in it
+        EXPECT_GE(sum, 0.5 * out.filter_ms) << "frame " << i;
+        if (i == 0) {
+            EXPECT_EQ(t.corners, 0.0);
+            EXPECT_EQ(t.flow, 0.0);
+            EXPECT_EQ(t.ego_motion, 0.0);
+        } else {
+            EXPECT_GT(t.corners, 0.0) << "frame " << i;
+            EXPECT_GT(t.flow, 0.0) << "frame " << i;
+        }
+    }
+}
+
 TEST(DynamicFilter, ModesAndMask) {
     dynamic::SyntheticOptions so;
     so.person = dynamic::PersonMotion::Static;

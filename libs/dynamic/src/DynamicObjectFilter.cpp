@@ -347,7 +347,8 @@ struct DynamicObjectFilter::Impl {
     bool prepareImages(const core::Frame& frame, const Options& o);
     /// 1. Flow of the previous frame's Shi-Tomasi corners: over the whole image, and more
     ///    inside each box, on the person's depth band when known.
-    PointFlow trackCorners(const Options& o, const cv::Rect2f& image);
+    PointFlow trackCorners(const Options& o, const cv::Rect2f& image,
+                           FilterOutput::StageTimes& times);
     /// 2. Carries each box with the median flow of its points (the prediction for the
     ///    association, and the box itself on frames without detection).
     void carryBoxes(const PointFlow& f, const cv::Rect2f& image);
@@ -418,28 +419,44 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
     const cv::Rect2f image(0.f, 0.f, static_cast<float>(size.width),
                            static_cast<float>(size.height));
 
+    FilterOutput::StageTimes& times = out.stage_ms;
+    auto t_stage = Clock::now();
+    const auto lap = [&t_stage](double& ms) {  // the time since the last lap, into ms
+        const auto now = Clock::now();
+        ms += std::chrono::duration<double, std::milli>(now - t_stage).count();
+        t_stage = now;
+    };
+
     const bool have_prev = im.prepareImages(frame, opts_);
+    lap(times.images);
     PointFlow flow;
-    if (have_prev) flow = im.trackCorners(opts_, image);
+    if (have_prev) flow = im.trackCorners(opts_, image, times);
+    t_stage = Clock::now();
     im.carryBoxes(flow, image);
     if (im.frame_count % opts_.detect_every == 0) {
-        const auto t_det0 = Clock::now();
+        lap(times.boxes);
         const auto dets = detector_->detect(frame.bgr);
-        detect_ms = msSince(t_det0);
+        lap(detect_ms);
         out.detector_ran = true;
         im.associate(dets, opts_);
     }
     im.measureBoxes(frame.depth, opts_);  // the boxes are final for this step
+    lap(times.boxes);
     Residuals res;
     if (have_prev && !flow.p0.empty()) {
         const Eigen::Isometry3d T_prev_cur =
             im.egoMotion(flow, frame.K, T_prev_cur_prior, opts_, res, out);
+        lap(times.ego_motion);
         im.residualFlow(frame, flow, T_prev_cur, opts_, res, out);
+        lap(times.residuals);
     }
     im.classifyBoxes(res, size, opts_, out);
     im.forgetUnseen(opts_);
+    lap(times.evidence);
     im.drawMask(frame, have_prev, opts_, out);
+    lap(times.mask);
     im.endStep(frame);
+    lap(times.images);
 
     out.detect_ms = detect_ms;
     out.filter_ms = msSince(t_filter0) - detect_ms;
@@ -467,7 +484,9 @@ bool DynamicObjectFilter::Impl::prepareImages(const core::Frame& frame, const Op
            prev_depth.size() == frame.bgr.size();
 }
 
-PointFlow DynamicObjectFilter::Impl::trackCorners(const Options& o, const cv::Rect2f& image) {
+PointFlow DynamicObjectFilter::Impl::trackCorners(const Options& o, const cv::Rect2f& image,
+                                                  FilterOutput::StageTimes& times) {
+    const auto t0 = Clock::now();
     const double sc = o.flow_scale;
     PointFlow f;
     std::vector<cv::Point2f>& p0 = f.p0;
@@ -503,6 +522,8 @@ PointFlow DynamicObjectFilter::Impl::trackCorners(const Options& o, const cv::Re
             p0.insert(p0.end(), pts.begin(), pts.end());
         }
     }
+    const auto t1 = Clock::now();
+    times.corners = std::chrono::duration<double, std::milli>(t1 - t0).count();
     if (p0.empty()) return f;
     const cv::Size win(o.lk_window, o.lk_window);
     std::vector<uchar> st, st_back;
@@ -524,6 +545,7 @@ PointFlow DynamicObjectFilter::Impl::trackCorners(const Options& o, const cv::Re
     }
     p0.resize(n);
     p1.resize(n);
+    times.flow = msSince(t1);
     return f;
 }
 

@@ -59,6 +59,18 @@ struct FilterOutput {
     std::vector<TrackedBox> boxes;
     bool detector_ran = false;
     double detect_ms = 0, filter_ms = 0;  ///< [ms] wall time of this step's stages
+    /// [ms] wall time of the filter's own stages this step (together about filter_ms), in
+    /// the order they run; devslam-filter-bench reports their medians
+    struct StageTimes {
+        double images = 0;      ///< grey image, scaling, LK pyramid; kept for the next step
+        double corners = 0;     ///< Shi-Tomasi map of the previous frame, corner selection
+        double flow = 0;        ///< pyramidal LK, forward and back
+        double boxes = 0;       ///< carrying, association (the detector excluded), depths
+        double ego_motion = 0;  ///< 3D of the points, PnP-RANSAC on the background
+        double residuals = 0;   ///< residual flow and the image-wide threshold
+        double evidence = 0;    ///< per-box evidence, states, forgetting
+        double mask = 0;        ///< reported boxes and the mask
+    } stage_ms;
     /// Ego-motion refined on background points (p_prev = T * p_cur), if computed.
     std::optional<Eigen::Isometry3d> T_prev_cur_refined;
 
