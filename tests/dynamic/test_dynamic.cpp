@@ -74,7 +74,8 @@ const std::vector<dynamic::SyntheticFrame>& sequence(const dynamic::SyntheticOpt
     static std::map<std::string, std::vector<dynamic::SyntheticFrame>> cache;
     std::ostringstream k;  // every option a test changes
     k << static_cast<int>(so.person) << "/" << so.person_x0 << "/" << so.n_frames << "/"
-      << so.person_speed << "/" << so.person_depth << "/" << so.person_direction.transpose() << "/"
+      << so.person_speed << "/" << so.person_depth << "/" << so.person_height << "/"
+      << so.person_direction.transpose() << "/"
       << so.cam_velocity.transpose() << "/" << so.cam_rate_deg.transpose();
     const std::string key = k.str();
     auto it = cache.find(key);
@@ -672,6 +673,45 @@ TEST(DynamicFilter, SlowWalkerIsCaughtByItsMeanResidualFlow) {
     EXPECT_LE(a.moving, a.frames / 3) << "the walker is too fast for this test";
     // the mean needs slow_frames steps with evidence (the first has no flow)
     EXPECT_GE(b.moving, b.frames - slow.slow_frames);
+}
+
+TEST(DynamicFilter, SlowMoverThresholdIsASpeedNearTheCamera) {
+    // slow_speed: the slow-mover test's threshold is also a speed. A person 1.2 m from the
+    // camera leaning sideways at 0.07 m/s (a seated person's sway) moves just over the
+    // pixel threshold (1 px a frame), so the pixel test alone flags them; at 0.15 m/s the
+    // threshold there is 2.2 px a frame. The slow walker of the test above (0.2 m/s at
+    // 2.2 m, 1.6 px a frame) is still caught. (At 0.1 m/s the near person's points pass
+    // threshold1 themselves: per-frame evidence, which slow_speed does not change.)
+    auto px_only = testOptions();
+    px_only.slow_frames = 5;
+    px_only.slow_speed = 0;
+    auto speed = px_only;
+    speed.slow_speed = 0.15;
+
+    dynamic::SyntheticOptions near;
+    near.person = dynamic::PersonMotion::Walking;
+    near.person_speed = 0.07;
+    near.person_depth = 1.2;
+    near.person_height = 0.9;  // head and torso: the whole person stays in view
+    near.person_x0 = -0.15;
+    near.n_frames = kFrames;
+    const RunStats a = runSynthetic(near, px_only, true);
+    const RunStats b = runSynthetic(near, speed, true);
+    std::printf("0.07 m/s at 1.2 m: moving in %d/%d frames (pixel threshold), %d/%d "
+                "(slow_speed 0.15)\n",
+                a.moving, a.frames, b.moving, b.frames);
+    EXPECT_GE(a.moving, a.frames - px_only.slow_frames - 2) << "the pixel test should flag them";
+    EXPECT_LE(b.moving, b.frames / 5);
+
+    dynamic::SyntheticOptions far;
+    far.person = dynamic::PersonMotion::Walking;
+    far.person_speed = 0.2;
+    far.person_x0 = -0.3;
+    far.n_frames = kFrames;
+    const RunStats c = runSynthetic(far, speed, true);
+    std::printf("0.2 m/s at 2.2 m: moving in %d/%d frames (slow_speed 0.15)\n", c.moving,
+                c.frames);
+    EXPECT_GE(c.moving, c.frames - speed.slow_frames);
 }
 
 TEST(DynamicFilter, PersonWalkingTowardsTheCameraIsCaughtByTheirDepth) {

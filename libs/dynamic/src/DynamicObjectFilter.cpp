@@ -61,6 +61,7 @@ const std::vector<std::string> kKeys{"mode",
                                      "silhouette_depth_band",
                                      "slow_frames",
                                      "slow_threshold",
+                                     "slow_speed",
                                      "depth_frames",
                                      "depth_rate_threshold",
                                      "depth_noise_z2",
@@ -184,6 +185,7 @@ void DynamicObjectFilter::Options::loadFromConfig(const mrpt::config::CConfigFil
     silhouette_depth_band = core::readDouble(c, s, "silhouette_depth_band", silhouette_depth_band);
     slow_frames = core::readInt(c, s, "slow_frames", slow_frames);
     slow_threshold = core::readDouble(c, s, "slow_threshold", slow_threshold);
+    slow_speed = core::readDouble(c, s, "slow_speed", slow_speed);
     depth_frames = core::readInt(c, s, "depth_frames", depth_frames);
     depth_rate_threshold = core::readDouble(c, s, "depth_rate_threshold", depth_rate_threshold);
     depth_noise_z2 = core::readDouble(c, s, "depth_noise_z2", depth_noise_z2);
@@ -226,6 +228,7 @@ void DynamicObjectFilter::Options::loadFromConfig(const mrpt::config::CConfigFil
                        "must be >= 0 (0 = fg_depth_band's)");
     core::requireValue(slow_frames >= 0, s, "slow_frames", "must be >= 0 (0 = off)");
     core::requireValue(slow_threshold > 0, s, "slow_threshold", "must be > 0");
+    core::requireValue(slow_speed >= 0, s, "slow_speed", "must be >= 0 (0 = off)");
     core::requireValue(depth_frames >= 0, s, "depth_frames", "must be >= 0 (0 = off)");
     core::requireValue(depth_rate_threshold > 0, s, "depth_rate_threshold", "must be > 0");
     core::requireValue(depth_noise_z2 >= 0, s, "depth_noise_z2", "must be >= 0");
@@ -267,6 +270,7 @@ void DynamicObjectFilter::Options::saveToConfig(mrpt::config::CConfigFileBase& c
     c.write(s, "silhouette_depth_band", silhouette_depth_band);
     c.write(s, "slow_frames", slow_frames);
     c.write(s, "slow_threshold", slow_threshold);
+    c.write(s, "slow_speed", slow_speed);
     c.write(s, "depth_frames", depth_frames);
     c.write(s, "depth_rate_threshold", depth_rate_threshold);
     c.write(s, "depth_noise_z2", depth_noise_z2);
@@ -338,6 +342,7 @@ struct DynamicObjectFilter::Impl {
     std::vector<cv::Mat> pyr;
     ShiTomasiMap corner_map;
     core::CameraIntrinsics prev_K;
+    double prev_timestamp = 0.0;
     std::vector<Track> tracks;
     int next_id = 0;
     long frame_count = 0;
@@ -377,8 +382,9 @@ struct DynamicObjectFilter::Impl {
     [[nodiscard]] double localThreshold(const cv::Rect2f& box, const FilterOutput& out,
                                         const Options& o) const;
     /// 6. Per-box evidence (Algorithm 1 with residual flow) and the state's hysteresis.
-    void classifyBoxes(const Residuals& r, const cv::Size& size, const Options& o,
-                       FilterOutput& out);
+    ///    dt: [s] since the previous frame (<= 0: unknown).
+    void classifyBoxes(const Residuals& r, const core::Frame& frame, double dt,
+                       const Options& o, FilterOutput& out);
     /// Forgets tracks unseen for more than forget_unseen_frames steps.
     void forgetUnseen(const Options& o);
     /// 7. The boxes to report and the mask (out.boxes, out.mask).
@@ -450,7 +456,8 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
         im.residualFlow(frame, flow, T_prev_cur, opts_, res, out);
         lap(times.residuals);
     }
-    im.classifyBoxes(res, size, opts_, out);
+    im.classifyBoxes(res, frame, have_prev ? frame.timestamp - im.prev_timestamp : 0.0, opts_,
+                     out);
     im.forgetUnseen(opts_);
     lap(times.evidence);
     im.drawMask(frame, have_prev, opts_, out);
@@ -773,8 +780,9 @@ double DynamicObjectFilter::Impl::localThreshold(const cv::Rect2f& box, const Fi
     return local_thr;
 }
 
-void DynamicObjectFilter::Impl::classifyBoxes(const Residuals& r, const cv::Size& size,
-                                              const Options& o, FilterOutput& out) {
+void DynamicObjectFilter::Impl::classifyBoxes(const Residuals& r, const core::Frame& frame,
+                                              double dt, const Options& o, FilterOutput& out) {
+    const cv::Size size = frame.bgr.size();
     for (auto& t : tracks) {
         const cv::Rect2f inner = shrink(t.tb.box, o.box_shrink);
         const double local_thr = localThreshold(t.tb.box, out, o);
@@ -833,7 +841,10 @@ void DynamicObjectFilter::Impl::classifyBoxes(const Residuals& r, const cv::Size
                 cv::Point2f sum(0.f, 0.f);
                 for (const auto& v : t.slow_history) sum += v;
                 const double mean = cv::norm(sum) / o.slow_frames;
-                moving |= mean > std::max(o.slow_threshold, 0.5 * local_thr);
+                double slow_px = o.slow_threshold;
+                if (o.slow_speed > 0 && t.depth && dt > 0 && dt < 1)
+                    slow_px = std::max(slow_px, o.slow_speed * dt * frame.K.fx / *t.depth);
+                moving |= mean > std::max(slow_px, 0.5 * local_thr);
             }
         }
         if (o.depth_frames > 0) {
@@ -933,6 +944,7 @@ void DynamicObjectFilter::Impl::endStep(const core::Frame& frame) {
     std::swap(prev_pyr, pyr);
     frame.depth.copyTo(prev_depth);
     prev_K = frame.K;
+    prev_timestamp = frame.timestamp;
     ++frame_count;
 }
 

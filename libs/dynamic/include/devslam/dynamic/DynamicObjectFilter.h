@@ -134,6 +134,12 @@ class DynamicObjectFilter {
         /// their walk). 0 = off (per-frame evidence only).
         int slow_frames = 0;
         double slow_threshold = 1.0;  ///< [px per frame]
+        /// [m/s] with the person's depth z and the time dt between the frames, the
+        /// slow-mover test also needs more than slow_speed * dt * fx / z px per frame: the
+        /// same speed moves a near person's pixels farther, so a seated person's sway near
+        /// the camera would pass a pixel threshold that a slow walker far away needs.
+        /// 0 = the pixel threshold alone.
+        double slow_speed = 0.0;
         /// People walking towards or away from the camera: their image barely moves (a
         /// point 100 px from the centre of a person 1.5 m away, walking at 0.45 m/s,
         /// moves 1 px a frame), but their depth does. Each step adds the median depth
