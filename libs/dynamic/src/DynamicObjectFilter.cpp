@@ -841,6 +841,8 @@ void DynamicObjectFilter::Impl::classifyBoxes(const Residuals& r, const core::Fr
                 cv::Point2f sum(0.f, 0.f);
                 for (const auto& v : t.slow_history) sum += v;
                 const double mean = cv::norm(sum) / o.slow_frames;
+                // The speed in pixels per frame at the person's depth; not known without a
+                // depth, or for timestamps that do not advance or jump by a second or more.
                 double slow_px = o.slow_threshold;
                 if (o.slow_speed > 0 && t.depth && dt > 0 && dt < 1)
                     slow_px = std::max(slow_px, o.slow_speed * dt * frame.K.fx / *t.depth);

@@ -138,7 +138,8 @@ class DynamicObjectFilter {
         /// slow-mover test also needs more than slow_speed * dt * fx / z px per frame: the
         /// same speed moves a near person's pixels farther, so a seated person's sway near
         /// the camera would pass a pixel threshold that a slow walker far away needs.
-        /// 0 = the pixel threshold alone.
+        /// 0 = the pixel threshold alone (also used for a box without depth, and where the
+        /// frames' timestamps do not advance or jump by 1 s or more).
         double slow_speed = 0.0;
         /// People walking towards or away from the camera: their image barely moves (a
         /// point 100 px from the centre of a person 1.5 m away, walking at 0.45 m/s,
