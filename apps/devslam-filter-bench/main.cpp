@@ -73,12 +73,12 @@ struct StageSamples {
         "residual flow and threshold",
         "per-box evidence and states",
         "mask"};
+    static_assert(std::size(kNames) ==
+                  std::tuple_size_v<decltype(dynamic::FilterOutput::StageTimes{}.values())>);
     std::vector<double> ms[std::size(kNames)];
     void add(const dynamic::FilterOutput::StageTimes& t) {
-        const double v[] = {t.images,     t.corners,   t.flow,     t.boxes,
-                            t.ego_motion, t.residuals, t.evidence, t.mask};
-        static_assert(std::size(v) == std::size(kNames));
-        for (std::size_t i = 0; i < std::size(v); ++i) ms[i].push_back(v[i]);
+        const auto v = t.values();
+        for (std::size_t i = 0; i < v.size(); ++i) ms[i].push_back(v[i]);
     }
 };
 

@@ -305,10 +305,8 @@ TEST(DynamicFilter, StageTimesAddUpToTheFilterTime) {
         scripted->next = {{*seq[i].person_box, 0, "person", 0.9f}};
         const auto out = filter.step(seq[i].frame, seq[i].T_prev_cur);
         const auto& t = out.stage_ms;
-        const double stages[] = {t.images,     t.corners,   t.flow,     t.boxes,
-                                 t.ego_motion, t.residuals, t.evidence, t.mask};
         double sum = 0;
-        for (const double ms : stages) {
+        for (const double ms : t.values()) {
             EXPECT_GE(ms, 0.0) << "frame " << i;
             sum += ms;
         }

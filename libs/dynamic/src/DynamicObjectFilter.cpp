@@ -302,6 +302,9 @@ struct PointFlow {
 struct Residuals {
     /// 3D of the point in the previous camera frame (nullopt: no stable depth there)
     std::vector<std::optional<Eigen::Vector3d>> X;
+    /// for a point with X: near no person box (nearAnyBox), so it is background for the
+    /// ego-motion fit and the image-wide threshold
+    std::vector<bool> background;
     /// residual flow vector [px]: observed - predicted from ego-motion and depth
     std::vector<cv::Point2f> vec;
     /// depth residual [m]: measured depth at the point's new position - the depth
@@ -366,9 +369,10 @@ struct DynamicObjectFilter::Impl {
     /// mask_margin plus 20 % of the box's size (the detector's box may lag a walker's limbs).
     [[nodiscard]] bool nearAnyBox(const cv::Point2f& a, const cv::Point2f& b,
                                   const Options& o) const;
-    /// 4. Ego-motion: the 3D of each point from the previous depth (into r.X), and the
-    ///    relative pose p_prev = T * p_cur, the prior refined by PnP-RANSAC on the points
-    ///    near no box (also written to out.T_prev_cur_refined).
+    /// 4. Ego-motion: the 3D of each point from the previous depth (into r.X, and whether
+    ///    it is background into r.background), and the relative pose p_prev = T * p_cur,
+    ///    the prior refined by PnP-RANSAC on the background points (also written to
+    ///    out.T_prev_cur_refined).
     Eigen::Isometry3d egoMotion(const PointFlow& f, const core::CameraIntrinsics& Kc,
                                 const std::optional<Eigen::Isometry3d>& prior, const Options& o,
                                 Residuals& r, FilterOutput& out) const;
@@ -657,13 +661,15 @@ Eigen::Isometry3d DynamicObjectFilter::Impl::egoMotion(
     const std::vector<cv::Point2f>& p0 = f.p0;
     const std::vector<cv::Point2f>& p1 = f.p1;
     r.X.assign(p0.size(), std::nullopt);
+    r.background.assign(p0.size(), false);
     std::vector<cv::Point3f> bg_obj;
     std::vector<cv::Point2f> bg_img;
     for (std::size_t i = 0; i < p0.size(); ++i) {
         const auto z = stableDepth(prev_depth, p0[i], o.max_depth);
         if (!z) continue;
         r.X[i] = core::backproject(p0[i].x, p0[i].y, *z, prev_K);
-        if (!nearAnyBox(p0[i], p1[i], o)) {
+        r.background[i] = !nearAnyBox(p0[i], p1[i], o);
+        if (r.background[i]) {
             bg_obj.emplace_back(static_cast<float>(r.X[i]->x()), static_cast<float>(r.X[i]->y()),
                                 static_cast<float>(r.X[i]->z()));
             bg_img.push_back(p1[i]);
@@ -731,7 +737,7 @@ void DynamicObjectFilter::Impl::residualFlow(const core::Frame& frame, const Poi
                         r.z[i] = *z - static_cast<float>(Xc.z());
             }
         }
-        if (fp.residual >= 0.f && !nearAnyBox(p0[i], p1[i], o)) {
+        if (fp.residual >= 0.f && r.background[i]) {  // (a residual needs X)
             bg_res.push_back(fp.residual);
             if (!std::isnan(r.z[i])) bg_z.push_back(r.z[i]);
         }

@@ -12,6 +12,7 @@
 #include <devslam/detect/PersonDetector.h>
 
 #include <Eigen/Geometry>
+#include <array>
 #include <memory>
 #include <opencv2/core/mat.hpp>
 #include <optional>
@@ -70,6 +71,10 @@ struct FilterOutput {
         double residuals = 0;   ///< residual flow and the image-wide threshold
         double evidence = 0;    ///< per-box evidence, states, forgetting
         double mask = 0;        ///< reported boxes and the mask
+        /// the stages above, in that order
+        [[nodiscard]] std::array<double, 8> values() const {
+            return {images, corners, flow, boxes, ego_motion, residuals, evidence, mask};
+        }
     } stage_ms;
     /// Ego-motion refined on background points (p_prev = T * p_cur), if computed.
     std::optional<Eigen::Isometry3d> T_prev_cur_refined;
