@@ -44,6 +44,25 @@ TEST(Camera, BackprojectProjectRoundTrip) {
     EXPECT_FALSE(project(Eigen::Vector3d(0, 0, -1), K).has_value());
 }
 
+TEST(Camera, ScaledKeepsPixelCentres) {
+    // A point seen at pixel (u, v) of the full image lies at ((u + 0.5) s - 0.5, ...) of the
+    // image resized by s: the corners of the image scale, the centres of pixels do not.
+    const auto K = CameraIntrinsics::fromPreset("freiburg3");
+    const auto H = K.scaled(0.5);
+    EXPECT_EQ(H.width, 320);
+    EXPECT_EQ(H.height, 240);
+    const Eigen::Vector3d p(0.3, -0.2, 2.0);
+    const auto full = project(p, K), half = project(p, H);
+    ASSERT_TRUE(full && half);
+    EXPECT_NEAR(half->x(), (full->x() + 0.5) * 0.5 - 0.5, 1e-9);
+    EXPECT_NEAR(half->y(), (full->y() + 0.5) * 0.5 - 0.5, 1e-9);
+    const auto back = H.scaled(2.0);  // and back
+    EXPECT_NEAR(back.cx, K.cx, 1e-12);
+    EXPECT_NEAR(back.cy, K.cy, 1e-12);
+    EXPECT_EQ(back.fx, K.fx);
+    EXPECT_EQ(back.width, K.width);
+}
+
 TEST(Camera, ConfigRoundTripAndErrors) {
     auto K = CameraIntrinsics::fromPreset("freiburg2");
     mrpt::config::CConfigFileMemory mem;

@@ -271,12 +271,7 @@ TEST(DynamicFilter, FrameOfAnotherSizeStartsAfresh) {
         if (i >= 3) {  // the same view at half the resolution
             cv::resize(seq[i].frame.bgr, f.bgr, cv::Size(), 0.5, 0.5, cv::INTER_AREA);
             cv::resize(seq[i].frame.depth, f.depth, cv::Size(), 0.5, 0.5, cv::INTER_NEAREST);
-            f.K.fx *= 0.5;
-            f.K.fy *= 0.5;
-            f.K.cx *= 0.5;
-            f.K.cy *= 0.5;
-            f.K.width /= 2;
-            f.K.height /= 2;
+            f.K = seq[i].frame.K.scaled(0.5);
         }
         const auto out = filter.step(f, seq[i].T_prev_cur);
         EXPECT_EQ(out.mask.size(), f.bgr.size()) << "frame " << i;

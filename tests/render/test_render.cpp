@@ -64,7 +64,7 @@ std::string readFile(const std::string& p) {
 /// The shipped short scenario at a quarter resolution (160x120) for speed.
 Scenario smallShort() {
     Scenario sc = loadScenario(kSynth + "/short_walking.ini");
-    sc.K = scaleIntrinsics(sc.K, 0.25);
+    sc.K = sc.K.scaled(0.25);
     return sc;
 }
 
@@ -72,7 +72,7 @@ Scenario smallShort() {
 Scenario bareRoom(const Eigen::Vector3d& eye, const Eigen::Vector3d& target) {
     Scenario sc;
     sc.name = "bare";
-    sc.K = scaleIntrinsics(core::CameraIntrinsics::fromPreset("freiburg3"), 0.25);
+    sc.K = core::CameraIntrinsics::fromPreset("freiburg3").scaled(0.25);
     sc.n_frames = 1;
     sc.rgb_noise_sigma = 0;
     sc.depth_noise.enabled = false;

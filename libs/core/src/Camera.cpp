@@ -4,6 +4,7 @@
 #include <mrpt/config/CConfigFileBase.h>
 #include <mrpt/img/TCamera.h>
 
+#include <cmath>
 #include <map>
 #include <stdexcept>
 
@@ -113,6 +114,17 @@ CameraIntrinsics CameraIntrinsics::fromMrpt(const mrpt::img::TCamera& cam) {
     K.height = static_cast<int>(cam.nrows);
     K.dist = {cam.k1(), cam.k2(), cam.p1(), cam.p2(), cam.k3()};
     return K;
+}
+
+CameraIntrinsics CameraIntrinsics::scaled(double s) const {
+    CameraIntrinsics o = *this;
+    o.fx = fx * s;
+    o.fy = fy * s;
+    o.cx = (cx + 0.5) * s - 0.5;
+    o.cy = (cy + 0.5) * s - 0.5;
+    o.width = static_cast<int>(std::lround(width * s));
+    o.height = static_cast<int>(std::lround(height * s));
+    return o;
 }
 
 bool CameraIntrinsics::operator==(const CameraIntrinsics& o) const {

@@ -170,17 +170,6 @@ std::vector<double> parseNumberList(const std::string& text, const std::string& 
     return out;
 }
 
-core::CameraIntrinsics scaleIntrinsics(const core::CameraIntrinsics& K, double s) {
-    core::CameraIntrinsics o = K;
-    o.fx = K.fx * s;
-    o.fy = K.fy * s;
-    o.cx = (K.cx + 0.5) * s - 0.5;
-    o.cy = (K.cy + 0.5) * s - 0.5;
-    o.width = int(std::lround(K.width * s));
-    o.height = int(std::lround(K.height * s));
-    return o;
-}
-
 namespace {
 
 Scenario readScenario(const std::string& path) {

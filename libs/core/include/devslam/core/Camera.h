@@ -46,6 +46,11 @@ struct CameraIntrinsics {
                                                      const std::string& section);
     void saveToConfig(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
 
+    /// The same camera at a resolution scaled by `s` (an image resized by `s`): pixel
+    /// centres kept exact, cx' = (cx + 0.5) s - 0.5; width and height rounded. Distortion
+    /// coefficients are unchanged (they act on normalised coordinates).
+    [[nodiscard]] CameraIntrinsics scaled(double s) const;
+
     /// The 3x3 camera matrix.
     [[nodiscard]] Eigen::Matrix3d matrix() const;
     /// As an MRPT camera model (for CObservation3DRangeScan).

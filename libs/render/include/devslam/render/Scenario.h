@@ -68,10 +68,6 @@ struct Scenario {
 /// section and key on any unknown key, missing file, or out-of-range value.
 [[nodiscard]] Scenario loadScenario(const std::string& path);
 
-/// Intrinsics of the same camera at a resolution scaled by `s` (pixel-centre convention
-/// kept exact: cx' = (cx + 0.5) s - 0.5). Used by tests to render small images.
-[[nodiscard]] core::CameraIntrinsics scaleIntrinsics(const core::CameraIntrinsics& K, double s);
-
 /// Parses "[a b c]" / "a, b, c" into numbers; throws naming `what` on a bad token or when
 /// `expected` (if > 0) does not match the count.
 [[nodiscard]] std::vector<double> parseNumberList(const std::string& text, const std::string& what,
