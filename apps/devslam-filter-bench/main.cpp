@@ -17,8 +17,10 @@
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
+#include <opencv2/video/tracking.hpp>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <ctime>
 #include <iostream>
@@ -352,6 +354,89 @@ int main(int argc, char** argv) {
             row("`ShiTomasiMap::compute` (OpenCV primitives, new buffers each call)", t_compute);
             row("`ShiTomasiMap::update` (the same, buffers kept: the filter since session 12)",
                 t_update);
+        }
+
+        {
+            // The forward-backward check, as the filter runs it (backward LK started at the
+            // forward track's start, OPTFLOW_USE_INITIAL_FLOW) and as it is usually written
+            // (started at the forward track's end), on an fr1 frame shifted by a known number
+            // of pixels, and with its right half replaced by other content (the half turned
+            // upside down: no true match there). LK settings as in the filter's trackCorners.
+            const cv::Mat& bgr = tum.front().bgr;
+            const cv::Size win(fo.lk_window, fo.lk_window);
+            const cv::TermCriteria term(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 10, 0.03);
+            const auto half = [&](const cv::Mat& img) {
+                cv::Mat gray, work;
+                cv::cvtColor(img, gray, cv::COLOR_BGR2GRAY);
+                cv::resize(gray, work, cv::Size(), fo.flow_scale, fo.flow_scale, cv::INTER_AREA);
+                return work;
+            };
+            const cv::Mat w0 = half(bgr);
+            const auto p0 = dynamic::selectShiTomasi(dynamic::ShiTomasiMap::compute(w0),
+                                                     cv::Rect(0, 0, w0.cols, w0.rows),
+                                                     fo.max_corners, fo.corner_quality,
+                                                     fo.corner_min_distance);
+            const auto inv = 1.0 / fo.flow_scale;
+            const double margin = fo.lk_window * inv;  // [px, full resolution]
+            md << "\n**Forward-backward check** (fr1_xyz_first37 frame 0 against itself moved "
+                  "by a known shift, and against itself with its right half turned upside down, "
+                  "where no point has a true match; the filter's corners and LK settings; a kept "
+                  "track is wrong when it ends more than 1 px from the truth; points whose true "
+                  "match leaves the image are not counted):\n\n"
+                  "| second frame | points | kept, backward from the start (the filter) | "
+                  "wrong among them | kept, backward from the end | wrong among them |\n"
+                  "|---|---|---|---|---|---|\n";
+            for (const double shift : {0.0, 10.0, 20.0, 40.0, 60.0, -1.0}) {
+                cv::Mat moved;
+                if (shift >= 0) {
+                    const cv::Mat M = (cv::Mat_<double>(2, 3) << 1, 0, shift, 0, 1, 0);
+                    cv::warpAffine(bgr, moved, M, bgr.size(), cv::INTER_LINEAR,
+                                   cv::BORDER_REFLECT);
+                } else {
+                    moved = bgr.clone();
+                    const cv::Rect right(bgr.cols / 2, 0, bgr.cols / 2, bgr.rows);
+                    cv::Mat turned;
+                    cv::flip(bgr(right), turned, -1);
+                    turned.copyTo(moved(right));
+                }
+                const cv::Mat w1 = half(moved);
+                std::vector<cv::Point2f> p1, back_start = p0, back_end;
+                std::vector<uchar> st, st_start, st_end;
+                std::vector<float> err;
+                cv::calcOpticalFlowPyrLK(w0, w1, p0, p1, st, err, win, fo.lk_levels, term);
+                cv::calcOpticalFlowPyrLK(w1, w0, p1, back_start, st_start, err, win,
+                                         fo.lk_levels, term, cv::OPTFLOW_USE_INITIAL_FLOW);
+                cv::calcOpticalFlowPyrLK(w1, w0, p1, back_end, st_end, err, win, fo.lk_levels,
+                                         term);
+                int points = 0, kept_start = 0, wrong_start = 0, kept_end = 0, wrong_end = 0;
+                for (std::size_t i = 0; i < p0.size(); ++i) {
+                    const double x = p0[i].x * inv;
+                    if (shift >= 0 ? x + shift > bgr.cols - margin : x < bgr.cols / 2 + margin)
+                        continue;
+                    ++points;
+                    if (!st[i]) continue;
+                    // With a shift the truth is p0 + shift; in the turned half every track is
+                    // wrong.
+                    const bool wrong = shift < 0 || std::abs((p1[i].x - p0[i].x) * inv - shift) +
+                                                            std::abs(p1[i].y - p0[i].y) * inv >
+                                                        1.0;
+                    const auto keep = [&](const std::vector<cv::Point2f>& back,
+                                          const std::vector<uchar>& ok) {
+                        return ok[i] && cv::norm(back[i] - p0[i]) * inv <= fo.fb_max_error;
+                    };
+                    if (keep(back_start, st_start)) {
+                        ++kept_start;
+                        wrong_start += wrong;
+                    }
+                    if (keep(back_end, st_end)) {
+                        ++kept_end;
+                        wrong_end += wrong;
+                    }
+                }
+                md << "| " << (shift >= 0 ? "shifted " + fmt(shift, 0) + " px" : "right half turned")
+                   << " | " << points << " | " << kept_start << " | " << wrong_start << " | "
+                   << kept_end << " | " << wrong_end << " |\n";
+            }
         }
 
         // 3. detect_every trade-off with the real detector.

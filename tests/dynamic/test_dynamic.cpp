@@ -375,6 +375,44 @@ TEST(DynamicFilter, RefinedEgoMotionMatchesTruth) {
     }
 }
 
+TEST(DynamicFilter, ForwardBackwardCheckDropsTracksIntoOtherContent) {
+    // The right half of the second frame shows other content (the wall turned upside down),
+    // as where something enters the view: no point there has a true match, and LK's forward
+    // tracks into it are wrong. The check must drop them and keep the unchanged left half;
+    // with the check off (a huge fb_max_error) they are kept.
+    core::Frame f0 = flatWallFrame(), f1 = flatWallFrame();
+    f1.index = 1;
+    f1.timestamp = f0.timestamp + 1.0 / 30;
+    const cv::Rect right(f1.bgr.cols / 2, 0, f1.bgr.cols / 2, f1.bgr.rows);
+    cv::Mat turned;
+    cv::flip(f0.bgr(right), turned, -1);
+    turned.copyTo(f1.bgr(right));
+    const auto o = testOptions();
+    // Away from the seam by more than an LK window at full resolution.
+    const auto margin = static_cast<float>(2 * o.lk_window / o.flow_scale);
+    auto count = [&](double fb_max_error) {
+        auto fo = o;
+        fo.fb_max_error = fb_max_error;
+        DynamicObjectFilter filter(fo, std::make_unique<ScriptedDetector>());
+        (void)filter.step(f0, Eigen::Isometry3d::Identity());
+        const auto out = filter.step(f1, Eigen::Isometry3d::Identity());
+        std::pair<int, int> left_other{0, 0};
+        for (const auto& p : out.flow) {
+            left_other.first += p.prev.x < static_cast<float>(right.x) - margin;
+            left_other.second += p.prev.x > static_cast<float>(right.x) + margin;
+        }
+        return left_other;
+    };
+    const auto [left, into_other] = count(o.fb_max_error);
+    const auto [left_off, into_other_off] = count(1e6);
+    EXPECT_GE(left, 100);
+    EXPECT_LE(into_other, 2);
+    // The premise: without the check, wrong tracks into the right half are kept (12 of them
+    // when written) and none of the left half's is lost.
+    EXPECT_GE(into_other_off, 8);
+    EXPECT_EQ(left_off, left);
+}
+
 TEST(DynamicFilter, RealTumFramesHaveNoMovingRegion) {
     // Static desk scene, moving camera (the io reader pairs 32 of the 37 rgb images with a
     // depth image within 0.02 s). Its only person sits behind the monitor, cut by the top
