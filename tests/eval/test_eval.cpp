@@ -1,11 +1,13 @@
 #include <devslam/core/Pose.h>
 #include <devslam/eval/MaskScore.h>
 #include <devslam/eval/Metrics.h>
+#include <devslam/eval/Plot.h>
 #include <devslam/eval/Report.h>
 #include <devslam/io/TrajectoryIO.h>
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include <gtest/gtest.h>
 
@@ -340,4 +342,20 @@ TEST(MaskScore, WalkerMaskIsTheWalkersPixelsDilated) {
     EXPECT_EQ(s.movingRecall(), 1.0);
     EXPECT_EQ(s.staticMasked(), 0.0);
     fs::remove_all(dir);
+}
+
+TEST(Plot, LongTitleStaysInsideItsArea) {
+    // A title naming a long path is shortened from the front, so it does not run into the
+    // plot beside it (devslam-eval's top view has the x/y/z plots to its right).
+    const std::string title = "out/bench/runs/walking_halfsphere/dynamic/seed14_r0/"
+                              "trajectory.txt: top view, ATE RMSE 0.0353 m";
+    cv::Mat canvas(200, 600, CV_8UC3, cv::Scalar(255, 255, 255));
+    eval::Plot p(cv::Rect(0, 0, 300, 200), title, "x [m]", "y [m]");
+    p.fit({0.0, 1.0}, {0.0, 1.0});
+    p.axes(canvas);
+    cv::Mat gray;
+    cv::cvtColor(canvas(cv::Rect(300, 0, 300, 200)), gray, cv::COLOR_BGR2GRAY);
+    EXPECT_EQ(cv::countNonZero(gray < 255), 0) << "ink right of the plot's area";
+    cv::cvtColor(canvas(cv::Rect(0, 0, 300, 30)), gray, cv::COLOR_BGR2GRAY);
+    EXPECT_GT(cv::countNonZero(gray < 128), 50) << "the title is drawn";
 }

@@ -5,12 +5,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <string>
 
 namespace devslam::eval {
 
 namespace {
 constexpr int kMarginLeft = 70, kMarginRight = 15, kMarginTop = 30, kMarginBottom = 45;
 const cv::Scalar kInk(40, 40, 40);
+constexpr int kFont = cv::FONT_HERSHEY_SIMPLEX;
 
 double niceStep(double range, int target_ticks) {
     const double raw = range / std::max(1, target_ticks);
@@ -19,7 +21,19 @@ double niceStep(double range, int target_ticks) {
         if (raw <= m * mag) return m * mag;
     return 10 * mag;
 }
+
 }  // namespace
+
+std::string fitTextFromTheFront(const std::string& text, int width, double scale) {
+    const auto wide = [&](const std::string& t) {
+        int base = 0;
+        return cv::getTextSize(t, kFont, scale, 1, &base).width > width;
+    };
+    if (!wide(text)) return text;
+    for (std::size_t cut = 1; cut < text.size(); ++cut)
+        if (const std::string t = "..." + text.substr(cut); !wide(t)) return t;
+    return {};
+}
 
 cv::Scalar heatColour(double t) {
     t = std::clamp(t, 0.0, 1.0);
@@ -78,7 +92,10 @@ void Plot::axes(cv::Mat& c) const {
         cv::putText(c, buf, p + cv::Point(-55, 4), font, 0.4, kInk, 1, cv::LINE_AA);
     }
     cv::rectangle(c, inner_, kInk, 1);
-    cv::putText(c, title_, {inner_.x, area_.y + 20}, font, 0.55, kInk, 1, cv::LINE_AA);
+    constexpr double kTitleScale = 0.55;
+    const int title_width = area_.x + area_.width - 4 - inner_.x;  // stays inside the area
+    cv::putText(c, fitTextFromTheFront(title_, title_width, kTitleScale),
+                {inner_.x, area_.y + 20}, font, kTitleScale, kInk, 1, cv::LINE_AA);
     cv::putText(c, xlabel_, {inner_.x + inner_.width / 2 - 20, area_.y + area_.height - 8}, font,
                 0.45, kInk, 1, cv::LINE_AA);
     cv::putText(c, ylabel_, {area_.x + 2, inner_.y - 8}, font, 0.45, kInk, 1, cv::LINE_AA);

@@ -91,7 +91,16 @@ void writeJson(const std::string& path, const AteResult* ate, const RpeResult* r
 }
 
 void plotAte(const std::string& path, const AteResult& ate, const std::string& title) {
-    cv::Mat canvas(900, 1200, CV_8UC3, cv::Scalar(255, 255, 255));
+    // The title (often a file path) gets a band of its own across the figure, so that it
+    // runs into no plot; the plots below it have short titles.
+    constexpr int kBand = 32, kWidth = 1200;
+    cv::Mat canvas(kBand + 900, kWidth, CV_8UC3, cv::Scalar(255, 255, 255));
+    constexpr double kTitleScale = 0.6;
+    cv::putText(canvas,
+                fitTextFromTheFront(title + ", ATE RMSE " + fmt("%.4f", ate.trans.rmse) + " m",
+                                    kWidth - 20, kTitleScale),
+                {10, 22}, cv::FONT_HERSHEY_SIMPLEX, kTitleScale, cv::Scalar(40, 40, 40), 1,
+                cv::LINE_AA);
     std::vector<double> gx, gy, ex, ey, t;
     for (std::size_t i = 0; i < ate.gt_xyz.size(); ++i) {
         gx.push_back(ate.gt_xyz[i].x()), gy.push_back(ate.gt_xyz[i].y());
@@ -102,9 +111,7 @@ void plotAte(const std::string& path, const AteResult& ate, const std::string& t
     std::vector<cv::Scalar> colours;
     for (double e : ate.errors) colours.push_back(heatColour(e / emax));
 
-    Plot top(cv::Rect(0, 0, 600, 900),
-             title + ": top view, ATE RMSE " + fmt("%.4f", ate.trans.rmse) + " m", "x [m]",
-             "y [m]");
+    Plot top(cv::Rect(0, kBand, 600, 900), "top view", "x [m]", "y [m]");
     top.fit(gx, gy);
     top.fit(ex, ey);
     top.equalAspect();
@@ -122,16 +129,14 @@ void plotAte(const std::string& path, const AteResult& ate, const std::string& t
         std::vector<double> g, e;
         for (std::size_t i = 0; i < ate.gt_xyz.size(); ++i)
             g.push_back(ate.gt_xyz[i][a]), e.push_back(ate.est_xyz[i][a]);
-        Plot p(cv::Rect(600, 300 * a, 600, 300), std::string(names[a]) + " over time", "t [s]",
+        Plot p(cv::Rect(600, kBand + 300 * a, 600, 300),
+               std::string(names[a]) + " over time: truth black, estimate orange", "t [s]",
                std::string(names[a]) + " [m]");
         p.fit(t, g);
         p.fit(t, e);
         p.axes(canvas);
         p.line(canvas, t, g, cv::Scalar(0, 0, 0), 2);
         p.line(canvas, t, e, cv::Scalar(30, 120, 255), 1);
-        if (a == 0)
-            p.legend(canvas, {{"ground truth", cv::Scalar(0, 0, 0)},
-                              {"estimate", cv::Scalar(30, 120, 255)}});
     }
     if (!cv::imwrite(path, canvas)) throw std::runtime_error("cannot write plot '" + path + "'");
 }

@@ -38,6 +38,10 @@ class Plot {
     double x0_ = 1e300, x1_ = -1e300, y0_ = 1e300, y1_ = -1e300;
 };
 
+/// `text` shortened from the front ("...end") to at most `width` pixels in Plot's font at
+/// `scale`: a title that names a long path keeps its end (the file, and what is shown).
+[[nodiscard]] std::string fitTextFromTheFront(const std::string& text, int width, double scale);
+
 /// Blue (0) to red (1) colour ramp, BGR.
 [[nodiscard]] cv::Scalar heatColour(double t);
 

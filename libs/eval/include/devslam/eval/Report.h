@@ -22,8 +22,9 @@ namespace devslam::eval {
 /// Writes toJson() to a file; throws std::runtime_error if it cannot.
 void writeJson(const std::string& path, const AteResult* ate, const RpeResult* rpe,
                const RpeOptions* rpe_opts = nullptr);
-/// 1200x900 PNG: top view (x-y) of ground truth and the aligned estimate coloured by ATE
-/// error (blue low, red high) and x, y, z over time. Throws if the file cannot be written.
+/// 1200x932 PNG: `title` and the ATE RMSE across the top, then the top view (x-y) of ground
+/// truth and the aligned estimate coloured by ATE error (blue low, red high) and x, y, z
+/// over time. Throws if the file cannot be written.
 void plotAte(const std::string& path, const AteResult& ate, const std::string& title);
 
 }  // namespace devslam::eval
