@@ -31,7 +31,7 @@ std::string fitTextFromTheFront(const std::string& text, int width, double scale
     };
     if (!wide(text)) return text;
     for (std::size_t cut = 1; cut < text.size(); ++cut)
-        if (const std::string t = "..." + text.substr(cut); !wide(t)) return t;
+        if (std::string t = "..." + text.substr(cut); !wide(t)) return t;
     return {};
 }
 
