@@ -251,6 +251,21 @@ TEST(Stats, MatchesNumpy) {
     EXPECT_EQ(summarize({}).count, 0u);
 }
 
+TEST(Stats, InterquartileMean) {
+    EXPECT_DOUBLE_EQ(interquartileMean({}), 0);
+    EXPECT_DOUBLE_EQ(interquartileMean({7}), 7);
+    EXPECT_DOUBLE_EQ(interquartileMean({4, 1, 3, 2}), 2.5);  // drops 1 and 4
+    // An outlier among eight is dropped, as by the median.
+    EXPECT_DOUBLE_EQ(interquartileMean({1, 1, 1, 1, 1, 1, 1, 100}), 1);
+    // Depth residuals in 2 cm steps, 11 of 20 points unchanged (static, or not across a
+    // step this frame) and 9 a step deeper: the median says 0, the interquartile mean
+    // keeps the change (the mean of the middle ten, 4 x 0.02 / 10).
+    std::vector<double> steps(11, 0.0);
+    steps.insert(steps.end(), 9, 0.02);
+    EXPECT_DOUBLE_EQ(median(steps), 0.0);
+    EXPECT_NEAR(interquartileMean(steps), 0.008, 1e-12);
+}
+
 TEST(Pose, TumQuaternionRoundTrip) {
     const auto p = fromTum(1, 2, 3, 0.6132, 0.5962, -0.3311, -0.3986);
     EXPECT_NEAR(p.x(), 1, 1e-12);

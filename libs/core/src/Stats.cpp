@@ -16,6 +16,15 @@ double median(std::vector<double> v) {
     return 0.5 * (lo + hi);
 }
 
+double interquartileMean(std::vector<double> v) {
+    if (v.empty()) return 0.0;
+    std::sort(v.begin(), v.end());
+    const std::size_t cut = v.size() / 4;
+    const auto first = v.begin() + static_cast<std::ptrdiff_t>(cut);
+    const auto last = v.end() - static_cast<std::ptrdiff_t>(cut);
+    return std::accumulate(first, last, 0.0) / static_cast<double>(last - first);
+}
+
 Summary summarize(const std::vector<double>& v) {
     Summary s;
     s.count = v.size();

@@ -15,5 +15,10 @@ struct Summary {
 [[nodiscard]] Summary summarize(const std::vector<double>& v);
 /// Median (numpy.median); 0 for an empty vector.
 [[nodiscard]] double median(std::vector<double> v);
+/// Interquartile mean: the mean of the values left after dropping the lowest and the highest
+/// quarter (floor(n / 4) each); 0 for an empty vector. As robust to a minority of outliers
+/// as the median, but it keeps the size of a change shown by part of the values (quantized
+/// samples, a mixture) where the median jumps between them.
+[[nodiscard]] double interquartileMean(std::vector<double> v);
 
 }  // namespace devslam::core
