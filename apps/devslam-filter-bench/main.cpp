@@ -323,17 +323,19 @@ int main(int argc, char** argv) {
                << fmt(core::median(stages_synthetic.ms[i]), 3) << " | "
                << fmt(core::median(stages_tum.ms[i]), 3) << " |\n";
 
+        // The image the filter's corners and LK work on: grey, scaled by flow_scale.
+        const auto toWork = [&](const cv::Mat& bgr) {
+            cv::Mat gray, work;
+            cv::cvtColor(bgr, gray, cv::COLOR_BGR2GRAY);
+            cv::resize(gray, work, cv::Size(), fo.flow_scale, fo.flow_scale, cv::INTER_AREA);
+            return work;
+        };
         {
             // The filter's corner map, timed against what it replaces: the three ways are
             // interleaved frame by frame, so the VM's drift hits them alike and the ratio
             // holds even where the absolute figures move.
             std::vector<cv::Mat> works;
-            for (const auto& f : tum) {
-                cv::Mat gray, work;
-                cv::cvtColor(f.bgr, gray, cv::COLOR_BGR2GRAY);
-                cv::resize(gray, work, cv::Size(), fo.flow_scale, fo.flow_scale, cv::INTER_AREA);
-                works.push_back(work);
-            }
+            for (const auto& f : tum) works.push_back(toWork(f.bgr));
             std::vector<double> t_cv, t_compute, t_update;
             dynamic::ShiTomasiMap kept;
             for (int pass = 0; pass < 10; ++pass)
@@ -373,14 +375,8 @@ int main(int argc, char** argv) {
             // upside down: no true match there). LK settings as in the filter's trackCorners.
             const cv::Mat& bgr = tum.front().bgr;
             const cv::Size win(fo.lk_window, fo.lk_window);
-            const cv::TermCriteria term(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 10, 0.03);
-            const auto half = [&](const cv::Mat& img) {
-                cv::Mat gray, work;
-                cv::cvtColor(img, gray, cv::COLOR_BGR2GRAY);
-                cv::resize(gray, work, cv::Size(), fo.flow_scale, fo.flow_scale, cv::INTER_AREA);
-                return work;
-            };
-            const cv::Mat w0 = half(bgr);
+            const cv::TermCriteria term = dynamic::lkTermination();
+            const cv::Mat w0 = toWork(bgr);
             const auto p0 = dynamic::selectShiTomasi(dynamic::ShiTomasiMap::compute(w0),
                                                      cv::Rect(0, 0, w0.cols, w0.rows),
                                                      fo.max_corners, fo.corner_quality,
@@ -408,7 +404,7 @@ int main(int argc, char** argv) {
                     cv::flip(bgr(right), turned, -1);
                     turned.copyTo(moved(right));
                 }
-                const cv::Mat w1 = half(moved);
+                const cv::Mat w1 = toWork(moved);
                 std::vector<cv::Point2f> p1, back_start = p0, back_end;
                 std::vector<uchar> st, st_start, st_end;
                 std::vector<float> err;

@@ -540,7 +540,7 @@ PointFlow DynamicObjectFilter::Impl::trackCorners(const Options& o, const cv::Re
     const cv::Size win(o.lk_window, o.lk_window);
     std::vector<uchar> st, st_back;
     std::vector<float> err;
-    const cv::TermCriteria term(cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 10, 0.03);
+    const cv::TermCriteria term = lkTermination();
     cv::calcOpticalFlowPyrLK(prev_pyr, pyr, p0, p1, st, err, win, o.lk_levels, term);
     std::vector<cv::Point2f> back = p0;
     cv::calcOpticalFlowPyrLK(pyr, prev_pyr, p1, back, st_back, err, win, o.lk_levels, term,
@@ -861,8 +861,8 @@ void DynamicObjectFilter::Impl::classifyBoxes(const Residuals& r, const core::Fr
             // then spans more steps).
             // The interquartile mean, not the median, of the box's depth residuals: depth
             // comes in disparity steps (2 cm at 2.6 m), larger than a walker's change a frame
-            // there, and where the band holds static points too (the floor at the feet), the
-            // median sat at 0 in most frames. A walker of walking_towards was Static for 100
+            // there, and where the band holds static points too (most likely the floor at the
+            // feet), the median sat at 0 in most frames. A walker of walking_towards was Static for 100
             // frames; masked 86.8 -> 91.6 % of their frames (docs/dynamic.md, session 14).
             if (rz.size() >= static_cast<std::size_t>(o.min_points)) {
                 t.depth_history.push_back(static_cast<float>(

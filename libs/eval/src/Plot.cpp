@@ -35,6 +35,12 @@ std::string fitTextFromTheFront(const std::string& text, int width, double scale
     return {};
 }
 
+void drawTitle(cv::Mat& canvas, const std::string& text, cv::Point origin, int width,
+               double scale) {
+    cv::putText(canvas, fitTextFromTheFront(text, width, scale), origin, kFont, scale, kInk, 1,
+                cv::LINE_AA);
+}
+
 cv::Scalar heatColour(double t) {
     t = std::clamp(t, 0.0, 1.0);
     return {255 * (1 - t), 60 + 100 * (1 - std::abs(2 * t - 1)), 255 * t};
@@ -74,7 +80,7 @@ cv::Point Plot::toPixel(double x, double y) const {
 
 void Plot::axes(cv::Mat& c) const {
     cv::rectangle(c, inner_, kInk, 1);
-    const auto font = cv::FONT_HERSHEY_SIMPLEX;
+    const auto font = kFont;
     char buf[32];
     const double sx = niceStep(x1_ - x0_, 6), sy = niceStep(y1_ - y0_, 6);
     for (double x = std::ceil(x0_ / sx) * sx; x <= x1_; x += sx) {
@@ -92,10 +98,8 @@ void Plot::axes(cv::Mat& c) const {
         cv::putText(c, buf, p + cv::Point(-55, 4), font, 0.4, kInk, 1, cv::LINE_AA);
     }
     cv::rectangle(c, inner_, kInk, 1);
-    constexpr double kTitleScale = 0.55;
-    const int title_width = area_.x + area_.width - 4 - inner_.x;  // stays inside the area
-    cv::putText(c, fitTextFromTheFront(title_, title_width, kTitleScale),
-                {inner_.x, area_.y + 20}, font, kTitleScale, kInk, 1, cv::LINE_AA);
+    // The title stays inside the plot's area.
+    drawTitle(c, title_, {inner_.x, area_.y + 20}, area_.x + area_.width - 4 - inner_.x, 0.55);
     cv::putText(c, xlabel_, {inner_.x + inner_.width / 2 - 20, area_.y + area_.height - 8}, font,
                 0.45, kInk, 1, cv::LINE_AA);
     cv::putText(c, ylabel_, {area_.x + 2, inner_.y - 8}, font, 0.45, kInk, 1, cv::LINE_AA);

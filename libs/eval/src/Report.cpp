@@ -95,12 +95,8 @@ void plotAte(const std::string& path, const AteResult& ate, const std::string& t
     // runs into no plot; the plots below it have short titles.
     constexpr int kBand = 32, kWidth = 1200;
     cv::Mat canvas(kBand + 900, kWidth, CV_8UC3, cv::Scalar(255, 255, 255));
-    constexpr double kTitleScale = 0.6;
-    cv::putText(canvas,
-                fitTextFromTheFront(title + ", ATE RMSE " + fmt("%.4f", ate.trans.rmse) + " m",
-                                    kWidth - 20, kTitleScale),
-                {10, 22}, cv::FONT_HERSHEY_SIMPLEX, kTitleScale, cv::Scalar(40, 40, 40), 1,
-                cv::LINE_AA);
+    drawTitle(canvas, title + ", ATE RMSE " + fmt("%.4f", ate.trans.rmse) + " m", {10, 22},
+              kWidth - 20, 0.6);
     std::vector<double> gx, gy, ex, ey, t;
     for (std::size_t i = 0; i < ate.gt_xyz.size(); ++i) {
         gx.push_back(ate.gt_xyz[i].x()), gy.push_back(ate.gt_xyz[i].y());

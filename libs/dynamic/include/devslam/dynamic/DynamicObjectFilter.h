@@ -91,6 +91,12 @@ struct FilterOutput {
     double threshold = 0;  ///< [px] residual threshold used this step (see background_factor)
 };
 
+/// When the filter's pyramidal LK stops iterating on a point (forward and backward tracks;
+/// devslam-filter-bench runs the same LK to measure the forward-backward check).
+[[nodiscard]] inline cv::TermCriteria lkTermination() {
+    return {cv::TermCriteria::COUNT | cv::TermCriteria::EPS, 10, 0.03};
+}
+
 /// Dynamic-object filter. Not thread-safe; consumes frames in order.
 class DynamicObjectFilter {
   public:

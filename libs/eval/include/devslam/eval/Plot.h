@@ -42,6 +42,11 @@ class Plot {
 /// `scale`: a title that names a long path keeps its end (the file, and what is shown).
 [[nodiscard]] std::string fitTextFromTheFront(const std::string& text, int width, double scale);
 
+/// Draws a title in Plot's font and ink, baseline starting at `origin`, shortened from the
+/// front (fitTextFromTheFront) to at most `width` pixels.
+void drawTitle(cv::Mat& canvas, const std::string& text, cv::Point origin, int width,
+               double scale);
+
 /// Blue (0) to red (1) colour ramp, BGR.
 [[nodiscard]] cv::Scalar heatColour(double t);
 
