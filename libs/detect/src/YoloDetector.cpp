@@ -1,5 +1,7 @@
 #include <devslam/detect/YoloDetector.h>
 
+#include <devslam/detect/FastConvolution.h>
+
 #include <devslam/core/Config.h>
 
 #include <mrpt/config/CConfigFileBase.h>
@@ -9,6 +11,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <sstream>
 #include <stdexcept>
 
@@ -57,7 +60,8 @@ std::vector<std::string> readNames(const std::string& path) {
 
 const std::vector<std::string> kYoloKeys{
     "detector",     "model",          "weights",       "names",   "input_width",
-    "input_height", "conf_threshold", "nms_threshold", "classes", "validate_on_load"};
+    "input_height", "conf_threshold", "nms_threshold", "classes", "validate_on_load",
+    "fast_convolutions"};
 }  // namespace
 
 std::string resolveModelPath(const std::string& path, const std::string& what) {
@@ -97,6 +101,7 @@ void YoloDetector::Options::loadFromConfig(const mrpt::config::CConfigFileBase& 
     nms_threshold = static_cast<float>(core::readDouble(c, s, "nms_threshold", nms_threshold));
     if (c.keyExists(s, "classes")) classes = splitList(c.read_string(s, "classes", ""));
     validate_on_load = core::readBool(c, s, "validate_on_load", validate_on_load);
+    fast_convolutions = core::readBool(c, s, "fast_convolutions", fast_convolutions);
     core::requireValue(input_width > 0 && input_width % 32 == 0, s, "input_width",
                        "must be a positive multiple of 32");
     core::requireValue(input_height > 0 && input_height % 32 == 0, s, "input_height",
@@ -122,6 +127,7 @@ void YoloDetector::Options::saveToConfig(mrpt::config::CConfigFileBase& c,
     for (const auto& n : classes) list += (list.empty() ? "" : ", ") + n;
     c.write(s, "classes", list);
     c.write(s, "validate_on_load", validate_on_load);
+    c.write(s, "fast_convolutions", fast_convolutions);
 }
 
 YoloDetector::YoloDetector(const Options& opts) : opts_(opts) {
@@ -135,9 +141,12 @@ YoloDetector::YoloDetector(const Options& opts) : opts_(opts) {
         wanted_.push_back(static_cast<int>(it - names_.begin()));
     }
     std::string weights;
+    const auto read = [&](const std::function<cv::dnn::Net()>& reader) {
+        return opts_.fast_convolutions ? withFastConvolutions(reader) : reader();
+    };
     try {
         if (onnx_) {
-            net_ = cv::dnn::readNetFromONNX(model);
+            net_ = read([&] { return cv::dnn::readNetFromONNX(model); });
         } else {
             weights = resolveModelPath(opts_.weights, "yolo weights");
             // A truncated or foreign file must not silently give a half-loaded network.
@@ -145,7 +154,7 @@ YoloDetector::YoloDetector(const Options& opts) : opts_(opts) {
                 throw std::runtime_error("yolo weights '" + weights + "' is too small (" +
                                          std::to_string(fs::file_size(weights)) +
                                          " bytes) to be a darknet weights file");
-            net_ = cv::dnn::readNetFromDarknet(model, weights);
+            net_ = read([&] { return cv::dnn::readNetFromDarknet(model, weights); });
             // cv::dnn reads a truncated weights file without complaint (missing values
             // stay uninitialised): compare the file size with the parameters the cfg needs.
             std::size_t n_params = 0;

@@ -29,9 +29,13 @@ class YoloDetector final : public PersonDetector {
         float nms_threshold = 0.45f;   ///< IoU above which the weaker box is suppressed
         std::vector<std::string> classes{"person"};  ///< classes reported (potentially dynamic)
         bool validate_on_load = true;  ///< run one forward pass at load to catch bad weights
+        /// Depthwise and 1x1 convolutions by detect::withFastConvolutions (AVX2 kernels, same
+        /// output to float rounding); false: all of them by OpenCV's own layer.
+        bool fast_convolutions = true;
 
         /// Keys: model weights names input_width input_height conf_threshold nms_threshold
-        /// classes (comma separated) validate_on_load; unknown keys (besides `detector`) throw.
+        /// classes (comma separated) validate_on_load fast_convolutions; unknown keys
+        /// (besides `detector`) throw.
         void loadFromConfig(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
         void saveToConfig(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
     };
