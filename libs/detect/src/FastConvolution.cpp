@@ -96,171 +96,148 @@ __attribute__((target("avx2,fma"))) inline __m256 activate(__m256 v, const Activ
     return a.on ? _mm256_max_ps(v, _mm256_mul_ps(v, _mm256_set1_ps(a.slope))) : v;
 }
 
-// Depthwise convolution of one channel. The zero-padded input is copied, a band of rows at
-// a time (so that it stays in the L1 cache), split by column phase: column c of padded row r
-// goes to phases[((r - first row) * stride + c % stride) * pw + c / stride], so that every tap
-// reads contiguous memory also at stride 2. `offsets` are the taps' positions there relative
-// to an output's first tap. NB blocks of 8 outputs are summed at once to hide the FMA
-// latency: along a row (`base` + 8 b) or, for rows narrower than that, across rows.
-template <int NB>
-__attribute__((target("avx2,fma"))) void depthwiseRowBlocks(const float* base, const int* offsets,
-                                                             int taps, const float* w, float bias,
-                                                             const Activation& act, float* dst) {
-    __m256 acc[NB];
-    for (int b = 0; b < NB; ++b) acc[b] = _mm256_set1_ps(bias);
+// 8 x 8 transpose: r[i] holds row i on entry and column i on exit.
+__attribute__((target("avx2,fma"))) inline void transpose8(__m256 r[8]) {
+    const __m256 t0 = _mm256_unpacklo_ps(r[0], r[1]), t1 = _mm256_unpackhi_ps(r[0], r[1]);
+    const __m256 t2 = _mm256_unpacklo_ps(r[2], r[3]), t3 = _mm256_unpackhi_ps(r[2], r[3]);
+    const __m256 t4 = _mm256_unpacklo_ps(r[4], r[5]), t5 = _mm256_unpackhi_ps(r[4], r[5]);
+    const __m256 t6 = _mm256_unpacklo_ps(r[6], r[7]), t7 = _mm256_unpackhi_ps(r[6], r[7]);
+    const __m256 u0 = _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(1, 0, 1, 0));
+    const __m256 u1 = _mm256_shuffle_ps(t0, t2, _MM_SHUFFLE(3, 2, 3, 2));
+    const __m256 u2 = _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(1, 0, 1, 0));
+    const __m256 u3 = _mm256_shuffle_ps(t1, t3, _MM_SHUFFLE(3, 2, 3, 2));
+    const __m256 u4 = _mm256_shuffle_ps(t4, t6, _MM_SHUFFLE(1, 0, 1, 0));
+    const __m256 u5 = _mm256_shuffle_ps(t4, t6, _MM_SHUFFLE(3, 2, 3, 2));
+    const __m256 u6 = _mm256_shuffle_ps(t5, t7, _MM_SHUFFLE(1, 0, 1, 0));
+    const __m256 u7 = _mm256_shuffle_ps(t5, t7, _MM_SHUFFLE(3, 2, 3, 2));
+    r[0] = _mm256_permute2f128_ps(u0, u4, 0x20);
+    r[1] = _mm256_permute2f128_ps(u1, u5, 0x20);
+    r[2] = _mm256_permute2f128_ps(u2, u6, 0x20);
+    r[3] = _mm256_permute2f128_ps(u3, u7, 0x20);
+    r[4] = _mm256_permute2f128_ps(u0, u4, 0x31);
+    r[5] = _mm256_permute2f128_ps(u1, u5, 0x31);
+    r[6] = _mm256_permute2f128_ps(u2, u6, 0x31);
+    r[7] = _mm256_permute2f128_ps(u3, u7, 0x31);
+}
+
+// Depthwise convolution, 8 channels at a time with one channel per SIMD lane: the group's
+// planes are interleaved ([row][column][8 channels], zero padding included), a band of
+// rows at a time so that they stay in cache, and each output position is one vector FMA per
+// tap. So every row width and stride is as fast as any other (vectorising along a row of 10
+// or 20 outputs leaves lanes idle and at stride 2 needs deinterleaving), and no output
+// position waits on another: NX positions are summed at once to hide the FMA latency.
+struct DepthwiseGroup {
+    const float* planes[kLanes];  // input planes of the group's channels (nullptr: none)
+    float* out[kLanes];           // output planes (nullptr: none)
+    const float* w;               // [tap][8] weights, lane = channel
+    const float* bias;            // [8]
+};
+
+template <int NX>
+__attribute__((target("avx2,fma"))) void depthwisePositions(const float* src, int step,
+                                                            const int* offsets, int taps,
+                                                            const float* w, const float* bias,
+                                                            const Activation& act, float* dst) {
+    __m256 acc[NX];
+    const __m256 b = _mm256_loadu_ps(bias);
+    for (int j = 0; j < NX; ++j) acc[j] = b;
     for (int t = 0; t < taps; ++t) {
-        const float* src = base + offsets[t];
-        const __m256 wv = _mm256_set1_ps(w[t]);
-        for (int b = 0; b < NB; ++b)
-            acc[b] = _mm256_fmadd_ps(_mm256_loadu_ps(src + b * kLanes), wv, acc[b]);
+        const __m256 wv = _mm256_loadu_ps(w + t * kLanes);
+        const float* p = src + offsets[t];
+        for (int j = 0; j < NX; ++j)
+            acc[j] = _mm256_fmadd_ps(_mm256_loadu_ps(p + j * step), wv, acc[j]);
     }
-    for (int b = 0; b < NB; ++b) _mm256_storeu_ps(dst + b * kLanes, activate(acc[b], act));
+    for (int j = 0; j < NX; ++j) _mm256_storeu_ps(dst + j * kLanes, activate(acc[j], act));
 }
 
-template <int NB>
-__attribute__((target("avx2,fma"))) void depthwiseScattered(const float* const* bases,
-                                                             const int* offsets, int taps,
-                                                             const float* w, float bias,
-                                                             const Activation& act,
-                                                             float* const* dsts) {
-    __m256 acc[NB];
-    for (int b = 0; b < NB; ++b) acc[b] = _mm256_set1_ps(bias);
-    for (int t = 0; t < taps; ++t) {
-        const __m256 wv = _mm256_set1_ps(w[t]);
-        for (int b = 0; b < NB; ++b)
-            acc[b] = _mm256_fmadd_ps(_mm256_loadu_ps(bases[b] + offsets[t]), wv, acc[b]);
-    }
-    for (int b = 0; b < NB; ++b) _mm256_storeu_ps(dsts[b], activate(acc[b], act));
-}
-
-// Padded row r of the input into its phase rows at `dst`; `row` is scratch of at least
-// max(stride * pw, w + 2 pad) floats whose padding columns are zero.
-__attribute__((target("avx2,fma"))) void copyPhases(const float* in, int h, int w, int pad,
-                                                     int stride, int pw, int r, float* row,
-                                                     float* dst) {
-    const int iy = r - pad;
-    if (iy < 0 || iy >= h) {
-        std::fill(dst, dst + static_cast<std::ptrdiff_t>(stride) * pw, 0.f);
-        return;
-    }
-    const float* src = in + static_cast<std::ptrdiff_t>(iy) * w;
-    if (stride == 1) {
-        std::fill(dst, dst + pad, 0.f);
-        std::memcpy(dst + pad, src, sizeof(float) * static_cast<std::size_t>(w));
-        std::fill(dst + pad + w, dst + pw, 0.f);
-        return;
-    }
-    // stride 2: even columns to phase 0, odd ones to phase 1
-    std::memcpy(row + pad, src, sizeof(float) * static_cast<std::size_t>(w));
-    float* even = dst;
-    float* odd = dst + pw;
-    int j = 0;
-    for (; j + kLanes <= pw; j += kLanes) {
-        const __m256 a = _mm256_loadu_ps(row + 2 * j);
-        const __m256 b = _mm256_loadu_ps(row + 2 * j + kLanes);
-        // per 128-bit lane: a0 a2 b0 b2 | a4 a6 b4 b6 -> reorder the 64-bit pairs
-        const __m256 e = _mm256_shuffle_ps(a, b, _MM_SHUFFLE(2, 0, 2, 0));
-        const __m256 o = _mm256_shuffle_ps(a, b, _MM_SHUFFLE(3, 1, 3, 1));
-        _mm256_storeu_ps(even + j, _mm256_castpd_ps(_mm256_permute4x64_pd(
-                                       _mm256_castps_pd(e), _MM_SHUFFLE(3, 1, 2, 0))));
-        _mm256_storeu_ps(odd + j, _mm256_castpd_ps(_mm256_permute4x64_pd(
-                                      _mm256_castps_pd(o), _MM_SHUFFLE(3, 1, 2, 0))));
-    }
-    for (; j < pw; ++j) {
-        even[j] = row[2 * j];
-        odd[j] = row[2 * j + 1];
-    }
-}
-
-__attribute__((target("avx2,fma"))) void depthwiseChannel(const Shape& s, const float* in, int h,
-                                                          int w, float* out, int oh, int ow,
-                                                          const float* weights, float bias,
-                                                          const Activation& act) {
-    constexpr int kGroup = 4;
-    const int pw = roundUp(ow, kLanes) + (s.k - 1) / s.stride + 1;  // phase row length read
-    const int phase_row = s.stride * pw;          // floats per padded input row
-    const std::ptrdiff_t out_step = static_cast<std::ptrdiff_t>(s.stride) * phase_row;
-    // Output rows per band: its input rows take about 16 KiB.
-    const int band = std::clamp((4096 / phase_row - s.k) / s.stride + 1, 1, oh);
-    const int band_rows = (band - 1) * s.stride + s.k;
-    thread_local std::vector<float> phases, row, tmp;
-    phases.resize(static_cast<std::size_t>(band_rows) * phase_row);
-    row.assign(static_cast<std::size_t>(std::max(phase_row, w + 2 * s.pad)), 0.f);
-    tmp.resize(kGroup * kLanes);
-    // Tap (ky, kx) of output (oy, ox) reads padded row oy * stride + ky, column
-    // ox * stride + kx, i.e. phase kx % stride at ox + kx / stride.
+__attribute__((target("avx2,fma"))) void depthwiseGroup(const Shape& s, const DepthwiseGroup& g,
+                                                        int h, int w, int oh, int ow,
+                                                        const Activation& act) {
+    constexpr int kNx = 4;
+    const int wp = (ow - 1) * s.stride + s.k;  // padded columns read
+    const int row_floats = wp * kLanes;
+    // Output rows per band: its interleaved input takes about 64 KiB.
+    const int band = std::clamp((16384 / row_floats - s.k) / s.stride + 1, 1, oh);
+    thread_local std::vector<float> buf, res;
+    buf.resize(static_cast<std::size_t>((band - 1) * s.stride + s.k) * row_floats);
+    res.resize(static_cast<std::size_t>(roundUp(ow, kLanes)) * kLanes);
     int offsets[7 * 7];
     const int taps = s.k * s.k;
     for (int ky = 0; ky < s.k; ++ky)
-        for (int kx = 0; kx < s.k; ++kx)
-            offsets[ky * s.k + kx] = ky * phase_row + (kx % s.stride) * pw + kx / s.stride;
-
-    // Narrow rows: blocks gathered across rows. A block that ends past its row is computed
-    // into `tmp` and copied, here and below: past the row is the next row or the next
-    // channel, which another thread may be writing.
-    const float* bases[kGroup];
-    float* dsts[kGroup];
-    float* partial_dst[kGroup];
-    int partial_len[kGroup];
-    int n = 0;
-    const auto flush = [&] {
-        switch (n) {
-            case 4: depthwiseScattered<4>(bases, offsets, taps, weights, bias, act, dsts); break;
-            case 3: depthwiseScattered<3>(bases, offsets, taps, weights, bias, act, dsts); break;
-            case 2: depthwiseScattered<2>(bases, offsets, taps, weights, bias, act, dsts); break;
-            case 1: depthwiseScattered<1>(bases, offsets, taps, weights, bias, act, dsts); break;
-            default: break;
-        }
-        for (int b = 0; b < n; ++b)
-            if (partial_len[b] > 0)
-                std::memcpy(partial_dst[b], dsts[b],
-                            sizeof(float) * static_cast<std::size_t>(partial_len[b]));
-        n = 0;
-    };
+        for (int kx = 0; kx < s.k; ++kx) offsets[ky * s.k + kx] = (ky * wp + kx) * kLanes;
+    const __m256 zero = _mm256_setzero_ps();
 
     for (int oy0 = 0; oy0 < oh; oy0 += band) {
         const int oy1 = std::min(oh, oy0 + band);
         const int r0 = oy0 * s.stride;
-        for (int r = r0; r < (oy1 - 1) * s.stride + s.k; ++r)
-            copyPhases(in, h, w, s.pad, s.stride, pw, r, row.data(),
-                       phases.data() + static_cast<std::ptrdiff_t>(r - r0) * phase_row);
-        for (int oy = oy0; oy < oy1; ++oy) {
-            const float* base = phases.data() + (oy - oy0) * out_step;
-            float* yrow = out + static_cast<std::ptrdiff_t>(oy) * ow;
-            if (ow < kGroup * kLanes) {
-                for (int ox = 0; ox < ow; ox += kLanes) {
-                    const bool partial = ox + kLanes > ow;
-                    bases[n] = base + ox;
-                    partial_len[n] = partial ? ow - ox : 0;
-                    partial_dst[n] = yrow + ox;
-                    dsts[n] = partial ? tmp.data() + n * kLanes : yrow + ox;
-                    if (++n == kGroup) flush();
-                }
+        const int r1 = (oy1 - 1) * s.stride + s.k;
+        for (int r = r0; r < r1; ++r) {  // interleave padded rows r0..r1-1
+            float* dst = buf.data() + static_cast<std::ptrdiff_t>(r - r0) * row_floats;
+            const int iy = r - s.pad;
+            if (iy < 0 || iy >= h) {
+                std::fill(dst, dst + row_floats, 0.f);
                 continue;
             }
+            // columns [0, pad) and [pad + w, wp) are padding
+            for (int px = 0; px < std::min(s.pad, wp); ++px)
+                _mm256_storeu_ps(dst + px * kLanes, zero);
+            for (int px = s.pad + w; px < wp; ++px) _mm256_storeu_ps(dst + px * kLanes, zero);
+            const int cols = std::min(w, wp - s.pad);  // input columns read
+            int ix = 0;
+            for (; ix + kLanes <= cols; ix += kLanes) {
+                __m256 v[kLanes];
+                for (int c = 0; c < kLanes; ++c)
+                    v[c] = g.planes[c] ? _mm256_loadu_ps(g.planes[c] +
+                                                         static_cast<std::ptrdiff_t>(iy) * w + ix)
+                                       : zero;
+                transpose8(v);
+                for (int j = 0; j < kLanes; ++j)
+                    _mm256_storeu_ps(dst + (s.pad + ix + j) * kLanes, v[j]);
+            }
+            for (; ix < cols; ++ix)
+                for (int c = 0; c < kLanes; ++c)
+                    dst[(s.pad + ix) * kLanes + c] =
+                        g.planes[c] ? g.planes[c][static_cast<std::ptrdiff_t>(iy) * w + ix] : 0.f;
+        }
+        for (int oy = oy0; oy < oy1; ++oy) {
+            const float* row = buf.data() + static_cast<std::ptrdiff_t>(oy - oy0) * s.stride *
+                                                row_floats;
+            const int step = s.stride * kLanes;
             int ox = 0;
-            for (; ox + kGroup * kLanes <= ow; ox += kGroup * kLanes)
-                depthwiseRowBlocks<4>(base + ox, offsets, taps, weights, bias, act, yrow + ox);
-            switch ((ow - ox) / kLanes) {
+            for (; ox + kNx <= ow; ox += kNx)
+                depthwisePositions<kNx>(row + ox * step, step, offsets, taps, g.w, g.bias, act,
+                                        res.data() + ox * kLanes);
+            switch (ow - ox) {
                 case 3:
-                    depthwiseRowBlocks<3>(base + ox, offsets, taps, weights, bias, act, yrow + ox);
+                    depthwisePositions<3>(row + ox * step, step, offsets, taps, g.w, g.bias, act,
+                                          res.data() + ox * kLanes);
                     break;
                 case 2:
-                    depthwiseRowBlocks<2>(base + ox, offsets, taps, weights, bias, act, yrow + ox);
+                    depthwisePositions<2>(row + ox * step, step, offsets, taps, g.w, g.bias, act,
+                                          res.data() + ox * kLanes);
                     break;
                 case 1:
-                    depthwiseRowBlocks<1>(base + ox, offsets, taps, weights, bias, act, yrow + ox);
+                    depthwisePositions<1>(row + ox * step, step, offsets, taps, g.w, g.bias, act,
+                                          res.data() + ox * kLanes);
                     break;
                 default:
                     break;
             }
-            ox += (ow - ox) / kLanes * kLanes;
-            if (ox < ow) {
-                depthwiseRowBlocks<1>(base + ox, offsets, taps, weights, bias, act, tmp.data());
-                std::memcpy(yrow + ox, tmp.data(), sizeof(float) * static_cast<std::size_t>(ow - ox));
+            // back to planes
+            int x = 0;
+            for (; x + kLanes <= ow; x += kLanes) {
+                __m256 v[kLanes];
+                for (int j = 0; j < kLanes; ++j) v[j] = _mm256_loadu_ps(res.data() + (x + j) * kLanes);
+                transpose8(v);
+                for (int c = 0; c < kLanes; ++c)
+                    if (g.out[c])
+                        _mm256_storeu_ps(g.out[c] + static_cast<std::ptrdiff_t>(oy) * ow + x, v[c]);
             }
+            for (; x < ow; ++x)
+                for (int c = 0; c < kLanes; ++c)
+                    if (g.out[c])
+                        g.out[c][static_cast<std::ptrdiff_t>(oy) * ow + x] = res[x * kLanes + c];
         }
-        flush();  // the band's phases are overwritten next
     }
 }
 
@@ -395,9 +372,22 @@ class FastConvolutionLayer final : public cv::dnn::Layer {
     }
 
   private:
-    // Pointwise weights in blocks of kPwRows output channels, zero rows past the last one.
+    // Weights in the kernels' layouts, zeros past the last channel: see each branch.
     void pack() {
-        if (shape_.kind != Shape::Pointwise) return;
+        if (shape_.kind == Shape::Depthwise) {  // [channel / 8][tap][channel % 8]
+            const int groups = (shape_.cout + kLanes - 1) / kLanes;
+            const int taps = shape_.k * shape_.k;
+            packed_.assign(static_cast<std::size_t>(groups) * taps * kLanes, 0.f);
+            packed_bias_.assign(static_cast<std::size_t>(groups) * kLanes, 0.f);
+            for (int ch = 0; ch < shape_.cout; ++ch) {
+                const int g = ch / kLanes, lane = ch % kLanes;
+                for (int t = 0; t < taps; ++t)
+                    packed_[(static_cast<std::size_t>(g) * taps + t) * kLanes + lane] =
+                        weights_[static_cast<std::size_t>(ch) * taps + t];
+                packed_bias_[static_cast<std::size_t>(g) * kLanes + lane] = bias_[ch];
+            }
+            return;
+        }
         const int blocks = (shape_.cout + kPwRows - 1) / kPwRows;
         packed_.assign(static_cast<std::size_t>(blocks) * shape_.cin * kPwRows, 0.f);
         packed_bias_.assign(static_cast<std::size_t>(blocks) * kPwRows, 0.f);
@@ -415,21 +405,29 @@ class FastConvolutionLayer final : public cv::dnn::Layer {
     void forwardDepthwise(const cv::Mat& x, cv::Mat& y) const {
         const int n = x.size[0], c = x.size[1], h = x.size[2], w = x.size[3];
         const int oh = y.size[2], ow = y.size[3];
-        const int kk = shape_.k * shape_.k;
+        const int groups = (c + kLanes - 1) / kLanes;
         const float* in = x.ptr<float>();
         float* out = y.ptr<float>();
         cv::parallel_for_(
-            cv::Range(0, n * c),
+            cv::Range(0, n * groups),
             [&](const cv::Range& r) {
                 for (int t = r.start; t < r.end; ++t) {
-                    const int ch = t % c;
-                    depthwiseChannel(shape_, in + static_cast<std::ptrdiff_t>(t) * h * w, h, w,
-                                     out + static_cast<std::ptrdiff_t>(t) * oh * ow, oh, ow,
-                                     weights_.data() + static_cast<std::ptrdiff_t>(ch) * kk,
-                                     bias_[ch], act_);
+                    const int img = t / groups, g = t % groups;
+                    DepthwiseGroup dg{};
+                    for (int lane = 0; lane < kLanes; ++lane) {
+                        const int ch = g * kLanes + lane;
+                        if (ch >= c) break;
+                        const std::ptrdiff_t plane = static_cast<std::ptrdiff_t>(img) * c + ch;
+                        dg.planes[lane] = in + plane * h * w;
+                        dg.out[lane] = out + plane * oh * ow;
+                    }
+                    dg.w = packed_.data() + static_cast<std::ptrdiff_t>(g) * shape_.k * shape_.k *
+                                                kLanes;
+                    dg.bias = packed_bias_.data() + static_cast<std::ptrdiff_t>(g) * kLanes;
+                    depthwiseGroup(shape_, dg, h, w, oh, ow, act_);
                 }
             },
-            stripes(n * c));
+            stripes(n * groups));
     }
 
     void forwardPointwise(const cv::Mat& x, cv::Mat& y) const {
@@ -437,59 +435,74 @@ class FastConvolutionLayer final : public cv::dnn::Layer {
         const int p = x.size[2] * x.size[3];
         const int tiles = (p + kPwCols - 1) / kPwCols;
         const int blocks = (cout + kPwRows - 1) / kPwRows;
+        // Tiles per task: their input panel takes about 32 KiB.
+        const int chunk = std::clamp(8192 / (cin * kPwCols), 1, tiles);
+        const int chunks = (tiles + chunk - 1) / chunk;
         const float* in = x.ptr<float>();
         float* out = y.ptr<float>();
-        // One task per tile of pixels: its input is copied once into a contiguous panel
+        // A task copies the input of `chunk` tiles into a contiguous panel, tile after tile
         // (rows of the input tensor lie a whole plane apart, often a multiple of 4 KiB, so
-        // reading them in place thrashes one set of the L1 cache) and then multiplied by
-        // every block of output channels.
+        // reading them in place thrashes one set of the L1 cache), then computes each block
+        // of output channels over all its tiles: 4 output planes written along a run of
+        // pixels, not 4 x 24 pixels in each of all planes in turn.
         cv::parallel_for_(
-            cv::Range(0, n * tiles),
+            cv::Range(0, n * chunks),
             [&](const cv::Range& r) {
                 thread_local std::vector<float> panel, dst_tmp;
-                panel.resize(static_cast<std::size_t>(cin) * kPwCols);
+                panel.resize(static_cast<std::size_t>(chunk) * cin * kPwCols);
                 dst_tmp.resize(static_cast<std::size_t>(kPwRows) * kPwCols);
                 for (int t = r.start; t < r.end; ++t) {
-                    const int tile = t % tiles;
-                    const int img = t / tiles;
-                    const int p0 = tile * kPwCols;
-                    const int cols = std::min(kPwCols, p - p0);
-                    const float* src = in + static_cast<std::ptrdiff_t>(img) * cin * p + p0;
-                    if (cols < kPwCols) std::fill(panel.begin(), panel.end(), 0.f);
-                    for (int ci = 0; ci < cin; ++ci)
-                        std::memcpy(panel.data() + static_cast<std::ptrdiff_t>(ci) * kPwCols,
-                                    src + static_cast<std::ptrdiff_t>(ci) * p,
-                                    sizeof(float) * static_cast<std::size_t>(cols));
+                    const int img = t / chunks;
+                    const int tile0 = (t % chunks) * chunk;
+                    const int ntiles = std::min(chunk, tiles - tile0);
+                    const float* src = in + static_cast<std::ptrdiff_t>(img) * cin * p;
+                    for (int i = 0; i < ntiles; ++i) {
+                        const int p0 = (tile0 + i) * kPwCols;
+                        const int cols = std::min(kPwCols, p - p0);
+                        float* dst = panel.data() + static_cast<std::ptrdiff_t>(i) * cin * kPwCols;
+                        for (int ci = 0; ci < cin; ++ci) {
+                            float* d = dst + static_cast<std::ptrdiff_t>(ci) * kPwCols;
+                            std::memcpy(d, src + static_cast<std::ptrdiff_t>(ci) * p + p0,
+                                        sizeof(float) * static_cast<std::size_t>(cols));
+                            std::fill(d + cols, d + kPwCols, 0.f);
+                        }
+                    }
                     for (int b = 0; b < blocks; ++b) {
                         const int rows = std::min(kPwRows, cout - b * kPwRows);
-                        float* dst = out +
-                                     (static_cast<std::ptrdiff_t>(img) * cout + b * kPwRows) * p +
-                                     p0;
                         const float* wp =
                             packed_.data() + static_cast<std::ptrdiff_t>(b) * cin * kPwRows;
                         const float* bp = packed_bias_.data() + b * kPwRows;
-                        if (cols == kPwCols) {
-                            pointwiseTile(panel.data(), kPwCols, cin, wp, bp, act_, dst, p, rows);
-                            continue;
+                        float* dst_block =
+                            out + (static_cast<std::ptrdiff_t>(img) * cout + b * kPwRows) * p;
+                        for (int i = 0; i < ntiles; ++i) {
+                            const int p0 = (tile0 + i) * kPwCols;
+                            const int cols = std::min(kPwCols, p - p0);
+                            const float* tile_in =
+                                panel.data() + static_cast<std::ptrdiff_t>(i) * cin * kPwCols;
+                            if (cols == kPwCols) {
+                                pointwiseTile(tile_in, kPwCols, cin, wp, bp, act_, dst_block + p0,
+                                              p, rows);
+                                continue;
+                            }
+                            // A partial tile: stores stay inside the output tensor.
+                            pointwiseTile(tile_in, kPwCols, cin, wp, bp, act_, dst_tmp.data(),
+                                          kPwCols, rows);
+                            for (int j = 0; j < rows; ++j)
+                                std::memcpy(dst_block + static_cast<std::ptrdiff_t>(j) * p + p0,
+                                            dst_tmp.data() + static_cast<std::ptrdiff_t>(j) * kPwCols,
+                                            sizeof(float) * static_cast<std::size_t>(cols));
                         }
-                        // A partial tile: stores stay inside the output tensor.
-                        pointwiseTile(panel.data(), kPwCols, cin, wp, bp, act_, dst_tmp.data(),
-                                      kPwCols, rows);
-                        for (int j = 0; j < rows; ++j)
-                            std::memcpy(dst + static_cast<std::ptrdiff_t>(j) * p,
-                                        dst_tmp.data() + static_cast<std::ptrdiff_t>(j) * kPwCols,
-                                        sizeof(float) * static_cast<std::size_t>(cols));
                     }
                 }
             },
-            stripes(n * tiles));
+            stripes(n * chunks));
     }
 
     Shape shape_;
     std::vector<float> weights_;  // [cout][cin / group][k][k], batch norm fused in
     std::vector<float> bias_;     // [cout], batch norm fused in
     Activation act_;
-    std::vector<float> packed_, packed_bias_;  // pointwise only, see pack()
+    std::vector<float> packed_, packed_bias_;  // see pack()
 };
 
 cv::Ptr<cv::dnn::Layer> createConvolution(LayerParams& params) {
