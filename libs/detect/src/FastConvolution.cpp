@@ -154,6 +154,14 @@ __attribute__((target("avx2,fma"))) void depthwiseGroup(const Shape& s, const De
                                                         int h, int w, int oh, int ow,
                                                         const Activation& act) {
     constexpr int kNx = 6;
+    using Positions = void (*)(const float*, int, const int*, int, const float*, const float*,
+                               const Activation&, float*);
+    static constexpr Positions kRest[kNx] = {nullptr,
+                                             depthwisePositions<1>,
+                                             depthwisePositions<2>,
+                                             depthwisePositions<3>,
+                                             depthwisePositions<4>,
+                                             depthwisePositions<5>};
     const int wp = (ow - 1) * s.stride + s.k;  // padded columns read
     const int row_floats = wp * kLanes;
     // Output rows per band: its interleaved input takes about 64 KiB.
@@ -207,30 +215,9 @@ __attribute__((target("avx2,fma"))) void depthwiseGroup(const Shape& s, const De
             for (; ox + kNx <= ow; ox += kNx)
                 depthwisePositions<kNx>(row + ox * step, step, offsets, taps, g.w, g.bias, act,
                                         res.data() + ox * kLanes);
-            switch (ow - ox) {
-                case 5:
-                    depthwisePositions<5>(row + ox * step, step, offsets, taps, g.w, g.bias, act,
-                                          res.data() + ox * kLanes);
-                    break;
-                case 4:
-                    depthwisePositions<4>(row + ox * step, step, offsets, taps, g.w, g.bias, act,
-                                          res.data() + ox * kLanes);
-                    break;
-                case 3:
-                    depthwisePositions<3>(row + ox * step, step, offsets, taps, g.w, g.bias, act,
-                                          res.data() + ox * kLanes);
-                    break;
-                case 2:
-                    depthwisePositions<2>(row + ox * step, step, offsets, taps, g.w, g.bias, act,
-                                          res.data() + ox * kLanes);
-                    break;
-                case 1:
-                    depthwisePositions<1>(row + ox * step, step, offsets, taps, g.w, g.bias, act,
-                                          res.data() + ox * kLanes);
-                    break;
-                default:
-                    break;
-            }
+            if (ox < ow)  // the row's last 1 to kNx - 1 positions
+                kRest[ow - ox](row + ox * step, step, offsets, taps, g.w, g.bias, act,
+                               res.data() + ox * kLanes);
             // back to planes
             int x = 0;
             for (; x + kLanes <= ow; x += kLanes) {
