@@ -249,6 +249,14 @@ __attribute__((target("avx2,fma"))) inline void storeRow(float* d, const Activat
     _mm256_storeu_ps(d + 2 * kLanes, activate(v2, act));
 }
 
+// c_v += a_v * w for v = 0, 1, 2 (one output channel, 24 pixels).
+__attribute__((target("avx2,fma"))) inline void fmaRow(__m256 a0, __m256 a1, __m256 a2, __m256 w,
+                                                       __m256& c0, __m256& c1, __m256& c2) {
+    c0 = _mm256_fmadd_ps(a0, w, c0);
+    c1 = _mm256_fmadd_ps(a1, w, c1);
+    c2 = _mm256_fmadd_ps(a2, w, c2);
+}
+
 __attribute__((target("avx2,fma"))) void pointwiseTile(const float* src, std::ptrdiff_t src_stride,
                                                         int cin, const float* packed,
                                                         const float* bias4,
@@ -266,22 +274,10 @@ __attribute__((target("avx2,fma"))) void pointwiseTile(const float* src, std::pt
         const __m256 a1 = _mm256_loadu_ps(x + kLanes);
         const __m256 a2 = _mm256_loadu_ps(x + 2 * kLanes);
         const float* wp = packed + static_cast<std::ptrdiff_t>(ci) * kPwRows;
-        __m256 w = _mm256_broadcast_ss(wp);
-        c00 = _mm256_fmadd_ps(a0, w, c00);
-        c01 = _mm256_fmadd_ps(a1, w, c01);
-        c02 = _mm256_fmadd_ps(a2, w, c02);
-        w = _mm256_broadcast_ss(wp + 1);
-        c10 = _mm256_fmadd_ps(a0, w, c10);
-        c11 = _mm256_fmadd_ps(a1, w, c11);
-        c12 = _mm256_fmadd_ps(a2, w, c12);
-        w = _mm256_broadcast_ss(wp + 2);
-        c20 = _mm256_fmadd_ps(a0, w, c20);
-        c21 = _mm256_fmadd_ps(a1, w, c21);
-        c22 = _mm256_fmadd_ps(a2, w, c22);
-        w = _mm256_broadcast_ss(wp + 3);
-        c30 = _mm256_fmadd_ps(a0, w, c30);
-        c31 = _mm256_fmadd_ps(a1, w, c31);
-        c32 = _mm256_fmadd_ps(a2, w, c32);
+        fmaRow(a0, a1, a2, _mm256_broadcast_ss(wp), c00, c01, c02);
+        fmaRow(a0, a1, a2, _mm256_broadcast_ss(wp + 1), c10, c11, c12);
+        fmaRow(a0, a1, a2, _mm256_broadcast_ss(wp + 2), c20, c21, c22);
+        fmaRow(a0, a1, a2, _mm256_broadcast_ss(wp + 3), c30, c31, c32);
     }
     storeRow(dst, act, c00, c01, c02);
     if (rows > 1) storeRow(dst + dst_stride, act, c10, c11, c12);
