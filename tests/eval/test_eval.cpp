@@ -359,3 +359,35 @@ TEST(Plot, LongTitleStaysInsideItsArea) {
     cv::cvtColor(canvas(cv::Rect(0, 0, 300, 30)), gray, cv::COLOR_BGR2GRAY);
     EXPECT_GT(cv::countNonZero(gray < 128), 50) << "the title is drawn";
 }
+
+TEST(Plot, LegendGoesToTheCornerWithoutData) {
+    // A trajectory in the top-left corner (where the legend used to be drawn) and along the
+    // right edge: the legend goes to the bottom left, the only free corner.
+    const cv::Scalar data(0, 0, 255), key(0, 200, 0);
+    std::vector<double> xs, ys;
+    for (int i = 0; i <= 40; ++i) {
+        xs.push_back(0.02 * i), ys.push_back(0.98);  // top left to top middle
+        xs.push_back(1.0), ys.push_back(0.025 * i);  // right edge, bottom to top
+    }
+    cv::Mat canvas(400, 400, CV_8UC3, cv::Scalar(255, 255, 255));
+    eval::Plot p(cv::Rect(0, 0, 400, 400), "t", "x [m]", "y [m]");
+    p.fit({0.0, 1.0}, {0.0, 1.0});
+    p.axes(canvas);
+    p.points(canvas, xs, ys, {data}, 3);
+    p.legend(canvas, {{"a long legend label", key}}, xs, ys);
+    const auto inkOf = [&](const cv::Scalar& colour, const cv::Rect& r) {
+        cv::Mat hit;
+        cv::inRange(canvas(r), colour, colour, hit);
+        return cv::countNonZero(hit);
+    };
+    const cv::Rect top_left(0, 0, 200, 200), bottom_left(0, 200, 200, 200);
+    EXPECT_EQ(inkOf(key, top_left), 0) << "legend drawn over the data";
+    EXPECT_GT(inkOf(key, bottom_left), 10) << "legend not in the free corner";
+    EXPECT_GT(inkOf(data, top_left), 100) << "the data stays visible";
+    // Without points to avoid it keeps the top-left corner.
+    cv::Mat plain(400, 400, CV_8UC3, cv::Scalar(255, 255, 255));
+    p.legend(plain, {{"a long legend label", key}});
+    cv::Mat hit;
+    cv::inRange(plain(top_left), key, key, hit);
+    EXPECT_GT(cv::countNonZero(hit), 10);
+}

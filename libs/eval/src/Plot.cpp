@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <string>
 
@@ -120,13 +121,38 @@ void Plot::points(cv::Mat& c, const std::vector<double>& xs, const std::vector<d
                    bgr.empty() ? kInk : bgr[std::min(i, bgr.size() - 1)], cv::FILLED, cv::LINE_AA);
 }
 
-void Plot::legend(cv::Mat& c, const std::vector<std::pair<std::string, cv::Scalar>>& items) const {
-    int y = inner_.y + 15;
+void Plot::legend(cv::Mat& c, const std::vector<std::pair<std::string, cv::Scalar>>& items,
+                  const std::vector<double>& avoid_xs, const std::vector<double>& avoid_ys) const {
+    constexpr double kScale = 0.42;
+    constexpr int kRow = 16, kMargin = 4;
+    int text = 0;
+    for (const auto& item : items)
+        text = std::max(text,
+                        cv::getTextSize(item.first, cv::FONT_HERSHEY_SIMPLEX, kScale, 1, nullptr)
+                            .width);
+    const cv::Size size(34 + text + 6, kRow * static_cast<int>(items.size()) + 6);
+    const int left = inner_.x + kMargin, right = inner_.x + inner_.width - kMargin - size.width;
+    const int top = inner_.y + kMargin, bottom = inner_.y + inner_.height - kMargin - size.height;
+    const std::vector<cv::Rect> corners{{{left, top}, size},
+                                        {{right, top}, size},
+                                        {{left, bottom}, size},
+                                        {{right, bottom}, size}};
+    cv::Rect box = corners.front();
+    std::size_t fewest = SIZE_MAX;
+    for (const auto& r : corners) {
+        std::size_t covered = 0;
+        for (std::size_t i = 0; i < std::min(avoid_xs.size(), avoid_ys.size()); ++i)
+            covered += r.contains(toPixel(avoid_xs[i], avoid_ys[i])) ? 1 : 0;
+        if (covered < fewest) fewest = covered, box = r;
+    }
+    cv::rectangle(c, box, cv::Scalar(255, 255, 255), cv::FILLED);
+    cv::rectangle(c, box, cv::Scalar(200, 200, 200), 1);
+    int y = box.y + 15;
     for (const auto& [label, colour] : items) {
-        cv::line(c, {inner_.x + 8, y - 4}, {inner_.x + 28, y - 4}, colour, 2, cv::LINE_AA);
-        cv::putText(c, label, {inner_.x + 34, y}, cv::FONT_HERSHEY_SIMPLEX, 0.42, kInk, 1,
+        cv::line(c, {box.x + 6, y - 4}, {box.x + 26, y - 4}, colour, 2, cv::LINE_AA);
+        cv::putText(c, label, {box.x + 32, y}, cv::FONT_HERSHEY_SIMPLEX, kScale, kInk, 1,
                     cv::LINE_AA);
-        y += 16;
+        y += kRow;
     }
 }
 

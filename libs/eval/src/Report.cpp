@@ -117,8 +117,13 @@ void plotAte(const std::string& path, const AteResult& ate, const std::string& t
         cv::line(canvas, top.toPixel(gx[i], gy[i]), top.toPixel(ex[i], ey[i]), colours[i], 1,
                  cv::LINE_AA);
     top.points(canvas, ex, ey, colours, 3);
-    top.legend(canvas, {{"ground truth", cv::Scalar(0, 0, 0)},
-                        {"estimate (blue 0 -> red " + fmt("%.4f", emax) + " m)", heatColour(1.0)}});
+    std::vector<double> all_x = gx, all_y = gy;  // the legend avoids both trajectories
+    all_x.insert(all_x.end(), ex.begin(), ex.end());
+    all_y.insert(all_y.end(), ey.begin(), ey.end());
+    top.legend(canvas,
+               {{"ground truth", cv::Scalar(0, 0, 0)},
+                {"estimate (blue 0 -> red " + fmt("%.4f", emax) + " m)", heatColour(1.0)}},
+               all_x, all_y);
 
     const char* names[3] = {"x", "y", "z"};
     for (int a = 0; a < 3; ++a) {

@@ -28,8 +28,12 @@ class Plot {
               const cv::Scalar& bgr, int thickness = 1) const;
     void points(cv::Mat& canvas, const std::vector<double>& xs, const std::vector<double>& ys,
                 const std::vector<cv::Scalar>& bgr, int radius = 2) const;
-    void legend(cv::Mat& canvas,
-                const std::vector<std::pair<std::string, cv::Scalar>>& items) const;
+    /// Draws the items (a line in their colour, then the label) on a white box in the corner
+    /// of the plot that covers the fewest of the points (avoid_xs, avoid_ys), in data units:
+    /// top left, top right, bottom left, bottom right, the first on a tie.
+    void legend(cv::Mat& canvas, const std::vector<std::pair<std::string, cv::Scalar>>& items,
+                const std::vector<double>& avoid_xs = {},
+                const std::vector<double>& avoid_ys = {}) const;
     [[nodiscard]] cv::Point toPixel(double x, double y) const;
 
   private:
