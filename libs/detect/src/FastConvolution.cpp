@@ -23,8 +23,6 @@ using cv::dnn::LayerParams;
 
 constexpr int kLanes = 8;  // floats in an AVX register
 
-int roundUp(int v, int m) { return (v + m - 1) / m * m; }
-
 // The convolutions handled here.
 struct Shape {
     enum Kind { Depthwise, Pointwise } kind = Pointwise;
@@ -168,7 +166,7 @@ __attribute__((target("avx2,fma"))) void depthwiseGroup(const Shape& s, const De
     const int band = std::clamp((16384 / row_floats - s.k) / s.stride + 1, 1, oh);
     thread_local std::vector<float> buf, res;
     buf.resize(static_cast<std::size_t>((band - 1) * s.stride + s.k) * row_floats);
-    res.resize(static_cast<std::size_t>(roundUp(ow, kLanes)) * kLanes);
+    res.resize(static_cast<std::size_t>(ow) * kLanes);  // [position][8 channels] of a row
     int offsets[7 * 7];
     const int taps = s.k * s.k;
     for (int ky = 0; ky < s.k; ++ky)
