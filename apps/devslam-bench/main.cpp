@@ -280,13 +280,13 @@ int run(int argc, char** argv) {
     fs::create_directories(b.out_dir);
     const auto repeatsOf = [&](const Sequence& q) { return q.repeats > 0 ? q.repeats : b.repeats; };
 
-    // 1. Synthetic sequences: render the missing ones.
+    // 1. Synthetic sequences: render the missing ones, and those whose scenario, room, seed,
+    //    frame count or renderer changed since (devslam-synth --if-changed, render.txt).
     for (const auto& q : b.sequences) {
         if (q.scenario.empty()) continue;
         for (const auto& in : inputsOf(q, b.out_dir)) {
-            if (fs::exists(fs::path(in.path) / "groundtruth.txt")) continue;
-            std::string cmd =
-                quote(bin + "/devslam-synth") + " " + quote(q.scenario) + " -o " + quote(in.path);
+            std::string cmd = quote(bin + "/devslam-synth") + " " + quote(q.scenario) + " -o " +
+                              quote(in.path) + " --if-changed";
             if (in.seed) cmd += " --seed " + std::to_string(*in.seed);
             if (b.max_frames) cmd += " --frames " + std::to_string(b.max_frames);
             std::cout << "rendering " << q.name << ": " << cmd << "\n" << std::flush;

@@ -30,11 +30,13 @@ namespace {
 const char* kUsage =
     "usage: devslam-synth SCENARIO [-o DIR] [--rawlog FILE] [--frames N] [--no-labels]\n"
     "                     [--seed N]  (another render of the scenario: noise, panel crops)\n"
+    "                     [--if-changed]  (skip when DIR already holds this exact render)\n"
     "       devslam-synth --list\n"
     "       devslam-synth --cut-texture IMAGE X,Y,W,H OUT.png\n"
     "SCENARIO: a name from sim_worlds/synth/ (e.g. walking_xyz) or an INI file.\n"
     "Writes a TUM folder (rgb/ depth/ rgb.txt depth.txt groundtruth.txt) plus persons.txt,\n"
-    "labels/, camera.ini and preview.png; default DIR: out/synth/<name>.\n";
+    "labels/, camera.ini and preview.png, and render.txt last (what the render is made of:\n"
+    "scenario and room text, seed, frames); default DIR: out/synth/<name>.\n";
 
 const std::string kSynthDir = std::string(DEVSLAM_SOURCE_DIR) + "/sim_worlds/synth";
 
@@ -107,7 +109,7 @@ int run(int argc, char** argv) {
     std::string scenario_arg, out_dir, rawlog;
     std::size_t frames = 0;
     std::optional<std::uint64_t> seed;
-    bool labels = true;
+    bool labels = true, if_changed = false;
     for (std::size_t i = 0; i < a.size(); ++i) {
         const auto value = [&]() -> std::string {
             if (i + 1 >= a.size()) throw std::invalid_argument(a[i] + " needs a value");
@@ -121,6 +123,8 @@ int run(int argc, char** argv) {
             frames = std::size_t(devslam::core::parseInteger(value(), "--frames", 1));
         else if (a[i] == "--no-labels")
             labels = false;
+        else if (a[i] == "--if-changed")
+            if_changed = true;
         else if (a[i] == "--seed")
             seed = std::uint64_t(devslam::core::parseInteger(value(), "--seed", 0));
         else if (!a[i].empty() && a[i][0] == '-')
@@ -144,6 +148,11 @@ int run(int argc, char** argv) {
     o.rawlog_path = rawlog;
     o.write_labels = labels;
     o.max_frames = frames;
+    if (if_changed && render::isRenderCurrent(sc, o)) {
+        std::cout << "scenario " << sc.name << ": " << out_dir
+                  << " holds this render already (render.txt), not rendered again\n";
+        return 0;
+    }
     const std::size_t n = frames > 0 ? std::min(frames, sc.n_frames) : sc.n_frames;
     core::ProgressBar bar("render " + sc.name, n);
     const auto sum =

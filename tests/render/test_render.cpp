@@ -12,6 +12,7 @@
 #include <devslam/render/SequenceRenderer.h>
 #include <devslam/render/SequenceWriter.h>
 
+#include <opencv2/features2d.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -177,6 +178,29 @@ TEST(RenderGeometry, FrontalWallDepthAndColour) {
     EXPECT_EQ(cv::countNonZero(f.labels), 0);
 }
 
+// `wall_blur` softens the wall photos: the same wall, seen from the same pose, keeps its
+// colours but loses most of its corners (the synthetic office's painted walls, docs/render.md).
+TEST(RenderGeometry, WallBlurKeepsTheColoursAndRemovesCorners) {
+    Scenario sc = bareRoom({2.5, 2.0, 1.5}, {4.0, 2.0, 1.5});
+    sc.K = core::CameraIntrinsics::fromPreset("freiburg3");
+    const auto corners = [](const cv::Mat& bgr) {
+        cv::Mat grey;
+        cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
+        std::vector<cv::KeyPoint> kp;
+        cv::FAST(grey, kp, 20);
+        return kp.size();
+    };
+    const auto sharp = SequenceRenderer(sc).render(0);
+    sc.room.wall_blur = 10;
+    const auto soft = SequenceRenderer(sc).render(0);
+    const auto n_sharp = corners(sharp.frame.bgr), n_soft = corners(soft.frame.bgr);
+    EXPECT_GT(n_sharp, 500u);
+    EXPECT_LT(n_soft * 5, n_sharp) << n_soft << " corners blurred, " << n_sharp << " sharp";
+    const cv::Scalar a = cv::mean(sharp.frame.bgr), b = cv::mean(soft.frame.bgr);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b[c], 8.0) << "channel " << c;
+    EXPECT_EQ(cv::norm(sharp.frame.depth, soft.frame.depth, cv::NORM_INF), 0.0);
+}
+
 TEST(RenderSequence, GroundTruthMatchesPosesUsed) {
     TempDir tmp;
     const Scenario sc = smallShort();
@@ -239,8 +263,47 @@ TEST(RenderSequence, SameSeedSameFilesOtherSeedOtherNoise) {
             differ_c += readFile(e.path().string()) != readFile(tmp.str("c/" + rel));
         ++compared;
     }
-    EXPECT_EQ(compared, 14u);  // 3 x (rgb, depth, labels) + 4 lists + camera.ini
+    EXPECT_EQ(compared, 15u);  // 3 x (rgb, depth, labels) + 4 lists + camera.ini + render.txt
     EXPECT_EQ(differ_c, 6u) << "another seed must change the noise of every image";
+}
+
+// render.txt, written after the last frame, says what a folder holds: the bench renders a
+// sequence again when its scenario, room, seed or length changed, or when a render stopped.
+TEST(RenderSequence, RenderTxtTellsWhetherAFolderHoldsThisRender) {
+    TempDir tmp;
+    Scenario sc = smallShort();
+    const std::string room = tmp.str("room.ini");
+    std::ofstream(room) << "[room]\nsize = [5 5 3]\n";
+    sc.room.source = room;
+    WriteOptions o;
+    o.out_dir = tmp.str("seq");
+    o.max_frames = 2;
+    EXPECT_FALSE(isRenderCurrent(sc, o)) << "no folder yet";
+    (void)writeSequence(sc, o);
+    EXPECT_TRUE(isRenderCurrent(sc, o));
+    const std::string sig = readFile(o.out_dir + "/render.txt");
+    EXPECT_NE(sig.find("size = [5 5 3]"), std::string::npos) << sig;
+    EXPECT_NE(sig.find("short_walking.ini"), std::string::npos) << sig;
+
+    Scenario other = sc;
+    other.seed += 1;
+    EXPECT_FALSE(isRenderCurrent(other, o)) << "another seed";
+    WriteOptions longer = o;
+    longer.max_frames = 3;
+    EXPECT_FALSE(isRenderCurrent(sc, longer)) << "another length";
+    std::ofstream(room) << "[room]\nsize = [5 5 3]\nwall_blur = 10\n";
+    EXPECT_FALSE(isRenderCurrent(sc, o)) << "the room file changed";
+    std::ofstream(room) << "[room]\nsize = [5 5 3]\n";
+    EXPECT_TRUE(isRenderCurrent(sc, o));
+
+    // A render that stops half-way leaves no render.txt, so the folder is not current.
+    EXPECT_THROW((void)writeSequence(sc, o,
+                                     [](std::size_t done, std::size_t) {
+                                         if (done == 1) throw std::runtime_error("stopped");
+                                     }),
+                 std::runtime_error);
+    EXPECT_FALSE(fs::exists(o.out_dir + "/render.txt"));
+    EXPECT_FALSE(isRenderCurrent(sc, o));
 }
 
 // The walking person of the short scenario: moving, visible, and the labelled pixels lie at
@@ -384,6 +447,23 @@ TEST(Scenario, ShippedFilesLoadAndTyposAreReported) {
     EXPECT_NO_THROW((void)loadScenario(base));
     expectMessage([&] { (void)loadScenario(withEdit(text, "rate_hz", "speeed = 3\nrate_hz")); },
                   "[scenario]: unknown key 'speeed'");
+    const std::string room_text = readFile(kSynth + "/office_room.ini");
+    for (const auto& [bad, msg] :
+         {std::pair<std::string, std::string>{"wall_blur     = -1", "wall_blur: must be 0..100"},
+          {"floor_blur    = x", "floor_blur"}}) {
+        std::string r = room_text;
+        for (std::size_t p = r.find("../../data"); p != std::string::npos;
+             p = r.find("../../data"))
+            r.replace(p, 10, kRoot + "/data");
+        const auto key = bad.substr(0, bad.find('='));  // the shipped line, with its value
+        const auto at = r.find(key);
+        ASSERT_NE(at, std::string::npos) << key;
+        r.replace(at, r.find('\n', at) - at, bad);
+        std::ofstream(tmp.str("bad_room.ini")) << r;
+        expectMessage([&] { (void)loadScenario(withEdit(text, "room = " + kSynth + "/office_room.ini",
+                                                        "room = " + tmp.str("bad_room.ini"))); },
+                      msg);
+    }
     expectMessage([&] { (void)loadScenario(withEdit(text, "kind    = walking", "kind = flying")); },
                   "unknown person kind 'flying'");
     expectMessage(

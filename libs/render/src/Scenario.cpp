@@ -77,13 +77,23 @@ void readRoom(const std::string& path, RoomSpec& room) {
     const std::string base = dirOf(path);
     const std::string s = "room";
     core::requireKnownKeys(
-        *cfg, s, {"size", "panel_width", "panel_height", "wall_textures", "floor_textures"}, path);
+        *cfg, s,
+        {"size", "panel_width", "panel_height", "wall_textures", "floor_textures", "wall_blur",
+         "floor_blur"},
+        path);
+    room.source = path;
     room.size = vec3(*cfg, s, "size", path, true);
     room.panel_width = core::readDouble(*cfg, s, "panel_width", room.panel_width);
     room.panel_height = core::readDouble(*cfg, s, "panel_height", room.panel_height);
     core::requireValue(room.size.minCoeff() > 0.5, path + " [room]", "size", "each side > 0.5 [m]");
     core::requireValue(room.panel_width > 0.05 && room.panel_height > 0.05, path + " [room]",
                        "panel_width", "panels must be > 0.05 m");
+    room.wall_blur = core::readDouble(*cfg, s, "wall_blur", 0.0);
+    room.floor_blur = core::readDouble(*cfg, s, "floor_blur", 0.0);
+    core::requireValue(room.wall_blur >= 0 && room.wall_blur <= 100, path + " [room]",
+                       "wall_blur", "must be 0..100 [px]");
+    core::requireValue(room.floor_blur >= 0 && room.floor_blur <= 100, path + " [room]",
+                       "floor_blur", "must be 0..100 [px]");
     room.wall_textures = resolveImages(cfg->read_string(s, "wall_textures", "", true), base,
                                        path + " [room] wall_textures");
     room.floor_textures = resolveImages(cfg->read_string(s, "floor_textures", "", true), base,

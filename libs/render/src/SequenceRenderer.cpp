@@ -89,7 +89,7 @@ cv::Mat panelCrop(const cv::Mat& img, std::mt19937_64& rng, double aspect) {
 struct SequenceRenderer::Impl {
     mrpt::opengl::COpenGLScene::Ptr scene;
     std::unique_ptr<mrpt::opengl::CFBORender> fbo;
-    std::map<std::string, cv::Mat> photos;  // path -> BGR
+    std::map<std::pair<std::string, double>, cv::Mat> photos;  // (path, blur) -> BGR
     struct Person {
         PersonTexture tex;
         double width = 0, height = 0;  // [m]
@@ -97,12 +97,15 @@ struct SequenceRenderer::Impl {
     };
     std::vector<Person> people;
 
-    const cv::Mat& photo(const std::string& path) {
-        auto it = photos.find(path);
+    /// The photo at `path`, blurred with a Gaussian of sigma `blur` px (0 = as read).
+    const cv::Mat& photo(const std::string& path, double blur = 0.0) {
+        const auto key = std::make_pair(path, blur);
+        auto it = photos.find(key);
         if (it != photos.end()) return it->second;
         cv::Mat img = cv::imread(path, cv::IMREAD_COLOR);
         if (img.empty()) throw std::runtime_error("render: cannot read texture '" + path + "'");
-        return photos.emplace(path, img).first->second;
+        if (blur > 0) cv::GaussianBlur(img, img, cv::Size(), blur);
+        return photos.emplace(key, img).first->second;
     }
 
     /// A rectangle given by an origin corner and two edge vectors, covered by panels of at
@@ -110,7 +113,7 @@ struct SequenceRenderer::Impl {
     void addPanelled(const Eigen::Vector3d& origin, const Eigen::Vector3d& right,
                      const Eigen::Vector3d& down, double pw, double ph,
                      const std::vector<std::string>& files, std::size_t& counter,
-                     std::mt19937_64& rng) {
+                     std::mt19937_64& rng, double blur = 0.0) {
         const double W = right.norm(), H = down.norm();
         const Eigen::Vector3d ex = right / W, ey = down / H;
         const int nx = std::max(1, int(std::ceil(W / pw - 1e-9)));
@@ -120,7 +123,7 @@ struct SequenceRenderer::Impl {
                 const double x0 = i * W / nx, x1 = (i + 1) * W / nx;
                 const double y0 = j * H / ny, y1 = (j + 1) * H / ny;
                 const cv::Mat crop =
-                    panelCrop(photo(files[counter++ % files.size()]), rng, (x1 - x0) / (y1 - y0));
+                    panelCrop(photo(files[counter++ % files.size()], blur), rng, (x1 - x0) / (y1 - y0));
                 auto obj = CSetOfTexturedTriangles::Create();
                 addQuad(*obj, origin + ex * x0 + ey * y0, origin + ex * x1 + ey * y0,
                         origin + ex * x1 + ey * y1, origin + ex * x0 + ey * y1, 0.f, 0.f, 1.f, 1.f);
@@ -136,14 +139,19 @@ struct SequenceRenderer::Impl {
         const double X = r.size.x(), Y = r.size.y(), Z = r.size.z();
         std::size_t k = 0;
         const double pw = r.panel_width, ph = r.panel_height;
+        const auto wall = [&](const Eigen::Vector3d& o, const Eigen::Vector3d& right,
+                              const Eigen::Vector3d& down) {
+            addPanelled(o, right, down, pw, ph, r.wall_textures, k, rng, r.wall_blur);
+        };
         // Walls seen from inside: origin = top-left corner as seen from the room.
-        addPanelled({X, 0, Z}, {0, Y, 0}, {0, 0, -Z}, pw, ph, r.wall_textures, k, rng);   // x = X
-        addPanelled({0, Y, Z}, {0, -Y, 0}, {0, 0, -Z}, pw, ph, r.wall_textures, k, rng);  // x = 0
-        addPanelled({X, Y, Z}, {-X, 0, 0}, {0, 0, -Z}, pw, ph, r.wall_textures, k, rng);  // y = Y
-        addPanelled({0, 0, Z}, {X, 0, 0}, {0, 0, -Z}, pw, ph, r.wall_textures, k, rng);   // y = 0
+        wall({X, 0, Z}, {0, Y, 0}, {0, 0, -Z});   // x = X
+        wall({0, Y, Z}, {0, -Y, 0}, {0, 0, -Z});  // x = 0
+        wall({X, Y, Z}, {-X, 0, 0}, {0, 0, -Z});  // y = Y
+        wall({0, 0, Z}, {X, 0, 0}, {0, 0, -Z});   // y = 0
         std::size_t kf = 0;
-        addPanelled({0, Y, 0}, {X, 0, 0}, {0, -Y, 0}, pw, ph, r.floor_textures, kf, rng);  // floor
-        addPanelled({0, 0, Z}, {X, 0, 0}, {0, Y, 0}, pw, ph, r.wall_textures, k, rng);  // ceiling
+        addPanelled({0, Y, 0}, {X, 0, 0}, {0, -Y, 0}, pw, ph, r.floor_textures, kf, rng,
+                    r.floor_blur);              // floor
+        wall({0, 0, Z}, {X, 0, 0}, {0, Y, 0});  // ceiling
         for (const auto& b : r.boxes) {
             const double c = std::cos(b.yaw), s = std::sin(b.yaw);
             const auto P = [&](double lx, double ly, double lz) {

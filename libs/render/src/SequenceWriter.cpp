@@ -13,14 +13,64 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <sstream>
 #include <stdexcept>
 
 namespace devslam::render {
 namespace fs = std::filesystem;
 
+namespace {
+
+std::string readWholeFile(const std::string& path) {
+    std::ifstream f(path, std::ios::binary);
+    if (!f) throw std::runtime_error("cannot read '" + path + "'");
+    std::ostringstream ss;
+    ss << f.rdbuf();
+    return ss.str();
+}
+
+fs::path signaturePath(const WriteOptions& o) { return fs::path(o.out_dir) / "render.txt"; }
+
+}  // namespace
+
+std::string renderSignature(const Scenario& sc, const WriteOptions& o) {
+    const std::size_t n = o.max_frames > 0 ? std::min(o.max_frames, sc.n_frames) : sc.n_frames;
+    std::ostringstream s;
+    s << "# devslam-synth render: a rerun with the same content would write the same files\n"
+      << "renderer_version " << kRendererVersion << "\nseed " << sc.seed << "\nframes " << n
+      << "\nlabels " << int(o.write_labels) << "\n";
+    for (const auto& file : {sc.source, sc.room.source})
+        if (!file.empty()) s << "--- " << file << "\n" << readWholeFile(file) << "\n";
+    // Texture contents are not hashed: their paths and sizes catch a replaced photo.
+    std::vector<std::string> textures = sc.room.wall_textures;
+    textures.insert(textures.end(), sc.room.floor_textures.begin(), sc.room.floor_textures.end());
+    for (const auto& b : sc.room.boxes)
+        textures.insert(textures.end(), b.textures.begin(), b.textures.end());
+    for (const auto& p : sc.people) textures.push_back(p.texture);
+    for (const auto& t : textures) {
+        std::error_code ec;
+        const auto size = fs::file_size(t, ec);
+        s << "texture " << t << " " << (ec ? std::string("missing") : std::to_string(size))
+          << "\n";
+    }
+    return s.str();
+}
+
+bool isRenderCurrent(const Scenario& sc, const WriteOptions& o) {
+    std::ifstream f(signaturePath(o), std::ios::binary);
+    if (!f) return false;
+    std::ostringstream ss;
+    ss << f.rdbuf();
+    return ss.str() == renderSignature(sc, o);
+}
+
 WriteSummary writeSequence(const Scenario& sc, const WriteOptions& o,
                            const std::function<void(std::size_t, std::size_t)>& progress) {
     if (o.out_dir.empty()) throw std::invalid_argument("writeSequence: empty output folder");
+    const std::string signature = renderSignature(sc, o);
+    // Until the last frame is written the folder is not a current render.
+    std::error_code ec;
+    fs::remove(signaturePath(o), ec);
     const std::size_t n = o.max_frames > 0 ? std::min(o.max_frames, sc.n_frames) : sc.n_frames;
     io::TumWriter tum(o.out_dir, "devslam-synth scenario " + sc.name);
     std::unique_ptr<io::RawlogWriter> rawlog;
@@ -82,6 +132,11 @@ WriteSummary writeSequence(const Scenario& sc, const WriteOptions& o,
        << sc.name << "\n"
        << text;
     if (!cf) throw std::runtime_error("cannot write '" + cam_path + "'");
+
+    const std::string sig_path = signaturePath(o).string();
+    std::ofstream sf(sig_path, std::ios::binary);
+    sf << signature;
+    if (!sf) throw std::runtime_error("cannot write '" + sig_path + "'");
 
     sum.n_frames = n;
     sum.render_ms_median = core::median(ms);

@@ -36,12 +36,18 @@ struct RoomSpec {
     double panel_height = 0.9;        ///< wall/floor panel height [m]
     std::vector<std::string> wall_textures;   ///< photo files (absolute paths)
     std::vector<std::string> floor_textures;  ///< photo files (absolute paths)
+    /// Gaussian blur of the wall/ceiling and floor photos before they are cropped [px of the
+    /// photo, sigma], 0 = sharp: painted walls and a carpet with a few soft shapes, whose
+    /// corners do not outnumber those of the people and the furniture (docs/render.md).
+    double wall_blur = 0.0;
+    double floor_blur = 0.0;
+    std::string source;  ///< the room INI file it was read from
     std::vector<BoxSpec> boxes;
 };
 
 struct Scenario {
     std::string name;          ///< [scenario] name
-    std::string source;        ///< the INI file it was read from
+    std::string source;        ///< the INI file it was read from (the room's: room.source)
     core::CameraIntrinsics K;  ///< exact intrinsics of the rendered images (TUM fr3 by default)
     double rate_hz = 30.0;     ///< frame rate [Hz]
     std::size_t n_frames = 60;

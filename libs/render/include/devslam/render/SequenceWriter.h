@@ -35,6 +35,21 @@ struct WriteSummary {
 WriteSummary writeSequence(const Scenario& sc, const WriteOptions& o,
                            const std::function<void(std::size_t, std::size_t)>& progress = {});
 
+/// Bump when the renderer's output for an unchanged scenario changes: renders made by an
+/// older version are then no longer current (isRenderCurrent).
+inline constexpr int kRendererVersion = 2;
+
+/// What a render is made of, as text: the renderer version, the seed, the frame count, the
+/// labels switch, the scenario and room files' full text, and the size of every texture file.
+/// writeSequence writes it to <out_dir>/render.txt after the last frame. Throws naming the
+/// file when a scenario or room file cannot be read.
+[[nodiscard]] std::string renderSignature(const Scenario& sc, const WriteOptions& o);
+
+/// True when `o.out_dir` holds a complete render of exactly `sc` and `o`: its render.txt
+/// equals renderSignature(sc, o). False for a folder written by an interrupted run, by an
+/// older renderer, or from another scenario, room, seed or frame count (rawlogs are not checked).
+[[nodiscard]] bool isRenderCurrent(const Scenario& sc, const WriteOptions& o);
+
 /// persons.txt line format (also written as the file's header comment).
 inline constexpr const char* kPersonsHeader =
     "# timestamp id name state x y w h visible_pixels   (state: moving|static; box of the "
