@@ -168,6 +168,44 @@ TEST(DynamicFilter, StaticPersonIsStaticUnderCameraMotion) {
     }
 }
 
+// A person who stands still is Static from the first step, but at the left or right border,
+// where walkers enter half seen, they stay Unknown, and masked, until confirm_border_frames
+// quiet steps confirm them.
+TEST(DynamicFilter, BoxAtTheBorderIsStaticOnlyAfterConfirmFrames) {
+    const auto fo = testOptions();
+    ASSERT_GT(fo.confirm_border_frames, 1) << "the shipped INI delays the Static state";
+    dynamic::SyntheticOptions so;
+    so.person = dynamic::PersonMotion::Static;
+    so.person_x0 = 0.3;
+    so.n_frames = kFrames;
+    const auto& seq = sequence(so);
+    for (bool border : {false, true}) {
+        auto det = std::make_unique<ScriptedDetector>();
+        ScriptedDetector* script = det.get();
+        DynamicObjectFilter filter(fo, std::move(det));
+        const int confirm = border ? fo.confirm_border_frames : 1;
+        for (int k = 0; k < static_cast<int>(seq.size()); ++k) {
+            cv::Rect2f box = *seq[k].person_box;
+            if (border) {  // the same person's box, reaching the left border
+                box.width += box.x;
+                box.x = 0;
+            }
+            script->next = {{box, 0, "person", 0.9f}};
+            const auto out = filter.step(seq[k].frame, seq[k].T_prev_cur);
+            ASSERT_EQ(out.boxes.size(), 1u);
+            const auto state = out.boxes[0].state;
+            const bool masked = cv::countNonZero(out.mask) > 0;
+            if (k < confirm) {
+                EXPECT_EQ(state, BoxState::Unknown) << "frame " << k << " border " << border;
+                EXPECT_EQ(masked, k > 0) << "frame " << k << ": Unknown is masked after frame 0";
+            } else {
+                EXPECT_EQ(state, BoxState::Static) << "frame " << k << " border " << border;
+                EXPECT_FALSE(masked) << "frame " << k << " border " << border;
+            }
+        }
+    }
+}
+
 TEST(DynamicFilter, PureCameraMotionFlagsNothing) {
     // No person; two boxes on the wall (false detections) must never be flagged, with or
     // without ego-motion prior. Raw displacement (no compensation) flags them: that is the
@@ -513,6 +551,7 @@ TEST(DynamicConfig, ShippedIniLoadsAndRoundTrips) {
     b.loadFromConfig(mem);
     EXPECT_EQ(b.threshold1, a.threshold1);
     EXPECT_EQ(b.release_frames, a.release_frames);
+    EXPECT_EQ(b.confirm_border_frames, a.confirm_border_frames);
     EXPECT_EQ(b.lk_window, a.lk_window);
     auto f = dynamic::makeFilterFromConfig(*cfg, MaskMode::None);
     EXPECT_EQ(f->options().mode, MaskMode::None);

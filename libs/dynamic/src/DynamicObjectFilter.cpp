@@ -47,6 +47,7 @@ const std::vector<std::string> kKeys{"mode",
                                      "box_shrink",
                                      "iou_match",
                                      "release_frames",
+                                     "confirm_border_frames",
                                      "max_missed_detections",
                                      "hide_unseen_frames",
                                      "forget_unseen_frames",
@@ -193,6 +194,7 @@ void DynamicObjectFilter::Options::loadFromConfig(const mrpt::config::CConfigFil
     new_track_score = core::readDouble(c, s, "new_track_score", new_track_score);
     iou_match = core::readDouble(c, s, "iou_match", iou_match);
     release_frames = core::readInt(c, s, "release_frames", release_frames);
+    confirm_border_frames = core::readInt(c, s, "confirm_border_frames", confirm_border_frames);
     max_missed_detections = core::readInt(c, s, "max_missed_detections", max_missed_detections);
     hide_unseen_frames = core::readInt(c, s, "hide_unseen_frames", hide_unseen_frames);
     forget_unseen_frames = core::readInt(c, s, "forget_unseen_frames", forget_unseen_frames);
@@ -237,6 +239,7 @@ void DynamicObjectFilter::Options::loadFromConfig(const mrpt::config::CConfigFil
                        "must be in [0, 1]");
     core::requireValue(iou_match > 0 && iou_match <= 1, s, "iou_match", "must be in (0, 1]");
     core::requireValue(release_frames >= 1, s, "release_frames", "must be >= 1");
+    core::requireValue(confirm_border_frames >= 1, s, "confirm_border_frames", "must be >= 1");
     core::requireValue(max_missed_detections >= 0, s, "max_missed_detections", "must be >= 0");
     core::requireValue(hide_unseen_frames >= 0, s, "hide_unseen_frames", "must be >= 0");
     core::requireValue(forget_unseen_frames >= hide_unseen_frames, s, "forget_unseen_frames",
@@ -278,6 +281,7 @@ void DynamicObjectFilter::Options::saveToConfig(mrpt::config::CConfigFileBase& c
     c.write(s, "new_track_score", new_track_score);
     c.write(s, "iou_match", iou_match);
     c.write(s, "release_frames", release_frames);
+    c.write(s, "confirm_border_frames", confirm_border_frames);
     c.write(s, "max_missed_detections", max_missed_detections);
     c.write(s, "hide_unseen_frames", hide_unseen_frames);
     c.write(s, "forget_unseen_frames", forget_unseen_frames);
@@ -817,14 +821,15 @@ void DynamicObjectFilter::Impl::classifyBoxes(const Residuals& r, const core::Fr
         }
         t.tb.n_points = n;
         t.tb.n_dynamic_points = n_dyn;
+        // The image's left or right border, where walkers enter, leave and come back, and
+        // where one cut by the border is often undetected, without points, or without motion
+        // on their first steps (the bottom border cuts every near person's box, so it does
+        // not count).
+        const auto m = static_cast<float>(o.mask_margin);
+        const bool at_border =
+            t.tb.box.x <= m || t.tb.box.br().x >= static_cast<float>(size.width) - m;
         if (n < o.min_points) {  // no evidence: keep the state
-            // and no detection either: unseen, unless the box reaches the image's left or
-            // right border, where walkers leave and come back, and where one cut by the
-            // border is often both undetected and without points (the bottom border cuts
-            // every near person's box, so it does not count)
-            const auto m = static_cast<float>(o.mask_margin);
-            const bool at_border =
-                t.tb.box.x <= m || t.tb.box.br().x >= static_cast<float>(size.width) - m;
+            // and no detection either: unseen, unless the box is at the border
             if (t.missed > 0 && !(o.keep_border_tracks && at_border))
                 ++t.unseen;
             else
@@ -883,8 +888,9 @@ void DynamicObjectFilter::Impl::classifyBoxes(const Residuals& r, const core::Fr
             t.quiet = 0;
         } else if (t.tb.state == BoxState::Moving) {
             if (++t.quiet >= o.release_frames) t.tb.state = BoxState::Static;
-        } else {
-            t.tb.state = BoxState::Static;
+        } else if (t.tb.state == BoxState::Unknown) {
+            if (++t.quiet >= (at_border ? o.confirm_border_frames : 1))
+                t.tb.state = BoxState::Static;
         }
     }
 }

@@ -170,6 +170,11 @@ class DynamicObjectFilter {
         // Tracking and hysteresis
         double iou_match = 0.3;         ///< min IoU to associate a detection with a track
         int release_frames = 5;         ///< quiet frames before a Moving box becomes Static
+        /// Quiet steps before a new (Unknown) box at the left or right image border (within
+        /// mask_margin) becomes Static; elsewhere, and with 1, the first quiet step does it.
+        /// While Unknown a box is masked (mask_unknown): a walker entering the view, half
+        /// seen, often shows no motion on their first steps.
+        int confirm_border_frames = 1;
         int max_missed_detections = 2;  ///< detector runs without a match before a track is dropped
         /// A Moving track outlives detector misses (walkers cut by the border, half hidden),
         /// carried by its points' flow. When neither the detector (unmatched at its last
