@@ -156,10 +156,6 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
         fl.keyframe = mr.keyframe_inserted;
         fl.keyframe_reason = slam::toString(mr.reason);
         fl.loop = br.loop_closed;
-        if (tr.state == slam::TrackingState::Lost) {
-            if (pending.valid()) pending.wait();  // never reset while the filter runs
-            masks->reset();
-        }
         fl.wall_ms = msSince(t_iter) - fl.read_ms;
         fl.cpu_ms = processCpuMs() - cpu_iter - fl.read_cpu_ms;
         elapsed_ms += fl.wall_ms;
