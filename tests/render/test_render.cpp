@@ -293,8 +293,8 @@ TEST(RenderSequence, RenderTxtTellsWhetherAFolderHoldsThisRender) {
     EXPECT_FALSE(isRenderCurrent(sc, longer)) << "another length";
     std::ofstream(room) << "[room]\nsize = [5 5 3]\nwall_blur = 10\n";
     EXPECT_FALSE(isRenderCurrent(sc, o)) << "the room file changed";
-    std::ofstream(room) << "[room]\nsize = [5 5 3]\n";
-    EXPECT_TRUE(isRenderCurrent(sc, o));
+    std::ofstream(room) << "# another comment\n[room]\nsize = [5 5 3]   // [m]\n\n";
+    EXPECT_TRUE(isRenderCurrent(sc, o)) << "comments and blank lines do not count";
 
     // A render that stops half-way leaves no render.txt, so the folder is not current.
     EXPECT_THROW((void)writeSequence(sc, o,

@@ -31,6 +31,21 @@ std::string readWholeFile(const std::string& path) {
 
 fs::path signaturePath(const WriteOptions& o) { return fs::path(o.out_dir) / "render.txt"; }
 
+/// An INI file's settings as text: comments (# and ; lines, // to the end of a line), blank
+/// lines and spaces at the ends dropped, so that editing a comment keeps a render current.
+std::string iniSettings(const std::string& path) {
+    std::istringstream in(readWholeFile(path));
+    std::string line, out;
+    while (std::getline(in, line)) {
+        if (const auto c = line.find("//"); c != std::string::npos) line.erase(c);
+        const auto b = line.find_first_not_of(" \t\r");
+        if (b == std::string::npos || line[b] == '#' || line[b] == ';') continue;
+        const auto e = line.find_last_not_of(" \t\r");
+        out += line.substr(b, e - b + 1) + "\n";
+    }
+    return out;
+}
+
 }  // namespace
 
 std::string renderSignature(const Scenario& sc, const WriteOptions& o) {
@@ -40,7 +55,7 @@ std::string renderSignature(const Scenario& sc, const WriteOptions& o) {
       << "renderer_version " << kRendererVersion << "\nseed " << sc.seed << "\nframes " << n
       << "\nlabels " << int(o.write_labels) << "\n";
     for (const auto& file : {sc.source, sc.room.source})
-        if (!file.empty()) s << "--- " << file << "\n" << readWholeFile(file) << "\n";
+        if (!file.empty()) s << "--- " << file << "\n" << iniSettings(file);
     // Texture contents are not hashed: their paths and sizes catch a replaced photo.
     std::vector<std::string> textures = sc.room.wall_textures;
     textures.insert(textures.end(), sc.room.floor_textures.begin(), sc.room.floor_textures.end());

@@ -40,7 +40,8 @@ WriteSummary writeSequence(const Scenario& sc, const WriteOptions& o,
 inline constexpr int kRendererVersion = 2;
 
 /// What a render is made of, as text: the renderer version, the seed, the frame count, the
-/// labels switch, the scenario and room files' full text, and the size of every texture file.
+/// labels switch, the settings of the scenario and room files (their lines without comments:
+/// editing a comment keeps a render current), and the size of every texture file.
 /// writeSequence writes it to <out_dir>/render.txt after the last frame. Throws naming the
 /// file when a scenario or room file cannot be read.
 [[nodiscard]] std::string renderSignature(const Scenario& sc, const WriteOptions& o);
