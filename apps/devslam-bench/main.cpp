@@ -289,7 +289,7 @@ int run(int argc, char** argv) {
                               quote(in.path) + " --if-changed";
             if (in.seed) cmd += " --seed " + std::to_string(*in.seed);
             if (b.max_frames) cmd += " --frames " + std::to_string(b.max_frames);
-            std::cout << "rendering " << q.name << ": " << cmd << "\n" << std::flush;
+            std::cout << "render (if changed) " << q.name << ": " << cmd << "\n" << std::flush;
             if (std::system(cmd.c_str()) != 0)
                 throw std::runtime_error(
                     "devslam-synth failed for " + q.name +
