@@ -10,7 +10,9 @@
 #include <devslam/io/TrajectoryIO.h>
 #include <devslam/slam/MapExporter.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
@@ -52,7 +54,31 @@ std::string timingJson(const FrameTiming& t) {
            ", \"mapping\": " + num(t.mapping, 3) + ", \"backend\": " + num(t.backend, 3) +
            ", \"total\": " + num(t.total(), 3) + "}";
 }
+std::vector<double> loopErrors(const std::vector<LoopReport>& loops) {
+    std::vector<double> e;
+    for (const auto& l : loops)
+        if (l.error_m) e.push_back(*l.error_m);
+    return e;
+}
+
 }  // namespace
+
+std::vector<LoopReport> scoreLoops(const std::vector<slam::Slam::ClosedLoop>& loops,
+                                   const core::Trajectory* ground_truth, double max_dt) {
+    std::vector<LoopReport> out;
+    for (const auto& l : loops) {
+        LoopReport r{l, std::nullopt, std::nullopt};
+        if (ground_truth) {
+            if (const auto e =
+                    eval::relativePoseError(*ground_truth, l.t_old, l.t_new, l.T_old_new, max_dt)) {
+                r.error_m = e->trans;
+                r.error_deg = e->rot;
+            }
+        }
+        out.push_back(r);
+    }
+    return out;
+}
 
 void resetPeakRss() {
     // Linux >= 4.0: writing 5 resets VmHWM to the current RSS; ignored where unsupported.
@@ -228,6 +254,8 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
         } catch (const std::invalid_argument&) {
         }
     }
+    rep.loop_reports = scoreLoops(slam.closedLoops(),
+                                  rep.ground_truth ? &*rep.ground_truth : nullptr);
 
     if (!rc.out_dir.empty()) {
         namespace fs = std::filesystem;
@@ -247,6 +275,20 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
             std::ofstream lf(out("lost_frames.txt"));
             lf << "# index timestamp (frames without a tracked pose)\n";
             for (std::size_t i : rep.lost) lf << i << " " << num(rep.trajectory[i].t, 6) << "\n";
+        }
+        {
+            std::ofstream lp(out("loops.txt"));
+            lp << "# loops closed: t_old t_new inliers, measured T_old_new (tx ty tz qx qy qz qw), "
+                  "its error against the ground truth [m] [deg] (- without truth)\n";
+            for (const auto& l : rep.loop_reports) {
+                const Eigen::Quaterniond q(l.loop.T_old_new.linear());
+                const Eigen::Vector3d& t = l.loop.T_old_new.translation();
+                lp << num(l.loop.t_old, 6) << " " << num(l.loop.t_new, 6) << " " << l.loop.inliers
+                   << " " << num(t.x()) << " " << num(t.y()) << " " << num(t.z()) << " "
+                   << num(q.x(), 7) << " " << num(q.y(), 7) << " " << num(q.z(), 7) << " "
+                   << num(q.w(), 7) << " " << (l.error_m ? num(*l.error_m) : "-") << " "
+                   << (l.error_deg ? num(*l.error_deg, 3) : "-") << "\n";
+            }
         }
         slam::writePly(out("map.ply"), slam.map());
         std::optional<core::Trajectory> gt_in_est;
@@ -305,7 +347,13 @@ std::string formatSummary(const RunReport& r) {
       << "camera     : " << r.camera << "\n"
       << "frames     : " << r.frames << "   keyframes: " << r.keyframes
       << "   landmarks: " << r.landmarks << "   loops closed: " << r.loops << "\n"
-      << "lost frames: " << r.lost.size();
+      ;
+    if (const auto e = loopErrors(r.loop_reports); !e.empty()) {
+        const auto s = core::summarize(e);
+        o << "loops      : measured relative poses vs truth: median " << num(1000 * s.median, 1)
+          << " mm, max " << num(1000 * s.max, 1) << " mm (loops.txt)\n";
+    }
+    o << "lost frames: " << r.lost.size();
     if (!r.lost.empty()) {
         o << " (indices:";
         for (std::size_t i = 0; i < r.lost.size() && i < 20; ++i) o << " " << r.lost[i];
@@ -398,6 +446,8 @@ std::string toJson(const RunReport& r) {
       << ",\n  \"map_mb\": " << num(r.map_mb, 3)
       << ",\n  \"bytes_per_keyframe\": " << num(r.bytes_per_keyframe, 0);
     if (r.ate) o << ",\n  \"ate\": " << summaryJson(r.ate->trans);
+    if (const auto e = loopErrors(r.loop_reports); !e.empty())
+        o << ",\n  \"loop_error_m\": " << summaryJson(core::summarize(e));
     if (r.mask_score) {
         const auto& m = *r.mask_score;
         o << ",\n  \"mask_truth\": {\"moving_recall\": " << num(m.movingRecall())

@@ -52,6 +52,19 @@ struct FrameLog {
     double read_ms = 0, read_cpu_ms = 0;  ///< reading the next frame and scoring (excluded)
 };
 
+/// A loop the SLAM closed and, with ground truth, how far its measured relative pose is from
+/// the true one (the loop's own error, whatever the trajectory's drift).
+struct LoopReport {
+    slam::Slam::ClosedLoop loop;
+    std::optional<double> error_m, error_deg;
+};
+
+/// Scores each closed loop's measured relative pose against `ground_truth` (the poses nearest
+/// in time to the two keyframes, within `max_dt` [s]; no error where either has none).
+[[nodiscard]] std::vector<LoopReport> scoreLoops(const std::vector<slam::Slam::ClosedLoop>& loops,
+                                                 const core::Trajectory* ground_truth,
+                                                 double max_dt = 0.02);
+
 struct RunReport {
     std::string input, mode, camera, mask_source;
     bool async_filter = false;
@@ -72,6 +85,7 @@ struct RunReport {
     std::vector<std::string> outputs;  ///< files written
     /// The masks scored against the person truth (rendered inputs only).
     std::optional<eval::MaskScore> mask_score;
+    std::vector<LoopReport> loop_reports;  ///< every closed loop (loops.txt)
 };
 
 /// Runs the pipeline over `reader` with the INI `cfg` (SLAM sections) and `filter_cfg`

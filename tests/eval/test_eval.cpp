@@ -109,6 +109,27 @@ TEST(Ate, AssociationWindowIsHonoured) {
     EXPECT_THROW((void)eval::computeAte(gt, far), std::invalid_argument);
 }
 
+TEST(RelativePose, ErrorOfAMeasuredConstraintAgainstTheTruth) {
+    const auto gt = helix(100, 10.0);
+    const Eigen::Isometry3d Qa = core::toIsometry(gt[10].pose), Qb = core::toIsometry(gt[70].pose);
+    const Eigen::Isometry3d T_true = Qa.inverse() * Qb;
+    const auto exact = eval::relativePoseError(gt, gt[10].t, gt[70].t, T_true);
+    ASSERT_TRUE(exact);
+    EXPECT_NEAR(exact->trans, 0.0, 1e-9);
+    EXPECT_NEAR(exact->rot, 0.0, 1e-6);
+    // 5 cm along the measured frame's x, 2 deg about its z
+    Eigen::Isometry3d d = Eigen::Isometry3d::Identity();
+    d.translation() = Eigen::Vector3d(0.05, 0, 0);
+    d.linear() = Eigen::AngleAxisd(2.0 * M_PI / 180.0, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+    const auto off = eval::relativePoseError(gt, gt[10].t + 0.01, gt[70].t, T_true * d);
+    ASSERT_TRUE(off) << "10 ms from a gt stamp is within the 20 ms window";
+    EXPECT_NEAR(off->trans, 0.05, 1e-9);
+    EXPECT_NEAR(off->rot, 2.0, 1e-6);
+    EXPECT_FALSE(eval::relativePoseError(gt, gt[10].t + 0.05, gt[70].t, T_true))
+        << "no gt pose within 20 ms of t_a";
+    EXPECT_FALSE(eval::relativePoseError({}, gt[10].t, gt[70].t, T_true));
+}
+
 TEST(Rpe, ConstantDriftGivesExpectedError) {
     // World-frame drift d per frame: E_i has translation -(j-i) R_j^T d, norm (j-i)|d|,
     // and no rotation, whatever the ground truth's orientation.

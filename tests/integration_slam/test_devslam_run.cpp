@@ -52,7 +52,7 @@ TEST(DevslamRun, WritesEveryOutputAndPrintsTheSummary) {
     EXPECT_EQ(lines(out / "trajectory.txt"), 32u);
     EXPECT_GE(lines(out / "keyframes.txt"), 3u);
     for (const char* f : {"map.ply", "map.3Dscene", "map_grid.png", "map_grid.gridmap",
-                          "trajectory.png", "run.json", "lost_frames.txt"})
+                          "trajectory.png", "run.json", "lost_frames.txt", "loops.txt"})
         EXPECT_TRUE(fs::exists(out / f) && fs::file_size(out / f) > 0) << f;
     mrpt::opengl::COpenGLScene scene;
     EXPECT_TRUE(scene.loadFromFile((out / "map.3Dscene").string()));

@@ -129,4 +129,21 @@ RpeResult computeRpe(const core::Trajectory& gt, const core::Trajectory& est,
     return r;
 }
 
+std::optional<RelativePoseError> relativePoseError(const core::Trajectory& gt, double t_a,
+                                                   double t_b, const Eigen::Isometry3d& T_a_b,
+                                                   double max_dt) {
+    const auto nearest = [&](double t) -> std::optional<Eigen::Isometry3d> {
+        const core::StampedPose* best = nullptr;
+        for (const auto& p : gt)  // gt need not be sorted
+            if (!best || std::abs(p.t - t) < std::abs(best->t - t)) best = &p;
+        if (!best || std::abs(best->t - t) > max_dt) return std::nullopt;
+        return core::toIsometry(best->pose);
+    };
+    const auto Qa = nearest(t_a), Qb = nearest(t_b);
+    if (!Qa || !Qb) return std::nullopt;
+    const Eigen::Isometry3d E = (Qa->inverse() * *Qb).inverse() * T_a_b;
+    return RelativePoseError{E.translation().norm(),
+                             Eigen::AngleAxisd(E.linear()).angle() * 180.0 / M_PI};
+}
+
 }  // namespace devslam::eval

@@ -301,6 +301,8 @@ BackendResult Slam::backendStep(const MappingResult& mapping, const core::Camera
     e.T_from_to = out.loop->T_old_new;
     e.information = diagonalInformation(opts_.loop.sigma_t, opts_.loop.sigma_r_deg * M_PI / 180.0);
     loop_edges_.push_back(e);
+    closed_loops_.push_back({map_.keyframe(e.from).timestamp, map_.keyframe(e.to).timestamp,
+                             out.loop->n_inliers, e.T_from_to});
     // Odometry edges from the current estimates (consistent), plus every loop edge.
     std::map<std::int64_t, Eigen::Isometry3d> poses;
     for (const auto& [id, kf] : map_.keyframes()) poses[id] = kf.T_wc;

@@ -12,6 +12,7 @@
 
 #include <Eigen/Geometry>
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -64,5 +65,19 @@ struct RpeResult {
 /// interval away, as evaluate_rpe.py does. Throws std::invalid_argument when no pair exists.
 [[nodiscard]] RpeResult computeRpe(const core::Trajectory& gt, const core::Trajectory& est,
                                    const RpeOptions& opts = {});
+
+struct RelativePoseError {
+    double trans = 0;  ///< [m]
+    double rot = 0;    ///< [deg]
+};
+
+/// Error of a measured relative pose `T_a_b` (pose at time t_b in the frame of the pose at
+/// t_a, e.g. a SLAM loop constraint) against the ground truth: E = (Q_a^-1 Q_b)^-1 T_a_b,
+/// Q the gt poses nearest in time to t_a and t_b. nullopt when either is more than
+/// `max_dt` [s] away. Unlike the ATE it does not depend on the trajectory's drift.
+[[nodiscard]] std::optional<RelativePoseError> relativePoseError(const core::Trajectory& gt,
+                                                                 double t_a, double t_b,
+                                                                 const Eigen::Isometry3d& T_a_b,
+                                                                 double max_dt = 0.02);
 
 }  // namespace devslam::eval

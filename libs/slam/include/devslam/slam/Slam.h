@@ -145,6 +145,14 @@ class Slam {
     [[nodiscard]] core::Trajectory keyframeTrajectory() const;
     [[nodiscard]] const Map& map() const { return map_; }
     [[nodiscard]] int loopsClosed() const { return static_cast<int>(loop_edges_.size()); }
+    /// A loop the back end closed, as measured when it was verified.
+    struct ClosedLoop {
+        double t_old = 0, t_new = 0;  ///< timestamps of the two keyframes
+        int inliers = 0;              ///< verified PnP inliers
+        Eigen::Isometry3d T_old_new = Eigen::Isometry3d::Identity();  ///< measured relative pose
+    };
+    /// Every loop closed so far, in closing order.
+    [[nodiscard]] const std::vector<ClosedLoop>& closedLoops() const { return closed_loops_; }
     [[nodiscard]] const SlamOptions& options() const { return opts_; }
 
   private:
@@ -170,6 +178,7 @@ class Slam {
     Map map_;
     std::vector<FrameRecord> records_;
     std::vector<PoseGraphEdge> loop_edges_;
+    std::vector<ClosedLoop> closed_loops_;
     int frames_since_kf_ = 0;
     int tracked_at_last_kf_ = 0;
     bool pending_init_ = false;
