@@ -727,6 +727,42 @@ TEST(DynamicFilter, NarrowSilhouetteBandKeepsTheWallRightBehindAPerson) {
     EXPECT_LT(masked_narrow, 0.6) << "and leaves the wall in the box";
 }
 
+TEST(DynamicFilter, SilhouetteGrowsBeyondTheBoxOnlyThroughThePerson) {
+    // A person 2 m away in front of a wall 4 m away; the detector's box stops 60 px short of
+    // the head. A desk at the person's depth starts 10 px to the right of the person, not
+    // touching them. With silhouette_grow the head above the box is masked (it is connected
+    // to the silhouette inside the box), the desk is not.
+    core::Frame f;
+    f.bgr = cv::Mat(480, 640, CV_8UC3, cv::Scalar(90, 120, 150));
+    f.depth = cv::Mat(480, 640, CV_32FC1, cv::Scalar(4.f));
+    const cv::Rect person(200, 40, 100, 360), head(200, 40, 100, 60), desk(310, 300, 110, 100);
+    f.depth(person).setTo(2.f);
+    f.depth(desk).setTo(2.f);
+    f.K = core::CameraIntrinsics{};  // 525 px, 640x480
+    const cv::Rect2f box(200.f, 100.f, 100.f, 300.f);
+    auto masks = [&](double grow) {
+        auto fo = testOptions();
+        fo.mode = MaskMode::AllPersons;
+        fo.mask_silhouette = true;
+        fo.silhouette_depth_band = 0.1;
+        fo.mask_margin = 0;
+        fo.silhouette_grow = grow;
+        auto det = std::make_unique<ScriptedDetector>();
+        det->next = {{box, 0, "person", 0.9f}};
+        DynamicObjectFilter filter(fo, std::move(det));
+        return filter.step(f, std::nullopt).mask;
+    };
+    const cv::Mat in_box = masks(0.0), grown = masks(0.25);
+    const auto frac = [](const cv::Mat& m, const cv::Rect& r) {
+        return cv::countNonZero(m(r)) / static_cast<double>(r.area());
+    };
+    EXPECT_EQ(frac(in_box, cv::Rect(box)), 1.0);
+    EXPECT_EQ(frac(in_box, head), 0.0) << "without growing, the mask ends at the box";
+    EXPECT_EQ(frac(grown, head), 1.0) << "the head is connected to the silhouette";
+    EXPECT_EQ(frac(grown, desk), 0.0) << "the desk is at the person's depth but apart";
+    EXPECT_EQ(cv::countNonZero(grown), person.area()) << "nothing of the wall";
+}
+
 TEST(DynamicFilter, SlowWalkerIsCaughtByItsMeanResidualFlow) {
     // A person walking at 0.2 m/s 2.2 m away moves about 1.6 px a frame after ego-motion
     // compensation: under threshold1 (2 px) for nearly every point, so per-frame evidence

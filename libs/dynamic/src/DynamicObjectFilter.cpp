@@ -61,6 +61,7 @@ const std::vector<std::string> kKeys{"mode",
                                      "fg_depth_band",
                                      "mask_silhouette",
                                      "silhouette_depth_band",
+                                     "silhouette_grow",
                                      "slow_frames",
                                      "slow_threshold",
                                      "slow_speed",
@@ -185,6 +186,7 @@ void DynamicObjectFilter::Options::loadFromConfig(const mrpt::config::CConfigFil
     fg_depth_band = core::readDouble(c, s, "fg_depth_band", fg_depth_band);
     mask_silhouette = core::readBool(c, s, "mask_silhouette", mask_silhouette);
     silhouette_depth_band = core::readDouble(c, s, "silhouette_depth_band", silhouette_depth_band);
+    silhouette_grow = core::readDouble(c, s, "silhouette_grow", silhouette_grow);
     slow_frames = core::readInt(c, s, "slow_frames", slow_frames);
     slow_threshold = core::readDouble(c, s, "slow_threshold", slow_threshold);
     slow_speed = core::readDouble(c, s, "slow_speed", slow_speed);
@@ -229,6 +231,8 @@ void DynamicObjectFilter::Options::loadFromConfig(const mrpt::config::CConfigFil
     core::requireValue(fg_depth_band >= 0, s, "fg_depth_band", "must be >= 0 (0 = off)");
     core::requireValue(silhouette_depth_band >= 0, s, "silhouette_depth_band",
                        "must be >= 0 (0 = fg_depth_band's)");
+    core::requireValue(silhouette_grow >= 0 && silhouette_grow <= 1, s, "silhouette_grow",
+                       "must be in [0, 1] (0 = the box only)");
     core::requireValue(slow_frames >= 0, s, "slow_frames", "must be >= 0 (0 = off)");
     core::requireValue(slow_threshold > 0, s, "slow_threshold", "must be > 0");
     core::requireValue(slow_speed >= 0, s, "slow_speed", "must be >= 0 (0 = off)");
@@ -272,6 +276,7 @@ void DynamicObjectFilter::Options::saveToConfig(mrpt::config::CConfigFileBase& c
     c.write(s, "fg_depth_band", fg_depth_band);
     c.write(s, "mask_silhouette", mask_silhouette);
     c.write(s, "silhouette_depth_band", silhouette_depth_band);
+    c.write(s, "silhouette_grow", silhouette_grow);
     c.write(s, "slow_frames", slow_frames);
     c.write(s, "slow_threshold", slow_threshold);
     c.write(s, "slow_speed", slow_speed);
@@ -908,6 +913,29 @@ void DynamicObjectFilter::Impl::forgetUnseen(const Options& o) {
                      tracks.end());
 }
 
+/// Clears the set pixels of `sil` not 8-connected to one inside `inner` (a rectangle in
+/// sil's coordinates). Pixels inside `inner` are all kept.
+void keepConnectedTo(cv::Mat& sil, const cv::Rect& inner) {
+    cv::Mat labels;
+    const int n = cv::connectedComponents(sil, labels, 8, CV_32S);
+    if (n <= 1) return;
+    std::vector<unsigned char> keep(static_cast<std::size_t>(n), 0);
+    const cv::Mat in = labels(inner);
+    for (int y = 0; y < in.rows; ++y) {
+        const int* row = in.ptr<int>(y);
+        for (int x = 0; x < in.cols; ++x) keep[static_cast<std::size_t>(row[x])] = 1;
+    }
+    keep[0] = 0;
+    cv::Mat inside = sil(inner).clone();
+    for (int y = 0; y < sil.rows; ++y) {
+        const int* l = labels.ptr<int>(y);
+        unsigned char* m = sil.ptr<unsigned char>(y);
+        for (int x = 0; x < sil.cols; ++x)
+            if (m[x] && !keep[static_cast<std::size_t>(l[x])]) m[x] = 0;
+    }
+    inside.copyTo(sil(inner));
+}
+
 void DynamicObjectFilter::Impl::drawMask(const core::Frame& frame, bool have_prev,
                                          const Options& o, FilterOutput& out) const {
     // Whole boxes, dilated by the margin. On a frame with no previous one every box is
@@ -944,17 +972,27 @@ void DynamicObjectFilter::Impl::drawMask(const core::Frame& frame, bool have_pre
         const float h = depthBand(band, zp);
         const cv::Rect inner = cv::Rect(t.tb.box) & cv::Rect({}, size);
         if (inner.empty()) continue;
+        // The band is sought in the box grown by silhouette_grow; outside the box only the
+        // parts connected to the silhouette inside it are kept (a head above the box, not
+        // a desk at the person's depth beside it).
+        const int gx = static_cast<int>(std::lround(o.silhouette_grow * t.tb.box.width));
+        const int gy = static_cast<int>(std::lround(o.silhouette_grow * t.tb.box.height));
+        const cv::Rect outer =
+            cv::Rect(inner.x - gx, inner.y - gy, inner.width + 2 * gx, inner.height + 2 * gy) &
+            cv::Rect({}, size);
         cv::Mat sil, holes;
-        cv::inRange(frame.depth(inner), zp - h, zp + h, sil);
-        cv::compare(frame.depth(inner), 0.f, holes, cv::CMP_LE);
+        cv::inRange(frame.depth(outer), zp - h, zp + h, sil);
+        cv::compare(frame.depth(outer), 0.f, holes, cv::CMP_LE);
         sil |= holes;
-        cv::Mat big = cv::Mat::zeros(r.size(), CV_8UC1);
-        sil.copyTo(big(inner - r.tl()));
+        if (outer != inner) keepConnectedTo(sil, inner - outer.tl());
+        const cv::Rect region = r | outer;
+        cv::Mat big = cv::Mat::zeros(region.size(), CV_8UC1);
+        sil.copyTo(big(outer - region.tl()));
         if (o.mask_margin > 0)
             cv::dilate(big, big,
                        cv::getStructuringElement(
                            cv::MORPH_RECT, cv::Size(2 * o.mask_margin + 1, 2 * o.mask_margin + 1)));
-        out.mask(r) |= big;
+        out.mask(region) |= big;
     }
 }
 

@@ -219,6 +219,11 @@ class DynamicObjectFilter {
         /// arms and back), the mask's narrow (the background right behind a person
         /// keeps its features).
         double silhouette_depth_band = 0.0;
+        /// With mask_silhouette: the silhouette may reach beyond the box by this fraction
+        /// of the box's height (top and bottom) and width (sides), through pixels of the
+        /// person's depth band (or without depth) connected to the silhouette inside the
+        /// box. A detector's box often stops short of the head or a hand; 0 = the box only.
+        double silhouette_grow = 0.0;
 
         /// Reads `[section]`; unknown keys throw std::invalid_argument naming them.
         void loadFromConfig(const mrpt::config::CConfigFileBase& cfg,
