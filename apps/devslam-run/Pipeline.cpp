@@ -254,8 +254,8 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
         } catch (const std::invalid_argument&) {
         }
     }
-    rep.loop_reports = scoreLoops(slam.closedLoops(),
-                                  rep.ground_truth ? &*rep.ground_truth : nullptr);
+    rep.loop_reports =
+        scoreLoops(slam.closedLoops(), rep.ground_truth ? &*rep.ground_truth : nullptr);
 
     if (!rc.out_dir.empty()) {
         namespace fs = std::filesystem;
@@ -346,8 +346,7 @@ std::string formatSummary(const RunReport& r) {
       << (r.async_filter ? ", filter one frame ahead in a second thread" : "") << ")\n"
       << "camera     : " << r.camera << "\n"
       << "frames     : " << r.frames << "   keyframes: " << r.keyframes
-      << "   landmarks: " << r.landmarks << "   loops closed: " << r.loops << "\n"
-      ;
+      << "   landmarks: " << r.landmarks << "   loops closed: " << r.loops << "\n";
     if (const auto e = loopErrors(r.loop_reports); !e.empty()) {
         const auto s = core::summarize(e);
         o << "loops      : measured relative poses vs truth: median " << num(1000 * s.median, 1)
