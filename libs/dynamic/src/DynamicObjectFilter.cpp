@@ -914,7 +914,7 @@ void DynamicObjectFilter::Impl::forgetUnseen(const Options& o) {
 }
 
 /// Clears the set pixels of `sil` not 8-connected to one inside `inner` (a rectangle in
-/// sil's coordinates). Pixels inside `inner` are all kept.
+/// sil's coordinates). Pixels inside `inner` are all kept: their components reach it.
 void keepConnectedTo(cv::Mat& sil, const cv::Rect& inner) {
     cv::Mat labels;
     const int n = cv::connectedComponents(sil, labels, 8, CV_32S);
@@ -926,14 +926,12 @@ void keepConnectedTo(cv::Mat& sil, const cv::Rect& inner) {
         for (int x = 0; x < in.cols; ++x) keep[static_cast<std::size_t>(row[x])] = 1;
     }
     keep[0] = 0;
-    cv::Mat inside = sil(inner).clone();
     for (int y = 0; y < sil.rows; ++y) {
         const int* l = labels.ptr<int>(y);
         unsigned char* m = sil.ptr<unsigned char>(y);
         for (int x = 0; x < sil.cols; ++x)
             if (m[x] && !keep[static_cast<std::size_t>(l[x])]) m[x] = 0;
     }
-    inside.copyTo(sil(inner));
 }
 
 void DynamicObjectFilter::Impl::drawMask(const core::Frame& frame, bool have_prev,
