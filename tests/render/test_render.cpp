@@ -408,6 +408,38 @@ TEST(PersonMotion, PingPongAlongThePath) {
     EXPECT_THROW((void)parsePersonKind("running"), std::invalid_argument);
 }
 
+TEST(PersonMotion, PhotoSwaysAboutItsPivotAndFacesTheCamera) {
+    PersonSpec p;
+    p.kind = PersonKind::Sitting;
+    p.path = {{3, 2}};
+    p.base_z = -0.3;
+    p.sway_deg = 4;
+    const Eigen::Vector3d eye(0, 2, 1.2);  // straight down -x from the person
+    auto world = [](const mrpt::poses::CPose3D& P, double lx, double lz) {
+        double x = 0, y = 0, z = 0;
+        P.composePoint(lx, 0, lz, x, y, z);
+        return Eigen::Vector3d(x, y, z);
+    };
+    for (double pivot : {0.0, 0.9}) {
+        p.sway_pivot = pivot;
+        const Eigen::Vector3d axis(3, 2, -0.3 + pivot);
+        const auto still = personPhotoPose(p, personStateAt(p, 0.0), eye);
+        const auto swayed = personPhotoPose(p, personStateAt(p, p.sway_period / 4), eye);
+        // The pivot stays put; unswayed, the bottom centre is at the place, the photo upright.
+        EXPECT_LT((world(swayed, 0, pivot) - axis).norm(), 1e-12) << pivot;
+        EXPECT_LT((world(still, 0, 0) - Eigen::Vector3d(3, 2, -0.3)).norm(), 1e-12) << pivot;
+        EXPECT_NEAR(world(still, 0, 1).z() - world(still, 0, 0).z(), 1.0, 1e-12);
+        // The photo's normal (local y) points at the camera, and the sway stays in its plane.
+        const auto R = swayed.getRotationMatrix();
+        EXPECT_NEAR(std::abs(R(0, 1)), 1.0, 1e-12);
+        EXPECT_NEAR(R(1, 1), 0.0, 1e-12);
+        EXPECT_NEAR(R(2, 1), 0.0, 1e-12);
+        // The head (1.7 m up the photo) moves sideways by (1.7 - pivot) * sin(sway).
+        const double moved = (world(swayed, 0, 1.7) - world(still, 0, 1.7)).norm();
+        EXPECT_NEAR(moved, 2 * (1.7 - pivot) * std::sin(2 * kPi / 180), 1e-9) << pivot;
+    }
+}
+
 TEST(Scenario, ShippedFilesLoadAndTyposAreReported) {
     std::size_t n = 0;
     for (const auto& e : fs::directory_iterator(kSynth)) {

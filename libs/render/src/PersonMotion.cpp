@@ -29,6 +29,17 @@ std::string toString(PersonKind k) {
     return "?";
 }
 
+mrpt::poses::CPose3D personPhotoPose(const PersonSpec& p, const PersonState& s,
+                                     const Eigen::Vector3d& eye) {
+    const Eigen::Vector3d& b = s.position;
+    const double yaw = std::atan2(-(eye.x() - b.x()), eye.y() - b.y());
+    // Rotating about the pivot: shift the origin by what the rotation does to the pivot.
+    const mrpt::poses::CPose3D R(0, 0, 0, yaw, s.sway, 0);
+    double ox = 0, oy = 0, oz = 0;
+    R.composePoint(0, 0, p.sway_pivot, ox, oy, oz);
+    return {b.x() - ox, b.y() - oy, b.z() + p.sway_pivot - oz, yaw, s.sway, 0};
+}
+
 double pathLength(const std::vector<Eigen::Vector2d>& path) {
     double L = 0;
     for (std::size_t i = 1; i < path.size(); ++i) L += (path[i] - path[i - 1]).norm();

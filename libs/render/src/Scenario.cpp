@@ -121,7 +121,7 @@ PersonSpec loadPerson(const mrpt::config::CConfigFileBase& cfg, const std::strin
                       const std::string& path) {
     core::requireKnownKeys(cfg, s,
                            {"kind", "texture", "height", "path", "speed", "start_offset", "base_z",
-                            "sway_deg", "sway_period", "bob"},
+                            "sway_deg", "sway_period", "sway_pivot", "bob"},
                            path);
     PersonSpec p;
     p.name = s;
@@ -137,6 +137,7 @@ PersonSpec loadPerson(const mrpt::config::CConfigFileBase& cfg, const std::strin
     p.base_z = core::readDouble(cfg, s, "base_z", p.base_z);
     p.sway_deg = core::readDouble(cfg, s, "sway_deg", p.sway_deg);
     p.sway_period = core::readDouble(cfg, s, "sway_period", p.sway_period);
+    p.sway_pivot = core::readDouble(cfg, s, "sway_pivot", p.sway_pivot);
     p.bob = core::readDouble(cfg, s, "bob", p.bob);
     const auto xy = parseNumberList(cfg.read_string(s, "path", "", true), where + " path");
     if (xy.size() < 2 || xy.size() % 2)
@@ -146,6 +147,8 @@ PersonSpec loadPerson(const mrpt::config::CConfigFileBase& cfg, const std::strin
                        "must be in (0.2, 3) [m]");
     core::requireValue(p.speed >= 0 && p.speed < 5, where, "speed", "must be in [0, 5) [m/s]");
     core::requireValue(p.sway_period > 0, where, "sway_period", "must be > 0 [s]");
+    core::requireValue(p.sway_pivot >= 0 && p.sway_pivot <= p.height, where, "sway_pivot",
+                       "must be in [0, height] [m]");
     if (p.kind == PersonKind::Walking)
         core::requireValue(p.path.size() >= 2 && pathLength(p.path) > 0.1, where, "path",
                            "a walker needs at least two points 0.1 m apart");

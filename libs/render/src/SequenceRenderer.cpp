@@ -245,10 +245,7 @@ RenderedFrame SequenceRenderer::render(std::size_t i) {
     std::vector<PersonState> state(sc_.people.size());
     for (std::size_t k = 0; k < sc_.people.size(); ++k) {
         state[k] = personStateAt(sc_.people[k], t);
-        const Eigen::Vector3d& p = state[k].position;
-        // Billboard facing the camera (yaw only), swaying in its own plane.
-        const double yaw = std::atan2(-(eye.x() - p.x()), eye.y() - p.y());
-        person_pose[k] = mrpt::poses::CPose3D(p.x(), p.y(), p.z(), yaw, state[k].sway, 0);
+        person_pose[k] = personPhotoPose(sc_.people[k], state[k], eye);
         impl_->people[k].mesh->setPose(person_pose[k]);
     }
 

@@ -8,6 +8,7 @@
 ///   auto s = devslam::render::personStateAt(p, t);   // s.position, s.sway, s.moving
 
 #include <Eigen/Core>
+#include <mrpt/poses/CPose3D.h>
 
 #include <string>
 #include <vector>
@@ -30,14 +31,17 @@ struct PersonSpec {
     double start_offset = 0.0;  ///< walking: arc length already walked at t = 0 [m]
     double base_z = 0.0;    ///< height of the photo's bottom edge above the floor [m] (sitting: < 0
                             ///< hides legs in a desk)
-    double sway_deg = 3.0;  ///< sitting/standing: side sway amplitude about the base [deg]
+    double sway_deg = 3.0;  ///< sitting/standing: side sway amplitude [deg]
     double sway_period = 3.0;  ///< [s]
+    double sway_pivot = 0.0;   ///< height of the sway axis above the photo's bottom edge [m]
+                               ///< (0: the whole photo sways about its bottom edge; a seated
+                               ///< person's torso sways about the hips)
     double bob = 0.02;         ///< walking: vertical bob amplitude [m]
 };
 
 struct PersonState {
     Eigen::Vector3d position{0, 0, 0};  ///< bottom centre of the photo in the world [m]
-    double sway = 0.0;                  ///< in-plane rotation about the bottom centre [rad]
+    double sway = 0.0;                  ///< in-plane rotation about the sway axis [rad]
     bool moving = false;                ///< true while the person walks
     Eigen::Vector2d velocity{0, 0};     ///< on the floor [m/s]
 };
@@ -45,6 +49,13 @@ struct PersonState {
 /// State at time t [s] since the start of the sequence. Walkers go along the path and back
 /// (ping-pong), so their motion is continuous and never ends.
 [[nodiscard]] PersonState personStateAt(const PersonSpec& p, double t);
+
+/// World pose of the person's photo in state s seen from a camera at eye: the photo faces the
+/// camera (yaw about z only) and sways in its own plane about a horizontal axis sway_pivot
+/// above its bottom edge, which stays fixed. Local frame: x along the photo's width, z up
+/// its height, origin at the bottom centre (where s.position is when unswayed).
+[[nodiscard]] mrpt::poses::CPose3D personPhotoPose(const PersonSpec& p, const PersonState& s,
+                                                   const Eigen::Vector3d& eye);
 
 /// Length of a polyline [m].
 [[nodiscard]] double pathLength(const std::vector<Eigen::Vector2d>& path);
