@@ -327,6 +327,31 @@ TEST(OrbExtractor, KeypointsOnOcclusionEdgesGetNoDepth) {
     for (std::size_t i = 0; i < all.size(); ++i) EXPECT_GT(all.depth[i], 0.f);
 }
 
+TEST(LoopDetector, LoopsAgreeWhenTheyImplyTheMapsRelativePose) {
+    // Old keyframes o1, o2 and new ones n1, n2 (0.1 m apart on the map). Two true loops
+    // imply the map's n1 -> n2; a loop whose measurement is 5 cm off does not.
+    Map map;
+    const auto at = [&](double x, double y) {
+        Keyframe k;
+        k.T_wc.translation() = Eigen::Vector3d(x, y, 0);
+        return map.addKeyframe(k);
+    };
+    const KeyframeId o1 = at(0, 0), o2 = at(0.1, 0), n1 = at(0.02, 0.3), n2 = at(0.12, 0.3);
+    const auto measured = [&](KeyframeId o, KeyframeId n, Eigen::Vector3d error) {
+        LoopConstraint l{o, n, map.keyframe(o).T_wc.inverse() * map.keyframe(n).T_wc, 100};
+        l.T_old_new.translation() += error;
+        return l;
+    };
+    // Drift: both loops find the new keyframes 4 cm from where the map has them; they agree.
+    const auto a = measured(o1, n1, {0.04, 0, 0}), b = measured(o2, n2, {0.04, 0, 0});
+    EXPECT_TRUE(loopsAgree(map, a, b, 0.02, 1.0));
+    EXPECT_FALSE(loopsAgree(map, a, measured(o2, n2, {0.04, 0.05, 0}), 0.02, 1.0));
+    LoopConstraint turned = b;
+    turned.T_old_new.linear() = Eigen::AngleAxisd(2.0 * M_PI / 180, Eigen::Vector3d::UnitZ())
+                                    .toRotationMatrix();
+    EXPECT_FALSE(loopsAgree(map, a, turned, 0.02, 1.0));
+}
+
 TEST(LoopDetector, MeasuresFromTheKeyframesAndRejectsImplausibleCorrections) {
     // Two keyframes of the same textured plane seen from the same place: the loop's
     // measured relative pose is the identity. It is accepted when the current estimate

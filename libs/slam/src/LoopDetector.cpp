@@ -13,7 +13,8 @@ void LoopOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, const s
     core::requireKnownKeys(c, s,
                            {"enabled", "min_keyframe_gap", "cooldown_keyframes", "max_distance",
                             "max_candidates", "max_hamming", "ratio", "min_inliers", "sigma_t",
-                            "sigma_r_deg", "max_correction", "max_correction_deg"});
+                            "sigma_r_deg", "max_correction", "max_correction_deg",
+                            "confirm_keyframes", "confirm_t", "confirm_deg"});
     enabled = core::readBool(c, s, "enabled", enabled);
     min_keyframe_gap = core::readInt(c, s, "min_keyframe_gap", min_keyframe_gap);
     cooldown_keyframes = core::readInt(c, s, "cooldown_keyframes", cooldown_keyframes);
@@ -24,6 +25,9 @@ void LoopOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, const s
     min_inliers = core::readInt(c, s, "min_inliers", min_inliers);
     max_correction = core::readDouble(c, s, "max_correction", max_correction);
     max_correction_deg = core::readDouble(c, s, "max_correction_deg", max_correction_deg);
+    confirm_keyframes = core::readInt(c, s, "confirm_keyframes", confirm_keyframes);
+    confirm_t = core::readDouble(c, s, "confirm_t", confirm_t);
+    confirm_deg = core::readDouble(c, s, "confirm_deg", confirm_deg);
     sigma_t = core::readDouble(c, s, "sigma_t", sigma_t);
     sigma_r_deg = core::readDouble(c, s, "sigma_r_deg", sigma_r_deg);
     core::requireValue(min_keyframe_gap >= 1, s, "min_keyframe_gap", "must be >= 1");
@@ -31,6 +35,9 @@ void LoopOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, const s
     core::requireValue(min_inliers >= 6, s, "min_inliers", "must be >= 6");
     core::requireValue(max_correction > 0 && max_correction_deg > 0, s,
                        "max_correction/max_correction_deg", "must be > 0");
+    core::requireValue(confirm_keyframes >= 0, s, "confirm_keyframes", "must be >= 0");
+    core::requireValue(confirm_t > 0 && confirm_deg > 0, s, "confirm_t/confirm_deg",
+                       "must be > 0");
     core::requireValue(sigma_t > 0 && sigma_r_deg > 0, s, "sigma_t/sigma_r_deg", "must be > 0");
 }
 
@@ -45,8 +52,22 @@ void LoopOptions::saveToConfig(mrpt::config::CConfigFileBase& c, const std::stri
     c.write(s, "min_inliers", min_inliers);
     c.write(s, "max_correction", max_correction);
     c.write(s, "max_correction_deg", max_correction_deg);
+    c.write(s, "confirm_keyframes", confirm_keyframes);
+    c.write(s, "confirm_t", confirm_t);
+    c.write(s, "confirm_deg", confirm_deg);
     c.write(s, "sigma_t", sigma_t);
     c.write(s, "sigma_r_deg", sigma_r_deg);
+}
+
+bool loopsAgree(const Map& map, const LoopConstraint& a, const LoopConstraint& b, double max_t,
+                double max_deg) {
+    const auto pose = [&](KeyframeId id) { return map.keyframe(id).T_wc; };
+    const Eigen::Isometry3d via_loops =
+        (pose(a.old_kf) * a.T_old_new).inverse() * (pose(b.old_kf) * b.T_old_new);
+    const Eigen::Isometry3d via_map = pose(a.new_kf).inverse() * pose(b.new_kf);
+    const Eigen::Isometry3d d = via_map.inverse() * via_loops;
+    return d.translation().norm() <= max_t &&
+           Eigen::AngleAxisd(d.linear()).angle() <= max_deg * M_PI / 180.0;
 }
 
 std::optional<LoopConstraint> detectLoop(const Map& map, KeyframeId current,

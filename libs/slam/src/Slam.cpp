@@ -294,15 +294,31 @@ BackendResult Slam::backendStep(const MappingResult& mapping, const core::Camera
         return out;
     out.loop = detectLoop(map_, mapping.keyframe, K, opts_.loop, opts_.tracker.refine,
                           opts_.seed + static_cast<unsigned long long>(mapping.keyframe));
+    const int confirm = opts_.loop.confirm_keyframes;
+    if (pending_loop_ && mapping.keyframe - pending_loop_->new_kf > confirm) pending_loop_.reset();
     if (!out.loop) return out;
-    PoseGraphEdge e;
-    e.from = out.loop->old_kf;
-    e.to = out.loop->new_kf;
-    e.T_from_to = out.loop->T_old_new;
-    e.information = diagonalInformation(opts_.loop.sigma_t, opts_.loop.sigma_r_deg * M_PI / 180.0);
-    loop_edges_.push_back(e);
-    closed_loops_.push_back({map_.keyframe(e.from).timestamp, map_.keyframe(e.to).timestamp,
-                             out.loop->n_inliers, e.T_from_to});
+    std::vector<LoopConstraint> closing{*out.loop};
+    if (confirm > 0) {
+        // Close only a loop that a later keyframe's loop confirms; the newer one waits.
+        if (!pending_loop_ || !loopsAgree(map_, *pending_loop_, *out.loop, opts_.loop.confirm_t,
+                                          opts_.loop.confirm_deg)) {
+            pending_loop_ = out.loop;
+            return out;
+        }
+        closing.insert(closing.begin(), *pending_loop_);
+        pending_loop_.reset();
+    }
+    for (const auto& l : closing) {
+        PoseGraphEdge e;
+        e.from = l.old_kf;
+        e.to = l.new_kf;
+        e.T_from_to = l.T_old_new;
+        e.information =
+            diagonalInformation(opts_.loop.sigma_t, opts_.loop.sigma_r_deg * M_PI / 180.0);
+        loop_edges_.push_back(e);
+        closed_loops_.push_back({map_.keyframe(e.from).timestamp, map_.keyframe(e.to).timestamp,
+                                 l.n_inliers, e.T_from_to});
+    }
     // Odometry edges from the current estimates (consistent), plus every loop edge.
     std::map<std::int64_t, Eigen::Isometry3d> poses;
     for (const auto& [id, kf] : map_.keyframes()) poses[id] = kf.T_wc;

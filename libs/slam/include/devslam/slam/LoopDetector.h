@@ -32,6 +32,13 @@ struct LoopOptions {
     /// verify a false loop with many inliers, and one false loop wrecks the whole graph.
     double max_correction = 0.25;      ///< [m]
     double max_correction_deg = 10.0;  ///< [deg]
+    /// Temporal consistency: a verified loop is closed only once one of the next
+    /// `confirm_keyframes` keyframes also verifies a loop that agrees with it (the relative
+    /// pose of the two new keyframes the loops imply matches the map's own within
+    /// confirm_t / confirm_deg); then both are closed. 0: every verified loop is closed.
+    int confirm_keyframes = 0;
+    double confirm_t = 0.02;          ///< [m]
+    double confirm_deg = 1.0;         ///< [deg]
     double sigma_t = 0.02;             ///< [m] loop-edge translation std (pose-graph information)
     double sigma_r_deg = 1.0;          ///< [deg] loop-edge rotation std
     double scale_factor = 1.3;         ///< ORB pyramid scale for level sigmas (copied from [orb])
@@ -47,6 +54,12 @@ struct LoopConstraint {
     Eigen::Isometry3d T_old_new;  ///< measured pose of the new keyframe in the old one
     int n_inliers = 0;
 };
+
+/// Whether two verified loops agree (see LoopOptions::confirm_keyframes): the pose of b's new
+/// keyframe in a's new keyframe, as the two loops and the old keyframes' poses imply it,
+/// against the same from the map's new-keyframe poses.
+[[nodiscard]] bool loopsAgree(const Map& map, const LoopConstraint& a, const LoopConstraint& b,
+                              double max_t, double max_deg);
 
 /// Looks for a loop between `current` and older keyframes (see LoopOptions).
 [[nodiscard]] std::optional<LoopConstraint> detectLoop(const Map& map, KeyframeId current,

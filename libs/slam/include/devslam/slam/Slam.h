@@ -179,6 +179,7 @@ class Slam {
     std::vector<FrameRecord> records_;
     std::vector<PoseGraphEdge> loop_edges_;
     std::vector<ClosedLoop> closed_loops_;
+    std::optional<LoopConstraint> pending_loop_;  ///< verified, awaiting confirmation
     int frames_since_kf_ = 0;
     int tracked_at_last_kf_ = 0;
     bool pending_init_ = false;
