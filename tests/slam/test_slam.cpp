@@ -347,8 +347,8 @@ TEST(LoopDetector, LoopsAgreeWhenTheyImplyTheMapsRelativePose) {
     EXPECT_TRUE(loopsAgree(map, a, b, 0.02, 1.0));
     EXPECT_FALSE(loopsAgree(map, a, measured(o2, n2, {0.04, 0.05, 0}), 0.02, 1.0));
     LoopConstraint turned = b;
-    turned.T_old_new.linear() = Eigen::AngleAxisd(2.0 * M_PI / 180, Eigen::Vector3d::UnitZ())
-                                    .toRotationMatrix();
+    turned.T_old_new.linear() =
+        Eigen::AngleAxisd(2.0 * M_PI / 180, Eigen::Vector3d::UnitZ()).toRotationMatrix();
     EXPECT_FALSE(loopsAgree(map, a, turned, 0.02, 1.0));
 }
 

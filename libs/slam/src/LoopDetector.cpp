@@ -10,11 +10,11 @@
 namespace devslam::slam {
 
 void LoopOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, const std::string& s) {
-    core::requireKnownKeys(c, s,
-                           {"enabled", "min_keyframe_gap", "cooldown_keyframes", "max_distance",
-                            "max_candidates", "max_hamming", "ratio", "min_inliers", "sigma_t",
-                            "sigma_r_deg", "max_correction", "max_correction_deg",
-                            "confirm_keyframes", "confirm_t", "confirm_deg"});
+    core::requireKnownKeys(
+        c, s,
+        {"enabled", "min_keyframe_gap", "cooldown_keyframes", "max_distance", "max_candidates",
+         "max_hamming", "ratio", "min_inliers", "sigma_t", "sigma_r_deg", "max_correction",
+         "max_correction_deg", "confirm_keyframes", "confirm_t", "confirm_deg"});
     enabled = core::readBool(c, s, "enabled", enabled);
     min_keyframe_gap = core::readInt(c, s, "min_keyframe_gap", min_keyframe_gap);
     cooldown_keyframes = core::readInt(c, s, "cooldown_keyframes", cooldown_keyframes);
@@ -36,8 +36,7 @@ void LoopOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, const s
     core::requireValue(max_correction > 0 && max_correction_deg > 0, s,
                        "max_correction/max_correction_deg", "must be > 0");
     core::requireValue(confirm_keyframes >= 0, s, "confirm_keyframes", "must be >= 0");
-    core::requireValue(confirm_t > 0 && confirm_deg > 0, s, "confirm_t/confirm_deg",
-                       "must be > 0");
+    core::requireValue(confirm_t > 0 && confirm_deg > 0, s, "confirm_t/confirm_deg", "must be > 0");
     core::requireValue(sigma_t > 0 && sigma_r_deg > 0, s, "sigma_t/sigma_r_deg", "must be > 0");
 }
 

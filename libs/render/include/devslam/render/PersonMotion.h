@@ -7,8 +7,8 @@
 ///   devslam::render::PersonSpec p; p.kind = PersonKind::Walking; p.path = {{2,1},{2,4}};
 ///   auto s = devslam::render::personStateAt(p, t);   // s.position, s.sway, s.moving
 
-#include <Eigen/Core>
 #include <mrpt/poses/CPose3D.h>
+#include <Eigen/Core>
 
 #include <string>
 #include <vector>

@@ -37,8 +37,8 @@ struct LoopOptions {
     /// pose of the two new keyframes the loops imply matches the map's own within
     /// confirm_t / confirm_deg); then both are closed. 0: every verified loop is closed.
     int confirm_keyframes = 0;
-    double confirm_t = 0.02;          ///< [m]
-    double confirm_deg = 1.0;         ///< [deg]
+    double confirm_t = 0.02;           ///< [m]
+    double confirm_deg = 1.0;          ///< [deg]
     double sigma_t = 0.02;             ///< [m] loop-edge translation std (pose-graph information)
     double sigma_r_deg = 1.0;          ///< [deg] loop-edge rotation std
     double scale_factor = 1.3;         ///< ORB pyramid scale for level sigmas (copied from [orb])
