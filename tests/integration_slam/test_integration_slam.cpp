@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <sstream>
 
 using namespace devslam;
@@ -230,8 +231,16 @@ TEST(SlamIntegration, ForwardBackwardClosesALoop) {
     auto opts = options();
     opts.loop.min_keyframe_gap = 4;
     opts.keyframes.max_frames = 5;
-    const auto r = runSlam(frames, opts);
-    EXPECT_TRUE(r.lost.empty());
-    EXPECT_GE(r.loops, 1);
-    EXPECT_LE(ate(gt, r.traj), 0.01);
+    // Every verified loop closed at once, and loops closed only in confirmed pairs.
+    for (int confirm : {0, 2}) {
+        opts.loop.confirm_keyframes = confirm;
+        const auto r = runSlam(frames, opts);
+        EXPECT_TRUE(r.lost.empty()) << confirm;
+        EXPECT_GE(r.loops, confirm > 0 ? 2 : 1) << confirm;
+        if (confirm > 0) {
+            EXPECT_EQ(r.loops % 2, 0) << "confirmed loops close in pairs";
+        }
+        EXPECT_LE(ate(gt, r.traj), 0.01) << confirm;
+        std::cout << "confirm_keyframes " << confirm << ": " << r.loops << " loops\n";
+    }
 }
