@@ -289,15 +289,13 @@ void Slam::finalize(const core::CameraIntrinsics& K) {
 BackendResult Slam::backendStep(const MappingResult& mapping, const core::CameraIntrinsics& K) {
     BackendResult out;
     if (!mapping.keyframe_inserted || !opts_.loop.enabled) return out;
-    if (!loop_edges_.empty() &&
-        mapping.keyframe - loop_edges_.back().to < opts_.loop.cooldown_keyframes)
+    if (!loops_.empty() && mapping.keyframe - loops_.back().new_kf < opts_.loop.cooldown_keyframes)
         return out;
     out.loop = detectLoop(map_, mapping.keyframe, K, opts_.loop, opts_.tracker.refine,
                           opts_.seed + static_cast<unsigned long long>(mapping.keyframe));
     const int confirm = opts_.loop.confirm_keyframes;
     if (pending_loop_ && mapping.keyframe - pending_loop_->new_kf > confirm) pending_loop_.reset();
     if (!out.loop) return out;
-    std::vector<LoopConstraint> closing{*out.loop};
     if (confirm > 0) {
         // Close only a loop that a later keyframe's loop confirms; the newer one waits.
         if (!pending_loop_ || !loopsAgree(map_, *pending_loop_, *out.loop, opts_.loop.confirm_t,
@@ -305,20 +303,10 @@ BackendResult Slam::backendStep(const MappingResult& mapping, const core::Camera
             pending_loop_ = out.loop;
             return out;
         }
-        closing.insert(closing.begin(), *pending_loop_);
+        loops_.push_back(*pending_loop_);
         pending_loop_.reset();
     }
-    for (const auto& l : closing) {
-        PoseGraphEdge e;
-        e.from = l.old_kf;
-        e.to = l.new_kf;
-        e.T_from_to = l.T_old_new;
-        e.information =
-            diagonalInformation(opts_.loop.sigma_t, opts_.loop.sigma_r_deg * M_PI / 180.0);
-        loop_edges_.push_back(e);
-        closed_loops_.push_back({map_.keyframe(e.from).timestamp, map_.keyframe(e.to).timestamp,
-                                 l.n_inliers, e.T_from_to});
-    }
+    loops_.push_back(*out.loop);
     // Odometry edges from the current estimates (consistent), plus every loop edge.
     std::map<std::int64_t, Eigen::Isometry3d> poses;
     for (const auto& [id, kf] : map_.keyframes()) poses[id] = kf.T_wc;
@@ -329,7 +317,9 @@ BackendResult Slam::backendStep(const MappingResult& mapping, const core::Camera
         auto nx = std::next(it);
         edges.push_back({it->first, nx->first, it->second.inverse() * nx->second, odo_info});
     }
-    edges.insert(edges.end(), loop_edges_.begin(), loop_edges_.end());
+    const auto loop_info =
+        diagonalInformation(opts_.loop.sigma_t, opts_.loop.sigma_r_deg * M_PI / 180.0);
+    for (const auto& l : loops_) edges.push_back({l.old_kf, l.new_kf, l.T_old_new, loop_info});
     out.graph = optimizePoseGraph(poses, edges, poses.begin()->first, opts_.pose_graph);
     applyCorrections(out.graph.poses);
     out.loop_closed = true;
@@ -380,6 +370,14 @@ std::vector<std::size_t> Slam::lostFrames() const {
     std::vector<std::size_t> out;
     for (std::size_t i = 0; i < records_.size(); ++i)
         if (!records_[i].valid) out.push_back(i);
+    return out;
+}
+
+std::vector<Slam::ClosedLoop> Slam::closedLoops() const {
+    std::vector<ClosedLoop> out;
+    for (const auto& l : loops_)
+        out.push_back({map_.keyframe(l.old_kf).timestamp, map_.keyframe(l.new_kf).timestamp,
+                       l.n_inliers, l.T_old_new});
     return out;
 }
 

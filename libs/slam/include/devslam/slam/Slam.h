@@ -144,7 +144,7 @@ class Slam {
     [[nodiscard]] std::vector<std::size_t> lostFrames() const;
     [[nodiscard]] core::Trajectory keyframeTrajectory() const;
     [[nodiscard]] const Map& map() const { return map_; }
-    [[nodiscard]] int loopsClosed() const { return static_cast<int>(loop_edges_.size()); }
+    [[nodiscard]] int loopsClosed() const { return static_cast<int>(loops_.size()); }
     /// A loop the back end closed, as measured when it was verified.
     struct ClosedLoop {
         double t_old = 0, t_new = 0;  ///< timestamps of the two keyframes
@@ -152,7 +152,7 @@ class Slam {
         Eigen::Isometry3d T_old_new = Eigen::Isometry3d::Identity();  ///< measured relative pose
     };
     /// Every loop closed so far, in closing order.
-    [[nodiscard]] const std::vector<ClosedLoop>& closedLoops() const { return closed_loops_; }
+    [[nodiscard]] std::vector<ClosedLoop> closedLoops() const;
     [[nodiscard]] const SlamOptions& options() const { return opts_; }
 
   private:
@@ -177,8 +177,7 @@ class Slam {
     Tracker tracker_;
     Map map_;
     std::vector<FrameRecord> records_;
-    std::vector<PoseGraphEdge> loop_edges_;
-    std::vector<ClosedLoop> closed_loops_;
+    std::vector<LoopConstraint> loops_;  ///< closed, in closing order (the graph's loop edges)
     std::optional<LoopConstraint> pending_loop_;  ///< verified, awaiting confirmation
     int frames_since_kf_ = 0;
     int tracked_at_last_kf_ = 0;
