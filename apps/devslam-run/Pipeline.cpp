@@ -179,6 +179,9 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
         fl.state = slam::toString(tr.state);
         fl.n_inliers = tr.n_inliers;
         fl.keyframe = mr.keyframe_inserted;
+        fl.ba_rejected = mr.ba.rejected;
+        if (mr.ba.n_keyframes > 0) ++rep.ba_runs;
+        if (mr.ba.rejected) ++rep.ba_rejected;
         fl.keyframe_reason = slam::toString(mr.reason);
         fl.loop = br.loop_closed;
         fl.wall_ms = msSince(t_iter) - fl.read_ms;
@@ -201,6 +204,7 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
     }
 
     rep.frames = n;
+    rep.ba_max_shift = slam_opts.local_ba.max_keyframe_shift;
     rep.keyframes = slam.map().keyframes().size();
     rep.landmarks = slam.map().landmarks().size();
     rep.loops = static_cast<std::size_t>(slam.loopsClosed());
@@ -358,8 +362,12 @@ std::string formatSummary(const RunReport& r) {
         if (r.lost.size() > 20) o << " ...";
         o << ")";
     }
-    o << "\n"
-      << "speed      : median " << num(r.median_fps, 1) << " FPS (" << num(r.median_ms, 1)
+    o << "\n";
+    if (r.ba_rejected > 0)
+        o << "local BA   : " << r.ba_rejected << " of " << r.ba_runs
+          << " optimisations not applied (a keyframe would have moved > "
+          << num(r.ba_max_shift, 3) << " m)\n";
+    o << "speed      : median " << num(r.median_fps, 1) << " FPS (" << num(r.median_ms, 1)
       << " ms/frame), mean " << num(r.mean_fps, 1) << " FPS (wall clock)\n"
       << "cpu time   : median " << num(r.median_cpu_ms, 1)
       << " ms/frame, all threads (load-independent; = "
@@ -431,6 +439,7 @@ std::string toJson(const RunReport& r) {
     o << "{\n  \"input\": \"" << esc(r.input) << "\",\n  \"mode\": \"" << r.mode
       << "\",\n  \"mask_source\": \"" << esc(r.mask_source) << "\",\n  \"frames\": " << r.frames
       << ",\n  \"keyframes\": " << r.keyframes << ",\n  \"landmarks\": " << r.landmarks
+      << ",\n  \"local_ba_runs\": " << r.ba_runs << ",\n  \"local_ba_rejected\": " << r.ba_rejected
       << ",\n  \"loops_closed\": " << r.loops << ",\n  \"lost_frames\": " << r.lost.size()
       << ",\n  \"lost_frame_indices\": [";
     for (std::size_t i = 0; i < r.lost.size(); ++i) o << (i ? ", " : "") << r.lost[i];
@@ -471,6 +480,7 @@ std::string toJson(const RunReport& r) {
           << ", \"inliers\": " << l.n_inliers << ", \"boxes\": " << l.n_boxes
           << ", \"moving\": " << l.n_moving << ", \"keyframe\": " << (l.keyframe ? "true" : "false")
           << ", \"keyframe_reason\": \"" << l.keyframe_reason << "\""
+          << (l.ba_rejected ? ", \"ba_rejected\": true" : "")
           << ", \"wall_ms\": " << num(l.wall_ms, 3) << ", \"cpu_ms\": " << num(l.cpu_ms, 3)
           << ", \"ms\": " << timingJson(l.ms) << "}";
     }

@@ -46,6 +46,7 @@ struct FrameLog {
     int n_features = 0, n_masked = 0, n_inliers = 0, n_boxes = 0, n_moving = 0;
     double masked_fraction = 0;  ///< of the image, by the dynamic mask
     bool keyframe = false, loop = false;
+    bool ba_rejected = false;  ///< the keyframe's local BA was not applied (max_keyframe_shift)
     FrameTiming ms;      ///< per stage (detect/filter overlap the SLAM when async)
     double wall_ms = 0;  ///< wall time of the frame's pipeline step (disk reading excluded)
     double cpu_ms = 0;   ///< process CPU time (all threads) of that step
@@ -70,6 +71,8 @@ struct RunReport {
     bool async_filter = false;
     std::size_t frames = 0, keyframes = 0, landmarks = 0, loops = 0;
     std::vector<std::size_t> lost;  ///< frame indices without a tracked pose
+    std::size_t ba_runs = 0, ba_rejected = 0;  ///< local BAs, and those not applied
+    double ba_max_shift = 0;  ///< [m] [local_ba] max_keyframe_shift (0 = off)
     std::vector<FrameLog> log;
     core::Trajectory trajectory, keyframe_trajectory;
     std::optional<core::Trajectory> ground_truth;

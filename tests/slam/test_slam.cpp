@@ -436,23 +436,29 @@ TEST(Map, ObservationsAndRemovalStayConsistent) {
     EXPECT_THROW((void)map.keyframe(42), std::out_of_range);
 }
 
-TEST(LocalBundleAdjuster, ReducesPoseAndPointErrors) {
-    // 4 keyframes looking at 300 points; keyframes 1..3 and all points perturbed.
+/// 4 keyframes looking at 300 points (noise-free keypoints and depths); keyframes 1..3
+/// start off their true pose by `error` (keyframe 3 also by `extra_3`), and the points by
+/// 1 cm noise. Keyframe 0 is the gauge.
+struct BaScene {
+    Map map;
+    std::vector<Eigen::Vector3d> pts;
+    std::vector<Eigen::Isometry3d> gt;
+};
+BaScene makeBaScene(const Eigen::Isometry3d& extra_3 = Eigen::Isometry3d::Identity()) {
     const auto K = fr1NoDist();
+    BaScene sc;
     std::mt19937 rng(11);
     std::uniform_real_distribution<double> U(-1, 1);
-    std::vector<Eigen::Vector3d> pts;
-    for (int i = 0; i < 300; ++i) pts.emplace_back(U(rng) * 1.0, U(rng) * 0.7, 2.5 + U(rng) * 0.8);
-    std::vector<Eigen::Isometry3d> gt;
+    for (int i = 0; i < 300; ++i)
+        sc.pts.emplace_back(U(rng) * 1.0, U(rng) * 0.7, 2.5 + U(rng) * 0.8);
     for (int k = 0; k < 4; ++k)
-        gt.push_back(makePose(0.08 * k, 0.02 * k, 0.03 * k, 0.01 * k, -0.02 * k, 0));
-    Map map;
-    std::vector<std::vector<int>> kp_of_pt(4);
+        sc.gt.push_back(makePose(0.08 * k, 0.02 * k, 0.03 * k, 0.01 * k, -0.02 * k, 0));
     for (int k = 0; k < 4; ++k) {
         Keyframe kf;
-        kf.T_wc = k == 0 ? gt[0] : gt[k] * makePose(0.01, -0.01, 0.01, 0.005, 0.005, -0.005);
-        for (const auto& p : pts) {
-            const Eigen::Vector3d pc = gt[k].inverse() * p;
+        kf.T_wc = k == 0 ? sc.gt[0] : sc.gt[k] * makePose(0.01, -0.01, 0.01, 0.005, 0.005, -0.005);
+        if (k == 3) kf.T_wc = kf.T_wc * extra_3;
+        for (const auto& p : sc.pts) {
+            const Eigen::Vector3d pc = sc.gt[k].inverse() * p;
             const auto uv = core::project(pc, K);
             kf.features.keypoints.emplace_back(
                 cv::Point2f(static_cast<float>(uv->x()), static_cast<float>(uv->y())), 7.f, -1.f,
@@ -460,31 +466,78 @@ TEST(LocalBundleAdjuster, ReducesPoseAndPointErrors) {
             kf.features.depth.push_back(static_cast<float>(pc.z()));
             kf.features.points_c.push_back(pc);
         }
-        kf.features.descriptors = cv::Mat(static_cast<int>(pts.size()), 32, CV_8U, cv::Scalar(0));
-        map.addKeyframe(kf);
+        kf.features.descriptors =
+            cv::Mat(static_cast<int>(sc.pts.size()), 32, CV_8U, cv::Scalar(0));
+        sc.map.addKeyframe(kf);
     }
     std::mt19937 rng2(12);
     std::normal_distribution<double> N(0, 0.01);
-    for (std::size_t i = 0; i < pts.size(); ++i) {
+    for (std::size_t i = 0; i < sc.pts.size(); ++i) {
         const LandmarkId l =
-            map.addLandmark(pts[i] + Eigen::Vector3d(N(rng2), N(rng2), N(rng2)),
-                            cv::Mat(1, 32, CV_8U, cv::Scalar(0)), {}, 0, static_cast<int>(i));
-        for (int k = 1; k < 4; ++k) map.addObservation(l, k, static_cast<int>(i));
+            sc.map.addLandmark(sc.pts[i] + Eigen::Vector3d(N(rng2), N(rng2), N(rng2)),
+                               cv::Mat(1, 32, CV_8U, cv::Scalar(0)), {}, 0, static_cast<int>(i));
+        for (int k = 1; k < 4; ++k) sc.map.addObservation(l, k, static_cast<int>(i));
     }
+    return sc;
+}
+
+TEST(LocalBundleAdjuster, ReducesPoseAndPointErrors) {
+    auto sc = makeBaScene();
+    Map& map = sc.map;
     LocalBaOptions o;
     o.iterations = 15;
-    const auto res = localBundleAdjust(map, 3, K, o);
+    const auto res = localBundleAdjust(map, 3, fr1NoDist(), o);
     EXPECT_EQ(res.n_keyframes, 3);  // keyframe 0 is the gauge
     EXPECT_EQ(res.n_landmarks, 300);
     EXPECT_LT(res.final_cost, 0.01 * res.initial_cost);
     for (int k = 1; k < 4; ++k)
-        EXPECT_LT((map.keyframe(k).T_wc.translation() - gt[k].translation()).norm(), 1e-3) << k;
-    EXPECT_TRUE(map.keyframe(0).T_wc.isApprox(gt[0]));
+        EXPECT_LT((map.keyframe(k).T_wc.translation() - sc.gt[k].translation()).norm(), 1e-3)
+            << k;
+    EXPECT_TRUE(map.keyframe(0).T_wc.isApprox(sc.gt[0]));
     double worst = 0;
-    for (std::size_t i = 0; i < pts.size(); ++i)
-        worst = std::max(worst, (map.landmark(static_cast<LandmarkId>(i))->p_w - pts[i]).norm());
+    for (std::size_t i = 0; i < sc.pts.size(); ++i)
+        worst =
+            std::max(worst, (map.landmark(static_cast<LandmarkId>(i))->p_w - sc.pts[i]).norm());
     EXPECT_LT(worst, 2e-3);
     EXPECT_EQ(res.n_outliers_removed, 0);
+    EXPECT_FALSE(res.rejected);
+    EXPECT_GT(res.max_shift, 0.005);  // the 1-2 cm start errors were corrected
+    EXPECT_LT(res.max_shift, 0.05);
+}
+
+TEST(LocalBundleAdjuster, ShiftAboveTheBoundIsNotApplied) {
+    // Keyframe 3 starts 0.25 m off: the optimisation moves it back by about that much. With
+    // max_keyframe_shift 0.1 m nothing is applied (the map is as before); with 0.3 m it is.
+    const Eigen::Isometry3d off = makePose(0.25, 0, 0, 0, 0, 0);
+    for (const double bound : {0.1, 0.3}) {
+        SCOPED_TRACE("max_keyframe_shift " + std::to_string(bound));
+        auto sc = makeBaScene(off);
+        std::vector<Eigen::Isometry3d> before;
+        for (int k = 0; k < 4; ++k) before.push_back(sc.map.keyframe(k).T_wc);
+        std::vector<Eigen::Vector3d> points_before;
+        for (std::size_t i = 0; i < sc.pts.size(); ++i)
+            points_before.push_back(sc.map.landmark(static_cast<LandmarkId>(i))->p_w);
+        LocalBaOptions o;
+        o.iterations = 15;
+        o.max_keyframe_shift = bound;
+        const auto res = localBundleAdjust(sc.map, 3, fr1NoDist(), o);
+        EXPECT_NEAR(res.max_shift, 0.25, 0.03);
+        EXPECT_EQ(res.rejected, bound < 0.25);
+        const double err3 = (sc.map.keyframe(3).T_wc.translation() - sc.gt[3].translation()).norm();
+        if (res.rejected) {
+            for (int k = 0; k < 4; ++k) EXPECT_TRUE(sc.map.keyframe(k).T_wc.isApprox(before[k]));
+            for (std::size_t i = 0; i < sc.pts.size(); ++i) {
+                const Landmark* l = sc.map.landmark(static_cast<LandmarkId>(i));
+                ASSERT_NE(l, nullptr) << "nothing removed";
+                EXPECT_EQ(l->p_w, points_before[i]);
+                EXPECT_EQ(l->observations.size(), 4u);  // keyframes 0-3
+            }
+            EXPECT_EQ(res.n_outliers_removed, 0);
+            EXPECT_GT(err3, 0.2);
+        } else {
+            EXPECT_LT(err3, 1e-3);
+        }
+    }
 }
 
 TEST(Slam, DepthStampAndCompensation) {

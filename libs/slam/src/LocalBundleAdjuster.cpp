@@ -6,6 +6,7 @@
 
 #include <Eigen/Cholesky>
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
 #include <unordered_map>
@@ -15,7 +16,8 @@ namespace devslam::slam {
 void LocalBaOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, const std::string& s) {
     core::requireKnownKeys(
         c, s,
-        {"enabled", "window", "iterations", "bf", "chi2_mono", "chi2_stereo", "outlier_rounds"});
+        {"enabled", "window", "iterations", "bf", "chi2_mono", "chi2_stereo", "outlier_rounds",
+         "max_keyframe_shift"});
     enabled = core::readBool(c, s, "enabled", enabled);
     window = core::readInt(c, s, "window", window);
     outlier_rounds = core::readInt(c, s, "outlier_rounds", outlier_rounds);
@@ -28,6 +30,8 @@ void LocalBaOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, cons
     core::requireValue(window >= 1 && window <= 30, s, "window", "must be in [1, 30]");
     core::requireValue(iterations >= 0, s, "iterations", "must be >= 0");
     core::requireValue(bf > 0, s, "bf", "must be > 0");
+    max_keyframe_shift = core::readDouble(c, s, "max_keyframe_shift", max_keyframe_shift);
+    core::requireValue(max_keyframe_shift >= 0, s, "max_keyframe_shift", "must be >= 0 (0 = off)");
 }
 
 void LocalBaOptions::saveToConfig(mrpt::config::CConfigFileBase& c, const std::string& s) const {
@@ -38,6 +42,7 @@ void LocalBaOptions::saveToConfig(mrpt::config::CConfigFileBase& c, const std::s
     c.write(s, "bf", bf);
     c.write(s, "chi2_mono", chi2_mono);
     c.write(s, "chi2_stereo", chi2_stereo);
+    c.write(s, "max_keyframe_shift", max_keyframe_shift);
 }
 
 namespace {
@@ -257,6 +262,13 @@ LocalBaResult localBundleAdjust(Map& map, KeyframeId newest, const core::CameraI
         }
     }
     res.final_cost = cost;
+    for (int p = 0; p < P; ++p)
+        res.max_shift =
+            std::max(res.max_shift, (T_cw[p].inverse().translation() -
+                                     map.keyframe(pose_ids[p]).T_wc.translation())
+                                        .norm());
+    res.rejected = opts.max_keyframe_shift > 0 && res.max_shift > opts.max_keyframe_shift;
+    if (res.rejected) return res;  // the map stays as it was, observations included
     for (int p = 0; p < P; ++p) map.keyframe(pose_ids[p]).T_wc = T_cw[p].inverse();
     for (int l = 0; l < L; ++l) map.landmark(lm_ids[l])->p_w = X[l];
 

@@ -30,6 +30,13 @@ struct LocalBaOptions {
     double chi2_mono = 5.991;    ///< outlier test for 2-dof residuals (Huber width too)
     double chi2_stereo = 7.815;  ///< for 3-dof residuals
     double scale_factor = 1.3;   ///< ORB pyramid scale (level sigmas), copied from [orb]
+    /// [m] when > 0, an optimisation that moves a keyframe farther than this is not
+    /// applied (the map stays as it was, no observation removed either). The
+    /// keyframes were tracked frame to frame, and a local BA refines them by millimetres to
+    /// a few centimetres; a shift of decimetres is the optimum of a problem corrupted by
+    /// moving landmarks (people the mask missed) with little static structure left, and it
+    /// drags the keyframes, and every frame tracked from them, away at once.
+    double max_keyframe_shift = 0.0;
 
     void loadFromConfig(const mrpt::config::CConfigFileBase& cfg,
                         const std::string& section = "local_ba");
@@ -46,6 +53,8 @@ struct LocalBaResult {
     double initial_cost = 0.0;  ///< robust cost (sum of Huber-weighted chi2)
     double final_cost = 0.0;
     int n_outliers_removed = 0;  ///< observations removed after the optimisation
+    double max_shift = 0.0;      ///< [m] largest keyframe translation the optimisation found
+    bool rejected = false;       ///< not applied: max_shift > max_keyframe_shift
 };
 
 /// Optimises the window ending at `newest`. Keyframe 0 (the gauge) is never moved.
