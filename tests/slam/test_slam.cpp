@@ -437,8 +437,8 @@ TEST(Map, ObservationsAndRemovalStayConsistent) {
 }
 
 /// 4 keyframes looking at 300 points (noise-free keypoints and depths); keyframes 1..3
-/// start off their true pose by `error` (keyframe 3 also by `extra_3`), and the points by
-/// 1 cm noise. Keyframe 0 is the gauge.
+/// start 1-2 cm off their true pose (keyframe 3 also by `extra_3`), and the points by 1 cm
+/// noise. Keyframe 0 is the gauge.
 struct BaScene {
     Map map;
     std::vector<Eigen::Vector3d> pts;
