@@ -201,6 +201,35 @@ TEST(RenderGeometry, WallBlurKeepsTheColoursAndRemovesCorners) {
     EXPECT_EQ(cv::norm(sharp.frame.depth, soft.frame.depth, cv::NORM_INF), 0.0);
 }
 
+// `texture_filter`: a wall photo seen from 0.5 m is magnified about 2-4x. Sampled at the
+// nearest texel it becomes blocks of equal pixels (whose corners ORB would track); sampled
+// bilinearly, neighbouring pixels differ as in a camera image (except where the photo
+// itself is flat or saturated). Depth does not change.
+TEST(RenderGeometry, BilinearTexturesHaveNoTexelBlocks) {
+    Scenario sc = bareRoom({3.5, 2.0, 1.5}, {4.0, 2.0, 1.5});
+    sc.K = core::CameraIntrinsics::fromPreset("freiburg3");
+    // Fraction of horizontally adjacent pixel pairs with the very same colour.
+    const auto equalNeighbours = [](const cv::Mat& bgr) {
+        cv::Mat diff;
+        cv::absdiff(bgr.colRange(1, bgr.cols), bgr.colRange(0, bgr.cols - 1), diff);
+        cv::Mat grey;
+        cv::cvtColor(diff, grey, cv::COLOR_BGR2GRAY);
+        return 1.0 - double(cv::countNonZero(grey)) / double(grey.total());
+    };
+    sc.texture_linear = false;
+    const auto nearest = SequenceRenderer(sc).render(0);
+    sc.texture_linear = true;
+    const auto linear = SequenceRenderer(sc).render(0);
+    const double f_nearest = equalNeighbours(nearest.frame.bgr);
+    const double f_linear = equalNeighbours(linear.frame.bgr);
+    EXPECT_GT(f_nearest, 0.4) << "nearest-texel sampling should give blocks";
+    EXPECT_LT(2 * f_linear, f_nearest) << "bilinear sampling should not";
+    const cv::Scalar a = cv::mean(nearest.frame.bgr), b = cv::mean(linear.frame.bgr);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b[c], 3.0) << "channel " << c;
+    EXPECT_EQ(cv::norm(nearest.frame.depth, linear.frame.depth, cv::NORM_INF), 0.0);
+    std::printf("equal neighbouring pixels: nearest %.3f, bilinear %.3f\n", f_nearest, f_linear);
+}
+
 TEST(RenderSequence, GroundTruthMatchesPosesUsed) {
     TempDir tmp;
     const Scenario sc = smallShort();
@@ -496,6 +525,12 @@ TEST(Scenario, ShippedFilesLoadAndTyposAreReported) {
                                                         "room = " + tmp.str("bad_room.ini"))); },
                       msg);
     }
+    expectMessage(
+        [&] {
+            (void)loadScenario(withEdit(text, "n_frames        = 60",
+                                        "n_frames = 60\ntexture_filter = cubic"));
+        },
+        "[scenario] texture_filter: must be linear or nearest, got 'cubic'");
     expectMessage([&] { (void)loadScenario(withEdit(text, "kind    = walking", "kind = flying")); },
                   "unknown person kind 'flying'");
     expectMessage(

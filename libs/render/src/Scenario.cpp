@@ -192,7 +192,7 @@ Scenario readScenario(const std::string& path) {
     const std::string s = "scenario";
     core::requireKnownKeys(*cfg, s,
                            {"name", "room", "duration", "n_frames", "rate_hz", "t0", "seed",
-                            "rgb_noise_sigma", "near_clip", "far_clip"},
+                            "rgb_noise_sigma", "near_clip", "far_clip", "texture_filter"},
                            path);
     sc.name = cfg->read_string(s, "name", fs::path(path).stem().string());
     sc.rate_hz = core::readDouble(*cfg, s, "rate_hz", sc.rate_hz);
@@ -209,6 +209,10 @@ Scenario readScenario(const std::string& path) {
     sc.rgb_noise_sigma = core::readDouble(*cfg, s, "rgb_noise_sigma", sc.rgb_noise_sigma);
     sc.near_clip = core::readDouble(*cfg, s, "near_clip", sc.near_clip);
     sc.far_clip = core::readDouble(*cfg, s, "far_clip", sc.far_clip);
+    const std::string filter = cfg->read_string(s, "texture_filter", "linear");
+    core::requireValue(filter == "linear" || filter == "nearest", s,
+                       "texture_filter", "must be linear or nearest, got '" + filter + "'");
+    sc.texture_linear = filter == "linear";
     core::requireValue(sc.rgb_noise_sigma >= 0, path + " [scenario]", "rgb_noise_sigma",
                        "must be >= 0");
     core::requireValue(sc.near_clip > 0 && sc.far_clip > sc.near_clip, path + " [scenario]",

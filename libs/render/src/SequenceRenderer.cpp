@@ -90,6 +90,7 @@ struct SequenceRenderer::Impl {
     mrpt::opengl::COpenGLScene::Ptr scene;
     std::unique_ptr<mrpt::opengl::CFBORender> fbo;
     std::map<std::pair<std::string, double>, cv::Mat> photos;  // (path, blur) -> BGR
+    bool texture_linear = true;  // Scenario::texture_linear, for every textured object
     struct Person {
         PersonTexture tex;
         double width = 0, height = 0;  // [m]
@@ -128,6 +129,7 @@ struct SequenceRenderer::Impl {
                 addQuad(*obj, origin + ex * x0 + ey * y0, origin + ex * x1 + ey * y0,
                         origin + ex * x1 + ey * y1, origin + ex * x0 + ey * y1, 0.f, 0.f, 1.f, 1.f);
                 obj->assignImage(toCImage(crop));
+                obj->enableTextureLinearInterpolation(texture_linear);
                 obj->enableLight(false);
                 scene->insert(obj);
             }
@@ -195,6 +197,7 @@ struct SequenceRenderer::Impl {
                             float(r1 / th));
                 }
             p.mesh->assignImage(toCImage(p.tex.bgr));
+            p.mesh->enableTextureLinearInterpolation(sc.texture_linear);
             p.mesh->enableLight(false);
             scene->insert(p.mesh);
             people.push_back(std::move(p));
@@ -210,6 +213,7 @@ SequenceRenderer::SequenceRenderer(Scenario sc)
     auto vp = impl_->scene->getViewport();
     vp->setViewportClipDistances(sc_.near_clip, sc_.far_clip);
     vp->setCustomBackgroundColor({0.f, 0.f, 0.f});
+    impl_->texture_linear = sc_.texture_linear;
     impl_->buildRoom(sc_);
     impl_->buildPeople(sc_);
     try {

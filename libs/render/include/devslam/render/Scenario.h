@@ -55,6 +55,12 @@ struct Scenario {
     std::uint64_t seed = 1;        ///< seeds the depth/colour noise and panel crops
     double rgb_noise_sigma = 1.5;  ///< Gaussian colour noise [8-bit grey levels], 0 = none
     double near_clip = 0.05, far_clip = 30.0;  ///< GL clip planes [m]
+    /// Texture sampling: bilinear (true, `texture_filter = linear`) or nearest texel
+    /// (`nearest`, MRPT's default and the renderer's before version 3). Nearest sampling
+    /// magnifies a photo into blocks whose corners ORB finds and tracks (a walker 0.5 m
+    /// from the camera shows 5x5-pixel texels) and makes edges jump a whole pixel as the
+    /// camera moves; a camera sees neither (docs/render.md, "Texture sampling").
+    bool texture_linear = true;
     RoomSpec room;
     std::vector<PersonSpec> people;
     TrajectoryOptions trajectory;
