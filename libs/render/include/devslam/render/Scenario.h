@@ -57,8 +57,8 @@ struct Scenario {
     double near_clip = 0.05, far_clip = 30.0;  ///< GL clip planes [m]
     /// Texture sampling: bilinear (true, `texture_filter = linear`) or nearest texel
     /// (`nearest`, MRPT's default and the renderer's before version 3). Nearest sampling
-    /// magnifies a photo into blocks whose corners ORB finds and tracks (a walker 0.5 m
-    /// from the camera shows 5x5-pixel texels) and makes edges jump a whole pixel as the
+    /// magnifies a photo into blocks whose corners ORB finds and tracks (a walker 0.55 m
+    /// from the camera shows 7x7-pixel texels) and makes edges jump a whole pixel as the
     /// camera moves; a camera sees neither (docs/render.md, "Texture sampling").
     bool texture_linear = true;
     RoomSpec room;
