@@ -201,7 +201,7 @@ TEST(RenderGeometry, WallBlurKeepsTheColoursAndRemovesCorners) {
     EXPECT_EQ(cv::norm(sharp.frame.depth, soft.frame.depth, cv::NORM_INF), 0.0);
 }
 
-// `texture_filter`: a wall photo seen from 0.5 m is magnified about 2-4x. Sampled at the
+// `texture_filter`: a wall photo seen from 0.5 m is magnified several times. Sampled at the
 // nearest texel it becomes blocks of equal pixels (whose corners ORB would track); sampled
 // bilinearly, neighbouring pixels differ as in a camera image (except where the photo
 // itself is flat or saturated). Depth does not change.
@@ -228,6 +228,8 @@ TEST(RenderGeometry, BilinearTexturesHaveNoTexelBlocks) {
     for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b[c], 3.0) << "channel " << c;
     EXPECT_EQ(cv::norm(nearest.frame.depth, linear.frame.depth, cv::NORM_INF), 0.0);
     std::printf("equal neighbouring pixels: nearest %.3f, bilinear %.3f\n", f_nearest, f_linear);
+    EXPECT_TRUE(loadScenario(kSynth + "/short_walking.ini").texture_linear)
+        << "bilinear is the default";
 }
 
 TEST(RenderSequence, GroundTruthMatchesPosesUsed) {

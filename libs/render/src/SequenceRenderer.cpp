@@ -197,7 +197,7 @@ struct SequenceRenderer::Impl {
                             float(r1 / th));
                 }
             p.mesh->assignImage(toCImage(p.tex.bgr));
-            p.mesh->enableTextureLinearInterpolation(sc.texture_linear);
+            p.mesh->enableTextureLinearInterpolation(texture_linear);
             p.mesh->enableLight(false);
             scene->insert(p.mesh);
             people.push_back(std::move(p));
