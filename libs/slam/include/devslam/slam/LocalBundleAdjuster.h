@@ -33,9 +33,10 @@ struct LocalBaOptions {
     /// [m] when > 0, an optimisation that moves a keyframe farther than this is not
     /// applied (the map stays as it was, no observation removed either). The
     /// keyframes were tracked frame to frame, and a local BA refines them by millimetres to
-    /// a few centimetres; a shift of decimetres is the optimum of a problem corrupted by
-    /// moving landmarks (people the mask missed) with little static structure left, and it
-    /// drags the keyframes, and every frame tracked from them, away at once.
+    /// a few centimetres; a shift of decimetres comes from a window barely tied to the
+    /// keyframes held fixed (few shared observations when the mask covers most of the
+    /// image: the window's own points then fit it better elsewhere; docs/slam.md, session
+    /// 20), and it drags the keyframes, and every frame tracked from them, away at once.
     double max_keyframe_shift = 0.0;
 
     void loadFromConfig(const mrpt::config::CConfigFileBase& cfg,
