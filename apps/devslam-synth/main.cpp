@@ -31,6 +31,7 @@ const char* kUsage =
     "usage: devslam-synth SCENARIO [-o DIR] [--rawlog FILE] [--frames N] [--no-labels]\n"
     "                     [--seed N]  (another render of the scenario: noise, panel crops)\n"
     "                     [--if-changed]  (skip when DIR already holds this exact render)\n"
+    "                     [--set SECTION.KEY=VALUE]...  (over the scenario file's settings)\n"
     "       devslam-synth --list\n"
     "       devslam-synth --cut-texture IMAGE X,Y,W,H OUT.png\n"
     "SCENARIO: a name from sim_worlds/synth/ (e.g. walking_xyz) or an INI file.\n"
@@ -109,6 +110,7 @@ int run(int argc, char** argv) {
     std::string scenario_arg, out_dir, rawlog;
     std::size_t frames = 0;
     std::optional<std::uint64_t> seed;
+    std::vector<std::string> sets;
     bool labels = true, if_changed = false;
     for (std::size_t i = 0; i < a.size(); ++i) {
         const auto value = [&]() -> std::string {
@@ -125,6 +127,8 @@ int run(int argc, char** argv) {
             labels = false;
         else if (a[i] == "--if-changed")
             if_changed = true;
+        else if (a[i] == "--set")
+            sets.push_back(value());
         else if (a[i] == "--seed")
             seed = std::uint64_t(devslam::core::parseInteger(value(), "--seed", 0));
         else if (!a[i].empty() && a[i][0] == '-')
@@ -137,7 +141,7 @@ int run(int argc, char** argv) {
     }
     if (scenario_arg.empty())
         throw std::invalid_argument(std::string("no scenario given\n") + kUsage);
-    auto sc = render::loadScenario(resolveScenario(scenario_arg));
+    auto sc = render::loadScenario(resolveScenario(scenario_arg), sets);
     // The same scene and motion, other noise and panel crops: renders to tell a setting's
     // effect from the SLAM's sensitivity to small changes (docs/render.md).
     if (seed) sc.seed = *seed;

@@ -201,6 +201,37 @@ TEST(RenderGeometry, WallBlurKeepsTheColoursAndRemovesCorners) {
     EXPECT_EQ(cv::norm(sharp.frame.depth, soft.frame.depth, cv::NORM_INF), 0.0);
 }
 
+// A box's `blur` softens its own photos only: with blurred walls, the sharp corners are the
+// box's, and blurring it removes most of them; colours and depth stay.
+TEST(RenderGeometry, BoxBlurSoftensTheBoxPhotos) {
+    Scenario sc = bareRoom({1.0, 2.0, 1.2}, {3.0, 2.0, 0.4});
+    sc.K = core::CameraIntrinsics::fromPreset("freiburg3");
+    sc.room.wall_blur = sc.room.floor_blur = 10;
+    BoxSpec box;
+    box.name = "box_test";
+    box.base = {2.6, 2.0, 0.0};
+    box.size = {0.8, 1.6, 0.8};
+    box.textures = {kRoot + "/data/images/dog.jpg"};
+    sc.room.boxes.push_back(box);
+    const auto corners = [](const cv::Mat& bgr) {
+        cv::Mat grey;
+        cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
+        std::vector<cv::KeyPoint> kp;
+        cv::FAST(grey, kp, 20);
+        return kp.size();
+    };
+    const auto sharp = SequenceRenderer(sc).render(0);
+    sc.room.boxes.back().blur = 10;
+    const auto soft = SequenceRenderer(sc).render(0);
+    const auto n_sharp = corners(sharp.frame.bgr), n_soft = corners(soft.frame.bgr);
+    EXPECT_GT(n_sharp, 300u);
+    EXPECT_LT(n_soft * 3, n_sharp) << n_soft << " corners blurred, " << n_sharp << " sharp";
+    const cv::Scalar a = cv::mean(sharp.frame.bgr), b = cv::mean(soft.frame.bgr);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b[c], 8.0) << "channel " << c;
+    EXPECT_EQ(cv::norm(sharp.frame.depth, soft.frame.depth, cv::NORM_INF), 0.0);
+    std::printf("FAST corners: sharp box %zu, blurred box %zu\n", n_sharp, n_soft);
+}
+
 // `texture_filter`: a wall photo seen from 0.5 m is magnified several times. Sampled at the
 // nearest texel it becomes blocks of equal pixels (whose corners ORB would track); sampled
 // bilinearly, neighbouring pixels differ as in a camera image (except where the photo
@@ -326,6 +357,10 @@ TEST(RenderSequence, RenderTxtTellsWhetherAFolderHoldsThisRender) {
     EXPECT_FALSE(isRenderCurrent(sc, o)) << "the room file changed";
     std::ofstream(room) << "# another comment\n[room]\nsize = [5 5 3]   // [m]\n\n";
     EXPECT_TRUE(isRenderCurrent(sc, o)) << "comments and blank lines do not count";
+    Scenario set = sc;  // devslam-synth --set
+    set.overrides = {"person_1.speed=0.9"};
+    EXPECT_FALSE(isRenderCurrent(set, o)) << "an override";
+    EXPECT_NE(renderSignature(set, o).find("set person_1.speed=0.9\n"), std::string::npos);
 
     // A render that stops half-way leaves no render.txt, so the folder is not current.
     EXPECT_THROW((void)writeSequence(sc, o,
@@ -486,8 +521,8 @@ TEST(Scenario, ShippedFilesLoadAndTyposAreReported) {
             EXPECT_TRUE(sc.n_frames >= 600 && sc.n_frames <= 900) << name << ": 20-30 s at 30 Hz";
         ++n;
     }
-    EXPECT_EQ(n, 6u);  // walking_xyz, sitting_xyz, walking_static, walking_halfsphere,
-                       // walking_towards, short_walking
+    EXPECT_EQ(n, 7u);  // walking_xyz, sitting_xyz, walking_static, walking_halfsphere,
+                       // walking_towards, short_walking, sitting_bare
     TempDir tmp;
     const std::string room = "room            = office_room.ini";
     const auto withEdit = [&](std::string s, const std::string& from, const std::string& to) {
@@ -512,7 +547,7 @@ TEST(Scenario, ShippedFilesLoadAndTyposAreReported) {
                   "[scenario]: unknown key 'speeed'");
     const std::string room_text = readFile(kSynth + "/office_room.ini");
     for (const auto& [bad, msg] :
-         {std::pair<std::string, std::string>{"wall_blur     = -1", "wall_blur: must be 0..100"},
+         {std::pair<std::string, std::string>{"wall_blur     = -1", "bad_room.ini [room] wall_blur: must be 0..100"},
           {"floor_blur    = x", "floor_blur"}}) {
         std::string r = room_text;
         for (std::size_t p = r.find("../../data"); p != std::string::npos;
@@ -527,6 +562,30 @@ TEST(Scenario, ShippedFilesLoadAndTyposAreReported) {
                                                         "room = " + tmp.str("bad_room.ini"))); },
                       msg);
     }
+    {  // a box's blur
+        std::string r = room_text;
+        for (std::size_t p = r.find("../../data"); p != std::string::npos;
+             p = r.find("../../data"))
+            r.replace(p, 10, kRoot + "/data");
+        r.replace(r.find("[box_crate]\n"), 12, "[box_crate]\nblur = 101\n");
+        std::ofstream(tmp.str("bad_room.ini")) << r;
+        expectMessage([&] { (void)loadScenario(withEdit(text, "room = " + kSynth + "/office_room.ini",
+                                                        "room = " + tmp.str("bad_room.ini"))); },
+                      tmp.str("bad_room.ini") + " [box_crate] blur: must be 0..100");
+    }
+    // --set: written over the scenario file's settings, checked like them.
+    (void)withEdit(text, "n_frames", "n_frames");  // s.ini (= base) as it was
+    EXPECT_DOUBLE_EQ(loadScenario(base).people.at(0).speed, 0.7);
+    const auto fast = loadScenario(base, {"person_1.speed=0.9", "scenario.seed=7"});
+    EXPECT_DOUBLE_EQ(fast.people.at(0).speed, 0.9);
+    EXPECT_EQ(fast.seed, 7u);
+    EXPECT_EQ(fast.overrides.size(), 2u);
+    expectMessage([&] { (void)loadScenario(base, {"person_1.sped=0.9"}); },
+                  "[person_1]: unknown key 'sped'");
+    expectMessage([&] { (void)loadScenario(base, {"person_1speed=0.9"}); },
+                  "expected SECTION.KEY=VALUE");
+    expectMessage([&] { (void)loadScenario(base, {"persn_1.speed=0.9"}); },
+                  "unknown section [persn_1]");
     expectMessage(
         [&] {
             (void)loadScenario(withEdit(text, "n_frames        = 60",

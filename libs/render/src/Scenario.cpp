@@ -85,30 +85,33 @@ void readRoom(const std::string& path, RoomSpec& room) {
     room.size = vec3(*cfg, s, "size", path, true);
     room.panel_width = core::readDouble(*cfg, s, "panel_width", room.panel_width);
     room.panel_height = core::readDouble(*cfg, s, "panel_height", room.panel_height);
-    core::requireValue(room.size.minCoeff() > 0.5, path + " [room]", "size", "each side > 0.5 [m]");
-    core::requireValue(room.panel_width > 0.05 && room.panel_height > 0.05, path + " [room]",
+    core::requireValue(room.size.minCoeff() > 0.5, "room", "size", "each side > 0.5 [m]");
+    core::requireValue(room.panel_width > 0.05 && room.panel_height > 0.05, "room",
                        "panel_width", "panels must be > 0.05 m");
     room.wall_blur = core::readDouble(*cfg, s, "wall_blur", 0.0);
     room.floor_blur = core::readDouble(*cfg, s, "floor_blur", 0.0);
-    core::requireValue(room.wall_blur >= 0 && room.wall_blur <= 100, path + " [room]",
+    core::requireValue(room.wall_blur >= 0 && room.wall_blur <= 100, "room",
                        "wall_blur", "must be 0..100 [px]");
-    core::requireValue(room.floor_blur >= 0 && room.floor_blur <= 100, path + " [room]",
+    core::requireValue(room.floor_blur >= 0 && room.floor_blur <= 100, "room",
                        "floor_blur", "must be 0..100 [px]");
     room.wall_textures = resolveImages(cfg->read_string(s, "wall_textures", "", true), base,
                                        path + " [room] wall_textures");
     room.floor_textures = resolveImages(cfg->read_string(s, "floor_textures", "", true), base,
                                         path + " [room] floor_textures");
     for (const auto& b : sectionsWithPrefix(*cfg, "box_")) {
-        core::requireKnownKeys(*cfg, b, {"base", "size", "yaw_deg", "textures"}, path);
+        core::requireKnownKeys(*cfg, b, {"base", "size", "yaw_deg", "textures", "blur"}, path);
         BoxSpec box;
         box.name = b;
         box.base = vec3(*cfg, b, "base", path, true);
         box.size = vec3(*cfg, b, "size", path, true);
-        core::requireValue(box.size.minCoeff() > 0, path + " [" + b + "]", "size",
+        core::requireValue(box.size.minCoeff() > 0, b, "size",
                            "must be > 0 [m]");
         box.yaw = core::readDouble(*cfg, b, "yaw_deg", 0.0) * kPi / 180.0;
         box.textures = resolveImages(cfg->read_string(b, "textures", "", true), base,
                                      path + " [" + b + "] textures");
+        box.blur = core::readDouble(*cfg, b, "blur", 0.0);
+        core::requireValue(box.blur >= 0 && box.blur <= 100, b, "blur",
+                           "must be 0..100 [px]");
         room.boxes.push_back(std::move(box));
     }
 }
@@ -143,14 +146,14 @@ PersonSpec loadPerson(const mrpt::config::CConfigFileBase& cfg, const std::strin
     if (xy.size() < 2 || xy.size() % 2)
         throw std::invalid_argument(where + " path: need x y pairs");
     for (std::size_t i = 0; i < xy.size(); i += 2) p.path.emplace_back(xy[i], xy[i + 1]);
-    core::requireValue(p.height > 0.2 && p.height < 3.0, where, "height",
+    core::requireValue(p.height > 0.2 && p.height < 3.0, s, "height",
                        "must be in (0.2, 3) [m]");
-    core::requireValue(p.speed >= 0 && p.speed < 5, where, "speed", "must be in [0, 5) [m/s]");
-    core::requireValue(p.sway_period > 0, where, "sway_period", "must be > 0 [s]");
-    core::requireValue(p.sway_pivot >= 0 && p.sway_pivot <= p.height, where, "sway_pivot",
+    core::requireValue(p.speed >= 0 && p.speed < 5, s, "speed", "must be in [0, 5) [m/s]");
+    core::requireValue(p.sway_period > 0, s, "sway_period", "must be > 0 [s]");
+    core::requireValue(p.sway_pivot >= 0 && p.sway_pivot <= p.height, s, "sway_pivot",
                        "must be in [0, height] [m]");
     if (p.kind == PersonKind::Walking)
-        core::requireValue(p.path.size() >= 2 && pathLength(p.path) > 0.1, where, "path",
+        core::requireValue(p.path.size() >= 2 && pathLength(p.path) > 0.1, s, "path",
                            "a walker needs at least two points 0.1 m apart");
     return p;
 }
@@ -185,10 +188,12 @@ std::vector<double> parseNumberList(const std::string& text, const std::string& 
 
 namespace {
 
-Scenario readScenario(const std::string& path) {
+Scenario readScenario(const std::string& path, const std::vector<std::string>& overrides) {
     const auto cfg = core::loadIni(path);
+    core::applyOverrides(*cfg, overrides, "--set");
     Scenario sc;
     sc.source = path;
+    sc.overrides = overrides;
     const std::string s = "scenario";
     core::requireKnownKeys(*cfg, s,
                            {"name", "room", "duration", "n_frames", "rate_hz", "t0", "seed",
@@ -196,7 +201,7 @@ Scenario readScenario(const std::string& path) {
                            path);
     sc.name = cfg->read_string(s, "name", fs::path(path).stem().string());
     sc.rate_hz = core::readDouble(*cfg, s, "rate_hz", sc.rate_hz);
-    core::requireValue(sc.rate_hz > 0 && sc.rate_hz <= 1000, path + " [scenario]", "rate_hz",
+    core::requireValue(sc.rate_hz > 0 && sc.rate_hz <= 1000, "scenario", "rate_hz",
                        "must be in (0, 1000] [Hz]");
     const double duration = core::readDouble(*cfg, s, "duration", 0.0);
     const int n = core::readInt(*cfg, s, "n_frames", 0);
@@ -213,9 +218,9 @@ Scenario readScenario(const std::string& path) {
     core::requireValue(filter == "linear" || filter == "nearest", s,
                        "texture_filter", "must be linear or nearest, got '" + filter + "'");
     sc.texture_linear = filter == "linear";
-    core::requireValue(sc.rgb_noise_sigma >= 0, path + " [scenario]", "rgb_noise_sigma",
+    core::requireValue(sc.rgb_noise_sigma >= 0, "scenario", "rgb_noise_sigma",
                        "must be >= 0");
-    core::requireValue(sc.near_clip > 0 && sc.far_clip > sc.near_clip, path + " [scenario]",
+    core::requireValue(sc.near_clip > 0 && sc.far_clip > sc.near_clip, "scenario",
                        "far_clip", "need 0 < near_clip < far_clip [m]");
 
     sc.K = cfg->sectionExists("camera") ? core::CameraIntrinsics::fromConfig(*cfg, "camera")
@@ -250,8 +255,8 @@ Scenario readScenario(const std::string& path) {
 
 }  // namespace
 
-Scenario loadScenario(const std::string& path) {
-    return core::namingSource(path, [&] { return readScenario(path); });
+Scenario loadScenario(const std::string& path, const std::vector<std::string>& overrides) {
+    return core::namingSource(path, [&] { return readScenario(path, overrides); });
 }
 
 }  // namespace devslam::render

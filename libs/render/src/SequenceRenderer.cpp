@@ -164,7 +164,7 @@ struct SequenceRenderer::Impl {
             std::size_t kb = 0;
             const auto face = [&](const Eigen::Vector3d& o, const Eigen::Vector3d& a,
                                   const Eigen::Vector3d& d) {
-                addPanelled(o, a - o, d - o, 1e9, 1e9, b.textures, kb, rng);
+                addPanelled(o, a - o, d - o, 1e9, 1e9, b.textures, kb, rng, b.blur);
             };
             face(P(hx, -hy, hz), P(hx, hy, hz), P(hx, -hy, 0));     // +x
             face(P(-hx, hy, hz), P(-hx, -hy, hz), P(-hx, hy, 0));   // -x

@@ -56,6 +56,7 @@ std::string renderSignature(const Scenario& sc, const WriteOptions& o) {
       << "\nlabels " << int(o.write_labels) << "\n";
     for (const auto& file : {sc.source, sc.room.source})
         if (!file.empty()) s << "--- " << file << "\n" << iniSettings(file);
+    for (const auto& item : sc.overrides) s << "set " << item << "\n";
     // Texture contents are not hashed: their paths and sizes catch a replaced photo.
     std::vector<std::string> textures = sc.room.wall_textures;
     textures.insert(textures.end(), sc.room.floor_textures.begin(), sc.room.floor_textures.end());

@@ -27,6 +27,7 @@ struct BoxSpec {
     Eigen::Vector3d size{1, 1, 1};      ///< extent along its own x, y, z [m]
     double yaw = 0.0;                   ///< rotation about world z [rad]
     std::vector<std::string> textures;  ///< images (absolute paths), used round-robin per face
+    double blur = 0.0;  ///< Gaussian sigma [px of the photo] applied to its photos (0 = sharp)
 };
 
 /// A closed room with textured walls, floor and ceiling made of photo panels.
@@ -48,6 +49,8 @@ struct RoomSpec {
 struct Scenario {
     std::string name;          ///< [scenario] name
     std::string source;        ///< the INI file it was read from (the room's: room.source)
+    /// "section.key=value" items applied over the scenario file (loadScenario), in order
+    std::vector<std::string> overrides;
     core::CameraIntrinsics K;  ///< exact intrinsics of the rendered images (TUM fr3 by default)
     double rate_hz = 30.0;     ///< frame rate [Hz]
     std::size_t n_frames = 60;
@@ -78,7 +81,11 @@ struct Scenario {
 /// the directory of the file that names them; a directory stands for all its *.png/*.jpg
 /// files in name order. Throws std::invalid_argument / std::runtime_error naming the file,
 /// section and key on any unknown key, missing file, or out-of-range value.
-[[nodiscard]] Scenario loadScenario(const std::string& path);
+/// `overrides`: "section.key=value" items written over the scenario file's settings before
+/// it is read (devslam-synth --set; sections of the scenario file, not of the room), checked
+/// like the file's own keys.
+[[nodiscard]] Scenario loadScenario(const std::string& path,
+                                    const std::vector<std::string>& overrides = {});
 
 /// Parses "[a b c]" / "a, b, c" into numbers; throws naming `what` on a bad token or when
 /// `expected` (if > 0) does not match the count.
