@@ -88,6 +88,23 @@ Scenario bareRoom(const Eigen::Vector3d& eye, const Eigen::Vector3d& target) {
     return sc;
 }
 
+/// FAST corners (threshold 20) of a colour image: how much texture ORB would find.
+std::size_t fastCorners(const cv::Mat& bgr) {
+    cv::Mat grey;
+    cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
+    std::vector<cv::KeyPoint> kp;
+    cv::FAST(grey, kp, 20);
+    return kp.size();
+}
+
+/// Two renders of one view that differ only in texture sampling or blur: the same mean
+/// colour (within `tol` grey levels per channel) and the very same depth.
+void expectSameColourAndDepth(const RenderedFrame& a, const RenderedFrame& b, double tol) {
+    const cv::Scalar ma = cv::mean(a.frame.bgr), mb = cv::mean(b.frame.bgr);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(ma[c], mb[c], tol) << "channel " << c;
+    EXPECT_EQ(cv::norm(a.frame.depth, b.frame.depth, cv::NORM_INF), 0.0);
+}
+
 /// Runs f and expects an exception whose message contains `needle`.
 template <class F>
 void expectMessage(F&& f, const std::string& needle) {
@@ -183,22 +200,13 @@ TEST(RenderGeometry, FrontalWallDepthAndColour) {
 TEST(RenderGeometry, WallBlurKeepsTheColoursAndRemovesCorners) {
     Scenario sc = bareRoom({2.5, 2.0, 1.5}, {4.0, 2.0, 1.5});
     sc.K = core::CameraIntrinsics::fromPreset("freiburg3");
-    const auto corners = [](const cv::Mat& bgr) {
-        cv::Mat grey;
-        cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
-        std::vector<cv::KeyPoint> kp;
-        cv::FAST(grey, kp, 20);
-        return kp.size();
-    };
     const auto sharp = SequenceRenderer(sc).render(0);
     sc.room.wall_blur = 10;
     const auto soft = SequenceRenderer(sc).render(0);
-    const auto n_sharp = corners(sharp.frame.bgr), n_soft = corners(soft.frame.bgr);
+    const auto n_sharp = fastCorners(sharp.frame.bgr), n_soft = fastCorners(soft.frame.bgr);
     EXPECT_GT(n_sharp, 500u);
     EXPECT_LT(n_soft * 5, n_sharp) << n_soft << " corners blurred, " << n_sharp << " sharp";
-    const cv::Scalar a = cv::mean(sharp.frame.bgr), b = cv::mean(soft.frame.bgr);
-    for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b[c], 8.0) << "channel " << c;
-    EXPECT_EQ(cv::norm(sharp.frame.depth, soft.frame.depth, cv::NORM_INF), 0.0);
+    expectSameColourAndDepth(sharp, soft, 8.0);
 }
 
 // A box's `blur` softens its own photos only: with blurred walls, the sharp corners are the
@@ -213,22 +221,13 @@ TEST(RenderGeometry, BoxBlurSoftensTheBoxPhotos) {
     box.size = {0.8, 1.6, 0.8};
     box.textures = {kRoot + "/data/images/dog.jpg"};
     sc.room.boxes.push_back(box);
-    const auto corners = [](const cv::Mat& bgr) {
-        cv::Mat grey;
-        cv::cvtColor(bgr, grey, cv::COLOR_BGR2GRAY);
-        std::vector<cv::KeyPoint> kp;
-        cv::FAST(grey, kp, 20);
-        return kp.size();
-    };
     const auto sharp = SequenceRenderer(sc).render(0);
     sc.room.boxes.back().blur = 10;
     const auto soft = SequenceRenderer(sc).render(0);
-    const auto n_sharp = corners(sharp.frame.bgr), n_soft = corners(soft.frame.bgr);
+    const auto n_sharp = fastCorners(sharp.frame.bgr), n_soft = fastCorners(soft.frame.bgr);
     EXPECT_GT(n_sharp, 300u);
     EXPECT_LT(n_soft * 3, n_sharp) << n_soft << " corners blurred, " << n_sharp << " sharp";
-    const cv::Scalar a = cv::mean(sharp.frame.bgr), b = cv::mean(soft.frame.bgr);
-    for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b[c], 8.0) << "channel " << c;
-    EXPECT_EQ(cv::norm(sharp.frame.depth, soft.frame.depth, cv::NORM_INF), 0.0);
+    expectSameColourAndDepth(sharp, soft, 8.0);
     std::printf("FAST corners: sharp box %zu, blurred box %zu\n", n_sharp, n_soft);
 }
 
@@ -255,9 +254,7 @@ TEST(RenderGeometry, BilinearTexturesHaveNoTexelBlocks) {
     const double f_linear = equalNeighbours(linear.frame.bgr);
     EXPECT_GT(f_nearest, 0.4) << "nearest-texel sampling should give blocks";
     EXPECT_LT(2 * f_linear, f_nearest) << "bilinear sampling should not";
-    const cv::Scalar a = cv::mean(nearest.frame.bgr), b = cv::mean(linear.frame.bgr);
-    for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b[c], 3.0) << "channel " << c;
-    EXPECT_EQ(cv::norm(nearest.frame.depth, linear.frame.depth, cv::NORM_INF), 0.0);
+    expectSameColourAndDepth(nearest, linear, 3.0);
     std::printf("equal neighbouring pixels: nearest %.3f, bilinear %.3f\n", f_nearest, f_linear);
     EXPECT_TRUE(loadScenario(kSynth + "/short_walking.ini").texture_linear)
         << "bilinear is the default";
