@@ -542,34 +542,36 @@ TEST(Scenario, ShippedFilesLoadAndTyposAreReported) {
     EXPECT_NO_THROW((void)loadScenario(base));
     expectMessage([&] { (void)loadScenario(withEdit(text, "rate_hz", "speeed = 3\nrate_hz")); },
                   "[scenario]: unknown key 'speeed'");
+    // The shipped room with absolute photo paths, changed by `edit`, behind the scenario:
+    // loading must fail with `msg`.
     const std::string room_text = readFile(kSynth + "/office_room.ini");
-    for (const auto& [bad, msg] :
-         {std::pair<std::string, std::string>{"wall_blur     = -1", "bad_room.ini [room] wall_blur: must be 0..100"},
-          {"floor_blur    = x", "floor_blur"}}) {
+    const auto expectRoomMessage = [&](auto&& edit, const std::string& msg) {
         std::string r = room_text;
         for (std::size_t p = r.find("../../data"); p != std::string::npos;
              p = r.find("../../data"))
             r.replace(p, 10, kRoot + "/data");
-        const auto key = bad.substr(0, bad.find('='));  // the shipped line, with its value
-        const auto at = r.find(key);
-        ASSERT_NE(at, std::string::npos) << key;
-        r.replace(at, r.find('\n', at) - at, bad);
+        edit(r);
         std::ofstream(tmp.str("bad_room.ini")) << r;
         expectMessage([&] { (void)loadScenario(withEdit(text, "room = " + kSynth + "/office_room.ini",
                                                         "room = " + tmp.str("bad_room.ini"))); },
                       msg);
+    };
+    for (const auto& bad_msg :
+         {std::pair<std::string, std::string>{"wall_blur     = -1", "bad_room.ini [room] wall_blur: must be 0..100"},
+          {"floor_blur    = x", "floor_blur"}}) {
+        const std::string& bad = bad_msg.first;
+        expectRoomMessage(
+            [&](std::string& r) {
+                const auto key = bad.substr(0, bad.find('='));  // the shipped line, with its value
+                const auto at = r.find(key);
+                ASSERT_NE(at, std::string::npos) << key;
+                r.replace(at, r.find('\n', at) - at, bad);
+            },
+            bad_msg.second);
     }
-    {  // a box's blur
-        std::string r = room_text;
-        for (std::size_t p = r.find("../../data"); p != std::string::npos;
-             p = r.find("../../data"))
-            r.replace(p, 10, kRoot + "/data");
-        r.replace(r.find("[box_crate]\n"), 12, "[box_crate]\nblur = 101\n");
-        std::ofstream(tmp.str("bad_room.ini")) << r;
-        expectMessage([&] { (void)loadScenario(withEdit(text, "room = " + kSynth + "/office_room.ini",
-                                                        "room = " + tmp.str("bad_room.ini"))); },
-                      tmp.str("bad_room.ini") + " [box_crate] blur: must be 0..100");
-    }
+    expectRoomMessage(  // a box's blur
+        [](std::string& r) { r.replace(r.find("[box_crate]\n"), 12, "[box_crate]\nblur = 101\n"); },
+        tmp.str("bad_room.ini") + " [box_crate] blur: must be 0..100");
     // --set: written over the scenario file's settings, checked like them.
     (void)withEdit(text, "n_frames", "n_frames");  // s.ini (= base) as it was
     EXPECT_DOUBLE_EQ(loadScenario(base).people.at(0).speed, 0.7);
