@@ -17,6 +17,8 @@
 #include <devslam/eval/MaskScore.h>
 #include <devslam/io/RgbdReader.h>
 
+#include <mrpt/config/CConfigFileMemory.h>
+
 #include <opencv2/imgcodecs.hpp>
 
 #include <algorithm>
@@ -58,6 +60,9 @@ struct Sequence {
     /// Synthetic: renders of the scenario (`devslam-synth --seed`); empty = the scenario's
     /// own seed, one render.
     std::vector<std::uint64_t> seeds;
+    /// Synthetic: `devslam-synth --set` items (SECTION.KEY=VALUE) over the scenario file, e.g.
+    /// the same scene with still people; empty = the scenario as shipped.
+    std::vector<std::string> sets;
     int repeats = 0;  ///< runs per render and mode; 0 = [bench] repeats
 };
 
@@ -124,7 +129,7 @@ Bench loadBench(const std::string& path) {
             throw std::invalid_argument(path + ": unknown section [" + s +
                                         "] (known: bench, sequence_*)");
         core::requireKnownKeys(
-            *cfg, s, {"name", "path", "scenario", "slam_config", "seeds", "repeats"}, path);
+            *cfg, s, {"name", "path", "scenario", "slam_config", "seeds", "set", "repeats"}, path);
         Sequence q;
         q.name = cfg->read_string(s, "name", s.substr(9));
         q.scenario = cfg->read_string(s, "scenario", "");
@@ -146,6 +151,17 @@ Bench loadBench(const std::string& path) {
         if (!q.seeds.empty() && q.scenario.empty())
             throw std::invalid_argument(where +
                                         " seeds: only a synthetic sequence (scenario) has renders");
+        // Whitespace-separated, as [run] filter_overrides; the format is checked here, the
+        // sections and keys by devslam-synth, which renders before any run starts.
+        std::istringstream sets(cfg->read_string(s, "set", ""));
+        for (std::string item; sets >> item;) q.sets.push_back(item);
+        if (!q.sets.empty() && q.scenario.empty())
+            throw std::invalid_argument(where + " set: only a synthetic sequence (scenario) " +
+                                        "has render settings");
+        {
+            mrpt::config::CConfigFileMemory scratch;
+            core::applyOverrides(scratch, q.sets, where + " set item");
+        }
         q.repeats = core::readInt(*cfg, s, "repeats", 0);
         core::requireValue(q.repeats >= 0 && q.repeats <= 100, where, "repeats",
                            "must be 1..100 (0 or missing = [bench] repeats)");
@@ -288,6 +304,7 @@ int run(int argc, char** argv) {
             std::string cmd = quote(bin + "/devslam-synth") + " " + quote(q.scenario) + " -o " +
                               quote(in.path) + " --if-changed";
             if (in.seed) cmd += " --seed " + std::to_string(*in.seed);
+            for (const auto& item : q.sets) cmd += " --set " + quote(item);
             if (b.max_frames) cmd += " --frames " + std::to_string(b.max_frames);
             std::cout << "render (if changed) " << q.name << ": " << cmd << "\n" << std::flush;
             if (std::system(cmd.c_str()) != 0)
@@ -474,6 +491,17 @@ int run(int argc, char** argv) {
         runsLine << repeatsOf(q) << " run" << (repeatsOf(q) > 1 ? "s" : "");
     }
     runsLine << " per mode";
+    // What each synthetic sequence renders, where its name does not say it alone.
+    std::ostringstream scenes;
+    for (const auto& q : b.sequences) {
+        if (q.scenario.empty() || (q.sets.empty() && q.name == q.scenario)) continue;
+        scenes << (scenes.tellp() > 0 ? "; " : "Sequences: ") << q.name << " is scenario `"
+               << q.scenario << "`";
+        for (std::size_t k = 0; k < q.sets.size(); ++k)
+            scenes << (k ? " " : " with `devslam-synth ") << "--set " << q.sets[k];
+        if (!q.sets.empty()) scenes << "`";
+    }
+    if (scenes.tellp() > 0) scenes << ".\n\n";
     std::ostringstream md;
     md << "## Dynamic-SLAM benchmark: the paper's Tables 1-3 (`devslam-bench`)\n\n"
        << "Measured " << core::measuredOnLine() << " by `devslam-bench --config "
@@ -486,6 +514,7 @@ int run(int argc, char** argv) {
           "docs/render.md), each in the renders listed (`--seed`: the same scene and motion "
           "with other image and depth noise, docs/dynamic.md), because one render cannot rank "
           "two settings of this SLAM. RPE over 1 s.\n\n"
+       << scenes.str()
        << (std::find(b.modes.begin(), b.modes.end(), "truth") != b.modes.end()
                ? std::string("Mode `truth` is a diagnostic, not a method: the SLAM gets the "
                              "renderer's walking people (their pixels, dilated by the filter's "

@@ -43,6 +43,7 @@ TEST(DevslamBench, TwoFrameSmokeRunOfTheWholeCommand) {
         << root
         << "/config_ini/slam_synthetic.ini\n"
            "[sequence_short]\nscenario = short_walking\nseeds = 5 6\n"
+           "set = person_1.speed=0.5 person_2.sway_deg=1\n"
            "[sequence_fr1]\npath = "
         << root << "/data/tum/fr1_xyz_first37\nslam_config = " << root
         << "/config_ini/slam_tum_fr1.ini\n";
@@ -60,6 +61,10 @@ TEST(DevslamBench, TwoFrameSmokeRunOfTheWholeCommand) {
     }
     EXPECT_EQ(readFile(tmp / "out/synth/short_seed5/groundtruth.txt"),
               readFile(tmp / "out/synth/short_seed6/groundtruth.txt"));
+    // The sequence's `set` items reached devslam-synth (its render.txt records them).
+    const std::string render_txt = readFile(tmp / "out/synth/short_seed5/render.txt");
+    EXPECT_NE(render_txt.find("set person_1.speed=0.5"), std::string::npos) << render_txt;
+    EXPECT_NE(render_txt.find("set person_2.sway_deg=1"), std::string::npos) << render_txt;
     EXPECT_NE(readFile(tmp / "out/synth/short_seed5/depth/1700000400.000000.png"),
               readFile(tmp / "out/synth/short_seed6/depth/1700000400.000000.png"));
     // 4 modes on each render of the synthetic sequence, 3 on fr1 (no person truth for mode
@@ -92,6 +97,10 @@ TEST(DevslamBench, TwoFrameSmokeRunOfTheWholeCommand) {
     EXPECT_NE(results.find("| short | dynamic | "), std::string::npos);
     EXPECT_NE(results.find("ATE RMSE (m) per render"), std::string::npos);
     EXPECT_NE(results.find(" (seed 5), "), std::string::npos) << results;
+    EXPECT_NE(results.find("Sequences: short is scenario `short_walking` with `devslam-synth "
+                           "--set person_1.speed=0.5 --set person_2.sway_deg=1`."),
+              std::string::npos)
+        << results;
     fs::remove_all(tmp);
 }
 
@@ -129,6 +138,19 @@ TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
               std::string::npos)
         << readFile(tmp / "log.txt");
     EXPECT_NE(refused("[sequence_a]\n" + fr1 + "seed = 5\n").find("seed"), std::string::npos)
+        << readFile(tmp / "log.txt");
+    EXPECT_NE(refused("[sequence_a]\n" + fr1 + "set = person_1.speed=1\n")
+                  .find("[sequence_a] set: only a synthetic sequence"),
+              std::string::npos)
+        << readFile(tmp / "log.txt");
+    EXPECT_NE(refused("[sequence_a]\nscenario = short_walking\nset = person_1.speed=1 speed=2\n")
+                  .find("[sequence_a] set item 'speed=2': expected SECTION.KEY=VALUE"),
+              std::string::npos)
+        << readFile(tmp / "log.txt");
+    // A key the scenario does not know stops the bench at the render, before any run.
+    EXPECT_NE(refused("[sequence_a]\nscenario = short_walking\nset = person_1.sped=1\n")
+                  .find("sped"),
+              std::string::npos)
         << readFile(tmp / "log.txt");
     fs::remove_all(tmp);
 }
