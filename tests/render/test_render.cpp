@@ -486,8 +486,8 @@ TEST(PersonMotion, PhotoSwaysAboutItsPivotAndFacesTheCamera) {
     for (double pivot : {0.0, 0.9}) {
         p.sway_pivot = pivot;
         const Eigen::Vector3d axis(3, 2, -0.3 + pivot);
-        const auto still = personPhotoPose(p, personStateAt(p, 0.0), eye);
-        const auto swayed = personPhotoPose(p, personStateAt(p, p.sway_period / 4), eye);
+        const auto still = personPhotoPose(p, personStateAt(p, 0.0), eye, eye);
+        const auto swayed = personPhotoPose(p, personStateAt(p, p.sway_period / 4), eye, eye);
         // The pivot stays put; unswayed, the bottom centre is at the place, the photo upright.
         EXPECT_LT((world(swayed, 0, pivot) - axis).norm(), 1e-12) << pivot;
         EXPECT_LT((world(still, 0, 0) - Eigen::Vector3d(3, 2, -0.3)).norm(), 1e-12) << pivot;
@@ -501,6 +501,35 @@ TEST(PersonMotion, PhotoSwaysAboutItsPivotAndFacesTheCamera) {
         const double moved = (world(swayed, 0, 1.7) - world(still, 0, 1.7)).norm();
         EXPECT_NEAR(moved, 2 * (1.7 - pivot) * std::sin(2 * kPi / 180), 1e-9) << pivot;
     }
+}
+
+// A seated person keeps the yaw of the first frame wherever the camera goes (rigid apart from
+// the sway, as the person truth says); a walker turns to face the camera where it is.
+TEST(PersonMotion, SeatedPeopleKeepTheirYawWalkersFaceTheCamera) {
+    PersonSpec p;
+    p.path = {{3, 2}};
+    p.sway_deg = 0;
+    const Eigen::Vector3d first_eye(0, 2, 1.2), moved_eye(0.3, 2.8, 1.0);
+    const auto yawOf = [&](const Eigen::Vector3d& eye) {
+        return personPhotoPose(p, personStateAt(p, 1.0), eye, first_eye).yaw();
+    };
+    for (const auto kind : {PersonKind::Sitting, PersonKind::Standing}) {
+        p.kind = kind;
+        EXPECT_NEAR(yawOf(moved_eye), yawOf(first_eye), 1e-12) << toString(kind);
+        const auto a = personPhotoPose(p, personStateAt(p, 1.0), first_eye, first_eye);
+        const auto b = personPhotoPose(p, personStateAt(p, 1.0), moved_eye, first_eye);
+        EXPECT_LT((a.asVectorVal() - b.asVectorVal()).norm(), 1e-12) << toString(kind);
+    }
+    p.kind = PersonKind::Walking;
+    p.path = {{3, 2}, {3, 4}};
+    p.speed = 0.5;
+    // Facing the camera: the photo's normal (local y) points from the person to the eye.
+    const auto pose = personPhotoPose(p, personStateAt(p, 1.0), moved_eye, first_eye);
+    const Eigen::Vector3d n = pose.getRotationMatrix().col(1);
+    Eigen::Vector3d to_eye = moved_eye - Eigen::Vector3d(pose.x(), pose.y(), pose.z());
+    to_eye.z() = 0;
+    EXPECT_NEAR(std::abs(n.dot(to_eye.normalized())), 1.0, 1e-9);
+    EXPECT_GT(std::abs(yawOf(moved_eye) - yawOf(first_eye)), 0.1);
 }
 
 TEST(Scenario, ShippedFilesLoadAndTyposAreReported) {

@@ -244,12 +244,14 @@ RenderedFrame SequenceRenderer::render(std::size_t i) {
     RenderedFrame out;
     out.T_wc = cameraPoseAt(sc_.trajectory, t);
     const Eigen::Vector3d eye(out.T_wc.x(), out.T_wc.y(), out.T_wc.z());
+    const auto T0 = cameraPoseAt(sc_.trajectory, 0.0);
+    const Eigen::Vector3d first_eye(T0.x(), T0.y(), T0.z());
 
     std::vector<mrpt::poses::CPose3D> person_pose(sc_.people.size());
     std::vector<PersonState> state(sc_.people.size());
     for (std::size_t k = 0; k < sc_.people.size(); ++k) {
         state[k] = personStateAt(sc_.people[k], t);
-        person_pose[k] = personPhotoPose(sc_.people[k], state[k], eye);
+        person_pose[k] = personPhotoPose(sc_.people[k], state[k], eye, first_eye);
         impl_->people[k].mesh->setPose(person_pose[k]);
     }
 

@@ -50,12 +50,17 @@ struct PersonState {
 /// (ping-pong), so their motion is continuous and never ends.
 [[nodiscard]] PersonState personStateAt(const PersonSpec& p, double t);
 
-/// World pose of the person's photo in state s seen from a camera at eye: the photo faces the
-/// camera (yaw about z only) and sways in its own plane about a horizontal axis sway_pivot
-/// above its bottom edge, which stays fixed. Local frame: x along the photo's width, z up
-/// its height, origin at the bottom centre (where s.position is when unswayed).
+/// World pose of the person's photo in state s: the photo faces a camera position (yaw
+/// about z only) and sways in its own plane about a horizontal axis sway_pivot above its
+/// bottom edge, which stays fixed. A walker faces the camera where it is now (`eye`); a
+/// sitting or standing person faces where it was in the first frame (`first_eye`) and keeps
+/// that yaw, so that apart from the sway they are rigid, as the person truth says they are
+/// (they turned with the camera until session 22: points at the photo's edges moved by
+/// centimetres in depth). Local frame: x along the photo's width, z up its height, origin
+/// at the bottom centre (where s.position is when unswayed).
 [[nodiscard]] mrpt::poses::CPose3D personPhotoPose(const PersonSpec& p, const PersonState& s,
-                                                   const Eigen::Vector3d& eye);
+                                                   const Eigen::Vector3d& eye,
+                                                   const Eigen::Vector3d& first_eye);
 
 /// Length of a polyline [m].
 [[nodiscard]] double pathLength(const std::vector<Eigen::Vector2d>& path);

@@ -37,7 +37,8 @@ WriteSummary writeSequence(const Scenario& sc, const WriteOptions& o,
 
 /// Bump when the renderer's output for an unchanged scenario changes: renders made by an
 /// older version are then no longer current (isRenderCurrent).
-inline constexpr int kRendererVersion = 3;  // 3: bilinear texture sampling by default
+inline constexpr int kRendererVersion = 4;  // 3: bilinear texture sampling by default;
+                                            // 4: seated/standing people keep their yaw
 
 /// What a render is made of, as text: the renderer version, the seed, the frame count, the
 /// labels switch, the settings of the scenario and room files (their lines without comments:
