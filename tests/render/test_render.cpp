@@ -638,6 +638,44 @@ TEST(Scenario, ShippedFilesLoadAndTyposAreReported) {
     expectMessage(
         [&] { (void)loadScenario(withEdit(text, "n_frames        = 60", "n_frames = 60x")); },
         tmp.str("s.ini") + " [scenario] n_frames: expected an integer, got '60x'");
+    // room_set: written over the room file's [room] and [box_*] settings, checked like them.
+    const auto withRoomSet = [&](const std::string& items) {
+        return withEdit(text, "n_frames        = 60", "n_frames = 60\nroom_set = " + items);
+    };
+    const auto set = loadScenario(withRoomSet("box_desk.blur=5 room.wall_blur=3"));
+    EXPECT_DOUBLE_EQ(set.room.wall_blur, 3.0);
+    EXPECT_EQ(set.room.overrides.size(), 2u);
+    for (const auto& b : set.room.boxes) EXPECT_DOUBLE_EQ(b.blur, b.name == "box_desk" ? 5 : 0);
+    expectMessage([&] { (void)loadScenario(withRoomSet("box_dsk.blur=5")); },
+                  "room_set item 'box_dsk.blur=5': the room file has no [box_dsk] section");
+    expectMessage([&] { (void)loadScenario(withRoomSet("box_desk.blurr=5")); },
+                  "[box_desk]: unknown key 'blurr'");
+    expectMessage([&] { (void)loadScenario(withRoomSet("box_desk.blur=500")); },
+                  "[box_desk] blur: must be 0..100 [px] (room_set of " + tmp.str("s.ini") + ")");
+    expectMessage([&] { (void)loadScenario(withRoomSet("box_desk")); },
+                  "room_set item 'box_desk': expected SECTION.KEY=VALUE");
+    // --set reaches room_set too (one item: --set values have no spaces).
+    (void)withEdit(text, "n_frames", "n_frames");
+    const auto via_set = loadScenario(base, {"scenario.room_set=box_crate.blur=2"});
+    for (const auto& b : via_set.room.boxes)
+        EXPECT_DOUBLE_EQ(b.blur, b.name == "box_crate" ? 2 : 0);
+}
+
+// sitting_bare is sitting_xyz's room with every box blurred through room_set: the same
+// room file, boxes and walls, only the boxes' blur differs.
+TEST(Scenario, SittingBareBlursTheOfficeRoomsFurniture) {
+    const auto xyz = loadScenario(kSynth + "/sitting_xyz.ini");
+    const auto bare = loadScenario(kSynth + "/sitting_bare.ini");
+    EXPECT_EQ(bare.room.source, xyz.room.source);
+    ASSERT_EQ(bare.room.boxes.size(), xyz.room.boxes.size());
+    ASSERT_FALSE(bare.room.boxes.empty());
+    for (std::size_t i = 0; i < bare.room.boxes.size(); ++i) {
+        EXPECT_EQ(bare.room.boxes[i].textures, xyz.room.boxes[i].textures);
+        EXPECT_DOUBLE_EQ(xyz.room.boxes[i].blur, 0.0);
+        EXPECT_DOUBLE_EQ(bare.room.boxes[i].blur, xyz.room.wall_blur) << bare.room.boxes[i].name;
+    }
+    EXPECT_DOUBLE_EQ(bare.room.wall_blur, xyz.room.wall_blur);
+    EXPECT_EQ(bare.people.size(), xyz.people.size());
 }
 
 TEST(PersonTexture, GrabCutCutsThePhotoAndCellsFollowAlpha) {

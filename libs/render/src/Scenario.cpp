@@ -74,6 +74,17 @@ std::vector<std::string> sectionsWithPrefix(const mrpt::config::CConfigFileBase&
 
 void readRoom(const std::string& path, RoomSpec& room) {
     const auto cfg = core::loadIni(path);
+    // The scenario's room_set: only sections the room file has, else a typo in a section
+    // name would set nothing and say nothing (keys are checked below, as the file's own).
+    for (const auto& item : room.overrides) {
+        const auto dot = item.find('.');
+        if (dot == std::string::npos) continue;  // malformed: applyOverrides says how
+        const std::string sec = item.substr(0, dot);
+        if (!cfg->sectionExists(sec) || (sec != "room" && sec.rfind("box_", 0) != 0))
+            throw std::invalid_argument("room_set item '" + item + "': the room file has no [" +
+                                        sec + "] section to set (sections: room, box_*)");
+    }
+    core::applyOverrides(*cfg, room.overrides, "room_set item");
     const std::string base = dirOf(path);
     const std::string s = "room";
     core::requireKnownKeys(
@@ -197,7 +208,8 @@ Scenario readScenario(const std::string& path, const std::vector<std::string>& o
     const std::string s = "scenario";
     core::requireKnownKeys(*cfg, s,
                            {"name", "room", "duration", "n_frames", "rate_hz", "t0", "seed",
-                            "rgb_noise_sigma", "near_clip", "far_clip", "texture_filter"},
+                            "rgb_noise_sigma", "near_clip", "far_clip", "texture_filter",
+                            "room_set"},
                            path);
     sc.name = cfg->read_string(s, "name", fs::path(path).stem().string());
     sc.rate_hz = core::readDouble(*cfg, s, "rate_hz", sc.rate_hz);
@@ -233,7 +245,14 @@ Scenario readScenario(const std::string& path, const std::vector<std::string>& o
     std::string room = cfg->read_string(s, "room", "", true);
     if (fs::path(room).is_relative())
         room = (fs::path(dirOf(path)) / room).lexically_normal().string();
-    loadRoom(room, sc.room);
+    std::istringstream room_set(cfg->read_string(s, "room_set", ""));
+    for (std::string item; room_set >> item;) sc.room.overrides.push_back(item);
+    try {
+        loadRoom(room, sc.room);
+    } catch (const std::invalid_argument& e) {
+        if (sc.room.overrides.empty()) throw;
+        throw std::invalid_argument(std::string(e.what()) + " (room_set of " + path + ")");
+    }
 
     if (cfg->sectionExists("trajectory")) sc.trajectory.loadFromConfig(*cfg, "trajectory");
     if (cfg->sectionExists("depth_noise")) sc.depth_noise.loadFromConfig(*cfg, "depth_noise");

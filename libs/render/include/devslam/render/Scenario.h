@@ -43,6 +43,8 @@ struct RoomSpec {
     double wall_blur = 0.0;
     double floor_blur = 0.0;
     std::string source;  ///< the room INI file it was read from
+    /// the scenario's `room_set` items applied over that file, in order
+    std::vector<std::string> overrides;
     std::vector<BoxSpec> boxes;
 };
 
@@ -83,7 +85,10 @@ struct Scenario {
 /// section and key on any unknown key, missing file, or out-of-range value.
 /// `overrides`: "section.key=value" items written over the scenario file's settings before
 /// it is read (devslam-synth --set; sections of the scenario file, not of the room), checked
-/// like the file's own keys.
+/// like the file's own keys. The scenario's own `room_set` (whitespace-separated
+/// "section.key=value" items) is written over the room file's settings the same way, on
+/// its [room] and existing [box_*] sections: one room file serves variants such as
+/// sitting_bare's blurred furniture.
 [[nodiscard]] Scenario loadScenario(const std::string& path,
                                     const std::vector<std::string>& overrides = {});
 
