@@ -17,6 +17,8 @@
 #include <devslam/eval/MaskScore.h>
 #include <devslam/io/RgbdReader.h>
 
+#include "Targets.h"
+
 #include <mrpt/config/CConfigFileMemory.h>
 
 #include <opencv2/imgcodecs.hpp>
@@ -91,6 +93,7 @@ struct Bench {
     std::string out_dir = "out/bench";
     std::string slam_config = kRoot + "/config_ini/slam_synthetic.ini";
     std::vector<Sequence> sequences;
+    std::vector<bench::Target> targets;  ///< [targets], checked on the medians
 };
 
 std::string resolve(const std::string& p, const std::string& base) {
@@ -124,10 +127,10 @@ Bench loadBench(const std::string& path) {
     std::vector<std::string> sections;
     cfg->getAllSections(sections);
     for (const auto& s : sections) {
-        if (s.empty() || s == "bench") continue;
+        if (s.empty() || s == "bench" || s == "targets") continue;
         if (s.rfind("sequence_", 0) != 0)
             throw std::invalid_argument(path + ": unknown section [" + s +
-                                        "] (known: bench, sequence_*)");
+                                        "] (known: bench, sequence_*, targets)");
         core::requireKnownKeys(
             *cfg, s, {"name", "path", "scenario", "slam_config", "seeds", "set", "repeats"}, path);
         Sequence q;
@@ -168,6 +171,9 @@ Bench loadBench(const std::string& path) {
         b.sequences.push_back(q);
     }
     if (b.sequences.empty()) throw std::invalid_argument(path + ": no [sequence_*] section");
+    std::vector<std::string> names;
+    for (const auto& q : b.sequences) names.push_back(q.name);
+    b.targets = bench::loadTargets(*cfg, path, names, b.modes);
     return b;
 }
 
@@ -327,7 +333,7 @@ int run(int argc, char** argv) {
             total += runsMode(q, b.out_dir, m)
                          ? std::size_t(repeatsOf(q)) * inputsOf(q, b.out_dir).size()
                          : 0;
-    std::size_t done = 0;
+    std::size_t done = 0, reused = 0;
     for (const auto& q : b.sequences)
         for (const auto& m : b.modes)
             for (const auto& in : inputsOf(q, b.out_dir))
@@ -348,6 +354,7 @@ int run(int argc, char** argv) {
                               << std::flush;
                     const bool have = reuse && fs::exists(dir / "run.json");
                     const int rc = have ? 0 : std::system(cmd.c_str());
+                    reused += have;
                     RunFigures f = rc == 0 ? readRun((dir / "run.json").string()) : RunFigures{};
                     f.seed = in.seed;
                     f.dir = dir;
@@ -477,6 +484,48 @@ int run(int argc, char** argv) {
             figs << " ![" << seq << " " << m << "](images/bench_" << seq << "_" << m << ".png) |";
         figs << "\n\n";
     }
+    // Targets, checked on the same medians as the tables.
+    const bench::FigureOf figureOf = [&](const std::string& seq, const std::string& mode,
+                                         const std::string& figure) {
+        using R = RunFigures;
+        const auto it = runs.find({seq, mode});
+        if (it == runs.end()) return std::numeric_limits<double>::quiet_NaN();
+        const auto& v = it->second;
+        if (figure == "ate") return med(v, &R::ate_rmse);
+        if (figure == "fps") return med(v, &R::fps_median);
+        if (figure == "walkers_masked")
+            return med(v, &R::moving_instances) > 0 ? med(v, &R::moving_recall) : NAN;
+        if (figure == "static_masked")
+            return med(v, &R::static_instances) > 0 ? med(v, &R::static_masked) : NAN;
+        const auto ref = runs.find({seq, figure.substr(figure.find('/') + 1)});  // ate/<mode>
+        if (ref == runs.end()) return std::numeric_limits<double>::quiet_NaN();
+        return med(v, &R::ate_rmse) / med(ref->second, &R::ate_rmse);
+    };
+    std::ostringstream targets_md;
+    if (!b.targets.empty()) {
+        std::vector<std::string> names;
+        for (const auto& q : b.sequences) names.push_back(q.name);
+        std::ofstream csv(fs::path(b.out_dir) / "targets.csv");
+        csv << "target,sequence,mode,figure,op,value,measured,measured_on,met\n";
+        targets_md << "**Targets** (bench.ini `[targets]`, checked on the medians of the tables "
+                      "below; `*`: every sequence with the figure, the worst one shown; ate in "
+                      "m, masked as fractions of the people's frames)\n\n"
+                      "| target | measured | met |\n|---|---|---|\n";
+        int met = 0;
+        for (const auto& t : b.targets) {
+            const auto c = bench::check(t, names, figureOf);
+            met += c.met;
+            const int prec = t.figure == "fps" ? 1 : t.figure == "ate" ? 5 : 3;
+            targets_md << "| " << t.key << ": " << t.text() << " | " << fmt(c.measured, prec)
+                       << (t.sequence == "*" && !c.sequence.empty() ? " (" + c.sequence + ")"
+                                                                      : std::string())
+                       << " | " << (c.met ? "yes" : "**no**") << " |\n";
+            csv << t.key << "," << t.sequence << "," << t.mode << "," << t.figure << ","
+                << t.op << "," << t.value << "," << fmt(c.measured, 6) << "," << c.sequence
+                << "," << (c.met ? 1 : 0) << "\n";
+        }
+        targets_md << "\n" << met << " of " << b.targets.size() << " targets met.\n\n";
+    }
     // How often each sequence ran, for the text: "walking_xyz: 3 renders x 1 run, ...".
     std::ostringstream runsLine;
     for (std::size_t i = 0; i < b.sequences.size(); ++i) {
@@ -508,9 +557,13 @@ int run(int argc, char** argv) {
        << fs::path(config).filename().string()
        << (repeats ? " --repeats " + std::to_string(b.repeats) : std::string())
        << (max_frames ? " --max-frames " + std::to_string(b.max_frames) : std::string())
-       << "`: " << runsLine.str()
+       << (reuse ? " --reuse-runs" : "") << "`: " << runsLine.str()
        << " with `devslam-run`; the tables give medians over all runs of a sequence and mode. "
-          "Synthetic sequences are rendered by `devslam-synth` (exact ground truth; "
+       << (reused ? std::to_string(reused) + " of " + std::to_string(total) +
+                        " runs were kept from an earlier invocation that made them "
+                        "(`--reuse-runs`: their run.json, speed included, is from then). "
+                  : std::string())
+       << "Synthetic sequences are rendered by `devslam-synth` (exact ground truth; "
           "docs/render.md), each in the renders listed (`--seed`: the same scene and motion "
           "with other image and depth noise, docs/dynamic.md), because one render cannot rank "
           "two settings of this SLAM. RPE over 1 s.\n\n"
@@ -521,7 +574,7 @@ int run(int argc, char** argv) {
                              "mask_margin) as the mask, i.e. what a perfect filter would give. "
                              "It bounds what any mask can do on a sequence (synthetic only).\n\n")
                : std::string())
-       << "**Table 1: RPE**\n\n"
+       << targets_md.str() << "**Table 1: RPE**\n\n"
        << t1.str() << "\n**Table 2: ATE**\n\n"
        << t2.str()
        << (t5.str().empty()

@@ -46,7 +46,9 @@ TEST(DevslamBench, TwoFrameSmokeRunOfTheWholeCommand) {
            "set = person_1.speed=0.5 person_2.sway_deg=1\n"
            "[sequence_fr1]\npath = "
         << root << "/data/tum/fr1_xyz_first37\nslam_config = " << root
-        << "/config_ini/slam_tum_fr1.ini\n";
+        << "/config_ini/slam_tum_fr1.ini\n"
+           "[targets]\na_fps = short dynamic fps >= 0.001\nb_fps = * dynamic fps >= 1e9\n"
+           "c_ratio = fr1 dynamic ate/none <= 1e9\n";
     std::ofstream(tmp / "RESULTS.md") << "# Results\n";
     const std::string cmd =
         "'" + bin + "/devslam-bench' --config '" + (tmp / "bench.ini").string() +
@@ -96,6 +98,27 @@ TEST(DevslamBench, TwoFrameSmokeRunOfTheWholeCommand) {
         << results;
     EXPECT_NE(results.find("| short | dynamic | "), std::string::npos);
     EXPECT_NE(results.find("ATE RMSE (m) per render"), std::string::npos);
+    // The targets, checked on the medians: one that every run meets, one that none can
+    // ("*": the worst sequence shown), and one without a figure (two frames give no ATE),
+    // which is not met.
+    EXPECT_NE(results.find("| a_fps: short dynamic fps >= 0.001 | "), std::string::npos)
+        << results;
+    EXPECT_NE(results.find("| b_fps: * dynamic fps >= 1e+09 | "), std::string::npos) << results;
+    EXPECT_NE(results.find("| c_ratio: fr1 dynamic ate/none <= 1e+09 | n/a | **no** |"),
+              std::string::npos)
+        << results;
+    EXPECT_NE(results.find("1 of 3 targets met."), std::string::npos) << results;
+    const std::string targets = readFile(tmp / "out/targets.csv");
+    EXPECT_EQ(countLines(targets), 1u + 3u) << targets;
+    const auto row = [&](const std::string& key) {
+        const auto at = targets.find("\n" + key + ",");
+        return at == std::string::npos ? std::string()
+                                       : targets.substr(at + 1, targets.find('\n', at + 1) - at - 1);
+    };
+    EXPECT_EQ(row("a_fps").rfind("a_fps,short,dynamic,fps,>=,0.001,", 0), 0u) << targets;
+    EXPECT_EQ(row("a_fps").back(), '1') << targets;
+    EXPECT_EQ(row("b_fps").back(), '0') << targets;
+    EXPECT_EQ(row("c_ratio"), "c_ratio,fr1,dynamic,ate/none,<=,1e+09,n/a,,0") << targets;
     EXPECT_NE(results.find(" (seed 5), "), std::string::npos) << results;
     EXPECT_NE(results.find("Sequences: short is scenario `short_walking` with `devslam-synth "
                            "--set person_1.speed=0.5 --set person_2.sway_deg=1`."),
@@ -145,6 +168,26 @@ TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
         << readFile(tmp / "log.txt");
     EXPECT_NE(refused("[sequence_a]\nscenario = short_walking\nset = person_1.speed=1 speed=2\n")
                   .find("[sequence_a] set item 'speed=2': expected SECTION.KEY=VALUE"),
+              std::string::npos)
+        << readFile(tmp / "log.txt");
+    const std::string seq = "[sequence_a]\n" + fr1;
+    EXPECT_NE(refused(seq + "[targets]\nx = a dynamic ate <=\n")
+                  .find("[targets] x: expected 'SEQUENCE MODE FIGURE OP VALUE'"),
+              std::string::npos)
+        << readFile(tmp / "log.txt");
+    EXPECT_NE(refused(seq + "[targets]\nx = b dynamic ate <= 1\n").find("unknown sequence 'b'"),
+              std::string::npos)
+        << readFile(tmp / "log.txt");
+    EXPECT_NE(refused(seq + "[targets]\nx = a dynamic speed <= 1\n").find("unknown figure 'speed'"),
+              std::string::npos)
+        << readFile(tmp / "log.txt");
+    EXPECT_NE(refused(seq + "[targets]\nx = a dynamic ate/truth <= 1\n").find("ratio 'ate/truth'"),
+              std::string::npos)
+        << readFile(tmp / "log.txt");
+    EXPECT_NE(refused(seq + "[targets]\nx = a dynamic ate =< 1\n").find("unknown comparison '=<'"),
+              std::string::npos)
+        << readFile(tmp / "log.txt");
+    EXPECT_NE(refused(seq + "[targets]\nx = * dynamic ate <= 1x\n").find("[targets] x"),
               std::string::npos)
         << readFile(tmp / "log.txt");
     // A key the scenario does not know stops the bench at the render, before any run.

@@ -1,0 +1,99 @@
+#include "Targets.h"
+
+#include <devslam/core/Parse.h>
+
+#include <mrpt/config/CConfigFileBase.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+namespace devslam::bench {
+
+std::string Target::text() const {
+    std::ostringstream s;
+    s << sequence << " " << mode << " " << figure << " " << op << " " << value;
+    return s.str();
+}
+
+bool Target::holds(double m) const {
+    if (std::isnan(m)) return false;
+    if (op == "<=") return m <= value;
+    if (op == "<") return m < value;
+    if (op == ">=") return m >= value;
+    return m > value;
+}
+
+std::vector<Target> loadTargets(const mrpt::config::CConfigFileBase& cfg, const std::string& path,
+                                const std::vector<std::string>& sequences,
+                                const std::vector<std::string>& modes) {
+    std::vector<std::string> keys;
+    cfg.getAllKeys("targets", keys);
+    std::vector<Target> out;
+    const auto known = [](const std::vector<std::string>& v, const std::string& x) {
+        return std::find(v.begin(), v.end(), x) != v.end();
+    };
+    const auto list = [](const std::vector<std::string>& v) {
+        std::string s;
+        for (const auto& x : v) s += (s.empty() ? "" : ", ") + x;
+        return s;
+    };
+    for (const auto& key : keys) {
+        const std::string where = path + " [targets] " + key;
+        const std::string line = cfg.read_string("targets", key, "");
+        std::istringstream in(line);
+        Target t;
+        t.key = key;
+        std::string value, extra;
+        if (!(in >> t.sequence >> t.mode >> t.figure >> t.op >> value) || (in >> extra))
+            throw std::invalid_argument(where + ": expected 'SEQUENCE MODE FIGURE OP VALUE', got '" +
+                                        line + "'");
+        if (t.sequence != "*" && !known(sequences, t.sequence))
+            throw std::invalid_argument(where + ": unknown sequence '" + t.sequence +
+                                        "' (known: *, " + list(sequences) + ")");
+        if (!known(modes, t.mode))
+            throw std::invalid_argument(where + ": mode '" + t.mode +
+                                        "' is not run (modes: " + list(modes) + ")");
+        const auto slash = t.figure.find('/');
+        const std::string base = t.figure.substr(0, slash);
+        if (slash != std::string::npos) {
+            const std::string ref = t.figure.substr(slash + 1);
+            if (base != "ate" || !known(modes, ref))
+                throw std::invalid_argument(where + ": ratio '" + t.figure +
+                                            "': only ate/<mode> with a mode that is run (modes: " +
+                                            list(modes) + ")");
+        } else if (!known({"ate", "fps", "walkers_masked", "static_masked"}, base)) {
+            throw std::invalid_argument(
+                where + ": unknown figure '" + t.figure +
+                "' (known: ate, ate/<mode>, fps, walkers_masked, static_masked)");
+        }
+        if (!known({"<=", "<", ">=", ">"}, t.op))
+            throw std::invalid_argument(where + ": unknown comparison '" + t.op +
+                                        "' (known: <=, <, >=, >)");
+        t.value = core::parseNumber(value, where);
+        out.push_back(t);
+    }
+    return out;
+}
+
+TargetCheck check(const Target& t, const std::vector<std::string>& sequences,
+                  const FigureOf& figure) {
+    TargetCheck c;
+    c.measured = std::numeric_limits<double>::quiet_NaN();
+    const bool upper = t.op[0] == '<';  // the target bounds the figure from above
+    for (const auto& s : sequences) {
+        if (t.sequence != "*" && s != t.sequence) continue;
+        const double v = figure(s, t.mode, t.figure);
+        if (std::isnan(v)) continue;
+        if (std::isnan(c.measured) || (upper ? v > c.measured : v < c.measured)) {
+            c.measured = v;
+            c.sequence = s;
+        }
+    }
+    c.met = t.holds(c.measured);
+    return c;
+}
+
+}  // namespace devslam::bench

@@ -1,0 +1,56 @@
+#pragma once
+// devslam-bench's [targets]: goals such as "walking_xyz dynamic ate <= 0.015", checked on the
+// bench's own medians and written with them, so that whether a target is met is measured by
+// the same command as the tables, never typed by hand.
+//
+//   [targets]
+//   walking_xyz_ate = walking_xyz dynamic ate <= 0.015
+//   sitting_vs_mask = sitting_xyz dynamic ate/all_persons < 1
+//   walkers         = * dynamic walkers_masked >= 0.9      // every sequence that has it
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace mrpt::config {
+class CConfigFileBase;
+}
+
+namespace devslam::bench {
+
+struct Target {
+    std::string key;       ///< INI key (its name in messages)
+    std::string sequence;  ///< a [sequence_*] name, or "*" = every sequence with the figure
+    std::string mode;
+    std::string figure;    ///< ate | fps | walkers_masked | static_masked | ate/<mode>
+    std::string op;        ///< <= < >= >
+    double value = 0;
+    [[nodiscard]] std::string text() const;  ///< "walking_xyz dynamic ate <= 0.015"
+    [[nodiscard]] bool holds(double measured) const;
+};
+
+/// Reads [targets] (each key one target, "SEQUENCE MODE FIGURE OP VALUE"); throws
+/// std::invalid_argument naming `path`, the section and the key for a malformed target, an
+/// unknown sequence, mode or figure.
+[[nodiscard]] std::vector<Target> loadTargets(const mrpt::config::CConfigFileBase& cfg,
+                                              const std::string& path,
+                                              const std::vector<std::string>& sequences,
+                                              const std::vector<std::string>& modes);
+
+/// The bench's median of a figure for (sequence, mode); NaN where it has none (a mode that
+/// did not run, no walkers in the sequence, ...).
+using FigureOf = std::function<double(const std::string& sequence, const std::string& mode,
+                                      const std::string& figure)>;
+
+struct TargetCheck {
+    double measured = 0;   ///< NaN: no figure
+    std::string sequence;  ///< where it was measured (for "*": the worst sequence)
+    bool met = false;
+};
+
+/// Evaluates a target; for "*" the sequence whose figure is furthest from the target
+/// (largest for <=, <; smallest for >=, >) decides.
+[[nodiscard]] TargetCheck check(const Target& t, const std::vector<std::string>& sequences,
+                                const FigureOf& figure);
+
+}  // namespace devslam::bench
