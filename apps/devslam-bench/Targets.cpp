@@ -6,7 +6,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -81,7 +80,6 @@ std::vector<Target> loadTargets(const mrpt::config::CConfigFileBase& cfg, const 
 TargetCheck check(const Target& t, const std::vector<std::string>& sequences,
                   const FigureOf& figure) {
     TargetCheck c;
-    c.measured = std::numeric_limits<double>::quiet_NaN();
     const bool upper = t.op[0] == '<';  // the target bounds the figure from above
     for (const auto& s : sequences) {
         if (t.sequence != "*" && s != t.sequence) continue;

@@ -8,7 +8,7 @@
 //   sitting_vs_mask = sitting_xyz dynamic ate/all_persons < 1
 //   walkers         = * dynamic walkers_masked >= 0.9      // every sequence that has it
 #include <functional>
-#include <optional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -43,7 +43,7 @@ using FigureOf = std::function<double(const std::string& sequence, const std::st
                                       const std::string& figure)>;
 
 struct TargetCheck {
-    double measured = 0;   ///< NaN: no figure
+    double measured = std::numeric_limits<double>::quiet_NaN();  ///< NaN: no figure
     std::string sequence;  ///< where it was measured (for "*": the worst sequence)
     bool met = false;
 };

@@ -30,11 +30,11 @@ std::string toString(PersonKind k) {
 }
 
 mrpt::poses::CPose3D personPhotoPose(const PersonSpec& p, const PersonState& s,
-                                     const Eigen::Vector3d& eye_now,
+                                     const Eigen::Vector3d& eye,
                                      const Eigen::Vector3d& first_eye) {
     const Eigen::Vector3d& b = s.position;
-    const Eigen::Vector3d& eye = p.kind == PersonKind::Walking ? eye_now : first_eye;
-    const double yaw = std::atan2(-(eye.x() - b.x()), eye.y() - b.y());
+    const Eigen::Vector3d& facing = p.kind == PersonKind::Walking ? eye : first_eye;
+    const double yaw = std::atan2(-(facing.x() - b.x()), facing.y() - b.y());
     // Rotating about the pivot: shift the origin by what the rotation does to the pivot.
     const mrpt::poses::CPose3D R(0, 0, 0, yaw, s.sway, 0);
     double ox = 0, oy = 0, oz = 0;
