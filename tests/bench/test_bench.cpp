@@ -9,6 +9,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <unistd.h>
@@ -145,56 +146,31 @@ TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
         return readFile(tmp / "log.txt");
     };
     const std::string fr1 = "path = " + root + "/data/tum/fr1_xyz_first37\n";
-    EXPECT_NE(refused("[sequence_a]\nscenario = short_walking\nseeds = 5 x\n")
-                  .find("[sequence_a] seeds: expected an integer"),
-              std::string::npos)
-        << readFile(tmp / "log.txt");
-    EXPECT_NE(refused("[sequence_a]\nscenario = short_walking\nseeds = 5 6 5\n")
-                  .find("seed 5 is listed twice"),
-              std::string::npos)
-        << readFile(tmp / "log.txt");
-    EXPECT_NE(refused("[sequence_a]\n" + fr1 + "seeds = 5\n")
-                  .find("[sequence_a] seeds: only a synthetic sequence"),
-              std::string::npos)
-        << readFile(tmp / "log.txt");
-    EXPECT_NE(refused("[sequence_a]\n" + fr1 + "repeats = 0x\n").find("[sequence_a] repeats"),
-              std::string::npos)
-        << readFile(tmp / "log.txt");
-    EXPECT_NE(refused("[sequence_a]\n" + fr1 + "seed = 5\n").find("seed"), std::string::npos)
-        << readFile(tmp / "log.txt");
-    EXPECT_NE(refused("[sequence_a]\n" + fr1 + "set = person_1.speed=1\n")
-                  .find("[sequence_a] set: only a synthetic sequence"),
-              std::string::npos)
-        << readFile(tmp / "log.txt");
-    EXPECT_NE(refused("[sequence_a]\nscenario = short_walking\nset = person_1.speed=1 speed=2\n")
-                  .find("[sequence_a] set item 'speed=2': expected SECTION.KEY=VALUE"),
-              std::string::npos)
-        << readFile(tmp / "log.txt");
-    const std::string seq = "[sequence_a]\n" + fr1;
-    EXPECT_NE(refused(seq + "[targets]\nx = a dynamic ate <=\n")
-                  .find("[targets] x: expected 'SEQUENCE MODE FIGURE OP VALUE'"),
-              std::string::npos)
-        << readFile(tmp / "log.txt");
-    EXPECT_NE(refused(seq + "[targets]\nx = b dynamic ate <= 1\n").find("unknown sequence 'b'"),
-              std::string::npos)
-        << readFile(tmp / "log.txt");
-    EXPECT_NE(refused(seq + "[targets]\nx = a dynamic speed <= 1\n").find("unknown figure 'speed'"),
-              std::string::npos)
-        << readFile(tmp / "log.txt");
-    EXPECT_NE(refused(seq + "[targets]\nx = a dynamic ate/truth <= 1\n").find("ratio 'ate/truth'"),
-              std::string::npos)
-        << readFile(tmp / "log.txt");
-    EXPECT_NE(refused(seq + "[targets]\nx = a dynamic ate =< 1\n").find("unknown comparison '=<'"),
-              std::string::npos)
-        << readFile(tmp / "log.txt");
-    EXPECT_NE(refused(seq + "[targets]\nx = * dynamic ate <= 1x\n").find("[targets] x"),
-              std::string::npos)
-        << readFile(tmp / "log.txt");
-    // A key the scenario does not know stops the bench at the render, before any run.
-    EXPECT_NE(refused("[sequence_a]\nscenario = short_walking\nset = person_1.sped=1\n")
-                  .find("sped"),
-              std::string::npos)
-        << readFile(tmp / "log.txt");
+    const std::string synth = "[sequence_a]\nscenario = short_walking\n";
+    const std::string real = "[sequence_a]\n" + fr1;
+    // (bench INI, what its message must say)
+    const std::vector<std::pair<std::string, std::string>> cases = {
+        {synth + "seeds = 5 x\n", "[sequence_a] seeds: expected an integer"},
+        {synth + "seeds = 5 6 5\n", "seed 5 is listed twice"},
+        {real + "seeds = 5\n", "[sequence_a] seeds: only a synthetic sequence"},
+        {real + "repeats = 0x\n", "[sequence_a] repeats"},
+        {real + "seed = 5\n", "seed"},
+        {real + "set = person_1.speed=1\n", "[sequence_a] set: only a synthetic sequence"},
+        {synth + "set = person_1.speed=1 speed=2\n",
+         "[sequence_a] set item 'speed=2': expected SECTION.KEY=VALUE"},
+        // A key the scenario does not know stops the bench at the render, before any run.
+        {synth + "set = person_1.sped=1\n", "sped"},
+        {real + "[targets]\nx = a dynamic ate <=\n",
+         "[targets] x: expected 'SEQUENCE MODE FIGURE OP VALUE'"},
+        {real + "[targets]\nx = b dynamic ate <= 1\n", "unknown sequence 'b'"},
+        {real + "[targets]\nx = a dynamic speed <= 1\n", "unknown figure 'speed'"},
+        {real + "[targets]\nx = a dynamic ate/truth <= 1\n", "ratio 'ate/truth'"},
+        {real + "[targets]\nx = a dynamic ate =< 1\n", "unknown comparison '=<'"},
+        {real + "[targets]\nx = * dynamic ate <= 1x\n", "[targets] x"},
+    };
+    for (const auto& [ini, msg] : cases)
+        EXPECT_NE(refused(ini).find(msg), std::string::npos)
+            << ini << "\n" << readFile(tmp / "log.txt");
     fs::remove_all(tmp);
 }
 
