@@ -94,6 +94,11 @@ struct Bench {
     std::string slam_config = kRoot + "/config_ini/slam_synthetic.ini";
     std::vector<Sequence> sequences;
     std::vector<bench::Target> targets;  ///< [targets], checked on the medians
+    [[nodiscard]] std::vector<std::string> names() const {
+        std::vector<std::string> v;
+        for (const auto& q : sequences) v.push_back(q.name);
+        return v;
+    }
 };
 
 std::string resolve(const std::string& p, const std::string& base) {
@@ -156,8 +161,7 @@ Bench loadBench(const std::string& path) {
                                         " seeds: only a synthetic sequence (scenario) has renders");
         // Whitespace-separated, as [run] filter_overrides; the format is checked here, the
         // sections and keys by devslam-synth, which renders before any run starts.
-        std::istringstream sets(cfg->read_string(s, "set", ""));
-        for (std::string item; sets >> item;) q.sets.push_back(item);
+        q.sets = core::overrideItems(cfg->read_string(s, "set", ""));
         if (!q.sets.empty() && q.scenario.empty())
             throw std::invalid_argument(where + " set: only a synthetic sequence (scenario) " +
                                         "has render settings");
@@ -171,9 +175,7 @@ Bench loadBench(const std::string& path) {
         b.sequences.push_back(q);
     }
     if (b.sequences.empty()) throw std::invalid_argument(path + ": no [sequence_*] section");
-    std::vector<std::string> names;
-    for (const auto& q : b.sequences) names.push_back(q.name);
-    b.targets = bench::loadTargets(*cfg, path, names, b.modes);
+    b.targets = bench::loadTargets(*cfg, path, b.names(), b.modes);
     return b;
 }
 
@@ -503,8 +505,7 @@ int run(int argc, char** argv) {
     };
     std::ostringstream targets_md;
     if (!b.targets.empty()) {
-        std::vector<std::string> names;
-        for (const auto& q : b.sequences) names.push_back(q.name);
+        const auto names = b.names();
         std::ofstream csv(fs::path(b.out_dir) / "targets.csv");
         csv << "target,sequence,mode,figure,op,value,measured,measured_on,met\n";
         targets_md << "**Targets** (bench.ini `[targets]`, checked on the medians of the tables "

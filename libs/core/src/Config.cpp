@@ -30,6 +30,13 @@ void applyOverrides(mrpt::config::CConfigFileMemory& cfg, const std::vector<std:
     }
 }
 
+std::vector<std::string> overrideItems(const std::string& text) {
+    std::vector<std::string> items;
+    std::istringstream in(text);
+    for (std::string item; in >> item;) items.push_back(item);
+    return items;
+}
+
 std::unique_ptr<mrpt::config::CConfigFileMemory> loadFilterIni(
     const mrpt::config::CConfigFileBase& cfg, const std::string& path) {
     namespace fs = std::filesystem;
@@ -38,10 +45,8 @@ std::unique_ptr<mrpt::config::CConfigFileMemory> loadFilterIni(
                        : fs::path(fc).is_absolute()
                            ? fc
                            : (fs::path(path).parent_path() / fc).string());
-    std::vector<std::string> items;
-    std::istringstream ov(cfg.read_string("run", "filter_overrides", ""));
-    for (std::string item; ov >> item;) items.push_back(item);
-    applyOverrides(*out, items, path + " [run] filter_overrides item");
+    applyOverrides(*out, overrideItems(cfg.read_string("run", "filter_overrides", "")),
+                   path + " [run] filter_overrides item");
     return out;
 }
 

@@ -245,8 +245,7 @@ Scenario readScenario(const std::string& path, const std::vector<std::string>& o
     std::string room = cfg->read_string(s, "room", "", true);
     if (fs::path(room).is_relative())
         room = (fs::path(dirOf(path)) / room).lexically_normal().string();
-    std::istringstream room_set(cfg->read_string(s, "room_set", ""));
-    for (std::string item; room_set >> item;) sc.room.overrides.push_back(item);
+    sc.room.overrides = core::overrideItems(cfg->read_string(s, "room_set", ""));
     try {
         loadRoom(room, sc.room);
     } catch (const std::invalid_argument& e) {

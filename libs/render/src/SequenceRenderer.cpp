@@ -91,6 +91,8 @@ struct SequenceRenderer::Impl {
     std::unique_ptr<mrpt::opengl::CFBORender> fbo;
     std::map<std::pair<std::string, double>, cv::Mat> photos;  // (path, blur) -> BGR
     bool texture_linear = true;  // Scenario::texture_linear, for every textured object
+    /// The camera's position in the first frame: seated and standing people face it.
+    Eigen::Vector3d first_eye{0, 0, 0};
     struct Person {
         PersonTexture tex;
         double width = 0, height = 0;  // [m]
@@ -209,6 +211,8 @@ SequenceRenderer::SequenceRenderer(Scenario sc)
     : sc_(std::move(sc)), impl_(std::make_unique<Impl>()) {
     if (sc_.K.width < 8 || sc_.K.height < 8)
         throw std::invalid_argument("render: image size must be at least 8x8");
+    const auto T0 = cameraPoseAt(sc_.trajectory, 0.0);
+    impl_->first_eye = {T0.x(), T0.y(), T0.z()};
     impl_->scene = mrpt::opengl::COpenGLScene::Create();
     auto vp = impl_->scene->getViewport();
     vp->setViewportClipDistances(sc_.near_clip, sc_.far_clip);
@@ -244,14 +248,12 @@ RenderedFrame SequenceRenderer::render(std::size_t i) {
     RenderedFrame out;
     out.T_wc = cameraPoseAt(sc_.trajectory, t);
     const Eigen::Vector3d eye(out.T_wc.x(), out.T_wc.y(), out.T_wc.z());
-    const auto T0 = cameraPoseAt(sc_.trajectory, 0.0);
-    const Eigen::Vector3d first_eye(T0.x(), T0.y(), T0.z());
 
     std::vector<mrpt::poses::CPose3D> person_pose(sc_.people.size());
     std::vector<PersonState> state(sc_.people.size());
     for (std::size_t k = 0; k < sc_.people.size(); ++k) {
         state[k] = personStateAt(sc_.people[k], t);
-        person_pose[k] = personPhotoPose(sc_.people[k], state[k], eye, first_eye);
+        person_pose[k] = personPhotoPose(sc_.people[k], state[k], eye, impl_->first_eye);
         impl_->people[k].mesh->setPose(person_pose[k]);
     }
 

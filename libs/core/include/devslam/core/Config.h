@@ -37,6 +37,11 @@ void requireKnownKeys(const mrpt::config::CConfigFileBase& cfg, const std::strin
 void applyOverrides(mrpt::config::CConfigFileMemory& cfg, const std::vector<std::string>& items,
                     const std::string& what = "override");
 
+/// The items of a whitespace-separated override list as INIs write them ("a.b=1 c.d=2":
+/// [run] filter_overrides, a bench sequence's `set`, a scenario's `room_set`); an item holds
+/// no blank.
+[[nodiscard]] std::vector<std::string> overrideItems(const std::string& text);
+
 /// The INI holding [detector] and [dynamic_filter] for the config `cfg` read from `path`:
 /// the file its [run] `filter_config` names (relative to `path`), or `path` itself when
 /// there is none, with the [run] `filter_overrides` ("section.key=value ..." items)
