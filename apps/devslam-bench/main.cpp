@@ -129,9 +129,8 @@ Bench loadBench(const std::string& path) {
     b.slam_config = resolve(cfg->read_string("bench", "slam_config", b.slam_config), base);
     core::requireValue(b.repeats >= 1 && b.repeats <= 100, path + " [bench]", "repeats",
                        "must be 1..100");
-    std::vector<std::string> sections;
-    cfg->getAllSections(sections);
-    for (const auto& s : sections) {
+    // In the file's order: the tables list the sequences as the user wrote them.
+    for (const auto& s : core::sectionsInFileOrder(*cfg, path)) {
         if (s.empty() || s == "bench" || s == "targets") continue;
         if (s.rfind("sequence_", 0) != 0)
             throw std::invalid_argument(path + ": unknown section [" + s +
@@ -161,7 +160,7 @@ Bench loadBench(const std::string& path) {
                                         " seeds: only a synthetic sequence (scenario) has renders");
         // Whitespace-separated, as [run] filter_overrides; the format is checked here, the
         // sections and keys by devslam-synth, which renders before any run starts.
-        q.sets = core::overrideItems(cfg->read_string(s, "set", ""));
+        q.sets = core::overrideItems(cfg->read_string(s, "set", ""), where + " set");
         if (!q.sets.empty() && q.scenario.empty())
             throw std::invalid_argument(where + " set: only a synthetic sequence (scenario) " +
                                         "has render settings");
@@ -257,8 +256,11 @@ std::string fmt(double v, int prec) {
     return b;
 }
 
+/// `s` as one word for /bin/sh (single quotes; a single quote inside closes, escapes, reopens).
 std::string quote(const std::string& s) {
-    return "'" + s + "'";
+    std::string q = "'";
+    for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return q + "'";
 }
 
 int run(int argc, char** argv) {
@@ -548,7 +550,8 @@ int run(int argc, char** argv) {
         scenes << (scenes.tellp() > 0 ? "; " : "Sequences: ") << q.name << " is scenario `"
                << q.scenario << "`";
         for (std::size_t k = 0; k < q.sets.size(); ++k)
-            scenes << (k ? " " : " with `devslam-synth ") << "--set " << q.sets[k];
+            scenes << (k ? " " : " with `devslam-synth ") << "--set "
+                   << (q.sets[k].find(' ') == std::string::npos ? q.sets[k] : quote(q.sets[k]));
         if (!q.sets.empty()) scenes << "`";
     }
     if (scenes.tellp() > 0) scenes << ".\n\n";

@@ -171,6 +171,31 @@ TEST(Parse, BooleansAreSpelledOut) {
     EXPECT_NE(invalidArgument([] { (void)parseBool("", "x"); }), "");
 }
 
+TEST(Config, OverrideListsKeepBracketedValuesWhole) {
+    EXPECT_EQ(overrideItems("  a.b=1\tc.d=2  "), (std::vector<std::string>{"a.b=1", "c.d=2"}));
+    EXPECT_EQ(overrideItems("p.path=[3.5 2.1]  p.speed=1 q.v=[1 [2 3]]"),
+              (std::vector<std::string>{"p.path=[3.5 2.1]", "p.speed=1", "q.v=[1 [2 3]]"}));
+    EXPECT_TRUE(overrideItems(" ").empty());
+    mrpt::config::CConfigFileMemory mem;
+    applyOverrides(mem, overrideItems("p.path=[3.5 2.1]"));
+    EXPECT_EQ(mem.read_string("p", "path", ""), "[3.5 2.1]");
+    const std::string msg = invalidArgument([] { (void)overrideItems("p.path=[3.5 2.1", "x.ini set"); });
+    EXPECT_EQ(msg, "x.ini set 'p.path=[3.5 2.1': a '[' is not closed");
+}
+
+TEST(Config, SectionsComeInTheFilesOrder) {
+    const std::string path = ::testing::TempDir() + "/order.ini";
+    std::ofstream(path) << "[zeta]\na = 1\n  [alpha]\nb = 2\n[mid]\n[alpha]\nc = 3\n";
+    const auto cfg = loadIni(path);
+    std::vector<std::string> sorted;
+    cfg->getAllSections(sorted);
+    ASSERT_EQ(sorted.size(), 3u);  // MRPT's own list is sorted, hence this helper
+    EXPECT_EQ(sectionsInFileOrder(*cfg, path),
+              (std::vector<std::string>{"zeta", "alpha", "mid"}));
+    // A file that cannot be read again still gives every section, in MRPT's order.
+    EXPECT_EQ(sectionsInFileOrder(*cfg, path + ".gone"), sorted);
+}
+
 TEST(Config, StrictReadsNameSectionKeyAndValue) {
     mrpt::config::CConfigFileMemory mem(
         "[a]\nn = 12 // a trailing comment is stripped\nbig = 1e3\nx = 0.25\non = yes\n"

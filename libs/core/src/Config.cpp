@@ -2,6 +2,7 @@
 #include <devslam/core/Parse.h>
 
 #include <algorithm>
+#include <cctype>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -30,11 +31,44 @@ void applyOverrides(mrpt::config::CConfigFileMemory& cfg, const std::vector<std:
     }
 }
 
-std::vector<std::string> overrideItems(const std::string& text) {
+std::vector<std::string> overrideItems(const std::string& text, const std::string& what) {
     std::vector<std::string> items;
-    std::istringstream in(text);
-    for (std::string item; in >> item;) items.push_back(item);
+    std::string item;
+    int depth = 0;  // inside brackets, blanks belong to the item
+    for (char c : text) {
+        if (c == '[') ++depth;
+        if (c == ']' && depth > 0) --depth;
+        if (depth == 0 && std::isspace(static_cast<unsigned char>(c))) {
+            if (!item.empty()) items.push_back(std::move(item));
+            item.clear();
+        } else {
+            item += c;
+        }
+    }
+    if (depth > 0)
+        throw std::invalid_argument(what + " '" + text + "': a '[' is not closed");
+    if (!item.empty()) items.push_back(std::move(item));
     return items;
+}
+
+std::vector<std::string> sectionsInFileOrder(const mrpt::config::CConfigFileBase& cfg,
+                                             const std::string& path) {
+    std::vector<std::string> known, ordered;
+    cfg.getAllSections(known);
+    std::ifstream in(path);
+    for (std::string line; std::getline(in, line);) {
+        const auto a = line.find_first_not_of(" \t");
+        if (a == std::string::npos || line[a] != '[') continue;
+        const auto b = line.find(']', a);
+        if (b == std::string::npos) continue;
+        const std::string name = line.substr(a + 1, b - a - 1);
+        if (std::find(known.begin(), known.end(), name) != known.end() &&
+            std::find(ordered.begin(), ordered.end(), name) == ordered.end())
+            ordered.push_back(name);
+    }
+    for (const auto& s : known)
+        if (std::find(ordered.begin(), ordered.end(), s) == ordered.end()) ordered.push_back(s);
+    return ordered;
 }
 
 std::unique_ptr<mrpt::config::CConfigFileMemory> loadFilterIni(
@@ -45,7 +79,8 @@ std::unique_ptr<mrpt::config::CConfigFileMemory> loadFilterIni(
                        : fs::path(fc).is_absolute()
                            ? fc
                            : (fs::path(path).parent_path() / fc).string());
-    applyOverrides(*out, overrideItems(cfg.read_string("run", "filter_overrides", "")),
+    applyOverrides(*out, overrideItems(cfg.read_string("run", "filter_overrides", ""),
+                                       path + " [run] filter_overrides"),
                    path + " [run] filter_overrides item");
     return out;
 }

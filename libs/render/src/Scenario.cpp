@@ -245,7 +245,8 @@ Scenario readScenario(const std::string& path, const std::vector<std::string>& o
     std::string room = cfg->read_string(s, "room", "", true);
     if (fs::path(room).is_relative())
         room = (fs::path(dirOf(path)) / room).lexically_normal().string();
-    sc.room.overrides = core::overrideItems(cfg->read_string(s, "room_set", ""));
+    sc.room.overrides = core::overrideItems(cfg->read_string(s, "room_set", ""),
+                                            path + " [" + s + "] room_set");
     try {
         loadRoom(room, sc.room);
     } catch (const std::invalid_argument& e) {

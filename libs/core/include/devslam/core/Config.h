@@ -38,9 +38,18 @@ void applyOverrides(mrpt::config::CConfigFileMemory& cfg, const std::vector<std:
                     const std::string& what = "override");
 
 /// The items of a whitespace-separated override list as INIs write them ("a.b=1 c.d=2":
-/// [run] filter_overrides, a bench sequence's `set`, a scenario's `room_set`); an item holds
-/// no blank.
-[[nodiscard]] std::vector<std::string> overrideItems(const std::string& text);
+/// [run] filter_overrides, a bench sequence's `set`, a scenario's `room_set`). A value in
+/// brackets may hold blanks, as MRPT writes vectors: "p.path=[3.5 2.1] p.speed=1" is two
+/// items. Throws std::invalid_argument naming `what` when a '[' is not closed.
+[[nodiscard]] std::vector<std::string> overrideItems(const std::string& text,
+                                                     const std::string& what = "override list");
+
+/// The section names of the INI file `path` in the order the file gives them. MRPT's
+/// getAllSections() sorts them; a list the user wrote (the bench's sequences) keeps
+/// the user's order this way. Sections of `cfg` (the same file, loaded) that the scan
+/// does not find come last, in MRPT's order, so none is ever lost.
+[[nodiscard]] std::vector<std::string> sectionsInFileOrder(
+    const mrpt::config::CConfigFileBase& cfg, const std::string& path);
 
 /// The INI holding [detector] and [dynamic_filter] for the config `cfg` read from `path`:
 /// the file its [run] `filter_config` names (relative to `path`), or `path` itself when
