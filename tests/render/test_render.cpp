@@ -601,6 +601,9 @@ TEST(Scenario, ShippedFilesLoadAndTyposAreReported) {
     expectRoomMessage(  // a box's blur
         [](std::string& r) { r.replace(r.find("[box_crate]\n"), 12, "[box_crate]\nblur = 101\n"); },
         tmp.str("bad_room.ini") + " [box_crate] blur: must be 0..100");
+    expectRoomMessage(  // a mistyped section is not ignored
+        [](std::string& r) { r.replace(r.find("[room]\n"), 7, "[rooom]\n"); },
+        tmp.str("bad_room.ini") + ": unknown section [rooom] (known: room, box_*)");
     // --set: written over the scenario file's settings, checked like them.
     (void)withEdit(text, "n_frames", "n_frames");  // s.ini (= base) as it was
     EXPECT_DOUBLE_EQ(loadScenario(base).people.at(0).speed, 0.7);

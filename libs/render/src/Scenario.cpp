@@ -74,6 +74,14 @@ std::vector<std::string> sectionsWithPrefix(const mrpt::config::CConfigFileBase&
 
 void readRoom(const std::string& path, RoomSpec& room) {
     const auto cfg = core::loadIni(path);
+    {  // a mistyped section would be ignored without a word, as a mistyped key
+        std::vector<std::string> all;
+        cfg->getAllSections(all);
+        for (const auto& sec : all)
+            if (!sec.empty() && sec != "room" && sec.rfind("box_", 0) != 0)
+                throw std::invalid_argument(path + ": unknown section [" + sec +
+                                            "] (known: room, box_*)");
+    }
     // The scenario's room_set: only sections the room file has, else a typo in a section
     // name would set nothing and say nothing (keys are checked below, as the file's own).
     for (const auto& item : room.overrides) {
