@@ -1,5 +1,6 @@
 #include "Targets.h"
 
+#include <devslam/core/Config.h>
 #include <devslam/core/Parse.h>
 
 #include <mrpt/config/CConfigFileBase.h>
@@ -28,8 +29,8 @@ bool Target::holds(double m) const {
 std::vector<Target> loadTargets(const mrpt::config::CConfigFileBase& cfg, const std::string& path,
                                 const std::vector<std::string>& sequences,
                                 const std::vector<std::string>& modes) {
-    std::vector<std::string> keys;
-    cfg.getAllKeys("targets", keys);
+    // In the file's order: the table lists the targets as the user wrote them.
+    const auto keys = core::keysInFileOrder(cfg, path, "targets");
     std::vector<Target> out;
     const auto known = [](const std::vector<std::string>& v, const std::string& x) {
         return std::find(v.begin(), v.end(), x) != v.end();
@@ -83,7 +84,7 @@ TargetCheck check(const Target& t, const std::vector<std::string>& sequences,
     const bool upper = t.op[0] == '<';  // the target bounds the figure from above
     for (const auto& s : sequences) {
         if (t.sequence != "*" && s != t.sequence) continue;
-        const double v = figure(s, t.mode, t.figure);
+        const double v = figure(s, t.mode, t.figure, std::nullopt);
         if (std::isnan(v)) continue;
         if (std::isnan(c.measured) || (upper ? v > c.measured : v < c.measured)) {
             c.measured = v;
@@ -92,6 +93,23 @@ TargetCheck check(const Target& t, const std::vector<std::string>& sequences,
     }
     c.met = t.holds(c.measured);
     return c;
+}
+
+InputTally tallyInputs(const Target& t, const std::vector<SequenceInputs>& inputs,
+                       const FigureOf& figure) {
+    InputTally n;
+    const auto count = [&](const std::string& seq, std::optional<std::uint64_t> seed) {
+        const double v = figure(seq, t.mode, t.figure, seed);
+        if (std::isnan(v)) return;
+        ++n.of;
+        n.met += t.holds(v);
+    };
+    for (const auto& in : inputs) {
+        if (t.sequence != "*" && in.name != t.sequence) continue;
+        if (in.seeds.empty()) count(in.name, std::nullopt);
+        for (const auto seed : in.seeds) count(in.name, seed);
+    }
+    return n;
 }
 
 }  // namespace devslam::bench

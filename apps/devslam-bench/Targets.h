@@ -8,7 +8,9 @@
 //   sitting_vs_mask = sitting_xyz dynamic ate/all_persons < 1
 //   walkers         = * dynamic walkers_masked >= 0.9      // every sequence that has it
 #include <functional>
+#include <cstdint>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -37,10 +39,12 @@ struct Target {
                                               const std::vector<std::string>& sequences,
                                               const std::vector<std::string>& modes);
 
-/// The bench's median of a figure for (sequence, mode); NaN where it has none (a mode that
-/// did not run, no walkers in the sequence, ...).
+/// The bench's median of a figure for (sequence, mode), over all its runs, or over the runs
+/// on one render when `seed` is given; NaN where it has none (a mode that did not run, no
+/// walkers in the sequence, ...).
 using FigureOf = std::function<double(const std::string& sequence, const std::string& mode,
-                                      const std::string& figure)>;
+                                      const std::string& figure,
+                                      std::optional<std::uint64_t> seed)>;
 
 struct TargetCheck {
     double measured = std::numeric_limits<double>::quiet_NaN();  ///< NaN: no figure
@@ -52,5 +56,21 @@ struct TargetCheck {
 /// (largest for <=, <; smallest for >=, >) decides.
 [[nodiscard]] TargetCheck check(const Target& t, const std::vector<std::string>& sequences,
                                 const FigureOf& figure);
+
+/// A sequence and its renders (seeds; none: one input, a real sequence or a single render).
+struct SequenceInputs {
+    std::string name;
+    std::vector<std::uint64_t> seeds;
+};
+
+/// How many inputs meet a target on their own figure (each render's median over its
+/// repeats; a ratio compares the two modes on the same render): says whether the median
+/// meets or misses the target on most renders, or only by the spread between them.
+struct InputTally {
+    int met = 0;
+    int of = 0;  ///< inputs with the figure
+};
+[[nodiscard]] InputTally tallyInputs(const Target& t, const std::vector<SequenceInputs>& inputs,
+                                     const FigureOf& figure);
 
 }  // namespace devslam::bench

@@ -194,6 +194,12 @@ TEST(Config, SectionsComeInTheFilesOrder) {
               (std::vector<std::string>{"zeta", "alpha", "mid"}));
     // A file that cannot be read again still gives every section, in MRPT's order.
     EXPECT_EQ(sectionsInFileOrder(*cfg, path + ".gone"), sorted);
+    const std::string keys = ::testing::TempDir() + "/keys.ini";
+    std::ofstream(keys) << "[t]\nzz = 1\n  b=2   // comment = x\n[u]\na = 0\n[t]\na = 3\n";
+    EXPECT_EQ(keysInFileOrder(*loadIni(keys), keys, "t"),
+              (std::vector<std::string>{"zz", "b", "a"}));
+    EXPECT_EQ(keysInFileOrder(*loadIni(keys), keys + ".gone", "t"),
+              (std::vector<std::string>{"a", "b", "zz"}));
 }
 
 TEST(Config, StrictReadsNameSectionKeyAndValue) {

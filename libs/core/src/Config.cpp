@@ -51,24 +51,54 @@ std::vector<std::string> overrideItems(const std::string& text, const std::strin
     return items;
 }
 
-std::vector<std::string> sectionsInFileOrder(const mrpt::config::CConfigFileBase& cfg,
-                                             const std::string& path) {
-    std::vector<std::string> known, ordered;
-    cfg.getAllSections(known);
+namespace {
+/// `known` reordered as the names `scan` finds in the file's lines (each line with the
+/// section it is in); names the scan misses come last, in their own order.
+template <class Scan>
+std::vector<std::string> inFileOrder(const std::string& path, const std::vector<std::string>& known,
+                                     Scan&& scan) {
+    std::vector<std::string> ordered;
+    const auto has = [](const std::vector<std::string>& v, const std::string& x) {
+        return std::find(v.begin(), v.end(), x) != v.end();
+    };
     std::ifstream in(path);
+    std::string section;
     for (std::string line; std::getline(in, line);) {
         const auto a = line.find_first_not_of(" \t");
-        if (a == std::string::npos || line[a] != '[') continue;
-        const auto b = line.find(']', a);
-        if (b == std::string::npos) continue;
-        const std::string name = line.substr(a + 1, b - a - 1);
-        if (std::find(known.begin(), known.end(), name) != known.end() &&
-            std::find(ordered.begin(), ordered.end(), name) == ordered.end())
-            ordered.push_back(name);
+        if (a == std::string::npos) continue;
+        if (line[a] == '[') {
+            const auto b = line.find(']', a);
+            if (b == std::string::npos) continue;
+            section = line.substr(a + 1, b - a - 1);
+        }
+        const std::string name = scan(section, line.substr(a));
+        if (!name.empty() && has(known, name) && !has(ordered, name)) ordered.push_back(name);
     }
     for (const auto& s : known)
-        if (std::find(ordered.begin(), ordered.end(), s) == ordered.end()) ordered.push_back(s);
+        if (!has(ordered, s)) ordered.push_back(s);
     return ordered;
+}
+}  // namespace
+
+std::vector<std::string> sectionsInFileOrder(const mrpt::config::CConfigFileBase& cfg,
+                                             const std::string& path) {
+    std::vector<std::string> known;
+    cfg.getAllSections(known);
+    return inFileOrder(path, known, [](const std::string& section, const std::string& line) {
+        return line[0] == '[' ? section : std::string();
+    });
+}
+
+std::vector<std::string> keysInFileOrder(const mrpt::config::CConfigFileBase& cfg,
+                                         const std::string& path, const std::string& section) {
+    std::vector<std::string> known;
+    cfg.getAllKeys(section, known);
+    return inFileOrder(path, known, [&](const std::string& sec, const std::string& line) {
+        const auto eq = line.find('=');
+        if (sec != section || line[0] == '[' || eq == std::string::npos) return std::string();
+        const auto end = line.find_last_not_of(" \t", eq - 1);
+        return end == std::string::npos || eq == 0 ? std::string() : line.substr(0, end + 1);
+    });
 }
 
 std::unique_ptr<mrpt::config::CConfigFileMemory> loadFilterIni(

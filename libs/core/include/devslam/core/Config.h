@@ -51,6 +51,12 @@ void applyOverrides(mrpt::config::CConfigFileMemory& cfg, const std::vector<std:
 [[nodiscard]] std::vector<std::string> sectionsInFileOrder(
     const mrpt::config::CConfigFileBase& cfg, const std::string& path);
 
+/// The keys of `section`, in the order the file `path` gives them (MRPT's getAllKeys() sorts
+/// them); keys the scan does not find come last, in MRPT's order.
+[[nodiscard]] std::vector<std::string> keysInFileOrder(const mrpt::config::CConfigFileBase& cfg,
+                                                       const std::string& path,
+                                                       const std::string& section);
+
 /// The INI holding [detector] and [dynamic_filter] for the config `cfg` read from `path`:
 /// the file its [run] `filter_config` names (relative to `path`), or `path` itself when
 /// there is none, with the [run] `filter_overrides` ("section.key=value ..." items)
