@@ -7,8 +7,8 @@
 //   walking_xyz_ate = walking_xyz dynamic ate <= 0.015
 //   sitting_vs_mask = sitting_xyz dynamic ate/all_persons < 1
 //   walkers         = * dynamic walkers_masked >= 0.9      // every sequence that has it
-#include <functional>
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <optional>
 #include <string>

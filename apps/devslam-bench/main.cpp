@@ -488,7 +488,7 @@ int run(int argc, char** argv) {
             figs << " ![" << seq << " " << m << "](images/bench_" << seq << "_" << m << ".png) |";
         figs << "\n\n";
     }
-    // Targets, checked on the same medians as the tables.
+    // Targets, checked on the same medians as the tables, and render by render.
     // The runs of (sequence, mode), of one render when `seed` is given.
     const auto runsOf = [&](const std::string& seq, const std::string& mode,
                             std::optional<std::uint64_t> seed) {
