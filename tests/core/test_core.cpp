@@ -9,10 +9,13 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
 #include <fstream>
 #include <limits>
 
 #include <cmath>
+
+#include <unistd.h>  // getpid: scratch folders of concurrent test runs must differ
 
 using namespace devslam::core;
 
@@ -96,7 +99,8 @@ TEST(Config, FilterIniFollowsRunFilterConfigWithOverrides) {
     EXPECT_TRUE(f->sectionExists("detector"));
     EXPECT_EQ(f->read_int("dynamic_filter", "detect_every", 0), 3);
     // Without [run] filter_config the INI is its own filter INI; overrides still apply.
-    const std::string dir = ::testing::TempDir();
+    const std::string dir = ::testing::TempDir() + "devslam_core_" + std::to_string(::getpid());
+    std::filesystem::create_directories(dir);
     const std::string own = dir + "/own.ini";
     std::ofstream(own) << "[run]\nfilter_overrides = dynamic_filter.mask_margin=3\n"
                           "[dynamic_filter]\nmask_margin = 10\n";
@@ -119,6 +123,7 @@ TEST(Config, FilterIniFollowsRunFilterConfigWithOverrides) {
     } catch (const std::runtime_error& e) {
         EXPECT_NE(std::string(e.what()).find("nowhere.ini"), std::string::npos) << e.what();
     }
+    std::filesystem::remove_all(dir);
 }
 
 /// The message of the std::invalid_argument `f` throws ("" when it throws none).
@@ -184,7 +189,7 @@ TEST(Config, OverrideListsKeepBracketedValuesWhole) {
 }
 
 TEST(Config, SectionsComeInTheFilesOrder) {
-    const std::string path = ::testing::TempDir() + "/order.ini";
+    const std::string path = ::testing::TempDir() + "/order_" + std::to_string(::getpid()) + ".ini";
     std::ofstream(path) << "[zeta]\na = 1\n  [alpha]\nb = 2\n[mid]\n[alpha]\nc = 3\n";
     const auto cfg = loadIni(path);
     std::vector<std::string> sorted;
@@ -194,12 +199,14 @@ TEST(Config, SectionsComeInTheFilesOrder) {
               (std::vector<std::string>{"zeta", "alpha", "mid"}));
     // A file that cannot be read again still gives every section, in MRPT's order.
     EXPECT_EQ(sectionsInFileOrder(*cfg, path + ".gone"), sorted);
-    const std::string keys = ::testing::TempDir() + "/keys.ini";
+    const std::string keys = ::testing::TempDir() + "/keys_" + std::to_string(::getpid()) + ".ini";
     std::ofstream(keys) << "[t]\nzz = 1\n  b=2   // comment = x\n[u]\na = 0\n[t]\na = 3\n";
     EXPECT_EQ(keysInFileOrder(*loadIni(keys), keys, "t"),
               (std::vector<std::string>{"zz", "b", "a"}));
     EXPECT_EQ(keysInFileOrder(*loadIni(keys), keys + ".gone", "t"),
               (std::vector<std::string>{"a", "b", "zz"}));
+    std::filesystem::remove(path);
+    std::filesystem::remove(keys);
 }
 
 TEST(Config, StrictReadsNameSectionKeyAndValue) {

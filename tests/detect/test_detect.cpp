@@ -11,6 +11,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include <unistd.h>  // getpid: scratch folders of concurrent test runs must differ
+
 using namespace devslam;
 namespace fs = std::filesystem;
 
@@ -146,7 +148,7 @@ TEST(DetectYolo, MissingWeightsGiveAClearError) {
 }
 
 TEST(DetectYolo, CorruptWeightsGiveAClearError) {
-    const fs::path dir = fs::temp_directory_path() / "devslam_test_detect";
+    const fs::path dir = fs::temp_directory_path() / ("devslam_test_detect_" + std::to_string(::getpid()));
     fs::create_directories(dir);
     // A truncated copy of the real weights (half of the file) and a tiny garbage file.
     const std::string real = kRoot + "/models/yolo-fastest-1.1/yolo-fastest-1.1-xl.weights";

@@ -13,6 +13,8 @@
 #include <sstream>
 #include <string>
 
+#include <unistd.h>  // getpid: scratch folders of concurrent test runs must differ
+
 namespace fs = std::filesystem;
 
 namespace {
@@ -42,7 +44,7 @@ std::size_t lines(const fs::path& p) {
 }  // namespace
 
 TEST(DevslamRun, WritesEveryOutputAndPrintsTheSummary) {
-    const fs::path out = fs::temp_directory_path() / "devslam_run_smoke";
+    const fs::path out = fs::temp_directory_path() / ("devslam_run_smoke_" + std::to_string(::getpid()));
     fs::remove_all(out);
     const auto r = run("--mode none --quiet --out " + out.string());
     ASSERT_EQ(r.rc, 0) << r.out;
@@ -77,7 +79,7 @@ TEST(DevslamRun, BadInputIsReported) {
     r = run("--input /nonexistent/folder --mode none --quiet --out ''");
     EXPECT_EQ(r.rc, 1);
     EXPECT_NE(r.out.find("/nonexistent/folder"), std::string::npos) << r.out;
-    const fs::path ini = fs::temp_directory_path() / "devslam_bad_slam.ini";
+    const fs::path ini = fs::temp_directory_path() / ("devslam_bad_slam_" + std::to_string(::getpid()) + ".ini");
     std::ofstream(ini) << "[tracker]\nfine_raduis = 3\n";
     r = run("--config " + ini.string() + " --mode none --quiet --out ''");
     EXPECT_EQ(r.rc, 1);

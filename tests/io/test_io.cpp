@@ -12,8 +12,11 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <algorithm>
 #include <fstream>
 #include <regex>
+
+#include <unistd.h>  // getpid: scratch folders of concurrent test runs must differ
 
 namespace fs = std::filesystem;
 using namespace devslam;
@@ -28,8 +31,10 @@ class TempDir {
   public:
     TempDir() {
         const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-        path_ = fs::temp_directory_path() /
-                ("devslam_io_" + std::string(info->test_suite_name()) + "_" + info->name());
+        std::string name = "devslam_io_" + std::string(info->test_suite_name()) + "_" +
+                           info->name() + "_" + std::to_string(::getpid());
+        std::replace(name.begin(), name.end(), '/', '_');  // parameterised: "Layouts/Rawlog..."
+        path_ = fs::temp_directory_path() / name;
         fs::remove_all(path_);
         fs::create_directories(path_);
     }
