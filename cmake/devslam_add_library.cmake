@@ -48,6 +48,7 @@ function(devslam_add_test name)
   endif()
   add_executable(${name} ${ARG_SOURCES})
   target_link_libraries(${name} PRIVATE devslam_options ${ARG_DEPS} GTest::gtest GTest::gtest_main)
+  target_include_directories(${name} PRIVATE ${DEVSLAM_SOURCE_DIR}/tests/common)  # Scratch.h
   target_compile_definitions(${name} PRIVATE
     DEVSLAM_SOURCE_DIR="${DEVSLAM_SOURCE_DIR}" DEVSLAM_BIN_DIR="${CMAKE_BINARY_DIR}/bin")
   set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)

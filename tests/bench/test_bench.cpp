@@ -6,23 +6,22 @@
 
 #include <gtest/gtest.h>
 
+#include "Scratch.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <limits>
-#include <map>
-#include <optional>
-
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
+#include <map>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <tuple>
 #include <utility>
 #include <vector>
-
-#include <unistd.h>
 
 namespace fs = std::filesystem;
 
@@ -45,7 +44,7 @@ std::size_t countLines(const std::string& s) {
 TEST(DevslamBench, TwoFrameSmokeRunOfTheWholeCommand) {
     const std::string root = DEVSLAM_SOURCE_DIR, bin = DEVSLAM_BIN_DIR;
     const fs::path tmp =
-        fs::temp_directory_path() / ("devslam_bench_smoke_" + std::to_string(::getpid()));
+        devslam::test::scratchPath("devslam_bench_smoke");
     fs::remove_all(tmp);
     fs::create_directories(tmp);
     std::ofstream(tmp / "bench.ini")
@@ -202,7 +201,7 @@ TEST(BenchTargets, MediansDecideRendersAreCountedOneByOne) {
 TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
     const std::string root = DEVSLAM_SOURCE_DIR, bin = DEVSLAM_BIN_DIR;
     const fs::path tmp =
-        fs::temp_directory_path() / ("devslam_bench_bad_" + std::to_string(::getpid()));
+        devslam::test::scratchPath("devslam_bench_bad");
     fs::remove_all(tmp);
     fs::create_directories(tmp);
     const auto refused = [&](const std::string& ini) {
@@ -250,7 +249,7 @@ TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
 TEST(DevslamSynth, SeedOptionGivesAnotherRenderOfTheSameScene) {
     const std::string bin = DEVSLAM_BIN_DIR;
     const fs::path tmp =
-        fs::temp_directory_path() / ("devslam_synth_seed_" + std::to_string(::getpid()));
+        devslam::test::scratchPath("devslam_synth_seed");
     fs::remove_all(tmp);
     fs::create_directories(tmp);
     auto render = [&](const std::string& name, const std::string& extra) {

@@ -9,13 +9,14 @@
 
 #include <gtest/gtest.h>
 
+#include "Scratch.h"
+
 #include <filesystem>
 #include <fstream>
 #include <limits>
 
 #include <cmath>
 
-#include <unistd.h>  // getpid: scratch folders of concurrent test runs must differ
 
 using namespace devslam::core;
 
@@ -99,7 +100,7 @@ TEST(Config, FilterIniFollowsRunFilterConfigWithOverrides) {
     EXPECT_TRUE(f->sectionExists("detector"));
     EXPECT_EQ(f->read_int("dynamic_filter", "detect_every", 0), 3);
     // Without [run] filter_config the INI is its own filter INI; overrides still apply.
-    const std::string dir = ::testing::TempDir() + "devslam_core_" + std::to_string(::getpid());
+    const std::string dir = devslam::test::scratchPath("devslam_core").string();
     std::filesystem::create_directories(dir);
     const std::string own = dir + "/own.ini";
     std::ofstream(own) << "[run]\nfilter_overrides = dynamic_filter.mask_margin=3\n"
@@ -189,7 +190,7 @@ TEST(Config, OverrideListsKeepBracketedValuesWhole) {
 }
 
 TEST(Config, SectionsComeInTheFilesOrder) {
-    const std::string path = ::testing::TempDir() + "/order_" + std::to_string(::getpid()) + ".ini";
+    const std::string path = devslam::test::scratchPath("devslam_order").string() + ".ini";
     std::ofstream(path) << "[zeta]\na = 1\n  [alpha]\nb = 2\n[mid]\n[alpha]\nc = 3\n";
     const auto cfg = loadIni(path);
     std::vector<std::string> sorted;
@@ -199,7 +200,7 @@ TEST(Config, SectionsComeInTheFilesOrder) {
               (std::vector<std::string>{"zeta", "alpha", "mid"}));
     // A file that cannot be read again still gives every section, in MRPT's order.
     EXPECT_EQ(sectionsInFileOrder(*cfg, path + ".gone"), sorted);
-    const std::string keys = ::testing::TempDir() + "/keys_" + std::to_string(::getpid()) + ".ini";
+    const std::string keys = devslam::test::scratchPath("devslam_keys").string() + ".ini";
     std::ofstream(keys) << "[t]\nzz = 1\n  b=2   // comment = x\n[u]\na = 0\n[t]\na = 3\n";
     EXPECT_EQ(keysInFileOrder(*loadIni(keys), keys, "t"),
               (std::vector<std::string>{"zz", "b", "a"}));

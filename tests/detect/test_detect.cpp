@@ -5,13 +5,14 @@
 #include <devslam/detect/YoloDetector.h>
 
 #include <gtest/gtest.h>
+
+#include "Scratch.h"
 #include <mrpt/config/CConfigFileMemory.h>
 #include <opencv2/imgcodecs.hpp>
 
 #include <filesystem>
 #include <fstream>
 
-#include <unistd.h>  // getpid: scratch folders of concurrent test runs must differ
 
 using namespace devslam;
 namespace fs = std::filesystem;
@@ -148,7 +149,7 @@ TEST(DetectYolo, MissingWeightsGiveAClearError) {
 }
 
 TEST(DetectYolo, CorruptWeightsGiveAClearError) {
-    const fs::path dir = fs::temp_directory_path() / ("devslam_test_detect_" + std::to_string(::getpid()));
+    const fs::path dir = devslam::test::scratchPath("devslam_test_detect");
     fs::create_directories(dir);
     // A truncated copy of the real weights (half of the file) and a tiny garbage file.
     const std::string real = kRoot + "/models/yolo-fastest-1.1/yolo-fastest-1.1-xl.weights";

@@ -11,13 +11,14 @@
 
 #include <gtest/gtest.h>
 
+#include "Scratch.h"
+
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <random>
 
-#include <unistd.h>  // getpid: scratch folders of concurrent test runs must differ
 
 using namespace devslam;
 using mrpt::poses::CPose3D;
@@ -227,7 +228,7 @@ TEST(Report, TableJsonPlotAndApp) {
               std::string::npos)
         << json;
 
-    const auto dir = std::filesystem::temp_directory_path() / ("devslam_eval_report_" + std::to_string(::getpid()));
+    const auto dir = devslam::test::scratchPath("devslam_eval_report");
     std::filesystem::create_directories(dir);
     io::writeTumTrajectory((dir / "gt.txt").string(), gt);
     io::writeTumTrajectory((dir / "est.txt").string(), est);
@@ -302,7 +303,7 @@ TEST(MaskScore, CountsWalkersStaticPeopleAndArea) {
 
 TEST(MaskScore, PersonTruthOfAFolder) {
     namespace fs = std::filesystem;
-    const fs::path dir = fs::temp_directory_path() / ("devslam_test_person_truth_" + std::to_string(::getpid()));
+    const fs::path dir = devslam::test::scratchPath("devslam_test_person_truth");
     fs::remove_all(dir);
     EXPECT_FALSE(eval::PersonTruth::open(dir.string()).has_value());  // no folder: real data
     fs::create_directories(dir);
@@ -341,7 +342,7 @@ TEST(MaskScore, PersonTruthOfAFolder) {
 // devslam-run's diagnostic mode `truth`: the walkers' pixels, dilated, never a static person.
 TEST(MaskScore, WalkerMaskIsTheWalkersPixelsDilated) {
     namespace fs = std::filesystem;
-    const fs::path dir = fs::temp_directory_path() / ("devslam_test_walker_mask_" + std::to_string(::getpid()));
+    const fs::path dir = devslam::test::scratchPath("devslam_test_walker_mask");
     fs::remove_all(dir);
     fs::create_directories(dir / "labels");
     std::ofstream(dir / "persons.txt") << "1.000000 1 walker moving 2 2 4 4 16\n"

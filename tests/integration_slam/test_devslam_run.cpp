@@ -1,5 +1,7 @@
 // Smoke tests of the devslam-run app: outputs written and loadable, bad input reported.
 #include <gtest/gtest.h>
+
+#include "Scratch.h"
 #include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/maps/COccupancyGridMap2D.h>
 #include <mrpt/opengl/COpenGLScene.h>
@@ -13,7 +15,6 @@
 #include <sstream>
 #include <string>
 
-#include <unistd.h>  // getpid: scratch folders of concurrent test runs must differ
 
 namespace fs = std::filesystem;
 
@@ -44,7 +45,7 @@ std::size_t lines(const fs::path& p) {
 }  // namespace
 
 TEST(DevslamRun, WritesEveryOutputAndPrintsTheSummary) {
-    const fs::path out = fs::temp_directory_path() / ("devslam_run_smoke_" + std::to_string(::getpid()));
+    const fs::path out = devslam::test::scratchPath("devslam_run_smoke");
     fs::remove_all(out);
     const auto r = run("--mode none --quiet --out " + out.string());
     ASSERT_EQ(r.rc, 0) << r.out;
@@ -79,7 +80,7 @@ TEST(DevslamRun, BadInputIsReported) {
     r = run("--input /nonexistent/folder --mode none --quiet --out ''");
     EXPECT_EQ(r.rc, 1);
     EXPECT_NE(r.out.find("/nonexistent/folder"), std::string::npos) << r.out;
-    const fs::path ini = fs::temp_directory_path() / ("devslam_bad_slam_" + std::to_string(::getpid()) + ".ini");
+    const fs::path ini = devslam::test::scratchPath("devslam_bad_slam").string() + ".ini";
     std::ofstream(ini) << "[tracker]\nfine_raduis = 3\n";
     r = run("--config " + ini.string() + " --mode none --quiet --out ''");
     EXPECT_EQ(r.rc, 1);

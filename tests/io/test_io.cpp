@@ -7,6 +7,9 @@
 #include <devslam/io/VideoReader.h>
 
 #include <gtest/gtest.h>
+
+#include "Scratch.h"
+
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
@@ -16,7 +19,6 @@
 #include <fstream>
 #include <regex>
 
-#include <unistd.h>  // getpid: scratch folders of concurrent test runs must differ
 
 namespace fs = std::filesystem;
 using namespace devslam;
@@ -26,25 +28,8 @@ namespace {
 const std::string kTum = std::string(DEVSLAM_SOURCE_DIR) + "/data/tum/fr1_xyz_first37";
 const std::string kMrptRgbd = "/usr/share/mrpt/datasets/tests_rgbd.rawlog";  // mrpt-common
 
-// A fresh scratch folder per test, removed afterwards.
-class TempDir {
-  public:
-    TempDir() {
-        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-        std::string name = "devslam_io_" + std::string(info->test_suite_name()) + "_" +
-                           info->name() + "_" + std::to_string(::getpid());
-        std::replace(name.begin(), name.end(), '/', '_');  // parameterised: "Layouts/Rawlog..."
-        path_ = fs::temp_directory_path() / name;
-        fs::remove_all(path_);
-        fs::create_directories(path_);
-    }
-    ~TempDir() { fs::remove_all(path_); }
-    [[nodiscard]] std::string str(const std::string& sub = {}) const {
-        return sub.empty() ? path_.string() : (path_ / sub).string();
-    }
-
-  private:
-    fs::path path_;
+struct TempDir : devslam::test::TempDir {  // a fresh scratch folder per test
+    TempDir() : devslam::test::TempDir("devslam_io_") {}
 };
 
 // Copies the first `n` associated frames of the shipped TUM folder into `dst`.

@@ -18,13 +18,13 @@
 
 #include <gtest/gtest.h>
 
+#include "Scratch.h"
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <sstream>
-
-#include <unistd.h>
 
 namespace fs = std::filesystem;
 using namespace devslam;
@@ -36,23 +36,8 @@ const std::string kRoot = DEVSLAM_SOURCE_DIR;
 const std::string kSynth = kRoot + "/sim_worlds/synth";
 constexpr double kPi = 3.14159265358979323846;
 
-class TempDir {
-  public:
-    TempDir() {
-        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-        path_ =
-            fs::temp_directory_path() / ("devslam_render_" + std::string(info->test_suite_name()) +
-                                         "_" + info->name() + "_" + std::to_string(::getpid()));
-        fs::remove_all(path_);
-        fs::create_directories(path_);
-    }
-    ~TempDir() { fs::remove_all(path_); }
-    [[nodiscard]] std::string str(const std::string& sub = {}) const {
-        return sub.empty() ? path_.string() : (path_ / sub).string();
-    }
-
-  private:
-    fs::path path_;
+struct TempDir : devslam::test::TempDir {  // a fresh scratch folder per test
+    TempDir() : devslam::test::TempDir("devslam_render_") {}
 };
 
 std::string readFile(const std::string& p) {
