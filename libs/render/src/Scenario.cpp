@@ -82,13 +82,15 @@ void readRoom(const std::string& path, RoomSpec& room) {
                 throw std::invalid_argument(path + ": unknown section [" + sec +
                                             "] (known: room, box_*)");
     }
-    // The scenario's room_set: only sections the room file has, else a typo in a section
-    // name would set nothing and say nothing (keys are checked below, as the file's own).
+    // The scenario's room_set: only sections the room file has (every one of them is [room]
+    // or a [box_*], checked above), else a typo in a section name would add a section: a box
+    // without `base` or an unknown one, with a message that does not say what went wrong
+    // (keys are checked below, as the file's own).
     for (const auto& item : room.overrides) {
         const auto dot = item.find('.');
         if (dot == std::string::npos) continue;  // malformed: applyOverrides says how
         const std::string sec = item.substr(0, dot);
-        if (!cfg->sectionExists(sec) || (sec != "room" && sec.rfind("box_", 0) != 0))
+        if (!cfg->sectionExists(sec))
             throw std::invalid_argument("room_set item '" + item + "': the room file has no [" +
                                         sec + "] section to set (sections: room, box_*)");
     }
