@@ -78,17 +78,17 @@ std::vector<Target> loadTargets(const mrpt::config::CConfigFileBase& cfg, const 
     return out;
 }
 
-TargetCheck check(const Target& t, const std::vector<std::string>& sequences,
+TargetCheck check(const Target& t, const std::vector<SequenceInputs>& sequences,
                   const FigureOf& figure) {
     TargetCheck c;
     const bool upper = t.op[0] == '<';  // the target bounds the figure from above
-    for (const auto& s : sequences) {
-        if (t.sequence != "*" && s != t.sequence) continue;
-        const double v = figure(s, t.mode, t.figure, std::nullopt);
+    for (const auto& q : sequences) {
+        if (t.sequence != "*" && q.name != t.sequence) continue;
+        const double v = figure(q.name, t.mode, t.figure, std::nullopt);
         if (std::isnan(v)) continue;
         if (std::isnan(c.measured) || (upper ? v > c.measured : v < c.measured)) {
             c.measured = v;
-            c.sequence = s;
+            c.sequence = q.name;
         }
     }
     c.met = t.holds(c.measured);

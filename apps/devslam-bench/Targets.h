@@ -52,16 +52,16 @@ struct TargetCheck {
     bool met = false;
 };
 
-/// Evaluates a target; for "*" the sequence whose figure is furthest from the target
-/// (largest for <=, <; smallest for >=, >) decides.
-[[nodiscard]] TargetCheck check(const Target& t, const std::vector<std::string>& sequences,
-                                const FigureOf& figure);
-
 /// A sequence and its renders (seeds; none: one input, a real sequence or a single render).
 struct SequenceInputs {
     std::string name;
     std::vector<std::uint64_t> seeds;
 };
+
+/// Evaluates a target on the medians over all runs; for "*" the sequence whose figure is
+/// furthest from the target (largest for <=, <; smallest for >=, >) decides.
+[[nodiscard]] TargetCheck check(const Target& t, const std::vector<SequenceInputs>& sequences,
+                                const FigureOf& figure);
 
 /// How many inputs meet a target on their own figure (each render's median over its
 /// repeats; a ratio compares the two modes on the same render): says whether the median

@@ -517,7 +517,6 @@ int run(int argc, char** argv) {
     };
     std::ostringstream targets_md;
     if (!b.targets.empty()) {
-        const auto names = b.names();
         std::vector<bench::SequenceInputs> inputs;
         for (const auto& q : b.sequences) inputs.push_back({q.name, q.seeds});
         std::ofstream csv(fs::path(b.out_dir) / "targets.csv");
@@ -531,7 +530,7 @@ int run(int argc, char** argv) {
                       "| target | measured | met | renders meeting it |\n|---|---|---|---|\n";
         int met = 0;
         for (const auto& t : b.targets) {
-            const auto c = bench::check(t, names, figureOf);
+            const auto c = bench::check(t, inputs, figureOf);
             const auto n = bench::tallyInputs(t, inputs, figureOf);
             met += c.met;
             const int prec = t.figure == "fps" ? 1 : t.figure == "ate" ? 5 : 3;

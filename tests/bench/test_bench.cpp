@@ -174,11 +174,10 @@ TEST(BenchTargets, MediansDecideRendersAreCountedOneByOne) {
         return median(seq, mode, seed) / median(seq, fig.substr(4), seed);  // ate/<mode>
     };
     const std::vector<devslam::bench::SequenceInputs> inputs = {{"s", {1, 2, 3}}, {"r", {}}};
-    const std::vector<std::string> names = {"s", "r"};
 
     // Medians: s dynamic 2.5, all 2.0 -> 1.25, not met; yet one render of three meets it.
     const Target ratio{"k", "s", "dynamic", "ate/all", "<", 1.0};
-    const auto c = devslam::bench::check(ratio, names, figure);
+    const auto c = devslam::bench::check(ratio, inputs, figure);
     EXPECT_DOUBLE_EQ(c.measured, 1.25);
     EXPECT_FALSE(c.met);
     const auto n = devslam::bench::tallyInputs(ratio, inputs, figure);
@@ -186,7 +185,7 @@ TEST(BenchTargets, MediansDecideRendersAreCountedOneByOne) {
     EXPECT_EQ(n.of, 3);
     // "*": every sequence's inputs; the worst median decides.
     const Target all{"k", "*", "dynamic", "ate", "<=", 2.0};
-    const auto ca = devslam::bench::check(all, names, figure);
+    const auto ca = devslam::bench::check(all, inputs, figure);
     EXPECT_EQ(ca.sequence, "s");
     EXPECT_DOUBLE_EQ(ca.measured, 2.5);
     const auto na = devslam::bench::tallyInputs(all, inputs, figure);
