@@ -105,6 +105,7 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
 
     RunReport rep;
     rep.input = rc.input;
+    rep.input_damage = reader.damage();
     rep.mode = rc.mode;
     rep.mask_source = masks->describe();
     rep.async_filter = rc.async_filter;
@@ -344,8 +345,9 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
 
 std::string formatSummary(const RunReport& r) {
     std::ostringstream o;
-    o << "input      : " << r.input << "\n"
-      << "mode       : " << r.mode << " (" << r.mask_source
+    o << "input      : " << r.input << "\n";
+    if (!r.input_damage.empty()) o << "left out   : " << r.input_damage << "\n";
+    o << "mode       : " << r.mode << " (" << r.mask_source
       << (r.async_filter ? ", filter one frame ahead in a second thread" : "") << ")\n"
       << "camera     : " << r.camera << "\n"
       << "frames     : " << r.frames << "   keyframes: " << r.keyframes
@@ -436,7 +438,8 @@ std::string toJson(const RunReport& r) {
         }
         return e;
     };
-    o << "{\n  \"input\": \"" << esc(r.input) << "\",\n  \"mode\": \"" << r.mode
+    o << "{\n  \"input\": \"" << esc(r.input) << "\",\n  \"input_damage\": \""
+      << esc(r.input_damage) << "\",\n  \"mode\": \"" << r.mode
       << "\",\n  \"mask_source\": \"" << esc(r.mask_source) << "\",\n  \"frames\": " << r.frames
       << ",\n  \"keyframes\": " << r.keyframes << ",\n  \"landmarks\": " << r.landmarks
       << ",\n  \"local_ba_runs\": " << r.ba_runs << ",\n  \"local_ba_rejected\": " << r.ba_rejected

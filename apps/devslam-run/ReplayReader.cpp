@@ -36,6 +36,7 @@ ReplayReader::ReplayReader(io::RgbdReader& source, int passes) : K_(source.intri
         }
         gt_ = g;
     }
+    damage_ = source.damage();
     what_ = source.describe() + " replayed " + std::to_string(passes) + " passes (" +
             std::to_string(order_.size()) + " frames)";
 }

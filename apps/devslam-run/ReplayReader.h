@@ -19,6 +19,7 @@ class ReplayReader final : public io::RgbdReader {
     [[nodiscard]] std::optional<core::Trajectory> groundTruth() const override { return gt_; }
     [[nodiscard]] core::CameraIntrinsics intrinsics() const override { return K_; }
     [[nodiscard]] std::string describe() const override { return what_; }
+    [[nodiscard]] std::string damage() const override { return damage_; }
 
   private:
     std::vector<core::Frame> frames_;
@@ -26,7 +27,7 @@ class ReplayReader final : public io::RgbdReader {
     std::vector<double> stamps_;      ///< output timestamps
     std::optional<core::Trajectory> gt_;
     core::CameraIntrinsics K_;
-    std::string what_;
+    std::string what_, damage_;
     std::size_t next_ = 0;
 };
 

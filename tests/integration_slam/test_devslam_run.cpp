@@ -96,6 +96,55 @@ TEST(DevslamRun, BadInputIsReported) {
     EXPECT_NE(r.out.find("usage"), std::string::npos);
 }
 
+// A rawlog cut short (a recording that crashed): refused with how much is intact, and run
+// on that part with --allow-truncated, which says what was left out.
+TEST(DevslamRun, TruncatedRawlogRunsOnItsIntactPartWhenAsked) {
+    const fs::path dir = devslam::test::scratchPath("devslam_run_truncated");
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    const fs::path rawlog = dir / "cut.rawlog";
+    const std::string convert = std::string(DEVSLAM_BIN_DIR) + "/devslam-convert " +
+                                DEVSLAM_SOURCE_DIR + "/data/tum/fr1_xyz_first37 " +
+                                rawlog.string() + " --max-frames 8 > /dev/null 2>&1";
+    ASSERT_EQ(std::system(convert.c_str()), 0) << convert;
+    fs::resize_file(rawlog, fs::file_size(rawlog) * 6 / 10);
+
+    auto r = run("--input " + rawlog.string() + " --mode none --quiet --out " +
+                 (dir / "refused").string());
+    EXPECT_EQ(r.rc, 1) << r.out;
+    EXPECT_NE(r.out.find("cut.rawlog"), std::string::npos) << r.out;
+    const std::string hint = "--allow-truncated runs on those ";
+    const auto at = r.out.find(hint);
+    ASSERT_NE(at, std::string::npos) << r.out;
+    const std::size_t intact = std::stoul(r.out.substr(at + hint.size()));
+    EXPECT_GE(intact, 2u);
+    EXPECT_LT(intact, 8u);
+    EXPECT_FALSE(fs::exists(dir / "refused" / "trajectory.txt"));
+
+    r = run("--input " + rawlog.string() + " --mode none --quiet --allow-truncated --out " +
+            (dir / "run").string());
+    ASSERT_EQ(r.rc, 0) << r.out;
+    EXPECT_NE(r.out.find("WARNING: running on the intact part"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("left out   : " + rawlog.string()), std::string::npos) << r.out;
+    EXPECT_EQ(lines(dir / "run" / "trajectory.txt"), intact);
+    std::ifstream js(dir / "run" / "run.json");
+    std::stringstream ss;
+    ss << js.rdbuf();
+    EXPECT_NE(ss.str().find("\"input_damage\": \"" + rawlog.string()), std::string::npos);
+
+    // devslam-convert salvages the intact part into a rawlog that reads without damage.
+    const fs::path saved = dir / "saved.rawlog";
+    const std::string salvage = std::string(DEVSLAM_BIN_DIR) + "/devslam-convert " +
+                                rawlog.string() + " " + saved.string() +
+                                " --allow-truncated > /dev/null 2>&1";
+    ASSERT_EQ(std::system(salvage.c_str()), 0) << salvage;
+    r = run("--input " + saved.string() + " --mode none --quiet --out " + (dir / "saved").string());
+    ASSERT_EQ(r.rc, 0) << r.out;
+    EXPECT_EQ(r.out.find("left out"), std::string::npos) << r.out;
+    EXPECT_EQ(lines(dir / "saved" / "trajectory.txt"), intact);
+    fs::remove_all(dir);
+}
+
 // The filter one frame ahead in a second thread (async_filter, the shipped setting) must
 // give the sequential run's result: its ego-motion prior is the constant-velocity
 // prediction instead of the tracker's, which on these slow real frames changes nothing.

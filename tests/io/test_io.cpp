@@ -263,11 +263,22 @@ TEST(Rawlog, TruncatedFileReportsWhatWasRead) {
     const auto size = fs::file_size(path);
     fs::resize_file(path, size * 7 / 12);
     expectError([&] { io::RawlogReader r(path); }, "six\\.rawlog: .* after 3 RGB-D observations");
-    io::RawlogReader partial(path, {}, /*allow_truncated=*/true);
-    EXPECT_EQ(partial.size(), 3u);
-    EXPECT_FALSE(partial.damage().empty());
+    try {
+        (void)io::openRgbd(path);
+        ADD_FAILURE() << "a truncated rawlog opened";
+    } catch (const io::TruncatedInput& e) {
+        EXPECT_EQ(e.intact(), 3u) << e.what();
+    }
+    io::ReaderOptions allow;
+    allow.allow_truncated = true;
+    const auto partial = io::openRgbd(path, allow);
+    EXPECT_EQ(partial->size(), 3u);
+    EXPECT_TRUE(std::regex_search(partial->damage(),
+                                  std::regex("six\\.rawlog: .* after 3 RGB-D observations")))
+        << partial->damage();
+    EXPECT_NE(partial->describe().find("DAMAGED"), std::string::npos) << partial->describe();
     std::size_t n = 0;
-    while (partial.next()) ++n;
+    while (partial->next()) ++n;
     EXPECT_EQ(n, 3u);
     // Cut inside the gzip header: nothing decodes, and the error says so.
     fs::resize_file(path, 60);

@@ -215,7 +215,7 @@ struct RawlogReader::Stream {
     }
 };
 
-RawlogReader::RawlogReader(std::string path, ReaderOptions opts, bool allow_truncated)
+RawlogReader::RawlogReader(std::string path, ReaderOptions opts)
     : path_(std::move(path)), opts_(std::move(opts)) {
     if (!fs::is_regular_file(path_)) throw std::runtime_error(path_ + ": rawlog file not found");
     mrpt::img::CImage::setImagesPathBase(rawlogImagesDir(path_));
@@ -237,7 +237,7 @@ RawlogReader::RawlogReader(std::string path, ReaderOptions opts, bool allow_trun
     } catch (const std::exception& e) {
         damage_ =
             path_ + ": " + e.what() + " after " + std::to_string(n_frames_) + " RGB-D observations";
-        if (!allow_truncated || n_frames_ == 0) throw std::runtime_error(damage_);
+        if (!opts_.allow_truncated || n_frames_ == 0) throw TruncatedInput(damage_, n_frames_);
     }
     n_skipped_ = skipped;
     format_ = saw_sf ? "action/sensory-frame" : "observations-only";

@@ -8,8 +8,9 @@
 /// reprojected into the colour camera; Euclidean range images are converted to depth.
 ///
 /// The whole file is scanned when the reader opens, so a damaged rawlog fails up front with
-/// how many observations were read before the damage (or, with `allow_truncated`, the
-/// intact prefix is used and `damage()` says what was lost).
+/// how many observations were read before the damage (TruncatedInput), or, with
+/// `ReaderOptions::allow_truncated`, the intact prefix is used and `damage()` says what
+/// was lost.
 ///
 /// Usage:
 ///   devslam::io::RawlogReader in("seq.rawlog");
@@ -31,7 +32,7 @@ namespace devslam::io {
 
 class RawlogReader final : public RgbdReader {
   public:
-    explicit RawlogReader(std::string path, ReaderOptions opts = {}, bool allow_truncated = false);
+    explicit RawlogReader(std::string path, ReaderOptions opts = {});
     ~RawlogReader() override;
     [[nodiscard]] std::optional<core::Frame> next() override;
     [[nodiscard]] std::optional<std::size_t> size() const override { return n_frames_; }
@@ -39,7 +40,7 @@ class RawlogReader final : public RgbdReader {
     [[nodiscard]] std::string describe() const override;
 
     /// Empty if the file is intact; otherwise what was wrong and how much was read.
-    [[nodiscard]] const std::string& damage() const { return damage_; }
+    [[nodiscard]] std::string damage() const override { return damage_; }
     /// "observations-only" or "action/sensory-frame".
     [[nodiscard]] const std::string& format() const { return format_; }
     /// Observations of other classes (odometry, lasers...) skipped while scanning.

@@ -13,6 +13,7 @@
 
 #include <memory>
 #include <optional>
+#include <stdexcept>
 #include <string>
 
 namespace mrpt::config {
@@ -32,8 +33,24 @@ struct ReaderOptions {
     double max_dt = 0.02;           ///< [s] rgb-depth association window (TUM associate.py)
     double tum_depth_scale = 5000;  ///< [units/m] TUM depth PNG scale
     std::string sensor_label;       ///< rawlog: only observations with this label ("" = all)
+    /// Rawlog: a damaged file (cut short by a crash or a full disk) yields its intact prefix
+    /// and `RgbdReader::damage()` says what was lost, instead of failing with TruncatedInput.
+    /// Not an INI key: the command-line flag `--allow-truncated` sets it, run by run.
+    bool allow_truncated = false;
 
     void loadFromConfig(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
+};
+
+/// A damaged input whose first `intact()` frames could still be read (with
+/// `ReaderOptions::allow_truncated` they are). The message names the file and where it broke.
+class TruncatedInput : public std::runtime_error {
+  public:
+    TruncatedInput(const std::string& what, std::size_t intact)
+        : std::runtime_error(what), intact_(intact) {}
+    [[nodiscard]] std::size_t intact() const { return intact_; }
+
+  private:
+    std::size_t intact_;
 };
 
 class RgbdReader {
@@ -51,6 +68,9 @@ class RgbdReader {
     /// Intrinsics the frames will carry.
     [[nodiscard]] virtual core::CameraIntrinsics intrinsics() const = 0;
     [[nodiscard]] virtual std::string describe() const = 0;
+    /// What of the input could not be read and is left out ("" = nothing): a truncated
+    /// rawlog read with `allow_truncated`.
+    [[nodiscard]] virtual std::string damage() const { return {}; }
 };
 
 /// A TUM folder (has rgb.txt) or a `.rawlog` file, chosen by what `path` is. Throws
