@@ -24,8 +24,8 @@ options:
   --compression N     gzip level 0..9 (default 1)
   --label TEXT        sensor label of the observations (default RGBD)
   --max-frames N      stop after N frames
-  --allow-truncated   a damaged rawlog (cut short by a crash or a full disk): convert its
-                      intact part, and say what was left out
+  --allow-damaged     a damaged input (a rawlog cut short by a crash or a full disk, a TUM
+                      folder missing images): convert what is intact, say what was left out
 )";
 
 bool endsWith(const std::string& s, const std::string& suffix) {
@@ -60,8 +60,8 @@ int main(int argc, char** argv) {
                 wo.compression = int(devslam::core::parseInteger(value(), "--compression", 0, 9));
             else if (a == "--label")
                 wo.sensor_label = value();
-            else if (a == "--allow-truncated")
-                ro.allow_truncated = true;
+            else if (a == "--allow-damaged")
+                ro.allow_damaged = true;
             else if (a == "--max-frames")
                 max_frames = std::size_t(devslam::core::parseInteger(value(), "--max-frames", 0));
             else if (!a.empty() && a[0] == '-')
@@ -103,10 +103,10 @@ int main(int argc, char** argv) {
         if (const std::string lost = reader->damage(); !lost.empty())
             std::cout << "left out (damaged input): " << lost << "\n";
         return 0;
-    } catch (const devslam::io::TruncatedInput& e) {
+    } catch (const devslam::io::DamagedInput& e) {
         std::cerr << "devslam-convert: " << e.what() << "\n";
         if (e.intact() > 0)
-            std::cerr << "devslam-convert: --allow-truncated converts those " << e.intact()
+            std::cerr << "devslam-convert: --allow-damaged converts those " << e.intact()
                       << " intact frames\n";
         return 1;
     } catch (const std::exception& e) {

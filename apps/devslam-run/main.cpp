@@ -28,7 +28,8 @@ const char* kUsage =
     "usage: devslam-run [--input PATH] [--mode none|all_persons|dynamic|truth] [--config INI]\n"
     "                   [--out DIR] [--max-frames N] [--quiet] [--set SECTION.KEY=VALUE]...\n"
     "                   [--replay N]  (play the input forward/backward N times)\n"
-    "                   [--allow-truncated]  (a damaged rawlog: use its intact part)\n"
+    "                   [--allow-damaged]  (a rawlog cut short, a TUM folder missing images:\n"
+    "                                       run on what is intact)\n"
     "       devslam-run --bench N [--input PATH] [--config INI] [--results FILE]\n"
     "                   [--section NAME] [--modes-only]\n"
     "defaults: --input " DEVSLAM_SOURCE_DIR
@@ -52,7 +53,7 @@ struct Args {
     int replay = 0;                 ///< > 0: ReplayReader with that many passes
     std::string section = "slam";   ///< RESULTS.md section written by --bench
     bool modes_only = false;        ///< --bench without the ablation and the long run
-    bool allow_truncated = false;   ///< a damaged rawlog: run on its intact prefix
+    bool allow_damaged = false;   ///< a damaged rawlog: run on its intact prefix
 };
 
 Args parse(int argc, char** argv) {
@@ -87,8 +88,8 @@ Args parse(int argc, char** argv) {
             a.replay = int(core::parseInteger(value(i), "--replay", 1, 1000));
         else if (k == "--set")
             a.sets.push_back(value(i));
-        else if (k == "--allow-truncated")
-            a.allow_truncated = true;
+        else if (k == "--allow-damaged")
+            a.allow_damaged = true;
         else if (k == "-h" || k == "--help") {
             std::cout << kUsage;
             std::exit(0);
@@ -125,7 +126,7 @@ Loaded loadConfig(const Args& a, const std::vector<std::string>& extra_sets = {}
     applySets(*l.filter_cfg, a.sets);
     applySets(*l.filter_cfg, extra_sets);
     l.reader.loadFromConfig(*l.cfg, "dataset");
-    l.reader.allow_truncated = a.allow_truncated;
+    l.reader.allow_damaged = a.allow_damaged;
     return l;
 }
 
@@ -300,10 +301,10 @@ int main(int argc, char** argv) {
     try {
         const Args a = parse(argc, argv);
         return a.bench > 0 ? runBench(a) : runOnce(a);
-    } catch (const io::TruncatedInput& e) {
+    } catch (const io::DamagedInput& e) {
         std::cerr << "devslam-run: " << e.what() << "\n";
         if (e.intact() > 0)
-            std::cerr << "devslam-run: --allow-truncated runs on those " << e.intact()
+            std::cerr << "devslam-run: --allow-damaged runs on those " << e.intact()
                       << " intact frames\n";
         return 1;
     } catch (const std::exception& e) {

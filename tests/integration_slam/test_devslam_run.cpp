@@ -97,7 +97,7 @@ TEST(DevslamRun, BadInputIsReported) {
 }
 
 // A rawlog cut short (a recording that crashed): refused with how much is intact, and run
-// on that part with --allow-truncated, which says what was left out.
+// on that part with --allow-damaged, which says what was left out.
 TEST(DevslamRun, TruncatedRawlogRunsOnItsIntactPartWhenAsked) {
     const fs::path dir = devslam::test::scratchPath("devslam_run_truncated");
     fs::remove_all(dir);
@@ -113,7 +113,7 @@ TEST(DevslamRun, TruncatedRawlogRunsOnItsIntactPartWhenAsked) {
                  (dir / "refused").string());
     EXPECT_EQ(r.rc, 1) << r.out;
     EXPECT_NE(r.out.find("cut.rawlog"), std::string::npos) << r.out;
-    const std::string hint = "--allow-truncated runs on those ";
+    const std::string hint = "--allow-damaged runs on those ";
     const auto at = r.out.find(hint);
     ASSERT_NE(at, std::string::npos) << r.out;
     const std::size_t intact = std::stoul(r.out.substr(at + hint.size()));
@@ -121,7 +121,7 @@ TEST(DevslamRun, TruncatedRawlogRunsOnItsIntactPartWhenAsked) {
     EXPECT_LT(intact, 8u);
     EXPECT_FALSE(fs::exists(dir / "refused" / "trajectory.txt"));
 
-    r = run("--input " + rawlog.string() + " --mode none --quiet --allow-truncated --out " +
+    r = run("--input " + rawlog.string() + " --mode none --quiet --allow-damaged --out " +
             (dir / "run").string());
     ASSERT_EQ(r.rc, 0) << r.out;
     EXPECT_NE(r.out.find("WARNING: running on the intact part"), std::string::npos) << r.out;
@@ -136,7 +136,7 @@ TEST(DevslamRun, TruncatedRawlogRunsOnItsIntactPartWhenAsked) {
     const fs::path saved = dir / "saved.rawlog";
     const std::string salvage = std::string(DEVSLAM_BIN_DIR) + "/devslam-convert " +
                                 rawlog.string() + " " + saved.string() +
-                                " --allow-truncated > /dev/null 2>&1";
+                                " --allow-damaged > /dev/null 2>&1";
     ASSERT_EQ(std::system(salvage.c_str()), 0) << salvage;
     r = run("--input " + saved.string() + " --mode none --quiet --out " + (dir / "saved").string());
     ASSERT_EQ(r.rc, 0) << r.out;

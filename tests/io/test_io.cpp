@@ -138,7 +138,32 @@ TEST(TumReader, BadImagesNameTheFile) {
     // A listed image that does not exist: caught when opening, with list file and line.
     fs::remove(f2.rgb_source);
     expectError([&] { io::TumReader r(d.str("s")); },
-                "rgb\\.txt line 6: image 'rgb/.*\\.png' not found");
+                "rgb\\.txt line 6: image 'rgb/.*\\.png' not found; 1 of 3 rgb-depth pairs left out");
+    try {
+        io::TumReader r(d.str("s"));
+    } catch (const io::DamagedInput& e) {
+        EXPECT_EQ(e.intact(), 2u);
+    }
+    // With allow_damaged the pairs whose images exist are read, and damage() says what not.
+    io::ReaderOptions allow;
+    allow.allow_damaged = true;
+    fs::remove(f0.depth_source);
+    {
+        io::TumReader partial(d.str("s"), allow);
+        EXPECT_EQ(partial.size(), 1u);
+        EXPECT_TRUE(std::regex_search(
+            partial.damage(),
+            std::regex("depth\\.txt line 4: image 'depth/.*' not found \\(and 1 more missing "
+                       "images\\); 2 of 3 rgb-depth pairs left out")))
+            << partial.damage();
+        const auto f = partial.next();
+        ASSERT_TRUE(f.has_value());
+        EXPECT_EQ(f->rgb_source, f1.rgb_source);
+        EXPECT_FALSE(partial.next().has_value());
+    }
+    cv::Mat raw;
+    f0.depth.convertTo(raw, CV_16U, f0.depth_scale);
+    ASSERT_TRUE(cv::imwrite(f0.depth_source, raw));  // restored for the checks below
     // An image that does not decode.
     writeText(f2.rgb_source, "this is not a png");
     expectError([&] { (void)io::TumReader(d.str("s")).read(2); },
@@ -266,11 +291,11 @@ TEST(Rawlog, TruncatedFileReportsWhatWasRead) {
     try {
         (void)io::openRgbd(path);
         ADD_FAILURE() << "a truncated rawlog opened";
-    } catch (const io::TruncatedInput& e) {
+    } catch (const io::DamagedInput& e) {
         EXPECT_EQ(e.intact(), 3u) << e.what();
     }
     io::ReaderOptions allow;
-    allow.allow_truncated = true;
+    allow.allow_damaged = true;
     const auto partial = io::openRgbd(path, allow);
     EXPECT_EQ(partial->size(), 3u);
     EXPECT_TRUE(std::regex_search(partial->damage(),

@@ -237,7 +237,7 @@ RawlogReader::RawlogReader(std::string path, ReaderOptions opts)
     } catch (const std::exception& e) {
         damage_ =
             path_ + ": " + e.what() + " after " + std::to_string(n_frames_) + " RGB-D observations";
-        if (!opts_.allow_truncated || n_frames_ == 0) throw TruncatedInput(damage_, n_frames_);
+        if (!opts_.allow_damaged || n_frames_ == 0) throw DamagedInput(damage_, n_frames_);
     }
     n_skipped_ = skipped;
     format_ = saw_sf ? "action/sensory-frame" : "observations-only";

@@ -85,18 +85,31 @@ TumReader::TumReader(std::string folder, ReaderOptions opts)
     std::vector<double> ta, tb;
     for (const auto& e : rgb) ta.push_back(e.t);
     for (const auto& e : depth) tb.push_back(e.t);
+    std::vector<std::string> missing;  // one message per listed image that is not there
+    std::size_t n_pairs = 0;
     for (const auto& [i, j] : core::associate(ta, tb, opts_.max_dt)) {
+        ++n_pairs;
+        bool complete = true;
         for (const auto* e : {&rgb[i], &depth[j]}) {
             const std::string list = e == &rgb[i] ? "/rgb.txt" : "/depth.txt";
-            if (!fs::exists(folder_ + "/" + e->file))
-                throw std::runtime_error(detail::lineError(folder_ + list, e->line,
-                                                           "image '" + e->file + "' not found"));
+            if (fs::exists(folder_ + "/" + e->file)) continue;
+            missing.push_back(
+                detail::lineError(folder_ + list, e->line, "image '" + e->file + "' not found"));
+            complete = false;
         }
-        pairs_.emplace_back(rgb[i], depth[j]);
+        if (complete) pairs_.emplace_back(rgb[i], depth[j]);
     }
-    if (pairs_.empty())
+    if (n_pairs == 0)
         throw std::runtime_error(folder_ + ": no rgb/depth pair within " +
                                  std::to_string(opts_.max_dt) + " s");
+    if (!missing.empty()) {
+        damage_ = missing.front();
+        if (missing.size() > 1)
+            damage_ += " (and " + std::to_string(missing.size() - 1) + " more missing images)";
+        damage_ += "; " + std::to_string(n_pairs - pairs_.size()) + " of " +
+                   std::to_string(n_pairs) + " rgb-depth pairs left out";
+        if (!opts_.allow_damaged || pairs_.empty()) throw DamagedInput(damage_, pairs_.size());
+    }
 
     const std::string camera_ini = folder_ + "/camera.ini";
     if (opts_.intrinsics) {
@@ -150,7 +163,7 @@ std::optional<core::Frame> TumReader::next() {
 std::string TumReader::describe() const {
     return "TUM folder " + folder_ + " (" + std::to_string(pairs_.size()) + " rgb-depth pairs" +
            (gt_ ? ", ground truth " + std::to_string(gt_->size()) + " poses" : "") + ", camera " +
-           camera_source_ + ")";
+           camera_source_ + (damage_.empty() ? "" : ", DAMAGED: " + damage_) + ")";
 }
 
 }  // namespace devslam::io

@@ -8,8 +8,8 @@
 /// reprojected into the colour camera; Euclidean range images are converted to depth.
 ///
 /// The whole file is scanned when the reader opens, so a damaged rawlog fails up front with
-/// how many observations were read before the damage (TruncatedInput), or, with
-/// `ReaderOptions::allow_truncated`, the intact prefix is used and `damage()` says what
+/// how many observations were read before the damage (DamagedInput), or, with
+/// `ReaderOptions::allow_damaged`, the intact prefix is used and `damage()` says what
 /// was lost.
 ///
 /// Usage:

@@ -33,19 +33,20 @@ struct ReaderOptions {
     double max_dt = 0.02;           ///< [s] rgb-depth association window (TUM associate.py)
     double tum_depth_scale = 5000;  ///< [units/m] TUM depth PNG scale
     std::string sensor_label;       ///< rawlog: only observations with this label ("" = all)
-    /// Rawlog: a damaged file (cut short by a crash or a full disk) yields its intact prefix
-    /// and `RgbdReader::damage()` says what was lost, instead of failing with TruncatedInput.
-    /// Not an INI key: the command-line flag `--allow-truncated` sets it, run by run.
-    bool allow_truncated = false;
+    /// Use what is intact of a damaged input instead of failing with DamagedInput, and say
+    /// what was left out in `RgbdReader::damage()`: of a rawlog cut short (a crash, a full
+    /// disk) the frames before the damage, of a TUM folder the rgb-depth pairs whose listed
+    /// images exist. Not an INI key: the command-line flag `--allow-damaged` sets it.
+    bool allow_damaged = false;
 
     void loadFromConfig(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
 };
 
 /// A damaged input whose first `intact()` frames could still be read (with
-/// `ReaderOptions::allow_truncated` they are). The message names the file and where it broke.
-class TruncatedInput : public std::runtime_error {
+/// `ReaderOptions::allow_damaged` they are). The message names the file and where it broke.
+class DamagedInput : public std::runtime_error {
   public:
-    TruncatedInput(const std::string& what, std::size_t intact)
+    DamagedInput(const std::string& what, std::size_t intact)
         : std::runtime_error(what), intact_(intact) {}
     [[nodiscard]] std::size_t intact() const { return intact_; }
 
@@ -68,8 +69,8 @@ class RgbdReader {
     /// Intrinsics the frames will carry.
     [[nodiscard]] virtual core::CameraIntrinsics intrinsics() const = 0;
     [[nodiscard]] virtual std::string describe() const = 0;
-    /// What of the input could not be read and is left out ("" = nothing): a truncated
-    /// rawlog read with `allow_truncated`.
+    /// What of the input could not be read and is left out ("" = nothing), with
+    /// `ReaderOptions::allow_damaged`.
     [[nodiscard]] virtual std::string damage() const { return {}; }
 };
 

@@ -9,7 +9,9 @@
 /// else the ROS default (describe() says which was used).
 ///
 /// Every list is parsed and every referenced file checked for existence when the reader
-/// is constructed, so a damaged folder fails before any work starts, with file and line.
+/// is constructed, so a damaged folder fails before any work starts, with file and line
+/// (DamagedInput when images are missing; with ReaderOptions::allow_damaged the pairs
+/// without them are left out and damage() lists them).
 ///
 /// Usage:
 ///   devslam::io::TumReader reader("data/tum/fr1_xyz_first37", opts);
@@ -44,6 +46,7 @@ class TumReader final : public RgbdReader {
     [[nodiscard]] std::optional<core::Trajectory> groundTruth() const override { return gt_; }
     [[nodiscard]] core::CameraIntrinsics intrinsics() const override { return K_; }
     [[nodiscard]] std::string describe() const override;
+    [[nodiscard]] std::string damage() const override { return damage_; }
 
     /// Random access to frame i (0-based) of the associated list.
     [[nodiscard]] core::Frame read(std::size_t i) const;
@@ -54,7 +57,7 @@ class TumReader final : public RgbdReader {
     core::CameraIntrinsics K_;
     std::vector<std::pair<TumListEntry, TumListEntry>> pairs_;  // (rgb, depth)
     std::optional<core::Trajectory> gt_;
-    std::string camera_source_;
+    std::string camera_source_, damage_;
     std::size_t cursor_ = 0;
 };
 
