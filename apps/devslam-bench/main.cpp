@@ -129,12 +129,10 @@ Bench loadBench(const std::string& path) {
     b.slam_config = resolve(cfg->read_string("bench", "slam_config", b.slam_config), base);
     core::requireValue(b.repeats >= 1 && b.repeats <= 100, path + " [bench]", "repeats",
                        "must be 1..100");
+    core::requireKnownSections(*cfg, {"bench", "sequence_*", "targets"}, path);
     // In the file's order: the tables list the sequences as the user wrote them.
     for (const auto& s : core::sectionsInFileOrder(*cfg, path)) {
-        if (s.empty() || s == "bench" || s == "targets") continue;
-        if (s.rfind("sequence_", 0) != 0)
-            throw std::invalid_argument(path + ": unknown section [" + s +
-                                        "] (known: bench, sequence_*, targets)");
+        if (s.rfind("sequence_", 0) != 0) continue;  // [bench], [targets]
         core::requireKnownKeys(
             *cfg, s, {"name", "path", "scenario", "slam_config", "seeds", "set", "repeats"}, path);
         Sequence q;

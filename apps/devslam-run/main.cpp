@@ -114,8 +114,18 @@ void applySets(mrpt::config::CConfigFileMemory& cfg, const std::vector<std::stri
 Loaded loadConfig(const Args& a, const std::vector<std::string>& extra_sets = {}) {
     Loaded l;
     l.cfg = core::loadIni(a.config);
+    // Every section the run reads: a mistyped one would be ignored with all of its keys. The
+    // filter's are in this file when [run] filter_config names none, and --set reaches both.
+    std::vector<std::string> sections = slam::SlamOptions::sections();
+    sections.insert(sections.end(), {"run", "dataset", "grid_map"});
+    std::vector<std::string> with_filter = sections;
+    with_filter.insert(with_filter.end(), {"detector", "dynamic_filter"});
+    core::requireKnownSections(
+        *l.cfg, l.cfg->read_string("run", "filter_config", "").empty() ? with_filter : sections,
+        a.config);
     applySets(*l.cfg, a.sets);
     applySets(*l.cfg, extra_sets);
+    core::requireKnownSections(*l.cfg, with_filter, "--set");
     core::requireKnownKeys(*l.cfg, "run",
                            {"mode", "filter_config", "filter_overrides", "async_filter"}, a.config);
     l.async_filter = core::readBool(*l.cfg, "run", "async_filter", true);

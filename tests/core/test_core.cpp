@@ -210,6 +210,25 @@ TEST(Config, SectionsComeInTheFilesOrder) {
     std::filesystem::remove(keys);
 }
 
+TEST(Config, UnknownSectionsAndKeysBeforeAnySectionAreErrors) {
+    const std::vector<std::string> known{"room", "box_*"};
+    mrpt::config::CConfigFileMemory ok("[room]\nsize = 1\n[box_desk]\nx = 2\n[box_]\n");
+    EXPECT_NO_THROW(requireKnownSections(ok, known, "r.ini"));
+    mrpt::config::CConfigFileMemory typo("[room]\nsize = 1\n[bx_desk]\nx = 2\n");
+    EXPECT_EQ(invalidArgument([&] { requireKnownSections(typo, known, "r.ini"); }),
+              "r.ini: unknown section [bx_desk] (known: room, box_*)");
+    // a prefix is only a prefix when it ends in '*'
+    mrpt::config::CConfigFileMemory longer("[rooms]\nsize = 1\n");
+    EXPECT_EQ(invalidArgument([&] { requireKnownSections(longer, known, "r.ini"); }),
+              "r.ini: unknown section [rooms] (known: room, box_*)");
+    mrpt::config::CConfigFileMemory early("size = 1\n[room]\nx = 2\n");
+    EXPECT_EQ(invalidArgument([&] { requireKnownSections(early, known, "r.ini"); }),
+              "r.ini: key 'size' before the first section");
+    // comments and blank lines before the first section are no keys
+    mrpt::config::CConfigFileMemory comments("# a room\n\n// and more\n[room]\nx = 2\n");
+    EXPECT_NO_THROW(requireKnownSections(comments, known, "r.ini"));
+}
+
 TEST(Config, StrictReadsNameSectionKeyAndValue) {
     mrpt::config::CConfigFileMemory mem(
         "[a]\nn = 12 // a trailing comment is stripped\nbig = 1e3\nx = 0.25\non = yes\n"

@@ -85,6 +85,16 @@ TEST(DevslamRun, BadInputIsReported) {
     r = run("--config " + ini.string() + " --mode none --quiet --out ''");
     EXPECT_EQ(r.rc, 1);
     EXPECT_NE(r.out.find("fine_raduis"), std::string::npos) << r.out;
+    // a mistyped section, in the file or in --set, would drop its keys without a word
+    std::ofstream(ini) << "[trackr]\nfine_radius = 3\n";
+    r = run("--config " + ini.string() + " --mode none --quiet --out ''");
+    EXPECT_EQ(r.rc, 1);
+    EXPECT_NE(r.out.find(ini.string() + ": unknown section [trackr] (known: orb, tracker,"),
+              std::string::npos)
+        << r.out;
+    r = run("--set trackr.fine_radius=3 --mode none --quiet --out ''");
+    EXPECT_EQ(r.rc, 1);
+    EXPECT_NE(r.out.find("--set: unknown section [trackr]"), std::string::npos) << r.out;
     fs::remove(ini);
     // the diagnostic truth mask needs a rendered folder's person truth
     r = run("--mode truth --quiet --out ''");

@@ -182,4 +182,17 @@ TEST(NavConfig, UnknownKeyIsReported) {
     } catch (const std::invalid_argument& e) {
         EXPECT_NE(std::string(e.what()).find("nav_perod"), std::string::npos);
     }
+    // A mistyped section: its keys would all be ignored.
+    mrpt::config::CConfigFileMemory s;
+    s.write("navigator", "nav_period", 0.1);
+    s.write("CHolonomicVFHPlu", "mu1", 6.0);
+    try {
+        (void)NavigatorOptions::fromConfig(s, "x.ini");
+        FAIL() << "[CHolonomicVFHPlu] was accepted";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("x.ini: unknown section [CHolonomicVFHPlu] (known: "
+                                             "navigator, global_planner, replan,"),
+                  std::string::npos)
+            << e.what();
+    }
 }

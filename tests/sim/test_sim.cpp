@@ -93,6 +93,18 @@ TEST(World, BadEntriesNameTheKey) {
         "[world]\nx_min=0\nx_max=5\ny_min=0\ny_max=5\nseed = 4294967296\n[robot]\nstart_x=1\n"
         "start_y=1\n[goal]\nx=4\ny=4\n");
     EXPECT_THROW((void)parseWorld(big, "w.ini"), std::invalid_argument);
+    // A mistyped section would drop all of its keys without a word.
+    const mrpt::config::CConfigFileMemory section(
+        "[world]\nx_min=0\nx_max=5\ny_min=0\ny_max=5\n[robot]\nstart_x=1\n"
+        "start_y=1\n[goal]\nx=4\ny=4\n[obstacle]\nbox_1 = box 2 2 0.5 0.5 0\n");
+    try {
+        (void)parseWorld(section, "w.ini");
+        FAIL() << "[obstacle] was accepted";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_STREQ(e.what(),
+                     "w.ini: unknown section [obstacle] (known: world, robot, goal, laser, "
+                     "obstacles, pedestrians)");
+    }
 }
 
 TEST(World, DistanceToRotatedBox) {

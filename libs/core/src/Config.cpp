@@ -109,6 +109,12 @@ std::unique_ptr<mrpt::config::CConfigFileMemory> loadFilterIni(
                        : fs::path(fc).is_absolute()
                            ? fc
                            : (fs::path(path).parent_path() / fc).string());
+    // A file of its own holds only the filter's sections (else the SLAM INI's check covers it).
+    if (!fc.empty())
+        requireKnownSections(*out, {"detector", "dynamic_filter"},
+                             fs::path(fc).is_absolute()
+                                 ? fc
+                                 : (fs::path(path).parent_path() / fc).string());
     applyOverrides(*out, overrideItems(cfg.read_string("run", "filter_overrides", ""),
                                        path + " [run] filter_overrides"),
                    path + " [run] filter_overrides item");
@@ -133,6 +139,35 @@ void requireKnownKeys(const mrpt::config::CConfigFileBase& cfg, const std::strin
     for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
     throw std::invalid_argument(source + " [" + section + "]: unknown key '" + unknown.front() +
                                 "' (known: " + list + ")");
+}
+
+void requireKnownSections(const mrpt::config::CConfigFileBase& cfg,
+                          const std::vector<std::string>& known, const std::string& source) {
+    const auto admitted = [&](const std::string& section) {
+        for (const auto& k : known) {
+            if (!k.empty() && k.back() == '*' ? section.rfind(k.substr(0, k.size() - 1), 0) == 0
+                                              : section == k)
+                return true;
+        }
+        return false;
+    };
+    std::vector<std::string> all;
+    cfg.getAllSections(all);
+    for (const auto& section : all) {
+        if (section.empty()) {  // MRPT files keys written before any [section] under ""
+            std::vector<std::string> keys;
+            cfg.getAllKeys(section, keys);
+            if (!keys.empty())
+                throw std::invalid_argument(source + ": key '" + keys.front() +
+                                            "' before the first section");
+            continue;
+        }
+        if (admitted(section)) continue;
+        std::string list;
+        for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
+        throw std::invalid_argument(source + ": unknown section [" + section + "] (known: " + list +
+                                    ")");
+    }
 }
 
 namespace {

@@ -55,6 +55,14 @@ void copyConfig(const mrpt::config::CConfigFileBase& from, mrpt::config::CConfig
 
 NavigatorOptions NavigatorOptions::fromConfig(const mrpt::config::CConfigFileBase& c,
                                               const std::string& source) {
+    // Ours, then those MRPT's reactive navigator and its holonomic methods read.
+    core::requireKnownSections(
+        c,
+        {"navigator", "global_planner", "replan", "CAbstractNavigator", "CWaypointsNavigator",
+         "CAbstractPTGBasedReactive", "CReactiveNavigationSystem", "CHolonomicVFHPlus",
+         "CHolonomicND", "CHolonomicVFF", "CHolonomicFullEval",
+         "CMultiObjectiveMotionOptimizerBase", "CMultiObjMotionOpt_Scalarization"},
+        source);
     NavigatorOptions o;
     const std::string s = "navigator";
     core::requireKnownKeys(c, s,

@@ -74,14 +74,7 @@ std::vector<std::string> sectionsWithPrefix(const mrpt::config::CConfigFileBase&
 
 void readRoom(const std::string& path, RoomSpec& room) {
     const auto cfg = core::loadIni(path);
-    {  // a mistyped section would be ignored without a word, as a mistyped key
-        std::vector<std::string> all;
-        cfg->getAllSections(all);
-        for (const auto& sec : all)
-            if (!sec.empty() && sec != "room" && sec.rfind("box_", 0) != 0)
-                throw std::invalid_argument(path + ": unknown section [" + sec +
-                                            "] (known: room, box_*)");
-    }
+    core::requireKnownSections(*cfg, {"room", "box_*"}, path);
     // The scenario's room_set: only sections the room file has (every one of them is [room]
     // or a [box_*], checked above), else a typo in a section name would add a section: a box
     // without `base` or an unknown one, with a message that does not say what went wrong
@@ -269,16 +262,8 @@ Scenario readScenario(const std::string& path, const std::vector<std::string>& o
     for (const auto& p : sectionsWithPrefix(*cfg, "person_"))
         sc.people.push_back(loadPerson(*cfg, p, path));
 
-    std::vector<std::string> all;
-    cfg->getAllSections(all);
-    for (const auto& sec : all) {
-        const bool ok = sec == "scenario" || sec == "camera" || sec == "trajectory" ||
-                        sec == "depth_noise" || sec.rfind("person_", 0) == 0;
-        if (!ok)
-            throw std::invalid_argument(
-                path + ": unknown section [" + sec +
-                "] (known: scenario, camera, trajectory, depth_noise, person_*)");
-    }
+    core::requireKnownSections(
+        *cfg, {"scenario", "camera", "trajectory", "depth_noise", "person_*"}, path);
     return sc;
 }
 

@@ -183,6 +183,8 @@ WorldSpec parseWorldFields(const mrpt::config::CConfigFileBase& c, const std::st
 }  // namespace
 
 WorldSpec parseWorld(const mrpt::config::CConfigFileBase& c, const std::string& source) {
+    core::requireKnownSections(c, {"world", "robot", "goal", "laser", "obstacles", "pedestrians"},
+                               source);
     return core::namingSource(source, [&] { return parseWorldFields(c, source); });
 }
 

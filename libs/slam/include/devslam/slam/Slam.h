@@ -24,6 +24,7 @@
 
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace mrpt::config {
 class CConfigFileBase;
@@ -76,6 +77,8 @@ struct SlamOptions {
     /// Sections [orb] [tracker] [keyframes] [mapping] [local_ba] [loop_closure]
     /// [pose_graph] (all optional; unknown keys throw naming section and key).
     [[nodiscard]] static SlamOptions fromConfig(const mrpt::config::CConfigFileBase& cfg);
+    /// The sections fromConfig reads, for a caller that checks a whole file's sections.
+    [[nodiscard]] static const std::vector<std::string>& sections();
     void saveToConfig(mrpt::config::CConfigFileBase& cfg) const;
 };
 
