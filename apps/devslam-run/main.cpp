@@ -53,7 +53,7 @@ struct Args {
     int replay = 0;                 ///< > 0: ReplayReader with that many passes
     std::string section = "slam";   ///< RESULTS.md section written by --bench
     bool modes_only = false;        ///< --bench without the ablation and the long run
-    bool allow_damaged = false;   ///< a damaged rawlog: run on its intact prefix
+    bool allow_damaged = false;     ///< a damaged input: run on what is intact
 };
 
 Args parse(int argc, char** argv) {

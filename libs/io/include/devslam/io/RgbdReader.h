@@ -42,8 +42,9 @@ struct ReaderOptions {
     void loadFromConfig(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
 };
 
-/// A damaged input whose first `intact()` frames could still be read (with
-/// `ReaderOptions::allow_damaged` they are). The message names the file and where it broke.
+/// A damaged input of which `intact()` frames could still be read (with
+/// `ReaderOptions::allow_damaged` they are). The message names the file and where it is
+/// damaged.
 class DamagedInput : public std::runtime_error {
   public:
     DamagedInput(const std::string& what, std::size_t intact)
