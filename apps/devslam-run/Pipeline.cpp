@@ -439,8 +439,8 @@ std::string toJson(const RunReport& r) {
         return e;
     };
     o << "{\n  \"input\": \"" << esc(r.input) << "\",\n  \"input_damage\": \""
-      << esc(r.input_damage) << "\",\n  \"mode\": \"" << r.mode
-      << "\",\n  \"mask_source\": \"" << esc(r.mask_source) << "\",\n  \"frames\": " << r.frames
+      << esc(r.input_damage) << "\",\n  \"mode\": \"" << r.mode << "\",\n  \"mask_source\": \""
+      << esc(r.mask_source) << "\",\n  \"frames\": " << r.frames
       << ",\n  \"keyframes\": " << r.keyframes << ",\n  \"landmarks\": " << r.landmarks
       << ",\n  \"local_ba_runs\": " << r.ba_runs << ",\n  \"local_ba_rejected\": " << r.ba_rejected
       << ",\n  \"loops_closed\": " << r.loops << ",\n  \"lost_frames\": " << r.lost.size()

@@ -137,8 +137,9 @@ TEST(TumReader, BadImagesNameTheFile) {
 
     // A listed image that does not exist: caught when opening, with list file and line.
     fs::remove(f2.rgb_source);
-    expectError([&] { io::TumReader r(d.str("s")); },
-                "rgb\\.txt line 6: image 'rgb/.*\\.png' not found; 1 of 3 rgb-depth pairs left out");
+    expectError(
+        [&] { io::TumReader r(d.str("s")); },
+        "rgb\\.txt line 6: image 'rgb/.*\\.png' not found; 1 of 3 rgb-depth pairs left out");
     try {
         io::TumReader r(d.str("s"));
     } catch (const io::DamagedInput& e) {

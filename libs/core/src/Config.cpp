@@ -105,9 +105,10 @@ std::unique_ptr<mrpt::config::CConfigFileMemory> loadFilterIni(
     const mrpt::config::CConfigFileBase& cfg, const std::string& path) {
     namespace fs = std::filesystem;
     const std::string fc = cfg.read_string("run", "filter_config", "");
-    const std::string file = fc.empty()                   ? path
-                             : fs::path(fc).is_absolute() ? fc
-                                                          : (fs::path(path).parent_path() / fc).string();
+    const std::string file = fc.empty() ? path
+                             : fs::path(fc).is_absolute()
+                                 ? fc
+                                 : (fs::path(path).parent_path() / fc).string();
     auto out = loadIni(file);
     // A file of its own holds only the filter's sections (else the SLAM INI's check covers it).
     if (!fc.empty()) requireKnownSections(*out, {"detector", "dynamic_filter"}, file);

@@ -69,7 +69,7 @@ void compensateDepthTime(FrameFeatures& f, const Eigen::Isometry3d& T_prev_cur, 
 }
 
 const std::vector<std::string>& SlamOptions::sections() {
-    static const std::vector<std::string> k{"orb",      "tracker",  "keyframes",   "mapping",
+    static const std::vector<std::string> k{"orb",      "tracker",      "keyframes", "mapping",
                                             "local_ba", "loop_closure", "pose_graph"};
     return k;
 }
