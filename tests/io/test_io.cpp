@@ -177,6 +177,19 @@ TEST(TumReader, BadImagesNameTheFile) {
                 "depth is 320x240 but .* is 640x480");
 }
 
+TEST(TumReader, CameraIniNamesItsMistakes) {
+    TempDir d;
+    copyTumSubset(d.str("s"), 2);
+    io::ReaderOptions ro;  // camera "auto": the folder's camera.ini comes first
+    writeText(d.str("s") + "/camera.ini", "[camera]\nfx = 500\nfy = 500\ncx = 320\ncy = 240\n");
+    EXPECT_NEAR(io::TumReader(d.str("s"), ro).intrinsics().fx, 500.0, 1e-12);
+    writeText(d.str("s") + "/camera.ini", "[camra]\nfx = 500\nfy = 500\ncx = 320\ncy = 240\n");
+    expectError([&] { io::TumReader r(d.str("s"), ro); },
+                "camera\\.ini: unknown section \\[camra\\] \\(known: camera\\)");
+    writeText(d.str("s") + "/camera.ini", "[camera]\nfx = 500\n");
+    expectError([&] { io::TumReader r(d.str("s"), ro); }, "camera\\.ini: .*fy: required key");
+}
+
 // ---------------------------------------------------------------- trajectories
 TEST(TrajectoryIO, RoundTripAndErrors) {
     TempDir d;

@@ -119,8 +119,14 @@ TumReader::TumReader(std::string folder, ReaderOptions opts)
         K_ = core::CameraIntrinsics::fromPreset(opts_.camera);
         camera_source_ = "preset " + opts_.camera;
     } else if (fs::exists(camera_ini)) {
+        const auto cfg = core::loadIni(camera_ini);
+        try {  // the reader's errors are runtime_errors, as its other damaged files
+            core::requireKnownSections(*cfg, {"camera"}, camera_ini);
+        } catch (const std::invalid_argument& e) {
+            throw std::runtime_error(e.what());
+        }
         try {
-            K_ = core::CameraIntrinsics::fromConfig(*core::loadIni(camera_ini), "camera");
+            K_ = core::CameraIntrinsics::fromConfig(*cfg, "camera");
         } catch (const std::exception& e) {
             throw std::runtime_error(camera_ini + ": " + e.what());
         }
