@@ -108,7 +108,7 @@ std::string resolve(const std::string& p, const std::string& base) {
     return (fs::path(kRoot) / p).lexically_normal().string();  // repository-relative
 }
 
-Bench loadBench(const std::string& path) {
+Bench readBench(const std::string& path) {
     auto cfg = core::loadIni(path);
     Bench b;
     const std::string base = fs::absolute(path).parent_path().string();
@@ -127,8 +127,7 @@ Bench loadBench(const std::string& path) {
     b.max_frames = std::size_t(core::readInt(*cfg, "bench", "max_frames", 0));
     b.out_dir = cfg->read_string("bench", "out_dir", b.out_dir);
     b.slam_config = resolve(cfg->read_string("bench", "slam_config", b.slam_config), base);
-    core::requireValue(b.repeats >= 1 && b.repeats <= 100, path + " [bench]", "repeats",
-                       "must be 1..100");
+    core::requireValue(b.repeats >= 1 && b.repeats <= 100, "bench", "repeats", "must be 1..100");
     core::requireKnownSections(*cfg, {"bench", "sequence_*", "targets"}, path);
     // In the file's order: the tables list the sequences as the user wrote them.
     for (const auto& s : core::sectionsInFileOrder(*cfg, path)) {
@@ -167,13 +166,19 @@ Bench loadBench(const std::string& path) {
             core::applyOverrides(scratch, q.sets, where + " set item");
         }
         q.repeats = core::readInt(*cfg, s, "repeats", 0);
-        core::requireValue(q.repeats >= 0 && q.repeats <= 100, where, "repeats",
+        core::requireValue(q.repeats >= 0 && q.repeats <= 100, s, "repeats",
                            "must be 1..100 (0 or missing = [bench] repeats)");
         b.sequences.push_back(q);
     }
     if (b.sequences.empty()) throw std::invalid_argument(path + ": no [sequence_*] section");
     b.targets = bench::loadTargets(*cfg, path, b.names(), b.modes);
     return b;
+}
+
+/// readBench, with the file named in front of the "[section] key: ..." errors of the
+/// strict readers.
+Bench loadBench(const std::string& path) {
+    return core::namingSource(path, [&] { return readBench(path); });
 }
 
 /// devslam-run's diagnostic mode `truth` (the renderer's walkers as the mask) needs the
