@@ -97,10 +97,12 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
                       const mrpt::config::CConfigFileBase& cfg,
                       const mrpt::config::CConfigFileBase& filter_cfg) {
     resetPeakRss();
-    const auto slam_opts = slam::SlamOptions::fromConfig(cfg);
+    const auto slam_opts = core::namingSource(rc.config_source,
+                                              [&] { return slam::SlamOptions::fromConfig(cfg); });
     slam::GridMapOptions grid_opts;
-    grid_opts.loadFromConfig(cfg, "grid_map");
-    auto masks = makeMaskSource(rc.mode, filter_cfg, rc.input);
+    core::namingSource(rc.config_source, [&] { grid_opts.loadFromConfig(cfg, "grid_map"); });
+    auto masks = core::namingSource(rc.filter_source,
+                                    [&] { return makeMaskSource(rc.mode, filter_cfg, rc.input); });
     slam::Slam slam(slam_opts);
 
     RunReport rep;

@@ -18,7 +18,9 @@ namespace devslam::run {
 struct RunConfig {
     std::string input;  ///< TUM folder or .rawlog
     std::string mode = "dynamic";
-    std::string config_path;     ///< the INI (for messages and the filter_config reference)
+    /// Named in front of the "[section] key: ..." errors of the SLAM INI (`cfg`) and of the
+    /// filter's (`filter_cfg`): the files, and what was written over them.
+    std::string config_source = "SLAM INI", filter_source = "filter INI";
     std::string out_dir;         ///< empty: write nothing
     bool progress = true;        ///< progress bar on stderr
     std::size_t max_frames = 0;  ///< 0 = all

@@ -104,6 +104,7 @@ struct Loaded {
     io::ReaderOptions reader;
     std::string mode;
     bool async_filter = true;
+    std::string config_source, filter_source;  ///< RunConfig's, for the INIs' errors
 };
 
 /// Applies --set "section.key=value" overrides to an INI held in memory.
@@ -128,14 +129,23 @@ Loaded loadConfig(const Args& a, const std::vector<std::string>& extra_sets = {}
     core::requireKnownSections(*l.cfg, with_filter, "--set");
     core::requireKnownKeys(*l.cfg, "run",
                            {"mode", "filter_config", "filter_overrides", "async_filter"}, a.config);
-    l.async_filter = core::readBool(*l.cfg, "run", "async_filter", true);
+    const bool set = !a.sets.empty() || !extra_sets.empty();
+    l.config_source = a.config + (set ? " with --set" : "");
+    l.filter_source = core::filterIniPath(*l.cfg, a.config);
+    if (!l.cfg->read_string("run", "filter_overrides", "").empty())
+        l.filter_source += " with " + a.config + " [run] filter_overrides";
+    if (set)
+        l.filter_source +=
+            l.filter_source.find(" with ") == std::string::npos ? " with --set" : " and --set";
+    l.async_filter = core::namingSource(
+        l.config_source, [&] { return core::readBool(*l.cfg, "run", "async_filter", true); });
     l.mode = a.mode.empty() ? l.cfg->read_string("run", "mode", "dynamic") : a.mode;
     // [run] filter_config / filter_overrides: the filter's INI, with "section.key=value ..."
     // overrides (so a SLAM config can pick e.g. the detection interval without copying it).
     l.filter_cfg = core::loadFilterIni(*l.cfg, a.config);
     applySets(*l.filter_cfg, a.sets);
     applySets(*l.filter_cfg, extra_sets);
-    l.reader.loadFromConfig(*l.cfg, "dataset");
+    core::namingSource(l.config_source, [&] { l.reader.loadFromConfig(*l.cfg, "dataset"); });
     l.reader.allow_damaged = a.allow_damaged;
     return l;
 }
@@ -155,9 +165,10 @@ int runOnce(const Args& a) {
         std::cerr << "devslam-run: WARNING: running on the intact part of the input only: " << lost
                   << "\n";
     run::RunConfig rc;
+    rc.config_source = l.config_source;
+    rc.filter_source = l.filter_source;
     rc.input = a.input;
     rc.mode = l.mode;
-    rc.config_path = a.config;
     rc.out_dir = a.out;
     rc.progress = !a.quiet;
     rc.max_frames = a.max_frames;
@@ -199,6 +210,8 @@ int runBench(const Args& a) {
             auto l = loadConfig(a);
             auto reader = io::openRgbd(a.input, l.reader);
             run::RunConfig rc;
+            rc.config_source = l.config_source;
+            rc.filter_source = l.filter_source;
             rc.input = a.input;
             rc.mode = mode;
             rc.progress = false;
@@ -260,6 +273,8 @@ int runBench(const Args& a) {
         auto l = loadConfig(a, sets);
         auto reader = io::openRgbd(a.input, l.reader);
         run::RunConfig rc;
+        rc.config_source = l.config_source;
+        rc.filter_source = l.filter_source;
         rc.input = a.input;
         rc.mode = "none";
         rc.progress = false;
@@ -278,6 +293,8 @@ int runBench(const Args& a) {
         auto src = io::openRgbd(a.input, l.reader);
         run::ReplayReader reader(*src, kPasses);
         run::RunConfig rc;
+        rc.config_source = l.config_source;
+        rc.filter_source = l.filter_source;
         rc.input = a.input;
         rc.mode = "dynamic";
         rc.progress = false;

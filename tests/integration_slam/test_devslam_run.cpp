@@ -84,7 +84,21 @@ TEST(DevslamRun, BadInputIsReported) {
     std::ofstream(ini) << "[tracker]\nfine_raduis = 3\n";
     r = run("--config " + ini.string() + " --mode none --quiet --out ''");
     EXPECT_EQ(r.rc, 1);
-    EXPECT_NE(r.out.find("fine_raduis"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find(ini.string() + " [tracker]: unknown key 'fine_raduis'"), std::string::npos)
+        << r.out;
+    // a bad value names the file it is in, and what was written over it
+    std::ofstream(ini) << "[tracker]\nfine_radius = 4x\n";
+    r = run("--config " + ini.string() + " --mode none --quiet --out ''");
+    EXPECT_EQ(r.rc, 1);
+    EXPECT_NE(r.out.find(ini.string() + " [tracker] fine_radius: expected a number, got '4x'"),
+              std::string::npos)
+        << r.out;
+    r = run("--set dynamic_filter.mask_margin=-3 --mode dynamic --quiet --out ''");
+    EXPECT_EQ(r.rc, 1);
+    EXPECT_NE(r.out.find("dynamic_filter.ini with "), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("[run] filter_overrides and --set [dynamic_filter] mask_margin: must be"),
+              std::string::npos)
+        << r.out;
     // a mistyped section, in the file or in --set, would drop its keys without a word
     std::ofstream(ini) << "[trackr]\nfine_radius = 3\n";
     r = run("--config " + ini.string() + " --mode none --quiet --out ''");

@@ -101,14 +101,18 @@ std::vector<std::string> keysInFileOrder(const mrpt::config::CConfigFileBase& cf
     });
 }
 
-std::unique_ptr<mrpt::config::CConfigFileMemory> loadFilterIni(
-    const mrpt::config::CConfigFileBase& cfg, const std::string& path) {
+std::string filterIniPath(const mrpt::config::CConfigFileBase& cfg, const std::string& path) {
     namespace fs = std::filesystem;
     const std::string fc = cfg.read_string("run", "filter_config", "");
-    const std::string file = fc.empty() ? path
-                             : fs::path(fc).is_absolute()
-                                 ? fc
-                                 : (fs::path(path).parent_path() / fc).string();
+    return fc.empty()                   ? path
+           : fs::path(fc).is_absolute() ? fc
+                                        : (fs::path(path).parent_path() / fc).string();
+}
+
+std::unique_ptr<mrpt::config::CConfigFileMemory> loadFilterIni(
+    const mrpt::config::CConfigFileBase& cfg, const std::string& path) {
+    const std::string fc = cfg.read_string("run", "filter_config", "");
+    const std::string file = filterIniPath(cfg, path);
     auto out = loadIni(file);
     // A file of its own holds only the filter's sections (else the SLAM INI's check covers it).
     if (!fc.empty()) requireKnownSections(*out, {"detector", "dynamic_filter"}, file);

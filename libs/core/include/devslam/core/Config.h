@@ -71,6 +71,9 @@ void applyOverrides(mrpt::config::CConfigFileMemory& cfg, const std::vector<std:
 /// applied. Throws naming the file when it cannot be read or an override is malformed.
 [[nodiscard]] std::unique_ptr<mrpt::config::CConfigFileMemory> loadFilterIni(
     const mrpt::config::CConfigFileBase& cfg, const std::string& path);
+/// The file loadFilterIni reads for the config `cfg` read from `path`.
+[[nodiscard]] std::string filterIniPath(const mrpt::config::CConfigFileBase& cfg,
+                                        const std::string& path);
 
 /// Strict typed reads of one key (core/Parse.h rules; MRPT strips a trailing `//` comment
 /// first). A missing key gives `def`, or throws when `required`; a value that does not
@@ -90,13 +93,15 @@ void applyOverrides(mrpt::config::CConfigFileMemory& cfg, const std::vector<std:
 
 /// Runs `load()` and returns what it returns. A std::invalid_argument whose message names
 /// only the field ("[section] key: ...", as the reads above and requireValue throw) comes
-/// back as "<source> [section] key: ...", so a loader that reads one file can name it.
+/// back as "<source> [section] key: ...", so a loader that reads one file can name it; so
+/// does one from requireKnownKeys without a source ("INI [section]: unknown key ...").
 template <class Load>
 decltype(auto) namingSource(const std::string& source, Load&& load) {
     try {
         return load();
     } catch (const std::invalid_argument& e) {
         const std::string msg = e.what();
+        if (msg.rfind("INI [", 0) == 0) throw std::invalid_argument(source + msg.substr(3));
         if (msg.empty() || msg.front() != '[') throw;
         throw std::invalid_argument(source + " " + msg);
     }
