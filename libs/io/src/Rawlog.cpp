@@ -1,5 +1,6 @@
 #include <devslam/io/Rawlog.h>
 
+#include <devslam/core/GzFile.h>
 #include <devslam/core/Pose.h>
 
 #include <mrpt/img/CImage.h>
@@ -15,7 +16,6 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include <zlib.h>
 
 #include <cmath>
 #include <filesystem>
@@ -86,34 +86,6 @@ cv::Mat registerDepth(const CObservation3DRangeScan& o, const cv::Mat& depth, in
             if (d == 0 || q.z() < d) d = static_cast<float>(q.z());
         }
     return out;
-}
-
-// A gzip stream cut short decodes cleanly up to the cut, and MRPT's stream reports a plain
-// end of file there; only zlib knows the trailer is missing. Returns the zlib error text,
-// or "" if the file is a complete gzip stream or not gzip at all (plain rawlogs).
-std::string gzipDamage(const std::string& path) {
-    gzFile f = gzopen(path.c_str(), "rb");
-    if (f == nullptr) return "cannot open";
-    std::vector<char> buf(1 << 20);
-    int n = 0;
-    while ((n = gzread(f, buf.data(), static_cast<unsigned>(buf.size()))) > 0) {
-    }
-    int err = Z_OK;
-    const char* msg = gzerror(f, &err);
-    std::string out = (n < 0 || (err != Z_OK && err != Z_STREAM_END)) ? msg : "";
-    gzclose(f);
-    return out;
-}
-
-// MRPT nests exception texts several levels deep; keep the innermost "Message:" line.
-std::string innermostMessage(const std::string& what) {
-    std::string best = what.substr(0, what.find('\n'));
-    for (std::size_t p = what.find("Message:"); p != std::string::npos;
-         p = what.find("Message:", p + 1)) {
-        const std::size_t b = what.find_first_not_of(' ', p + 8);
-        best = what.substr(b, what.find('\n', b) - b);
-    }
-    return best;
 }
 
 }  // namespace
@@ -191,7 +163,7 @@ struct RawlogReader::Stream {
                 throw std::runtime_error("cannot decode object " + std::to_string(objects) +
                                          " at byte " + std::to_string(pos) +
                                          " of the uncompressed stream (" +
-                                         innermostMessage(e.what()) + ")");
+                                         core::innermostMessage(e.what()) + ")");
             }
             ++objects;
             if (auto sf = std::dynamic_pointer_cast<mrpt::obs::CSensoryFrame>(obj)) {
@@ -232,7 +204,7 @@ RawlogReader::RawlogReader(std::string path, ReaderOptions opts)
             }
             ++n_frames_;
         }
-        if (const std::string gz = gzipDamage(path_); !gz.empty())
+        if (const std::string gz = core::gzipDamage(path_); !gz.empty())
             throw std::runtime_error("truncated or corrupt gzip stream (" + gz + ")");
     } catch (const std::exception& e) {
         damage_ =
