@@ -1,15 +1,18 @@
 // devslam-nav WORLD.ini: one closed-loop navigation run in the Bullet world.
 // Prints one result line, writes a PNG (map, A* path, trajectory, people tracks) and,
 // with --navlog, MRPT's .reactivenavlog (open it with MRPT's navlog-viewer).
+// devslam-nav --map GRIDMAP --to X,Y: the global route on a map devslam-run built.
 #include <devslam/core/Config.h>
 #include <devslam/core/Parse.h>
 #include <devslam/nav/CHolonomicVFHPlus.h>
+#include <devslam/nav/MapPlan.h>
 #include <devslam/sim/Episode.h>
 #include <devslam/sim/RandomWorlds.h>
 
 #include <mrpt/system/filesystem.h>
 
 #include <cstdio>
+#include <filesystem>
 #include <iostream>
 #include <string>
 
@@ -31,6 +34,40 @@ devslam::sim::WorldSpec loadOrGenerate(const std::string& spec) {
         "' (known: open_clutter, corridor_people, office, obstacle_near_goal)");
 }
 
+/// "X,Y" [m].
+mrpt::math::TPoint2D parsePoint(const std::string& text, const std::string& what) {
+    const auto comma = text.find(',');
+    if (comma == std::string::npos)
+        throw std::invalid_argument(what + ": expected X,Y in metres, got '" + text + "'");
+    return {devslam::core::parseNumber(text.substr(0, comma), what + " x"),
+            devslam::core::parseNumber(text.substr(comma + 1), what + " y")};
+}
+
+/// devslam-nav --map: A* and waypoints on a SLAM grid, one result line and a picture.
+int planOnSlamMap(const std::string& map, const std::string& from, const std::string& to,
+                  const std::string& config, std::string png) {
+    if (to.empty()) throw std::invalid_argument("--map needs --to X,Y (the goal, in metres)");
+    const auto ini = devslam::core::loadIni(config);
+    const auto opts = devslam::nav::NavigatorOptions::fromConfig(*ini, config).planner;
+    const auto grid = devslam::nav::loadGridMap(map);
+    const auto plan = devslam::nav::planOnMap(grid, parsePoint(from, "--from"),
+                                              parsePoint(to, "--to"), opts);
+    if (png.empty()) png = "plan.png";
+    devslam::nav::writeMapPlanPng(grid, plan, png, std::filesystem::path(map).filename().string());
+    std::printf("map=%s from=(%.2f, %.2f) to=(%.2f, %.2f) ", map.c_str(), plan.from.x,
+                plan.from.y, plan.to.x, plan.to.y);
+    if (!plan.path) {
+        std::printf("result=no_path png=%s\n", png.c_str());
+        return 1;
+    }
+    std::printf("result=path length=%.2f m waypoints=%zu min_clearance=%.3f m unknown=%.0f%% "
+                "png=%s\n",
+                plan.path->length, plan.waypoints.size(), plan.min_clearance,
+                100.0 * plan.unknown_fraction, png.c_str());
+    for (const auto& w : plan.waypoints) std::printf("waypoint %.2f %.2f\n", w.x, w.y);
+    return 0;
+}
+
 void usage() {
     std::cerr << "usage: devslam-nav WORLD.ini|random:CATEGORY:SEED [options]\n"
                  "  --config FILE   navigation INI (default config_ini/nav_reactive.ini)\n"
@@ -38,12 +75,16 @@ void usage() {
                  "                  CHolonomicVFF, CHolonomicFullEval\n"
                  "  --png FILE      picture of the run (default nav_<world>.png)\n"
                  "  --navlog DIR    also write MRPT's navlog into DIR\n"
-                 "  --verbose       MRPT navigator messages (DEBUG level)\n";
+                 "  --verbose       MRPT navigator messages (DEBUG level)\n"
+                 "       devslam-nav --map GRIDMAP --to X,Y [--from X,Y] [--config FILE] [--png FILE]\n"
+                 "  the global route (A* and waypoints, [global_planner] of --config) on a map\n"
+                 "  devslam-run built (its map_grid.gridmap: x forward, y left, metres, the\n"
+                 "  camera's start at 0,0, the default --from); picture in --png (plan.png)\n";
 }
 }  // namespace
 
 int main(int argc, char** argv) {
-    std::string world_path, png, navlog;
+    std::string world_path, png, navlog, map, from = "0,0", to;
     std::string config = std::string(DEVSLAM_SOURCE_DIR) + "/config_ini/nav_reactive.ini";
     std::string method = "CHolonomicVFHPlus";
     bool verbose = false;
@@ -64,6 +105,12 @@ int main(int argc, char** argv) {
                 navlog = next();
             else if (a == "--verbose")
                 verbose = true;
+            else if (a == "--map")
+                map = next();
+            else if (a == "--from")
+                from = next();
+            else if (a == "--to")
+                to = next();
             else if (a == "-h" || a == "--help") {
                 usage();
                 return 0;
@@ -76,6 +123,18 @@ int main(int argc, char** argv) {
         } catch (const std::exception& e) {
             std::cerr << "devslam-nav: " << e.what() << "\n";
             usage();
+            return 2;
+        }
+    }
+    if (!map.empty()) {
+        if (!world_path.empty()) {
+            std::cerr << "devslam-nav: give a world or --map, not both\n";
+            return 2;
+        }
+        try {
+            return planOnSlamMap(map, from, to, config, png);
+        } catch (const std::exception& e) {
+            std::cerr << "devslam-nav: " << e.what() << "\n";
             return 2;
         }
     }
