@@ -57,7 +57,7 @@ CameraIntrinsics CameraIntrinsics::fromPreset(const std::string& name) {
 
 CameraIntrinsics CameraIntrinsics::fromConfig(const mrpt::config::CConfigFileBase& c,
                                               const std::string& s) {
-    requireKnownKeys(c, s, {"preset", "fx", "fy", "cx", "cy", "width", "height", "dist"}, "camera");
+    requireKnownKeys(c, s, {"preset", "fx", "fy", "cx", "cy", "width", "height", "dist"});
     CameraIntrinsics K;
     const std::string preset = c.read_string(s, "preset", "");
     const bool has_preset = !preset.empty();

@@ -138,8 +138,8 @@ void requireKnownKeys(const mrpt::config::CConfigFileBase& cfg, const std::strin
     if (unknown.empty()) return;
     std::string list;
     for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
-    throw std::invalid_argument(source + " [" + section + "]: unknown key '" + unknown.front() +
-                                "' (known: " + list + ")");
+    throw std::invalid_argument((source.empty() ? "" : source + " ") + "[" + section +
+                                "]: unknown key '" + unknown.front() + "' (known: " + list + ")");
 }
 
 void requireKnownSections(const mrpt::config::CConfigFileBase& cfg,

@@ -16,8 +16,7 @@ namespace fs = std::filesystem;
 namespace devslam::io {
 
 void ReaderOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, const std::string& s) {
-    core::requireKnownKeys(c, s, {"camera", "max_dt", "tum_depth_scale", "sensor_label"},
-                           "dataset");
+    core::requireKnownKeys(c, s, {"camera", "max_dt", "tum_depth_scale", "sensor_label"});
     camera = c.read_string(s, "camera", camera);
     max_dt = core::readDouble(c, s, "max_dt", max_dt);
     tum_depth_scale = core::readDouble(c, s, "tum_depth_scale", tum_depth_scale);

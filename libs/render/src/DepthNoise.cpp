@@ -14,8 +14,7 @@ void DepthNoiseOptions::loadFromConfig(const mrpt::config::CConfigFileBase& cfg,
                                        const std::string& s) {
     core::requireKnownKeys(cfg, s,
                            {"enabled", "min_range", "max_range", "sigma_a", "sigma_b", "baseline",
-                            "disparity_step", "edge_jump", "edge_dilate", "dropout"},
-                           "depth_noise");
+                            "disparity_step", "edge_jump", "edge_dilate", "dropout"});
     enabled = core::readBool(cfg, s, "enabled", enabled);
     min_range = core::readDouble(cfg, s, "min_range", min_range);
     max_range = core::readDouble(cfg, s, "max_range", max_range);

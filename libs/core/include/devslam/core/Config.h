@@ -28,9 +28,11 @@ namespace devslam::core {
                                                    const std::vector<std::string>& known);
 
 /// Throws std::invalid_argument "<source> [section]: unknown key 'x' (known: a, b, c)"
-/// when the section holds a key that is not in `known`.
+/// when the section holds a key that is not in `known`; without a source the message names
+/// only the field ("[section]: ..."), as the strict reads below, so that namingSource names
+/// the file.
 void requireKnownKeys(const mrpt::config::CConfigFileBase& cfg, const std::string& section,
-                      const std::vector<std::string>& known, const std::string& source = "INI");
+                      const std::vector<std::string>& known, const std::string& source = "");
 
 /// Throws std::invalid_argument "<source>: unknown section [x] (known: a, b, box_*)" when the
 /// INI holds a section that is not in `known`, where an entry ending in '*' admits every
@@ -93,15 +95,13 @@ void applyOverrides(mrpt::config::CConfigFileMemory& cfg, const std::vector<std:
 
 /// Runs `load()` and returns what it returns. A std::invalid_argument whose message names
 /// only the field ("[section] key: ...", as the reads above and requireValue throw) comes
-/// back as "<source> [section] key: ...", so a loader that reads one file can name it; so
-/// does one from requireKnownKeys without a source ("INI [section]: unknown key ...").
+/// back as "<source> [section] key: ...", so a loader that reads one file can name it.
 template <class Load>
 decltype(auto) namingSource(const std::string& source, Load&& load) {
     try {
         return load();
     } catch (const std::invalid_argument& e) {
         const std::string msg = e.what();
-        if (msg.rfind("INI [", 0) == 0) throw std::invalid_argument(source + msg.substr(3));
         if (msg.empty() || msg.front() != '[') throw;
         throw std::invalid_argument(source + " " + msg);
     }
