@@ -126,23 +126,16 @@ int main(int argc, char** argv) {
             return 2;
         }
     }
-    if (!map.empty()) {
-        if (!world_path.empty()) {
-            std::cerr << "devslam-nav: give a world or --map, not both\n";
-            return 2;
-        }
-        try {
-            return planOnSlamMap(map, from, to, config, png);
-        } catch (const std::exception& e) {
-            std::cerr << "devslam-nav: " << e.what() << "\n";
-            return 2;
-        }
+    if (!map.empty() && !world_path.empty()) {
+        std::cerr << "devslam-nav: give a world or --map, not both\n";
+        return 2;
     }
-    if (world_path.empty()) {
+    if (map.empty() && world_path.empty()) {
         usage();
         return 2;
     }
     try {
+        if (!map.empty()) return planOnSlamMap(map, from, to, config, png);
         devslam::nav::registerNavClasses();
         const auto world = loadOrGenerate(world_path);
         const auto ini = devslam::core::loadIni(config);
