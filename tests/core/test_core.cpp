@@ -217,6 +217,8 @@ TEST(Config, UnknownSectionsAndKeysBeforeAnySectionAreErrors) {
     mrpt::config::CConfigFileMemory typo("[room]\nsize = 1\n[bx_desk]\nx = 2\n");
     EXPECT_EQ(invalidArgument([&] { requireKnownSections(typo, known, "r.ini"); }),
               "r.ini: unknown section [bx_desk] (known: room, box_*)");
+    EXPECT_EQ(invalidArgument([&] { requireKnownSections(typo, known); }),
+              "unknown section [bx_desk] (known: room, box_*)");  // for a caller that adds the file
     // a prefix is only a prefix when it ends in '*'
     mrpt::config::CConfigFileMemory longer("[rooms]\nsize = 1\n");
     EXPECT_EQ(invalidArgument([&] { requireKnownSections(longer, known, "r.ini"); }),

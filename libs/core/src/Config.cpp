@@ -152,6 +152,7 @@ void requireKnownSections(const mrpt::config::CConfigFileBase& cfg,
         }
         return false;
     };
+    const std::string in = source.empty() ? "" : source + ": ";
     std::vector<std::string> all;
     cfg.getAllSections(all);
     for (const auto& section : all) {
@@ -159,15 +160,14 @@ void requireKnownSections(const mrpt::config::CConfigFileBase& cfg,
             std::vector<std::string> keys;
             cfg.getAllKeys(section, keys);
             if (!keys.empty())
-                throw std::invalid_argument(source + ": key '" + keys.front() +
+                throw std::invalid_argument(in + "key '" + keys.front() +
                                             "' before the first section");
             continue;
         }
         if (admitted(section)) continue;
         std::string list;
         for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
-        throw std::invalid_argument(source + ": unknown section [" + section + "] (known: " + list +
-                                    ")");
+        throw std::invalid_argument(in + "unknown section [" + section + "] (known: " + list + ")");
     }
 }
 

@@ -120,12 +120,8 @@ TumReader::TumReader(std::string folder, ReaderOptions opts)
         camera_source_ = "preset " + opts_.camera;
     } else if (fs::exists(camera_ini)) {
         const auto cfg = core::loadIni(camera_ini);
-        try {  // the reader's errors are runtime_errors, as its other damaged files
-            core::requireKnownSections(*cfg, {"camera"}, camera_ini);
-        } catch (const std::invalid_argument& e) {
-            throw std::runtime_error(e.what());
-        }
         try {
+            core::requireKnownSections(*cfg, {"camera"});
             K_ = core::CameraIntrinsics::fromConfig(*cfg, "camera");
         } catch (const std::exception& e) {
             throw std::runtime_error(camera_ini + ": " + e.what());

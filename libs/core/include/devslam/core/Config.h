@@ -37,10 +37,10 @@ void requireKnownKeys(const mrpt::config::CConfigFileBase& cfg, const std::strin
 /// Throws std::invalid_argument "<source>: unknown section [x] (known: a, b, box_*)" when the
 /// INI holds a section that is not in `known`, where an entry ending in '*' admits every
 /// section that starts with what precedes it; and "<source>: key 'k' before the first
-/// section" for a key no section holds. A mistyped section name would otherwise be ignored
-/// without a word, with every key in it.
+/// section" for a key no section holds (without a source, the message alone). A mistyped
+/// section name would otherwise be ignored without a word, with every key in it.
 void requireKnownSections(const mrpt::config::CConfigFileBase& cfg,
-                          const std::vector<std::string>& known, const std::string& source = "INI");
+                          const std::vector<std::string>& known, const std::string& source = "");
 
 /// Applies "section.key=value" items to an INI held in memory. Throws std::invalid_argument
 /// naming `what` and the item when one is malformed.
