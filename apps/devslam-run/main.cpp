@@ -158,22 +158,30 @@ std::unique_ptr<io::RgbdReader> openInput(const std::string& input, const io::Re
     return std::make_unique<run::ReplayReader>(*reader, replay);
 }
 
+/// A run of `mode` with the loaded INIs and the command line's input and frame limit,
+/// without a progress bar or an output folder (the callers set what differs).
+run::RunConfig runConfig(const Args& a, const Loaded& l, const std::string& mode) {
+    run::RunConfig rc;
+    rc.config_source = l.config_source;
+    rc.filter_source = l.filter_source;
+    rc.input = a.input;
+    rc.mode = mode;
+    rc.progress = false;
+    rc.max_frames = a.max_frames;
+    rc.async_filter = l.async_filter;
+    return rc;
+}
+
 int runOnce(const Args& a) {
     auto l = loadConfig(a);
     auto reader = openInput(a.input, l.reader, a.replay);
     if (const std::string lost = reader->damage(); !lost.empty())
         std::cerr << "devslam-run: WARNING: running on the intact part of the input only: " << lost
                   << "\n";
-    run::RunConfig rc;
-    rc.config_source = l.config_source;
-    rc.filter_source = l.filter_source;
-    rc.input = a.input;
-    rc.mode = l.mode;
+    auto rc = runConfig(a, l, l.mode);
     rc.out_dir = a.out;
     rc.progress = !a.quiet;
-    rc.max_frames = a.max_frames;
     rc.score_masks = a.replay <= 0;
-    rc.async_filter = l.async_filter;
     const auto rep = run::runSequence(*reader, rc, *l.cfg, *l.filter_cfg);
     std::cout << run::formatSummary(rep);
     return 0;
@@ -209,14 +217,7 @@ int runBench(const Args& a) {
         for (int r = 0; r < a.bench; ++r) {
             auto l = loadConfig(a);
             auto reader = io::openRgbd(a.input, l.reader);
-            run::RunConfig rc;
-            rc.config_source = l.config_source;
-            rc.filter_source = l.filter_source;
-            rc.input = a.input;
-            rc.mode = mode;
-            rc.progress = false;
-            rc.max_frames = a.max_frames;
-            rc.async_filter = l.async_filter;
+            const auto rc = runConfig(a, l, mode);
             const auto rep = run::runSequence(*reader, rc, *l.cfg, *l.filter_cfg);
             if (rep.ate) {
                 ate.push_back(rep.ate->trans.rmse);
@@ -272,13 +273,7 @@ int runBench(const Args& a) {
         if (a.modes_only) break;
         auto l = loadConfig(a, sets);
         auto reader = io::openRgbd(a.input, l.reader);
-        run::RunConfig rc;
-        rc.config_source = l.config_source;
-        rc.filter_source = l.filter_source;
-        rc.input = a.input;
-        rc.mode = "none";
-        rc.progress = false;
-        rc.max_frames = a.max_frames;
+        const auto rc = runConfig(a, l, "none");
         const auto rep = run::runSequence(*reader, rc, *l.cfg, *l.filter_cfg);
         abl << "| " << name << " | " << (rep.ate ? fmt(rep.ate->trans.rmse, 4) : "-") << " | "
             << rep.keyframes << " | " << fmt(rep.median_fps, 1) << " |\n";
@@ -292,13 +287,8 @@ int runBench(const Args& a) {
         auto l = loadConfig(a);
         auto src = io::openRgbd(a.input, l.reader);
         run::ReplayReader reader(*src, kPasses);
-        run::RunConfig rc;
-        rc.config_source = l.config_source;
-        rc.filter_source = l.filter_source;
-        rc.input = a.input;
-        rc.mode = "dynamic";
-        rc.progress = false;
-        rc.async_filter = l.async_filter;
+        auto rc = runConfig(a, l, "dynamic");
+        rc.max_frames = 0;  // every replayed frame
         rc.score_masks = false;  // replayed: timestamps are not the truth's
         const auto rep = run::runSequence(reader, rc, *l.cfg, *l.filter_cfg);
         mem << "\nLong run (memory): the input replayed forward/backward " << kPasses
