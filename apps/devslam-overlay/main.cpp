@@ -142,8 +142,13 @@ int main(int argc, char** argv) {
     }
     try {
         cv::setNumThreads(threads);
-        // A SLAM INI names its filter INI ([run] filter_config, filter_overrides).
-        auto cfg = core::loadFilterIni(*core::loadIni(config), config);
+        // A SLAM INI ([run]) names its filter INI ([run] filter_config, filter_overrides),
+        // which loadFilterIni checks; a filter INI given directly holds only the filter's
+        // sections, and a mistyped one would be ignored with all of its keys.
+        const auto ini = core::loadIni(config);
+        if (!ini->sectionExists("run"))
+            core::requireKnownSections(*ini, {"detector", "dynamic_filter"}, config);
+        auto cfg = core::loadFilterIni(*ini, config);
         if (!cfg->sectionExists("detector") && !cfg->sectionExists("dynamic_filter"))
             throw std::invalid_argument("--config " + config +
                                         ": no [detector] or [dynamic_filter] section, and no "

@@ -1,14 +1,14 @@
 // Smoke tests of the devslam-run app: outputs written and loadable, bad input reported.
 #include <gtest/gtest.h>
 
+#include "Command.h"
 #include "Scratch.h"
 #include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/maps/COccupancyGridMap2D.h>
 #include <mrpt/opengl/COpenGLScene.h>
 #include <mrpt/serialization/CArchive.h>
 
-#include <array>
-#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -19,20 +19,8 @@
 namespace fs = std::filesystem;
 
 namespace {
-struct Result {
-    int rc = -1;
-    std::string out;
-};
-Result run(const std::string& args) {
-    const std::string cmd = std::string(DEVSLAM_BIN_DIR) + "/devslam-run " + args + " 2>&1";
-    Result r;
-    FILE* p = popen(cmd.c_str(), "r");
-    if (!p) return r;
-    std::array<char, 4096> buf{};
-    while (fgets(buf.data(), buf.size(), p)) r.out += buf.data();
-    const int st = pclose(p);
-    r.rc = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-    return r;
+devslam::test::CommandResult run(const std::string& args) {
+    return devslam::test::runApp("devslam-run", args);
 }
 std::size_t lines(const fs::path& p) {
     std::ifstream in(p);

@@ -6,11 +6,10 @@
 
 #include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/serialization/CArchive.h>
+#include "Command.h"
 #include "Scratch.h"
 
-#include <array>
 #include <cmath>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -119,13 +118,9 @@ TEST(MapPlan, DevslamNavPlansOnAMapFile) {
     const std::string file = d.str("room.gridmap");
     save(room(), file);
     const auto run = [&](const std::string& args, std::string& out) {
-        const std::string cmd = std::string(DEVSLAM_BIN_DIR) + "/devslam-nav " + args + " 2>&1";
-        FILE* p = popen(cmd.c_str(), "r");
-        out.clear();
-        std::array<char, 512> buf{};
-        while (p && fgets(buf.data(), buf.size(), p)) out += buf.data();
-        const int st = p ? pclose(p) : -1;
-        return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+        auto r = devslam::test::runApp("devslam-nav", args);
+        out = std::move(r.out);
+        return r.rc;
     };
     std::string out;
     EXPECT_EQ(run("--map " + file + " --to 4.5,0 --png " + d.str("p.png"), out), 0) << out;

@@ -1,0 +1,81 @@
+// Smoke tests of the devslam-overlay app: overlays written for a synthetic and a real
+// sequence, and bad arguments or INIs reported with the file and field.
+#include <gtest/gtest.h>
+
+#include "Command.h"
+#include "Scratch.h"
+
+#include <opencv2/imgcodecs.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+namespace fs = std::filesystem;
+using devslam::test::runApp;
+
+namespace {
+int pngsIn(const std::string& dir) {
+    int n = 0;
+    for (const auto& e : fs::directory_iterator(dir)) n += e.path().extension() == ".png";
+    return n;
+}
+}  // namespace
+
+// The built-in synthetic walker: one overlay per frame (every 2nd with --every 2), each the
+// size of the input image.
+TEST(DevslamOverlay, WritesOneOverlayPerFrame) {
+    devslam::test::TempDir d("devslam_overlay_");
+    auto r = runApp("devslam-overlay", "--input synthetic:walking --frames 6 --out " + d.str("a"));
+    ASSERT_EQ(r.rc, 0) << r.out;
+    EXPECT_NE(r.out.find("wrote 6 overlays"), std::string::npos) << r.out;
+    EXPECT_EQ(pngsIn(d.str("a")), 6);
+    const cv::Mat img = cv::imread(d.str("a/overlay_00005.png"));
+    ASSERT_FALSE(img.empty());
+    EXPECT_EQ(img.cols, 640);
+    EXPECT_EQ(img.rows, 480);
+
+    r = runApp("devslam-overlay", "--input synthetic:static --frames 6 --every 2 --out " +
+                                      d.str("b"));
+    ASSERT_EQ(r.rc, 0) << r.out;
+    EXPECT_EQ(pngsIn(d.str("b")), 3);
+}
+
+// The shipped real frames through a SLAM INI, whose [run] filter_config names the filter INI.
+TEST(DevslamOverlay, RunsOnTheShippedTumFramesThroughASlamIni) {
+    devslam::test::TempDir d("devslam_overlay_");
+    const std::string root = DEVSLAM_SOURCE_DIR;
+    const auto r = runApp("devslam-overlay", "--input " + root +
+                                                 "/data/tum/fr1_xyz_first37 --frames 3 --config " +
+                                                 root + "/config_ini/slam_tum_fr1.ini --out " +
+                                                 d.str());
+    ASSERT_EQ(r.rc, 0) << r.out;
+    EXPECT_EQ(pngsIn(d.str()), 3);
+}
+
+TEST(DevslamOverlay, BadInputIsNamed) {
+    devslam::test::TempDir d("devslam_overlay_");
+    const std::string out = " --out " + d.str("o");
+    // A mistyped section of a filter INI given directly.
+    const std::string ini = d.str("filter.ini");
+    std::ofstream(ini) << "[detector]\ndetector = hog\n[dynamic_filtr]\nthreshold1 = 2\n";
+    auto r = runApp("devslam-overlay", "--input synthetic:walking --config " + ini + out);
+    EXPECT_EQ(r.rc, 1) << r.out;
+    EXPECT_NE(r.out.find(ini + ": unknown section [dynamic_filtr]"), std::string::npos) << r.out;
+
+    r = runApp("devslam-overlay", "--input synthetic:walking --mode moving" + out);
+    EXPECT_EQ(r.rc, 1) << r.out;
+    EXPECT_NE(r.out.find("moving"), std::string::npos) << r.out;
+
+    r = runApp("devslam-overlay", "--input synthetic:running" + out);
+    EXPECT_EQ(r.rc, 1) << r.out;
+    EXPECT_NE(r.out.find("unknown synthetic sequence 'running'"), std::string::npos) << r.out;
+
+    r = runApp("devslam-overlay", "--input " + d.str("nowhere") + out);
+    EXPECT_EQ(r.rc, 1) << r.out;
+    EXPECT_NE(r.out.find("nowhere"), std::string::npos) << r.out;
+
+    r = runApp("devslam-overlay", "--input synthetic:walking --every 0" + out);
+    EXPECT_EQ(r.rc, 2) << r.out;
+    EXPECT_NE(r.out.find("--every"), std::string::npos) << r.out;
+}
