@@ -155,6 +155,8 @@ int main(int argc, char** argv) {
         return 2;
     }
     try {
+        // Read before the detectors' minutes of work, so a bad file stops the bench at once.
+        const auto filter_cfg = core::loadFilterConfig(filter_ini);
         cv::setNumThreads(threads);
         std::ostringstream md;
         md << "## Person detection and dynamic-object filter (`devslam-filter-bench`)\n\n"
@@ -264,9 +266,8 @@ int main(int argc, char** argv) {
         }
 
         // 2. Filter alone (detector time excluded).
-        auto cfg = core::loadIni(filter_ini);
         dynamic::DynamicObjectFilter::Options fo;
-        fo.loadFromConfig(*cfg);
+        fo.loadFromConfig(*filter_cfg);
 
         StageSamples stages_synthetic, stages_tum;
         md << "\n| filter stage (detector excluded) | sequence | median ms | mean ms | median "
@@ -308,7 +309,7 @@ int main(int argc, char** argv) {
                 std::vector<double> ms;
                 StageSamples stages;
                 for (int pass = 0; pass < 5; ++pass) {
-                    auto filter = dynamic::makeFilterFromConfig(*cfg);
+                    auto filter = dynamic::makeFilterFromConfig(*filter_cfg);
                     for (const auto& f : tum) {
                         const auto out = filter->step(f, std::nullopt);
                         if (f.index == 0) continue;
@@ -473,7 +474,7 @@ int main(int argc, char** argv) {
             std::size_t done = 0;
             for (int seq = 0; seq < 3; ++seq) {
                 const auto& frames = seq == 0 ? walking : seq == 1 ? standing : empty;
-                dynamic::DynamicObjectFilter filter(o, detect::makeDetector(*cfg));
+                dynamic::DynamicObjectFilter filter(o, detect::makeDetector(*filter_cfg));
                 for (const auto& s : frames) {
                     const auto out = filter.step(s.frame, s.T_prev_cur);
                     bar.update(++done);

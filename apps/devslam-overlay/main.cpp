@@ -142,17 +142,8 @@ int main(int argc, char** argv) {
     }
     try {
         cv::setNumThreads(threads);
-        // A SLAM INI ([run]) names its filter INI ([run] filter_config, filter_overrides),
-        // which loadFilterIni checks; a filter INI given directly holds only the filter's
-        // sections, and a mistyped one would be ignored with all of its keys.
-        const auto ini = core::loadIni(config);
-        if (!ini->sectionExists("run"))
-            core::requireKnownSections(*ini, {"detector", "dynamic_filter"}, config);
-        auto cfg = core::loadFilterIni(*ini, config);
-        if (!cfg->sectionExists("detector") && !cfg->sectionExists("dynamic_filter"))
-            throw std::invalid_argument("--config " + config +
-                                        ": no [detector] or [dynamic_filter] section, and no "
-                                        "[run] filter_config naming an INI that has them");
+        // A filter INI, or a SLAM INI naming one ([run] filter_config, filter_overrides).
+        auto cfg = core::loadFilterConfig(config);
         std::optional<dynamic::MaskMode> mode_override;
         if (!mode.empty()) mode_override = dynamic::parseMaskMode(mode);
         auto filter = dynamic::makeFilterFromConfig(*cfg, mode_override);

@@ -122,7 +122,10 @@ TEST(Config, FilterIniFollowsRunFilterConfigWithOverrides) {
         (void)loadFilterIni(*loadIni(missing), missing);
         FAIL();
     } catch (const std::runtime_error& e) {
-        EXPECT_NE(std::string(e.what()).find("nowhere.ini"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find(missing + " [run] filter_config: no such file '" +
+                                             dir + "/nowhere.ini'"),
+                  std::string::npos)
+            << e.what();
     }
     std::filesystem::remove_all(dir);
 }

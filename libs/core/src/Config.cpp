@@ -113,12 +113,27 @@ std::unique_ptr<mrpt::config::CConfigFileMemory> loadFilterIni(
     const mrpt::config::CConfigFileBase& cfg, const std::string& path) {
     const std::string fc = cfg.read_string("run", "filter_config", "");
     const std::string file = filterIniPath(cfg, path);
+    if (!fc.empty() && !std::filesystem::is_regular_file(file))
+        throw std::runtime_error(path + " [run] filter_config: no such file '" + file + "'");
     auto out = loadIni(file);
     // A file of its own holds only the filter's sections (else the SLAM INI's check covers it).
     if (!fc.empty()) requireKnownSections(*out, {"detector", "dynamic_filter"}, file);
     applyOverrides(*out, overrideItems(cfg.read_string("run", "filter_overrides", ""),
                                        path + " [run] filter_overrides"),
                    path + " [run] filter_overrides item");
+    return out;
+}
+
+std::unique_ptr<mrpt::config::CConfigFileMemory> loadFilterConfig(const std::string& path) {
+    const auto ini = loadIni(path);
+    // A SLAM INI's own sections are devslam-run's to check; loadFilterIni checks the file
+    // its [run] filter_config names.
+    if (!ini->sectionExists("run")) requireKnownSections(*ini, {"detector", "dynamic_filter"}, path);
+    auto out = loadFilterIni(*ini, path);
+    if (!out->sectionExists("detector") && !out->sectionExists("dynamic_filter"))
+        throw std::invalid_argument(path +
+                                    ": no [detector] or [dynamic_filter] section, and no [run] "
+                                    "filter_config naming an INI that has them");
     return out;
 }
 

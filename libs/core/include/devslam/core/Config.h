@@ -73,6 +73,12 @@ void applyOverrides(mrpt::config::CConfigFileMemory& cfg, const std::vector<std:
 /// applied. Throws naming the file when it cannot be read or an override is malformed.
 [[nodiscard]] std::unique_ptr<mrpt::config::CConfigFileMemory> loadFilterIni(
     const mrpt::config::CConfigFileBase& cfg, const std::string& path);
+/// The filter's INI named on a command line (`--config` of devslam-overlay and
+/// devslam-filter-bench): a filter INI, which may hold only [detector] and [dynamic_filter],
+/// or a SLAM INI (one with [run]), read through loadFilterIni. Throws naming the file when a
+/// section is unknown or neither filter section is there.
+[[nodiscard]] std::unique_ptr<mrpt::config::CConfigFileMemory> loadFilterConfig(
+    const std::string& path);
 /// The file loadFilterIni reads for the config `cfg` read from `path`.
 [[nodiscard]] std::string filterIniPath(const mrpt::config::CConfigFileBase& cfg,
                                         const std::string& path);

@@ -1,5 +1,6 @@
-// Smoke tests of the devslam-overlay app: overlays written for a synthetic and a real
-// sequence, and bad arguments or INIs reported with the file and field.
+// Smoke tests of the filter's apps: devslam-overlay writes overlays for a synthetic and a
+// real sequence; both it and devslam-filter-bench report bad arguments and INIs, naming the
+// file and field. (devslam-filter-bench's full run takes minutes: docs/RESULTS.md `detect`.)
 #include <gtest/gtest.h>
 
 #include "Command.h"
@@ -9,6 +10,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 
 namespace fs = std::filesystem;
@@ -78,4 +80,27 @@ TEST(DevslamOverlay, BadInputIsNamed) {
     r = runApp("devslam-overlay", "--input synthetic:walking --every 0" + out);
     EXPECT_EQ(r.rc, 2) << r.out;
     EXPECT_NE(r.out.find("--every"), std::string::npos) << r.out;
+}
+
+// The bench reads its filter INI before the detectors' minutes of work: a bad one stops it at
+// once, and the results file is left as it was.
+TEST(DevslamFilterBench, BadConfigStopsItBeforeAnyWork) {
+    devslam::test::TempDir d("devslam_filter_bench_");
+    const std::string ini = d.str("filter.ini"), results = d.str("R.md");
+    std::ofstream(ini) << "[dynamic_filter]\nthreshold1 = 2\n[detectr]\ndetector = hog\n";
+    std::ofstream(results) << "# Results\n";
+    auto r = runApp("devslam-filter-bench", "--config " + ini + " --results " + results);
+    EXPECT_EQ(r.rc, 1) << r.out;
+    EXPECT_NE(r.out.find(ini + ": unknown section [detectr]"), std::string::npos) << r.out;
+    std::ifstream in(results);
+    EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), "# Results\n");
+
+    std::ofstream(ini) << "[run]\nfilter_config = nowhere.ini\n";
+    r = runApp("devslam-filter-bench", "--config " + ini);
+    EXPECT_EQ(r.rc, 1) << r.out;
+    EXPECT_NE(r.out.find("nowhere.ini"), std::string::npos) << r.out;
+
+    r = runApp("devslam-filter-bench", "--frames 1");
+    EXPECT_EQ(r.rc, 2) << r.out;
+    EXPECT_NE(r.out.find("--frames"), std::string::npos) << r.out;
 }
