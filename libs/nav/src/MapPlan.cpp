@@ -1,6 +1,7 @@
 #include <devslam/nav/MapPlan.h>
 
 #include <devslam/core/GzFile.h>
+#include <devslam/nav/RoutePicture.h>
 
 #include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/serialization/CArchive.h>
@@ -66,53 +67,36 @@ void writeMapPlanPng(const mrpt::maps::COccupancyGridMap2D& grid, const MapPlan&
     const int gw = static_cast<int>(grid.getSizeX()), gh = static_cast<int>(grid.getSizeY());
     // at least 600 px across, whole pixels per cell
     const int k = std::max(1, static_cast<int>(std::ceil(600.0 / std::max(gw, gh))));
-    const int margin_top = 40;
-    cv::Mat img(gh * k + margin_top, gw * k, CV_8UC3, cv::Scalar(255, 255, 255));
+    cv::Mat img(gh * k + kTitleBandHeight, gw * k, CV_8UC3, cv::Scalar(255, 255, 255));
     for (int y = 0; y < gh; ++y)
         for (int x = 0; x < gw; ++x) {
             const auto v = static_cast<unsigned char>(std::lround(255.0 * grid.getCell(x, y)));
             // y up in the map, down in the image
-            img(cv::Rect(x * k, margin_top + (gh - 1 - y) * k, k, k)).setTo(cv::Scalar(v, v, v));
+            img(cv::Rect(x * k, kTitleBandHeight + (gh - 1 - y) * k, k, k))
+                .setTo(cv::Scalar(v, v, v));
         }
-    auto px = [&](const mrpt::math::TPoint2D& q) {
+    const ToPixel px = [&](const mrpt::math::TPoint2D& q) {
         return cv::Point(
             static_cast<int>(std::lround((q.x - grid.getXMin()) / grid.getResolution() * k)),
-            margin_top + gh * k - 1 -
+            img.rows - 1 -
                 static_cast<int>(std::lround((q.y - grid.getYMin()) / grid.getResolution() * k)));
     };
-    for (double x = std::ceil(grid.getXMin()); x <= grid.getXMax(); x += 1.0)
-        cv::line(img, px({x, grid.getYMin()}), px({x, grid.getYMax()}), cv::Scalar(200, 220, 200),
-                 1);
-    for (double y = std::ceil(grid.getYMin()); y <= grid.getYMax(); y += 1.0)
-        cv::line(img, px({grid.getXMin(), y}), px({grid.getXMax(), y}), cv::Scalar(200, 220, 200),
-                 1);
-    if (plan.path) {
-        std::vector<cv::Point> pts;
-        for (const auto& q : plan.path->points) pts.push_back(px(q));
-        if (pts.size() >= 2)
-            cv::polylines(img, pts, false, cv::Scalar(220, 120, 0), 2, cv::LINE_AA);
-        for (const auto& q : plan.waypoints)
-            cv::circle(img, px(q), 4, cv::Scalar(220, 120, 0), cv::FILLED, cv::LINE_AA);
-    }
-    cv::drawMarker(img, px(plan.from), cv::Scalar(0, 160, 0), cv::MARKER_SQUARE, 14, 2);
-    cv::drawMarker(img, px(plan.to), cv::Scalar(0, 0, 220), cv::MARKER_STAR, 16, 2);
-    cv::rectangle(img, cv::Point(0, 0), cv::Point(img.cols, margin_top - 1),
-                  cv::Scalar(250, 250, 250), cv::FILLED);
+    drawMetreGrid(img, px, grid.getXMin(), grid.getXMax(), grid.getYMin(), grid.getYMax(),
+                  cv::Scalar(200, 220, 200));
+    if (plan.path) drawRoute(img, px, plan.path->points, plan.waypoints);
+    drawStartGoal(img, px, plan.from, plan.to);
     std::ostringstream os;
     os.precision(3);
     os << title << ": ";
     if (plan.path)
         os << "path " << plan.path->length << " m, " << plan.waypoints.size()
-           << " waypoints, clearance >= " << plan.min_clearance << " m";
+           << (plan.waypoints.size() == 1 ? " waypoint" : " waypoints") << ", clearance >= "
+           << plan.min_clearance << " m";
     else
         os << "no path";
-    cv::putText(img, os.str(), cv::Point(8, 15), cv::FONT_HERSHEY_SIMPLEX, 0.45,
-                cv::Scalar(20, 20, 20), 1, cv::LINE_AA);
-    cv::putText(img,
-                "white free, black occupied, grey unknown; blue: A* + waypoints; green: "
-                "start; star: goal; 1 m grid",
-                cv::Point(8, 33), cv::FONT_HERSHEY_SIMPLEX, 0.38, cv::Scalar(60, 60, 60), 1,
-                cv::LINE_AA);
+    drawTitleBand(img, os.str(),
+                  "white free, black occupied, grey unknown; blue: A* + waypoints; green: "
+                  "start; star: goal; 1 m grid");
     if (!cv::imwrite(path, img)) throw std::runtime_error(path + ": cannot write the picture");
 }
 

@@ -2,6 +2,8 @@
 #include <devslam/sim/SimRobot.h>
 #include <devslam/sim/Simulator.h>
 
+#include <devslam/nav/RoutePicture.h>
+
 #include <mrpt/core/Clock.h>
 
 #include <opencv2/imgcodecs.hpp>
@@ -141,33 +143,28 @@ void writeEpisodePng(const WorldSpec& w, const EpisodeResult& r, const std::stri
                      const std::string& title) {
     const double ppm =
         std::clamp(1000.0 / std::max(w.x_max - w.x_min, w.y_max - w.y_min), 20.0, 100.0);
-    const int margin_top = 40;
     const int W = static_cast<int>(std::ceil((w.x_max - w.x_min) * ppm));
-    const int H = static_cast<int>(std::ceil((w.y_max - w.y_min) * ppm)) + margin_top;
+    const int H = static_cast<int>(std::ceil((w.y_max - w.y_min) * ppm)) + nav::kTitleBandHeight;
     cv::Mat img(H, W, CV_8UC3, cv::Scalar(255, 255, 255));
-    auto px = [&](double x, double y) {
-        return cv::Point(static_cast<int>(std::lround((x - w.x_min) * ppm)),
-                         H - 1 - static_cast<int>(std::lround((y - w.y_min) * ppm)));
+    const nav::ToPixel px = [&](const mrpt::math::TPoint2D& q) {
+        return cv::Point(static_cast<int>(std::lround((q.x - w.x_min) * ppm)),
+                         H - 1 - static_cast<int>(std::lround((q.y - w.y_min) * ppm)));
     };
-    // grid lines every metre
-    for (double x = std::ceil(w.x_min); x <= w.x_max; x += 1.0)
-        cv::line(img, px(x, w.y_min), px(x, w.y_max), cv::Scalar(235, 235, 235), 1);
-    for (double y = std::ceil(w.y_min); y <= w.y_max; y += 1.0)
-        cv::line(img, px(w.x_min, y), px(w.x_max, y), cv::Scalar(235, 235, 235), 1);
+    nav::drawMetreGrid(img, px, w.x_min, w.x_max, w.y_min, w.y_max, cv::Scalar(235, 235, 235));
     for (const auto& o : staticObstacles(w)) {
         cv::Scalar colour = o.kind == "block"  ? cv::Scalar(60, 120, 180)  // wood (BGR)
                             : o.kind == "wall" ? cv::Scalar(70, 70, 70)
                                                : cv::Scalar(110, 110, 140);
         if (o.shape == Obstacle::Shape::Cylinder) {
-            cv::circle(img, px(o.cx, o.cy), static_cast<int>(o.radius * ppm), colour, cv::FILLED,
-                       cv::LINE_AA);
+            cv::circle(img, px({o.cx, o.cy}), static_cast<int>(o.radius * ppm), colour,
+                       cv::FILLED, cv::LINE_AA);
             continue;
         }
         std::vector<cv::Point> poly;
         const double c = std::cos(o.yaw), s = std::sin(o.yaw);
         for (auto [u, v] : {std::pair{-1, -1}, {1, -1}, {1, 1}, {-1, 1}}) {
             const double lx = u * o.sx / 2, ly = v * o.sy / 2;
-            poly.push_back(px(o.cx + c * lx - s * ly, o.cy + s * lx + c * ly));
+            poly.push_back(px({o.cx + c * lx - s * ly, o.cy + s * lx + c * ly}));
         }
         cv::fillConvexPoly(img, poly, colour, cv::LINE_AA);
     }
@@ -177,43 +174,30 @@ void writeEpisodePng(const WorldSpec& w, const EpisodeResult& r, const std::stri
     // pedestrians' tracks (orange) with their final position
     for (size_t i = 0; i < r.pedestrian_tracks.size(); i++) {
         std::vector<cv::Point> pts;
-        for (const auto& q : r.pedestrian_tracks[i]) pts.push_back(px(q.x, q.y));
+        for (const auto& q : r.pedestrian_tracks[i]) pts.push_back(px({q.x, q.y}));
         polyline(pts, cv::Scalar(0, 140, 255), 2);
         if (!pts.empty())
             cv::circle(img, pts.back(), static_cast<int>(w.pedestrians[i].radius * ppm),
                        cv::Scalar(0, 140, 255), 2, cv::LINE_AA);
     }
-    // A* path (blue, dashed look by waypoints)
-    std::vector<cv::Point> ap;
-    for (const auto& q : r.global_path.points) ap.push_back(px(q.x, q.y));
-    polyline(ap, cv::Scalar(220, 120, 0), 2);
-    for (const auto& q : r.waypoints)
-        cv::circle(img, px(q.x, q.y), 4, cv::Scalar(220, 120, 0), cv::FILLED, cv::LINE_AA);
+    nav::drawRoute(img, px, r.global_path.points, r.waypoints);
     // driven trajectory (red) and robot footprints every 2 s
     std::vector<cv::Point> tp;
-    for (const auto& q : r.trajectory) tp.push_back(px(q.x, q.y));
+    for (const auto& q : r.trajectory) tp.push_back(px({q.x, q.y}));
     polyline(tp, cv::Scalar(30, 30, 220), 2);
     for (size_t i = 0; i < r.trajectory.size(); i += 20)
         cv::circle(img, tp[i], static_cast<int>(w.robot.radius * ppm), cv::Scalar(120, 120, 230), 1,
                    cv::LINE_AA);
-    // start and goal
-    const auto& s0 = w.robot.start;
-    cv::drawMarker(img, px(s0.x, s0.y), cv::Scalar(0, 160, 0), cv::MARKER_SQUARE, 16, 3);
-    cv::drawMarker(img, px(w.goal.x, w.goal.y), cv::Scalar(0, 0, 200), cv::MARKER_STAR, 18, 2);
-    cv::circle(img, px(w.goal.x, w.goal.y), static_cast<int>(w.goal_tolerance * ppm),
-               cv::Scalar(0, 0, 200), 1, cv::LINE_AA);
-    // title and legend
-    cv::rectangle(img, cv::Point(0, 0), cv::Point(W, margin_top - 1), cv::Scalar(250, 250, 250),
-                  cv::FILLED);
+    nav::drawStartGoal(img, px, {w.robot.start.x, w.robot.start.y}, {w.goal.x, w.goal.y});
+    cv::circle(img, px({w.goal.x, w.goal.y}), static_cast<int>(w.goal_tolerance * ppm),
+               cv::Scalar(0, 0, 210), 1, cv::LINE_AA);
     std::ostringstream os;
     os.precision(3);
     os << title << ": " << toString(r.outcome) << ", " << r.time << " s, path " << r.path_length
        << " m (A* " << r.astar_length << " m)";
-    cv::putText(img, os.str(), cv::Point(8, 16), cv::FONT_HERSHEY_SIMPLEX, 0.5, cv::Scalar(0, 0, 0),
-                1, cv::LINE_AA);
-    cv::putText(
-        img, "blue: A* + waypoints   red: robot   orange: people   green: start   star: goal",
-        cv::Point(8, 33), cv::FONT_HERSHEY_SIMPLEX, 0.42, cv::Scalar(60, 60, 60), 1, cv::LINE_AA);
+    nav::drawTitleBand(
+        img, os.str(),
+        "blue: A* + waypoints   red: robot   orange: people   green: start   star: goal");
     if (!cv::imwrite(path, img)) throw std::runtime_error("writeEpisodePng: cannot write " + path);
 }
 
