@@ -532,8 +532,8 @@ TEST(Scenario, ShippedFilesLoadAndTyposAreReported) {
             EXPECT_TRUE(sc.n_frames >= 600 && sc.n_frames <= 900) << name << ": 20-30 s at 30 Hz";
         ++n;
     }
-    EXPECT_EQ(n, 7u);  // walking_xyz, sitting_xyz, walking_static, walking_halfsphere,
-                       // walking_towards, short_walking, sitting_bare
+    EXPECT_EQ(n, 8u);  // walking_xyz, sitting_xyz, walking_static, walking_halfsphere,
+                       // walking_towards, walking_rpy, short_walking, sitting_bare
     TempDir tmp;
     const std::string room = "room            = office_room.ini";
     const auto withEdit = [&](std::string s, const std::string& from, const std::string& to) {
