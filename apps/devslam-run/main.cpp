@@ -288,7 +288,7 @@ int runBench(const Args& a) {
         auto src = io::openRgbd(a.input, l.reader);
         run::ReplayReader reader(*src, kPasses);
         auto rc = runConfig(a, l, "dynamic");
-        rc.max_frames = 0;  // every replayed frame
+        rc.max_frames = 0;       // every replayed frame
         rc.score_masks = false;  // replayed: timestamps are not the truth's
         const auto rep = run::runSequence(reader, rc, *l.cfg, *l.filter_cfg);
         mem << "\nLong run (memory): the input replayed forward/backward " << kPasses

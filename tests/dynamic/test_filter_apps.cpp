@@ -37,8 +37,8 @@ TEST(DevslamOverlay, WritesOneOverlayPerFrame) {
     EXPECT_EQ(img.cols, 640);
     EXPECT_EQ(img.rows, 480);
 
-    r = runApp("devslam-overlay", "--input synthetic:static --frames 6 --every 2 --out " +
-                                      d.str("b"));
+    r = runApp("devslam-overlay",
+               "--input synthetic:static --frames 6 --every 2 --out " + d.str("b"));
     ASSERT_EQ(r.rc, 0) << r.out;
     EXPECT_EQ(pngsIn(d.str("b")), 3);
 }
@@ -47,10 +47,9 @@ TEST(DevslamOverlay, WritesOneOverlayPerFrame) {
 TEST(DevslamOverlay, RunsOnTheShippedTumFramesThroughASlamIni) {
     devslam::test::TempDir d("devslam_overlay_");
     const std::string root = DEVSLAM_SOURCE_DIR;
-    const auto r = runApp("devslam-overlay", "--input " + root +
-                                                 "/data/tum/fr1_xyz_first37 --frames 3 --config " +
-                                                 root + "/config_ini/slam_tum_fr1.ini --out " +
-                                                 d.str());
+    const auto r = runApp("devslam-overlay",
+                          "--input " + root + "/data/tum/fr1_xyz_first37 --frames 3 --config " +
+                              root + "/config_ini/slam_tum_fr1.ini --out " + d.str());
     ASSERT_EQ(r.rc, 0) << r.out;
     EXPECT_EQ(pngsIn(d.str()), 3);
 }

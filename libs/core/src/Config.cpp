@@ -128,7 +128,8 @@ std::unique_ptr<mrpt::config::CConfigFileMemory> loadFilterConfig(const std::str
     const auto ini = loadIni(path);
     // A SLAM INI's own sections are devslam-run's to check; loadFilterIni checks the file
     // its [run] filter_config names.
-    if (!ini->sectionExists("run")) requireKnownSections(*ini, {"detector", "dynamic_filter"}, path);
+    if (!ini->sectionExists("run"))
+        requireKnownSections(*ini, {"detector", "dynamic_filter"}, path);
     auto out = loadFilterIni(*ini, path);
     if (!out->sectionExists("detector") && !out->sectionExists("dynamic_filter"))
         throw std::invalid_argument(path +

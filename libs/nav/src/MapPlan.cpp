@@ -90,8 +90,8 @@ void writeMapPlanPng(const mrpt::maps::COccupancyGridMap2D& grid, const MapPlan&
     os << title << ": ";
     if (plan.path)
         os << "path " << plan.path->length << " m, " << plan.waypoints.size()
-           << (plan.waypoints.size() == 1 ? " waypoint" : " waypoints") << ", clearance >= "
-           << plan.min_clearance << " m";
+           << (plan.waypoints.size() == 1 ? " waypoint" : " waypoints")
+           << ", clearance >= " << plan.min_clearance << " m";
     else
         os << "no path";
     drawTitleBand(img, os.str(),

@@ -23,7 +23,8 @@ void drawRoute(cv::Mat& img, const ToPixel& px, const std::vector<mrpt::math::TP
     std::vector<cv::Point> pts;
     for (const auto& q : route) pts.push_back(px(q));
     if (pts.size() >= 2) cv::polylines(img, pts, false, kRouteColour, 2, cv::LINE_AA);
-    for (const auto& q : waypoints) cv::circle(img, px(q), 4, kRouteColour, cv::FILLED, cv::LINE_AA);
+    for (const auto& q : waypoints)
+        cv::circle(img, px(q), 4, kRouteColour, cv::FILLED, cv::LINE_AA);
 }
 
 void drawStartGoal(cv::Mat& img, const ToPixel& px, const mrpt::math::TPoint2D& start,
@@ -35,8 +36,8 @@ void drawStartGoal(cv::Mat& img, const ToPixel& px, const mrpt::math::TPoint2D& 
 void drawTitleBand(cv::Mat& img, const std::string& title, const std::string& legend) {
     cv::rectangle(img, cv::Point(0, 0), cv::Point(img.cols, kTitleBandHeight - 1),
                   cv::Scalar(250, 250, 250), cv::FILLED);
-    cv::putText(img, title, cv::Point(8, 16), cv::FONT_HERSHEY_SIMPLEX, 0.48, cv::Scalar(0, 0, 0), 1,
-                cv::LINE_AA);
+    cv::putText(img, title, cv::Point(8, 16), cv::FONT_HERSHEY_SIMPLEX, 0.48, cv::Scalar(0, 0, 0),
+                1, cv::LINE_AA);
     cv::putText(img, legend, cv::Point(8, 33), cv::FONT_HERSHEY_SIMPLEX, 0.38,
                 cv::Scalar(60, 60, 60), 1, cv::LINE_AA);
 }

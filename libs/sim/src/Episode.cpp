@@ -156,8 +156,8 @@ void writeEpisodePng(const WorldSpec& w, const EpisodeResult& r, const std::stri
                             : o.kind == "wall" ? cv::Scalar(70, 70, 70)
                                                : cv::Scalar(110, 110, 140);
         if (o.shape == Obstacle::Shape::Cylinder) {
-            cv::circle(img, px({o.cx, o.cy}), static_cast<int>(o.radius * ppm), colour,
-                       cv::FILLED, cv::LINE_AA);
+            cv::circle(img, px({o.cx, o.cy}), static_cast<int>(o.radius * ppm), colour, cv::FILLED,
+                       cv::LINE_AA);
             continue;
         }
         std::vector<cv::Point> poly;
