@@ -120,7 +120,8 @@ Loaded loadConfig(const Args& a, const std::vector<std::string>& extra_sets = {}
     std::vector<std::string> sections = slam::SlamOptions::sections();
     sections.insert(sections.end(), {"run", "dataset", "grid_map"});
     std::vector<std::string> with_filter = sections;
-    with_filter.insert(with_filter.end(), {"detector", "dynamic_filter"});
+    with_filter.insert(with_filter.end(), core::filterSections().begin(),
+                       core::filterSections().end());
     core::requireKnownSections(
         *l.cfg, l.cfg->read_string("run", "filter_config", "").empty() ? with_filter : sections,
         a.config);

@@ -109,6 +109,11 @@ std::string filterIniPath(const mrpt::config::CConfigFileBase& cfg, const std::s
                                         : (fs::path(path).parent_path() / fc).string();
 }
 
+const std::vector<std::string>& filterSections() {
+    static const std::vector<std::string> sections{"detector", "dynamic_filter"};
+    return sections;
+}
+
 std::unique_ptr<mrpt::config::CConfigFileMemory> loadFilterIni(
     const mrpt::config::CConfigFileBase& cfg, const std::string& path) {
     const std::string fc = cfg.read_string("run", "filter_config", "");
@@ -117,7 +122,7 @@ std::unique_ptr<mrpt::config::CConfigFileMemory> loadFilterIni(
         throw std::runtime_error(path + " [run] filter_config: no such file '" + file + "'");
     auto out = loadIni(file);
     // A file of its own holds only the filter's sections (else the SLAM INI's check covers it).
-    if (!fc.empty()) requireKnownSections(*out, {"detector", "dynamic_filter"}, file);
+    if (!fc.empty()) requireKnownSections(*out, filterSections(), file);
     applyOverrides(*out, overrideItems(cfg.read_string("run", "filter_overrides", ""),
                                        path + " [run] filter_overrides"),
                    path + " [run] filter_overrides item");
@@ -128,8 +133,7 @@ std::unique_ptr<mrpt::config::CConfigFileMemory> loadFilterConfig(const std::str
     const auto ini = loadIni(path);
     // A SLAM INI's own sections are devslam-run's to check; loadFilterIni checks the file
     // its [run] filter_config names.
-    if (!ini->sectionExists("run"))
-        requireKnownSections(*ini, {"detector", "dynamic_filter"}, path);
+    if (!ini->sectionExists("run")) requireKnownSections(*ini, filterSections(), path);
     auto out = loadFilterIni(*ini, path);
     if (!out->sectionExists("detector") && !out->sectionExists("dynamic_filter"))
         throw std::invalid_argument(path +

@@ -73,6 +73,8 @@ void applyOverrides(mrpt::config::CConfigFileMemory& cfg, const std::vector<std:
 /// applied. Throws naming the file when it cannot be read or an override is malformed.
 [[nodiscard]] std::unique_ptr<mrpt::config::CConfigFileMemory> loadFilterIni(
     const mrpt::config::CConfigFileBase& cfg, const std::string& path);
+/// The sections a filter INI holds: [detector] and [dynamic_filter].
+[[nodiscard]] const std::vector<std::string>& filterSections();
 /// The filter's INI named on a command line (`--config` of devslam-overlay and
 /// devslam-filter-bench): a filter INI, which may hold only [detector] and [dynamic_filter],
 /// or a SLAM INI (one with [run]), read through loadFilterIni. Throws naming the file when a
