@@ -354,6 +354,57 @@ TEST(RenderSequence, RenderTxtTellsWhetherAFolderHoldsThisRender) {
     EXPECT_FALSE(isRenderCurrent(sc, o));
 }
 
+// A seated person who moves a hand: the labelled pixels follow the hand (they differ between
+// the swing's two extremes only near the hand, and lie on the photo's plane), the person stays
+// static in the truth, and a person whose gesture_deg is 0 renders exactly as one without.
+TEST(RenderSequence, GesturingHandIsRenderedAndLabelled) {
+    Scenario sc = bareRoom({0.6, 2, 1.3}, {3, 2, 1.0});
+    sc.n_frames = 4;
+    sc.rate_hz = 1.0;  // frame 1: the hand at +gesture_deg, frame 3: at -gesture_deg
+    PersonSpec p;
+    p.name = "person_1";
+    p.kind = PersonKind::Sitting;
+    p.texture = kRoot + "/data/textures/person_standing.png";
+    p.path = {{3, 2}};
+    p.sway_deg = 0;
+    p.gesture_deg = 20;
+    p.gesture_period = 4;
+    p.gesture_region = {0.72, 0.18, 1.0, 0.62};
+    p.gesture_pivot = {0.8, 0.2};
+    sc.people = {p};
+    SequenceRenderer r(sc);
+    const auto a = r.render(1), b = r.render(3);
+    ASSERT_EQ(a.persons.size(), 1u);
+    EXPECT_FALSE(a.persons[0].moving);
+    ASSERT_GT(a.persons[0].visible_pixels, 500);
+    const cv::Mat la = a.labels == 1, lb = b.labels == 1, changed = la ^ lb;
+    const int n_changed = cv::countNonZero(changed);
+    EXPECT_GT(n_changed, 20) << "the hand moved";
+    EXPECT_LT(n_changed, a.persons[0].visible_pixels / 3) << "the body did not";
+    // Every changed pixel lies in the right third of the person's box (the hand's side as
+    // the camera sees it: the texture's right columns), and within the gesture's rows.
+    const cv::Rect box = a.persons[0].box | b.persons[0].box;
+    const cv::Rect changed_box = cv::boundingRect(changed);
+    EXPECT_GE(changed_box.x, box.x + box.width / 2) << changed_box << " in " << box;
+    EXPECT_LE(changed_box.y + changed_box.height, box.y + int(0.7 * box.height));
+    // Labels agree with the rendered colour: the hand's pixels show the photo, not the wall
+    // (the depth of labelled pixels is the photo's, about 2.4 m away).
+    for (const auto* f : {&a, &b}) {
+        const cv::Scalar z = cv::mean(f->clean_depth, f->labels == 1);
+        EXPECT_NEAR(z[0], 2.4, 0.1);
+    }
+    // No gesture: the very same images with or without the region keys.
+    sc.people[0].gesture_deg = 0;
+    SequenceRenderer still(sc);
+    Scenario plain = sc;
+    plain.people[0].gesture_region.setZero();
+    plain.people[0].gesture_pivot.setZero();
+    SequenceRenderer plain_r(plain);
+    const auto s1 = still.render(1), s2 = plain_r.render(1);
+    EXPECT_EQ(cv::norm(s1.frame.bgr, s2.frame.bgr, cv::NORM_INF), 0.0);
+    EXPECT_EQ(cv::countNonZero(s1.labels != s2.labels), 0);
+}
+
 // The walking person of the short scenario: moving, visible, and the labelled pixels lie at
 // the person's distance from the camera.
 TEST(RenderSequence, PersonTruthIsConsistent) {
@@ -486,6 +537,45 @@ TEST(PersonMotion, PhotoSwaysAboutItsPivotAndFacesTheCamera) {
         const double moved = (world(swayed, 0, 1.7) - world(still, 0, 1.7)).norm();
         EXPECT_NEAR(moved, 2 * (1.7 - pivot) * std::sin(2 * kPi / 180), 1e-9) << pivot;
     }
+}
+
+// The hand (the gesture region's cells) turns in the photo's plane about its pivot: the pivot
+// stays where it is, a point 0.3 m below it moves by 2 * 0.3 * sin(amplitude) between the
+// two extremes, and the hand's plane is the photo's, 5 mm towards the viewer.
+TEST(PersonMotion, HandSwingsAboutItsPivotInThePhotosPlane) {
+    PersonSpec p;
+    p.kind = PersonKind::Sitting;
+    p.path = {{3, 2}};
+    p.height = 1.6;
+    p.gesture_deg = 12;
+    p.gesture_period = 2.0;
+    p.gesture_region = {0.7, 0.2, 1.0, 0.6};
+    p.gesture_pivot = {0.8, 0.25};
+    const double width = 0.6;
+    const Eigen::Vector3d pivot(width / 2 - 0.8 * width, 0.0, 1.6 - 0.25 * 1.6);
+    const auto local = [](const mrpt::poses::CPose3D& P, const Eigen::Vector3d& q) {
+        double x = 0, y = 0, z = 0;
+        P.composePoint(q.x(), q.y(), q.z(), x, y, z);
+        return Eigen::Vector3d(x, y, z);
+    };
+    const auto at = [&](double t) { return gestureLocalPose(p, personStateAt(p, t), width); };
+    const auto up = at(0.5), down = at(1.5), rest = at(0.0);
+    EXPECT_NEAR(personStateAt(p, 0.5).gesture, 12 * kPi / 180, 1e-12);
+    for (const auto& P : {up, down, rest}) {
+        EXPECT_LT((local(P, pivot) - pivot - Eigen::Vector3d(0, 0.005, 0)).norm(), 1e-12);
+        const auto R = P.getRotationMatrix();
+        EXPECT_NEAR(R(1, 1), 1.0, 1e-12) << "the hand stays in the photo's plane";
+    }
+    const Eigen::Vector3d below = pivot - Eigen::Vector3d(0, 0, 0.3);
+    EXPECT_LT((local(rest, below) - below - Eigen::Vector3d(0, 0.005, 0)).norm(), 1e-12);
+    EXPECT_NEAR((local(up, below) - local(down, below)).norm(), 2 * 0.3 * std::sin(12 * kPi / 180),
+                1e-9);
+    // Walkers may gesture too; without gesture_deg nobody does.
+    p.kind = PersonKind::Walking;
+    p.path = {{3, 2}, {3, 4}};
+    EXPECT_NEAR(personStateAt(p, 0.5).gesture, 12 * kPi / 180, 1e-12);
+    p.gesture_deg = 0;
+    EXPECT_EQ(personStateAt(p, 0.5).gesture, 0.0);
 }
 
 // A seated person keeps the yaw of the first frame wherever the camera goes (rigid apart from
@@ -626,6 +716,24 @@ TEST(Scenario, ShippedFilesLoadAndTyposAreReported) {
     expectMessage(
         [&] { (void)loadScenario(withEdit(text, "n_frames        = 60", "n_frames = 60x")); },
         tmp.str("s.ini") + " [scenario] n_frames: expected an integer, got '60x'");
+    // A gesture needs its region and pivot, as fractions of the photo.
+    (void)withEdit(text, "n_frames", "n_frames");  // s.ini (= base) as it was
+    const auto gesture = [&](const std::string& region, const std::string& pivot) {
+        std::vector<std::string> items = {"person_2.gesture_deg=10"};
+        if (!region.empty()) items.push_back("person_2.gesture_region=" + region);
+        if (!pivot.empty()) items.push_back("person_2.gesture_pivot=" + pivot);
+        return loadScenario(base, items);
+    };
+    EXPECT_DOUBLE_EQ(gesture("[0.7,0.2,1,0.6]", "[0.8,0.2]").people.at(1).gesture_region[2], 1.0);
+    expectMessage([&] { (void)gesture("", "[0.8,0.2]"); }, "gesture_region");
+    expectMessage([&] { (void)gesture("[0.7,0.2,0.6,0.6]", "[0.8,0.2]"); },
+                  "[person_2] gesture_region: must be [left top right bottom]");
+    expectMessage([&] { (void)gesture("[0.7,0.2,1,0.6]", "[0.8]"); },
+                  "gesture_pivot: expected 2 numbers, got 1");
+    expectMessage([&] { (void)gesture("[0.7,0.2,1,0.6]", "[0.8,1.2]"); },
+                  "[person_2] gesture_pivot: must be [across down]");
+    expectMessage([&] { (void)loadScenario(base, {"person_2.gesture_period=0"}); },
+                  "[person_2] gesture_period: must be > 0 [s]");
     // room_set: written over the room file's [room] and [box_*] settings, checked like them.
     const auto withRoomSet = [&](const std::string& items) {
         return withEdit(text, "n_frames        = 60", "n_frames = 60\nroom_set = " + items);
@@ -663,7 +771,17 @@ TEST(Scenario, SittingBareBlursTheOfficeRoomsFurniture) {
         EXPECT_DOUBLE_EQ(bare.room.boxes[i].blur, xyz.room.wall_blur) << bare.room.boxes[i].name;
     }
     EXPECT_DOUBLE_EQ(bare.room.wall_blur, xyz.room.wall_blur);
-    EXPECT_EQ(bare.people.size(), xyz.people.size());
+    ASSERT_EQ(bare.people.size(), xyz.people.size());
+    for (std::size_t i = 0; i < bare.people.size(); ++i) {  // the same sitters, same motion
+        const auto &a = bare.people[i], &b = xyz.people[i];
+        EXPECT_EQ(a.path, b.path);
+        EXPECT_EQ(a.sway_deg, b.sway_deg);
+        EXPECT_EQ(a.sway_period, b.sway_period);
+        EXPECT_EQ(a.gesture_deg, b.gesture_deg);
+        EXPECT_EQ(a.gesture_period, b.gesture_period);
+        EXPECT_EQ(a.gesture_region, b.gesture_region);
+        EXPECT_EQ(a.gesture_pivot, b.gesture_pivot);
+    }
 }
 
 TEST(PersonTexture, GrabCutCutsThePhotoAndCellsFollowAlpha) {

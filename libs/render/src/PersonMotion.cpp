@@ -7,6 +7,12 @@ namespace devslam::render {
 namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kStepFrequency = 1.8;  ///< walking steps per second [Hz] (vertical bob)
+constexpr double kGestureLift = 0.005;  ///< the hand's offset towards the viewer [m]
+
+double gestureAngle(const PersonSpec& p, double t) {
+    return p.gestures() ? p.gesture_deg * kPi / 180.0 * std::sin(2 * kPi * t / p.gesture_period)
+                        : 0.0;
+}
 }  // namespace
 
 PersonKind parsePersonKind(const std::string& name) {
@@ -42,6 +48,16 @@ mrpt::poses::CPose3D personPhotoPose(const PersonSpec& p, const PersonState& s,
     return {b.x() - ox, b.y() - oy, b.z() + p.sway_pivot - oz, yaw, s.sway, 0};
 }
 
+mrpt::poses::CPose3D gestureLocalPose(const PersonSpec& p, const PersonState& s, double width) {
+    // The photo's local frame has texture column 0 at +x and row 0 at z = height.
+    const double px = width / 2 - p.gesture_pivot.x() * width;
+    const double pz = p.height - p.gesture_pivot.y() * p.height;
+    const mrpt::poses::CPose3D R(0, 0, 0, 0, s.gesture, 0);
+    double ox = 0, oy = 0, oz = 0;
+    R.composePoint(px, 0, pz, ox, oy, oz);
+    return {px - ox, kGestureLift - oy, pz - oz, 0, s.gesture, 0};
+}
+
 double pathLength(const std::vector<Eigen::Vector2d>& path) {
     double L = 0;
     for (std::size_t i = 1; i < path.size(); ++i) L += (path[i] - path[i - 1]).norm();
@@ -56,6 +72,7 @@ PersonState personStateAt(const PersonSpec& p, double t) {
         s.sway = p.sway_period > 0
                      ? p.sway_deg * kPi / 180.0 * std::sin(2 * kPi * t / p.sway_period)
                      : 0.0;
+        s.gesture = gestureAngle(p, t);
         return s;
     }
     const double L = pathLength(p.path);
@@ -80,6 +97,7 @@ PersonState personStateAt(const PersonSpec& p, double t) {
         acc += len;
     }
     s.moving = p.speed > 0;
+    s.gesture = gestureAngle(p, t);
     return s;
 }
 

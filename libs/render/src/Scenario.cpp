@@ -138,7 +138,8 @@ PersonSpec loadPerson(const mrpt::config::CConfigFileBase& cfg, const std::strin
                       const std::string& path) {
     core::requireKnownKeys(cfg, s,
                            {"kind", "texture", "height", "path", "speed", "start_offset", "base_z",
-                            "sway_deg", "sway_period", "sway_pivot", "bob"},
+                            "sway_deg", "sway_period", "sway_pivot", "bob", "gesture_deg",
+                            "gesture_period", "gesture_region", "gesture_pivot"},
                            path);
     PersonSpec p;
     p.name = s;
@@ -156,6 +157,24 @@ PersonSpec loadPerson(const mrpt::config::CConfigFileBase& cfg, const std::strin
     p.sway_period = core::readDouble(cfg, s, "sway_period", p.sway_period);
     p.sway_pivot = core::readDouble(cfg, s, "sway_pivot", p.sway_pivot);
     p.bob = core::readDouble(cfg, s, "bob", p.bob);
+    p.gesture_deg = core::readDouble(cfg, s, "gesture_deg", p.gesture_deg);
+    p.gesture_period = core::readDouble(cfg, s, "gesture_period", p.gesture_period);
+    if (p.gestures()) {
+        const auto r = parseNumberList(cfg.read_string(s, "gesture_region", "", true),
+                                       where + " gesture_region", 4);
+        const auto c = parseNumberList(cfg.read_string(s, "gesture_pivot", "", true),
+                                       where + " gesture_pivot", 2);
+        p.gesture_region = {r[0], r[1], r[2], r[3]};
+        p.gesture_pivot = {c[0], c[1]};
+        const auto unit = [](double v) { return v >= 0 && v <= 1; };
+        core::requireValue(
+            unit(r[0]) && unit(r[1]) && unit(r[2]) && unit(r[3]) && r[0] < r[2] && r[1] < r[3], s,
+            "gesture_region",
+            "must be [left top right bottom], fractions of the photo in [0, 1] "
+            "with left < right and top < bottom");
+        core::requireValue(unit(c[0]) && unit(c[1]), s, "gesture_pivot",
+                           "must be [across down], fractions of the photo in [0, 1]");
+    }
     const auto xy = parseNumberList(cfg.read_string(s, "path", "", true), where + " path");
     if (xy.size() < 2 || xy.size() % 2)
         throw std::invalid_argument(where + " path: need x y pairs");
@@ -164,6 +183,9 @@ PersonSpec loadPerson(const mrpt::config::CConfigFileBase& cfg, const std::strin
                        "must be in (0.2, 3) [m]");
     core::requireValue(p.speed >= 0 && p.speed < 5, s, "speed", "must be in [0, 5) [m/s]");
     core::requireValue(p.sway_period > 0, s, "sway_period", "must be > 0 [s]");
+    core::requireValue(std::abs(p.gesture_deg) <= 90, s, "gesture_deg",
+                       "must be in [-90, 90] [deg]");
+    core::requireValue(p.gesture_period > 0, s, "gesture_period", "must be > 0 [s]");
     core::requireValue(p.sway_pivot >= 0 && p.sway_pivot <= p.height, s, "sway_pivot",
                        "must be in [0, height] [m]");
     if (p.kind == PersonKind::Walking)

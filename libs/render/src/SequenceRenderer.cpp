@@ -97,6 +97,8 @@ struct SequenceRenderer::Impl {
         PersonTexture tex;
         double width = 0, height = 0;  // [m]
         CSetOfTexturedTriangles::Ptr mesh;
+        CSetOfTexturedTriangles::Ptr hand;  // the gesture_region's cells (null: no gesture)
+        cv::Mat hand_cell;                  // CV_8UC1 like tex.cell_mask: 255 = a hand cell
     };
     std::vector<Person> people;
 
@@ -185,6 +187,19 @@ struct SequenceRenderer::Impl {
             p.mesh = CSetOfTexturedTriangles::Create();
             const auto& m = p.tex.cell_mask;
             const double tw = p.tex.bgr.cols, th = p.tex.bgr.rows, cp = p.tex.cell_px;
+            // A cell belongs to the hand when its centre lies in the gesture region.
+            p.hand_cell = cv::Mat(m.size(), CV_8UC1, cv::Scalar(0));
+            if (spec.gestures()) {
+                p.hand = CSetOfTexturedTriangles::Create();
+                const auto& g = spec.gesture_region;
+                for (int r = 0; r < m.rows; ++r)
+                    for (int c = 0; c < m.cols; ++c) {
+                        const double fc = std::min(tw, (c + 0.5) * cp) / tw;
+                        const double fr = std::min(th, (r + 0.5) * cp) / th;
+                        if (fc >= g[0] && fc <= g[2] && fr >= g[1] && fr <= g[3])
+                            p.hand_cell.at<uchar>(r, c) = 255;
+                    }
+            }
             // Local frame: x lateral, y towards the viewer, z up; texture column 0 at +x so
             // that the photo reads the right way round for a viewer on the +y side.
             for (int r = 0; r < m.rows; ++r)
@@ -194,14 +209,17 @@ struct SequenceRenderer::Impl {
                     const double r0 = r * cp, r1 = std::min(th, (r + 1) * cp);
                     const auto X = [&](double col) { return p.width / 2 - col / tw * p.width; };
                     const auto Z = [&](double row) { return p.height - row / th * p.height; };
-                    addQuad(*p.mesh, {X(c0), 0, Z(r0)}, {X(c1), 0, Z(r0)}, {X(c1), 0, Z(r1)},
-                            {X(c0), 0, Z(r1)}, float(c0 / tw), float(r0 / th), float(c1 / tw),
-                            float(r1 / th));
+                    addQuad(p.hand_cell.at<uchar>(r, c) ? *p.hand : *p.mesh, {X(c0), 0, Z(r0)},
+                            {X(c1), 0, Z(r0)}, {X(c1), 0, Z(r1)}, {X(c0), 0, Z(r1)}, float(c0 / tw),
+                            float(r0 / th), float(c1 / tw), float(r1 / th));
                 }
-            p.mesh->assignImage(toCImage(p.tex.bgr));
-            p.mesh->enableTextureLinearInterpolation(texture_linear);
-            p.mesh->enableLight(false);
-            scene->insert(p.mesh);
+            for (const auto& mesh : {p.mesh, p.hand}) {
+                if (!mesh) continue;
+                mesh->assignImage(toCImage(p.tex.bgr));
+                mesh->enableTextureLinearInterpolation(texture_linear);
+                mesh->enableLight(false);
+                scene->insert(mesh);
+            }
             people.push_back(std::move(p));
         }
     }
@@ -249,12 +267,17 @@ RenderedFrame SequenceRenderer::render(std::size_t i) {
     out.T_wc = cameraPoseAt(sc_.trajectory, t);
     const Eigen::Vector3d eye(out.T_wc.x(), out.T_wc.y(), out.T_wc.z());
 
-    std::vector<mrpt::poses::CPose3D> person_pose(sc_.people.size());
+    std::vector<mrpt::poses::CPose3D> person_pose(sc_.people.size()), hand_pose(sc_.people.size());
     std::vector<PersonState> state(sc_.people.size());
     for (std::size_t k = 0; k < sc_.people.size(); ++k) {
         state[k] = personStateAt(sc_.people[k], t);
         person_pose[k] = personPhotoPose(sc_.people[k], state[k], eye, impl_->first_eye);
-        impl_->people[k].mesh->setPose(person_pose[k]);
+        auto& person = impl_->people[k];
+        person.mesh->setPose(person_pose[k]);
+        if (person.hand) {
+            hand_pose[k] = person_pose[k] + gestureLocalPose(sc_.people[k], state[k], person.width);
+            person.hand->setPose(hand_pose[k]);
+        }
     }
 
     auto& cam = impl_->fbo->getCamera(*impl_->scene);
@@ -286,39 +309,73 @@ RenderedFrame SequenceRenderer::render(std::size_t i) {
     out.labels = cv::Mat(K.height, K.width, CV_8UC1, cv::Scalar(0));
     const auto Rwc = out.T_wc.getRotationMatrix();
     for (std::size_t k = 0; k < sc_.people.size(); ++k) {
-        const auto& P = person_pose[k];
         const auto& person = impl_->people[k];
         PersonTruth pt;
         pt.id = int(k + 1);
         pt.name = sc_.people[k].name;
         pt.moving = state[k].moving;
-        const auto Rp = P.getRotationMatrix();
-        const Eigen::Vector3d n(Rp(0, 1), Rp(1, 1), Rp(2, 1)), p0(P.x(), P.y(), P.z());
-        // Projected bounding box of the billboard's corners (whole image if one is behind).
+        // The person's planar parts: the body, and the hand in front of it when it gestures.
+        struct Part {
+            mrpt::poses::CPose3D P;
+            Eigen::Matrix3d R = Eigen::Matrix3d::Identity();  // columns: local x, y (normal), z
+            Eigen::Vector3d n = Eigen::Vector3d::Zero(), p0 = Eigen::Vector3d::Zero();
+            bool hand = false;
+        };
+        std::vector<Part> parts;
+        const auto addPart = [&](const mrpt::poses::CPose3D& P, bool hand) {
+            Part part;
+            part.P = P;
+            const auto Rp = P.getRotationMatrix();
+            for (int r = 0; r < 3; ++r)
+                for (int c = 0; c < 3; ++c) part.R(r, c) = Rp(r, c);
+            part.n = part.R.col(1);
+            part.p0 = {P.x(), P.y(), P.z()};
+            part.hand = hand;
+            parts.push_back(part);
+        };
+        if (person.hand) addPart(hand_pose[k], true);
+        addPart(person_pose[k], false);
+        // Projected bounding box of the parts' corners (whole image if one is behind).
         cv::Rect roi(0, 0, K.width, K.height);
         {
             double u0 = 1e9, v0 = 1e9, u1 = -1e9, v1 = -1e9;
             bool behind = false;
-            for (double lx : {-person.width / 2, person.width / 2})
-                for (double lz : {0.0, person.height}) {
-                    mrpt::math::TPoint3D w;
-                    P.composePoint(lx, 0, lz, w.x, w.y, w.z);
-                    mrpt::math::TPoint3D c;
-                    out.T_wc.inverseComposePoint(w, c);
-                    if (c.z < 1e-3) {
-                        behind = true;
-                        continue;
+            for (const auto& part : parts) {
+                for (double lx : {-person.width / 2, person.width / 2})
+                    for (double lz : {0.0, person.height}) {
+                        mrpt::math::TPoint3D w;
+                        part.P.composePoint(lx, 0, lz, w.x, w.y, w.z);
+                        mrpt::math::TPoint3D c;
+                        out.T_wc.inverseComposePoint(w, c);
+                        if (c.z < 1e-3) {
+                            behind = true;
+                            continue;
+                        }
+                        const double u = K.fx * c.x / c.z + K.cx, v = K.fy * c.y / c.z + K.cy;
+                        u0 = std::min(u0, u), u1 = std::max(u1, u), v0 = std::min(v0, v),
+                        v1 = std::max(v1, v);
                     }
-                    const double u = K.fx * c.x / c.z + K.cx, v = K.fy * c.y / c.z + K.cy;
-                    u0 = std::min(u0, u), u1 = std::max(u1, u), v0 = std::min(v0, v),
-                    v1 = std::max(v1, v);
-                }
+            }
             if (!behind)
                 roi &= cv::Rect(int(std::floor(u0)) - 1, int(std::floor(v0)) - 1,
                                 int(std::ceil(u1 - u0)) + 3, int(std::ceil(v1 - v0)) + 3);
         }
         const auto& m = person.tex.cell_mask;
         const double tw = person.tex.bgr.cols, th = person.tex.bgr.rows, cp = person.tex.cell_px;
+        // Pixel (u, v) at rendered depth zr along world ray dw lies on the part's solid cells.
+        const auto onPart = [&](const Part& part, const Eigen::Vector3d& dw, float zr) {
+            const double den = part.n.dot(dw);
+            if (std::abs(den) < 1e-9) return false;
+            const double s = part.n.dot(part.p0 - eye) / den;  // = depth along the optical axis
+            if (s <= 0 || std::abs(zr - s) > std::max(0.01, 0.005 * s)) return false;
+            const Eigen::Vector3d q = eye + s * dw - part.p0;
+            const double lx = part.R.col(0).dot(q), lz = part.R.col(2).dot(q);
+            const double col = (person.width / 2 - lx) / person.width * tw;
+            const double row = (person.height - lz) / person.height * th;
+            if (col < 0 || row < 0 || col >= tw || row >= th) return false;
+            const int r = int(row / cp), c = int(col / cp);
+            return m.at<uchar>(r, c) && (person.hand_cell.at<uchar>(r, c) != 0) == part.hand;
+        };
         int umin = K.width, vmin = K.height, umax = -1, vmax = -1;
         for (int v = roi.y; v < roi.y + roi.height; ++v)
             for (int u = roi.x; u < roi.x + roi.width; ++u) {
@@ -328,17 +385,9 @@ RenderedFrame SequenceRenderer::render(std::size_t i) {
                 Eigen::Vector3d dw;
                 for (int r = 0; r < 3; ++r)
                     dw[r] = Rwc(r, 0) * dc[0] + Rwc(r, 1) * dc[1] + Rwc(r, 2) * dc[2];
-                const double den = n.dot(dw);
-                if (std::abs(den) < 1e-9) continue;
-                const double s = n.dot(p0 - eye) / den;  // = depth along the optical axis
-                if (s <= 0 || std::abs(zr - s) > std::max(0.01, 0.005 * s)) continue;
-                const Eigen::Vector3d q = eye + s * dw - p0;
-                const double lx = Rp(0, 0) * q[0] + Rp(1, 0) * q[1] + Rp(2, 0) * q[2];
-                const double lz = Rp(0, 2) * q[0] + Rp(1, 2) * q[1] + Rp(2, 2) * q[2];
-                const double col = (person.width / 2 - lx) / person.width * tw;
-                const double row = (person.height - lz) / person.height * th;
-                if (col < 0 || row < 0 || col >= tw || row >= th) continue;
-                if (!m.at<uchar>(int(row / cp), int(col / cp))) continue;
+                bool hit = false;
+                for (const auto& part : parts) hit = hit || onPart(part, dw, zr);
+                if (!hit) continue;
                 out.labels.at<uchar>(v, u) = uchar(pt.id);
                 ++pt.visible_pixels;
                 umin = std::min(umin, u), umax = std::max(umax, u);

@@ -1,7 +1,8 @@
 #pragma once
 /// Scripted people: walkers follow a polyline back and forth at constant speed (with a
 /// small vertical bob); sitting/standing people stay in place with a small side sway of
-/// the torso. Pure functions of time.
+/// the torso, and any person may move a hand (a region of the photo that swings about an
+/// elbow in the photo's plane). Pure functions of time.
 ///
 /// Usage:
 ///   devslam::render::PersonSpec p; p.kind = PersonKind::Walking; p.path = {{2,1},{2,4}};
@@ -37,11 +38,20 @@ struct PersonSpec {
                                ///< (0: the whole photo sways about its bottom edge; a seated
                                ///< person's torso sways about the hips)
     double bob = 0.02;         ///< walking: vertical bob amplitude [m]
+    /// Hand motion (a gesture): the photo's cells inside gesture_region, a forearm and hand,
+    /// swing in the photo's plane about gesture_pivot. Both are given as fractions of the
+    /// photo's width (from its left edge) and height (from its top edge).
+    double gesture_deg = 0.0;                    ///< swing amplitude [deg] (0: no hand motion)
+    double gesture_period = 2.0;                 ///< [s]
+    Eigen::Vector4d gesture_region{0, 0, 0, 0};  ///< [left top right bottom], fractions
+    Eigen::Vector2d gesture_pivot{0, 0};         ///< [across down], fractions: the elbow
+    [[nodiscard]] bool gestures() const { return gesture_deg != 0.0; }
 };
 
 struct PersonState {
     Eigen::Vector3d position{0, 0, 0};  ///< bottom centre of the photo in the world [m]
     double sway = 0.0;                  ///< in-plane rotation about the sway axis [rad]
+    double gesture = 0.0;               ///< the hand's in-plane rotation about its pivot [rad]
     bool moving = false;                ///< true while the person walks
     Eigen::Vector2d velocity{0, 0};     ///< on the floor [m/s]
 };
@@ -61,6 +71,12 @@ struct PersonState {
 [[nodiscard]] mrpt::poses::CPose3D personPhotoPose(const PersonSpec& p, const PersonState& s,
                                                    const Eigen::Vector3d& eye,
                                                    const Eigen::Vector3d& first_eye);
+
+/// Pose of the hand (the cells in p.gesture_region) relative to the photo's pose, for a
+/// photo `width` x p.height metres: rotated by s.gesture about the pivot, in the photo's
+/// plane, and 5 mm in front of it so that it covers the body where it swings over it.
+[[nodiscard]] mrpt::poses::CPose3D gestureLocalPose(const PersonSpec& p, const PersonState& s,
+                                                    double width);
 
 /// Length of a polyline [m].
 [[nodiscard]] double pathLength(const std::vector<Eigen::Vector2d>& path);
