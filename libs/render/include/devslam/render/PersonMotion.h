@@ -38,13 +38,13 @@ struct PersonSpec {
                                ///< (0: the whole photo sways about its bottom edge; a seated
                                ///< person's torso sways about the hips)
     double bob = 0.02;         ///< walking: vertical bob amplitude [m]
-    /// Hand motion (a gesture): the photo's cells inside gesture_region, a forearm and hand,
-    /// swing in the photo's plane about gesture_pivot. Both are given as fractions of the
-    /// photo's width (from its left edge) and height (from its top edge).
+    /// Hand motion (a gesture): the photo's cells inside gesture_region (an arm, a hand)
+    /// swing in the photo's plane about gesture_pivot (a shoulder, an elbow). Both are given as
+    /// fractions of the photo's width (from its left edge) and height (from its top edge).
     double gesture_deg = 0.0;                    ///< swing amplitude [deg] (0: no hand motion)
     double gesture_period = 2.0;                 ///< [s]
     Eigen::Vector4d gesture_region{0, 0, 0, 0};  ///< [left top right bottom], fractions
-    Eigen::Vector2d gesture_pivot{0, 0};         ///< [across down], fractions: the elbow
+    Eigen::Vector2d gesture_pivot{0, 0};         ///< [across down], fractions
     [[nodiscard]] bool gestures() const { return gesture_deg != 0.0; }
 };
 
