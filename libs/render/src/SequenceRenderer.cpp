@@ -318,7 +318,7 @@ RenderedFrame SequenceRenderer::render(std::size_t i) {
         struct Part {
             mrpt::poses::CPose3D P;
             Eigen::Matrix3d R = Eigen::Matrix3d::Identity();  // columns: local x, y (normal), z
-            Eigen::Vector3d n = Eigen::Vector3d::Zero(), p0 = Eigen::Vector3d::Zero();
+            Eigen::Vector3d p0 = Eigen::Vector3d::Zero();
             bool hand = false;
         };
         std::vector<Part> parts;
@@ -328,7 +328,6 @@ RenderedFrame SequenceRenderer::render(std::size_t i) {
             const auto Rp = P.getRotationMatrix();
             for (int r = 0; r < 3; ++r)
                 for (int c = 0; c < 3; ++c) part.R(r, c) = Rp(r, c);
-            part.n = part.R.col(1);
             part.p0 = {P.x(), P.y(), P.z()};
             part.hand = hand;
             parts.push_back(part);
@@ -364,9 +363,10 @@ RenderedFrame SequenceRenderer::render(std::size_t i) {
         const double tw = person.tex.bgr.cols, th = person.tex.bgr.rows, cp = person.tex.cell_px;
         // Pixel (u, v) at rendered depth zr along world ray dw lies on the part's solid cells.
         const auto onPart = [&](const Part& part, const Eigen::Vector3d& dw, float zr) {
-            const double den = part.n.dot(dw);
+            const Eigen::Vector3d n = part.R.col(1);
+            const double den = n.dot(dw);
             if (std::abs(den) < 1e-9) return false;
-            const double s = part.n.dot(part.p0 - eye) / den;  // = depth along the optical axis
+            const double s = n.dot(part.p0 - eye) / den;  // = depth along the optical axis
             if (s <= 0 || std::abs(zr - s) > std::max(0.01, 0.005 * s)) return false;
             const Eigen::Vector3d q = eye + s * dw - part.p0;
             const double lx = part.R.col(0).dot(q), lz = part.R.col(2).dot(q);

@@ -1,8 +1,8 @@
 #pragma once
 /// Scripted people: walkers follow a polyline back and forth at constant speed (with a
 /// small vertical bob); sitting/standing people stay in place with a small side sway of
-/// the torso, and any person may move a hand (a region of the photo that swings about an
-/// elbow in the photo's plane). Pure functions of time.
+/// the torso, and any person may move a hand (a region of the photo that swings about a
+/// pivot in the photo's plane). Pure functions of time.
 ///
 /// Usage:
 ///   devslam::render::PersonSpec p; p.kind = PersonKind::Walking; p.path = {{2,1},{2,4}};
