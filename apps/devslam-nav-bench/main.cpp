@@ -25,6 +25,7 @@
 #include <ctime>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <random>
 #include <sstream>
 
@@ -47,6 +48,7 @@ struct Args {
     std::vector<std::string> methods{"CHolonomicVFHPlus", "CHolonomicND", "CHolonomicVFF",
                                      "CHolonomicFullEval"};
     uint32_t seed = 1;
+    std::optional<double> person_margin;  ///< [m] overrides [navigator] person_margin
 };
 
 void usage() {
@@ -57,13 +59,18 @@ void usage() {
                  "  --config FILE     navigation INI (default config_ini/nav_reactive.ini)\n"
                  "  --results FILE    RESULTS.md to update (default docs/RESULTS.md)\n"
                  "  --png-dir DIR     where PNGs go (default docs/images)\n"
-                 "  --seed S          first world seed (default 1)\n";
+                 "  --seed S          first world seed (default 1)\n"
+                 "  --person-margin M [m] overrides the INI's [navigator] person_margin\n";
 }
 
 struct Tally {
     int n = 0, success = 0, collision = 0, static_collision = 0, person_collision = 0, timeout = 0;
     std::vector<double> success_time, ratio, score;
+    std::vector<double> people_clearance;  ///< [m] each run's minimum, runs with people
 };
+
+/// A guide robot should not pass people closer than this (robot edge to person edge).
+constexpr double kPersonalSpace = 0.30;  // [m]
 
 std::string pct(int k, int n) {
     char b[32];
@@ -174,6 +181,8 @@ int main(int argc, char** argv) {
                 results_given = true;
             } else if (s == "--png-dir")
                 a.png_dir = next();
+            else if (s == "--person-margin")
+                a.person_margin = devslam::core::parseNumber(next(), "--person-margin");
             else if (s == "--seed")
                 a.seed = static_cast<uint32_t>(
                     devslam::core::parseInteger(next(), "--seed", 0, UINT32_MAX));
@@ -202,7 +211,12 @@ int main(int argc, char** argv) {
     try {
         devslam::nav::registerNavClasses();
         const auto ini = devslam::core::loadIni(a.config);
-        const auto nav_opts = devslam::nav::NavigatorOptions::fromConfig(*ini, a.config);
+        auto nav_opts = devslam::nav::NavigatorOptions::fromConfig(*ini, a.config);
+        if (a.person_margin) {
+            if (*a.person_margin < 0 || *a.person_margin > 2.0)
+                throw std::invalid_argument("--person-margin: must be in [0, 2] m");
+            nav_opts.person_margin = *a.person_margin;
+        }
         const auto cats = devslam::sim::allCategories();
         mrpt::system::createDirectory(a.png_dir);
 
@@ -244,6 +258,8 @@ int main(int argc, char** argv) {
                     t.static_collision += r.static_collisions > 0 ? 1 : 0;
                     t.person_collision += r.person_collisions > 0 ? 1 : 0;
                     t.score.push_back(score);
+                    if (!world.pedestrians.empty())
+                        t.people_clearance.push_back(r.min_clearance_people);
                     for (double s : r.step_seconds) step_ms[m].push_back(1e3 * s);
                     if (i == 0 && m == a.methods.front())
                         devslam::sim::writeEpisodePng(
@@ -265,7 +281,10 @@ int main(int argc, char** argv) {
         std::ostringstream md;
         md << "## Navigation benchmark (`devslam-nav-bench`)\n\n"
            << "Command: `devslam-nav-bench --per-category " << a.per_category << " --seed "
-           << a.seed << "` (config `config_ini/nav_reactive.ini`). " << a.per_category
+           << a.seed
+           << (a.person_margin ? " --person-margin " + num(*a.person_margin) : std::string())
+           << "` (config `config_ini/nav_reactive.ini`; people get " << num(nav_opts.person_margin)
+           << " m more room than walls, `person_margin`). " << a.per_category
            << " seeded random worlds "
            << "per category, " << a.per_category * cats.size()
            << " worlds in all, the same worlds for every method; Bullet simulation at 100 Hz, "
@@ -276,11 +295,15 @@ int main(int argc, char** argv) {
               "with OT = A* "
               "length / max speed, averaged over all runs.\n\n";
         for (size_t c = 0; c < cats.size(); c++) {
+            const bool people = devslam::sim::hasPeople(cats[c]);
             md << "### " << devslam::sim::toString(cats[c])
-               << (devslam::sim::hasPeople(cats[c]) ? " (moving people)" : " (static)") << "\n\n"
+               << (people ? " (moving people)" : " (static)") << "\n\n"
                << "| method | success | collision (static / people) | timeout | mean time to goal "
-                  "(s) "
-                  "| path / A* | score |\n|---|---|---|---|---|---|---|\n";
+                  "(s) | path / A* | score |"
+               << (people ? " closest to a person (median / min of runs, m) | runs within " +
+                                num(kPersonalSpace) + " m of a person |"
+                          : std::string())
+               << "\n|---|---|---|---|---|---|---|" << (people ? "---|---|" : "") << "\n";
             for (const auto& m : a.methods) {
                 const auto& t = tally[{static_cast<int>(c), m}];
                 const auto st = devslam::core::summarize(t.success_time);
@@ -290,8 +313,18 @@ int main(int argc, char** argv) {
                    << "/" << t.n << ") | " << pct(t.collision, t.n) << " (" << t.static_collision
                    << " / " << t.person_collision << ") | " << pct(t.timeout, t.n) << " | "
                    << (t.success_time.empty() ? "-" : num(st.mean, 1)) << " | "
-                   << (t.ratio.empty() ? "-" : num(rt.mean, 2)) << " | " << num(sc.mean, 3)
-                   << " |\n";
+                   << (t.ratio.empty() ? "-" : num(rt.mean, 2)) << " | " << num(sc.mean, 3) << " |";
+                if (people && !t.people_clearance.empty()) {
+                    const auto pc = devslam::core::summarize(t.people_clearance);
+                    const auto close =
+                        std::count_if(t.people_clearance.begin(), t.people_clearance.end(),
+                                      [](double d) { return d < kPersonalSpace; });
+                    md << " " << num(pc.median, 2) << " / " << num(pc.min, 3) << " | "
+                       << pct(static_cast<int>(close), static_cast<int>(t.people_clearance.size()))
+                       << " |";
+                } else if (people)
+                    md << " - | - |";
+                md << "\n";
             }
             md << "\n![" << devslam::sim::toString(cats[c]) << "](images/nav_bench_"
                << devslam::sim::toString(cats[c]) << ".png)\n\n";

@@ -168,6 +168,7 @@ TEST(NavConfig, EveryNavIniLoads) {
     EXPECT_EQ(o.holonomic_method, "CHolonomicVFHPlus");
     EXPECT_DOUBLE_EQ(o.nav_period, 0.1);
     EXPECT_DOUBLE_EQ(o.planner.waypoint_spacing, 1.5);
+    EXPECT_DOUBLE_EQ(o.person_margin, 0.1);
     VfhPlusOptions v;
     v.loadFromConfigFile(*cfg, "CHolonomicVFHPlus", path);
     EXPECT_GT(v.mu1, v.mu2 + v.mu3);
@@ -181,6 +182,14 @@ TEST(NavConfig, UnknownKeyIsReported) {
         FAIL();
     } catch (const std::invalid_argument& e) {
         EXPECT_NE(std::string(e.what()).find("nav_perod"), std::string::npos);
+    }
+    mrpt::config::CConfigFileMemory m;
+    m.write("navigator", "person_margin", -0.1);
+    try {
+        (void)NavigatorOptions::fromConfig(m, "x.ini");
+        FAIL() << "a negative person_margin was accepted";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("person_margin"), std::string::npos) << e.what();
     }
     // A mistyped section: its keys would all be ignored.
     mrpt::config::CConfigFileMemory s;

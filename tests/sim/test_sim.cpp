@@ -229,6 +229,59 @@ TEST(SimRobot, AdapterImplementsTheNavInterface) {
     EXPECT_TRUE(stop->isStopCmd());
 }
 
+TEST(SimRobot, PeopleGetARingOfPointsTheMarginOut) {
+    auto w = room();
+    w.pedestrians_yield = false;
+    w.laser.range = 15.0;  // every ray hits: 360 points without margin
+    Pedestrian p;
+    p.name = "p";
+    p.radius = 0.22;
+    p.speed = 0;  // stands 1.5 m ahead: its near edge at x = 3.28
+    p.path = {{3.5, 3}};
+    w.pedestrians.push_back(p);
+    Simulator sim(w);
+    ASSERT_TRUE(sim.scan().person[180]);
+    EXPECT_FALSE(sim.scan().person[0]);  // the wall behind
+    const auto sense = [&](double margin) {
+        SimRobot robot(sim, margin);
+        mrpt::maps::CSimplePointsMap pts;
+        mrpt::system::TTimeStamp ts;
+        EXPECT_TRUE(robot.senseObstacles(pts, ts));
+        return pts;
+    };
+    const auto plain = sense(0.0), ringed = sense(0.3);
+    size_t on_person = 0;
+    for (uint8_t v : sim.scan().person) on_person += v;
+    ASSERT_GT(on_person, 2u);
+    EXPECT_EQ(plain.size(), 360u);
+    EXPECT_EQ(ringed.size(), 360u + 12u * on_person);  // 12 ring points per person point
+    // The nearest sensed point ahead moves 0.3 m closer; the walls' points stay.
+    const auto nearest_ahead = [](const mrpt::maps::CSimplePointsMap& m) {
+        double best = 1e9;
+        for (size_t i = 0; i < m.size(); i++) {
+            float x, y;
+            m.getPoint(i, x, y);
+            if (std::abs(y) < 0.05 && x > 0) best = std::min(best, double(x));
+        }
+        return best;
+    };
+    EXPECT_NEAR(nearest_ahead(plain), 1.28, 0.02);
+    EXPECT_NEAR(nearest_ahead(ringed), 0.98, 0.02);
+    // A person already inside the margin: no ring point inside the robot's own disc.
+    WorldSpec near = w;
+    near.pedestrians[0].path = {{2.6, 3}};  // edge 0.13 m from the robot's edge
+    Simulator sim_near(near);
+    SimRobot robot(sim_near, 0.3);
+    mrpt::maps::CSimplePointsMap pts;
+    mrpt::system::TTimeStamp ts;
+    ASSERT_TRUE(robot.senseObstacles(pts, ts));
+    for (size_t i = 0; i < pts.size(); i++) {
+        float x, y;
+        pts.getPoint(i, x, y);
+        EXPECT_GE(std::hypot(x, y), w.robot.radius) << "point " << i;
+    }
+}
+
 TEST(RandomWorlds, SameSeedSameWorldAndAlwaysSolvable) {
     for (auto c : allCategories())
         for (uint32_t s = 1; s <= 3; s++) {

@@ -67,17 +67,20 @@ NavigatorOptions NavigatorOptions::fromConfig(const mrpt::config::CConfigFileBas
     const std::string s = "navigator";
     core::requireKnownKeys(c, s,
                            {"nav_period", "waypoint_allowed_distance", "holonomic_method",
-                            "robot_radius", "log_file", "log_directory"},
+                            "robot_radius", "person_margin", "log_file", "log_directory"},
                            source);
     o.nav_period = core::readDouble(c, s, "nav_period", o.nav_period);
     o.waypoint_allowed_distance =
         core::readDouble(c, s, "waypoint_allowed_distance", o.waypoint_allowed_distance);
     o.holonomic_method = c.read_string(s, "holonomic_method", o.holonomic_method);
     o.robot_radius = core::readDouble(c, s, "robot_radius", o.robot_radius);
+    o.person_margin = core::readDouble(c, s, "person_margin", o.person_margin);
     o.log_file = core::readBool(c, s, "log_file", o.log_file);
     o.log_directory = c.read_string(s, "log_directory", o.log_directory);
     core::requireValue(o.nav_period > 0, s, "nav_period", "must be > 0 s");
     core::requireValue(o.robot_radius > 0, s, "robot_radius", "must be > 0 m");
+    core::requireValue(o.person_margin >= 0 && o.person_margin <= 2.0, s, "person_margin",
+                       "must be in [0, 2] m");
     o.planner.loadFromConfigFile(c, "global_planner", source);
     o.replan.loadFromConfigFile(c, "replan", source);
     return o;

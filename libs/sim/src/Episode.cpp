@@ -59,7 +59,7 @@ EpisodeResult runEpisode(const WorldSpec& world, const mrpt::config::CConfigFile
     nav_opts.log_directory = opts.log_directory;
 
     Simulator sim(world);
-    SimRobot robot(sim);
+    SimRobot robot(sim, nav_opts.person_margin);
     const auto grid = rasterize(world);
     const auto statics = staticObstacles(world);
     nav::Navigator navigator(robot, nav_ini, nav_opts);

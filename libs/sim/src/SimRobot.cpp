@@ -47,10 +47,25 @@ bool SimRobot::senseObstacles(mrpt::maps::CSimplePointsMap& obstacles,
                               mrpt::system::TTimeStamp& timestamp) {
     const auto& s = sim_.scan();
     obstacles.clear();
-    for (size_t i = 0; i < s.ranges.size(); i++)
-        if (s.hit[i])
-            obstacles.insertPoint(static_cast<float>(s.ranges[i] * std::cos(s.angles[i])),
-                                  static_cast<float>(s.ranges[i] * std::sin(s.angles[i])), 0.2f);
+    // Ring points closer to the robot's centre than its edge (a person already inside the
+    // margin) are left out: they would put an obstacle inside the robot's own shape, which
+    // blocks every motion; the person's real points still stop it touching them.
+    constexpr int kRing = 12;  // chord 0.5 x margin: no gap the robot fits through
+    const double keep_out = sim_.world().robot.radius + 0.02;
+    for (size_t i = 0; i < s.ranges.size(); i++) {
+        if (!s.hit[i]) continue;
+        const double x = s.ranges[i] * std::cos(s.angles[i]);
+        const double y = s.ranges[i] * std::sin(s.angles[i]);
+        obstacles.insertPoint(static_cast<float>(x), static_cast<float>(y), 0.2f);
+        if (person_margin_ <= 0 || !s.person[i]) continue;
+        for (int k = 0; k < kRing; k++) {
+            const double a = 2 * M_PI * k / kRing;
+            const double rx = x + person_margin_ * std::cos(a);
+            const double ry = y + person_margin_ * std::sin(a);
+            if (std::hypot(rx, ry) < keep_out) continue;
+            obstacles.insertPoint(static_cast<float>(rx), static_cast<float>(ry), 0.2f);
+        }
+    }
     timestamp = mrpt::Clock::now();
     return true;
 }

@@ -224,6 +224,7 @@ struct Simulator::Impl {
         scan.angles.resize(n);
         scan.ranges.resize(n);
         scan.hit.resize(n);
+        scan.person.resize(n);
         std::normal_distribution<double> noise(0.0, L.noise_std);
         const btVector3 from(p.x, p.y, L.height);
         const int mask = btBroadphaseProxy::StaticFilter |
@@ -242,9 +243,11 @@ struct Simulator::Impl {
                     (cb.m_hitPointWorld - from).length() + (L.noise_std > 0 ? noise(rng) : 0.0);
                 scan.ranges[i] = std::clamp(r, 0.0, L.range);
                 scan.hit[i] = 1;
+                scan.person[i] = cb.m_collisionObject->getUserIndex() == kPersonTag ? 1 : 0;
             } else {
                 scan.ranges[i] = L.range;
                 scan.hit[i] = 0;
+                scan.person[i] = 0;
             }
         }
     }

@@ -4,6 +4,11 @@
 /// the rigid body, (v, w) commands through CVehicleVelCmd_DiffDriven, obstacles from the
 /// latest laser scan in the robot frame, time from the simulation clock.
 ///
+/// People get extra room: with `person_margin` > 0 every laser point on a pedestrian is
+/// surrounded by a ring of points that far out, so every holonomic method and the replanner
+/// keep that much more distance from people than from walls. (The simulator knows which
+/// body a ray hit; on the robot that knowledge would come from the person detector.)
+///
 /// Usage:
 ///   devslam::sim::SimRobot robot(sim);
 ///   mrpt::nav::CReactiveNavigationSystem nav(robot);
@@ -16,7 +21,11 @@ namespace devslam::sim {
 
 class SimRobot : public mrpt::nav::CRobot2NavInterface {
   public:
-    explicit SimRobot(Simulator& sim) : sim_(sim) { setMinLoggingLevel(mrpt::system::LVL_WARN); }
+    /// `person_margin` [m]: see above; 0 reports the scan as it is.
+    explicit SimRobot(Simulator& sim, double person_margin = 0.0)
+        : sim_(sim), person_margin_(person_margin) {
+        setMinLoggingLevel(mrpt::system::LVL_WARN);
+    }
 
     bool getCurrentPoseAndSpeeds(mrpt::math::TPose2D& pose, mrpt::math::TTwist2D& vel_global,
                                  mrpt::system::TTimeStamp& timestamp, mrpt::math::TPose2D& odometry,
@@ -46,6 +55,7 @@ class SimRobot : public mrpt::nav::CRobot2NavInterface {
 
   private:
     Simulator& sim_;
+    double person_margin_ = 0;  ///< [m]
     double nav_t0_ = 0;
     int end_events_ = 0, error_events_ = 0, blocked_events_ = 0;
 };

@@ -24,6 +24,7 @@ struct LaserScan {
     std::vector<double> angles;  ///< [rad] robot frame, increasing (right to left)
     std::vector<double> ranges;  ///< [m]
     std::vector<uint8_t> hit;    ///< 1 if the ray hit something
+    std::vector<uint8_t> person;  ///< 1 if what it hit is a pedestrian
 };
 
 struct CollisionCounts {
