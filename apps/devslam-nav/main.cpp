@@ -43,6 +43,14 @@ mrpt::math::TPoint2D parsePoint(const std::string& text, const std::string& what
             devslam::core::parseNumber(text.substr(comma + 1), what + " y")};
 }
 
+/// Pictures go here unless --png says otherwise (out/ is ignored by git, as devslam-run's).
+const std::string kDefaultDir = "out/devslam-nav";
+
+void makeParentDirectory(const std::string& file) {
+    const auto parent = std::filesystem::path(file).parent_path();
+    if (!parent.empty()) std::filesystem::create_directories(parent);
+}
+
 /// devslam-nav --map: A* and waypoints on a SLAM grid, one result line and a picture.
 int planOnSlamMap(const std::string& map, const std::string& from, const std::string& to,
                   const std::string& config, std::string png) {
@@ -52,7 +60,8 @@ int planOnSlamMap(const std::string& map, const std::string& from, const std::st
     const auto grid = devslam::nav::loadGridMap(map);
     const auto plan = devslam::nav::planOnMap(grid, parsePoint(from, "--from"),
                                               parsePoint(to, "--to"), opts);
-    if (png.empty()) png = "plan.png";
+    if (png.empty()) png = kDefaultDir + "/plan.png";
+    makeParentDirectory(png);
     devslam::nav::writeMapPlanPng(grid, plan, png, std::filesystem::path(map).filename().string());
     std::printf("map=%s from=(%.2f, %.2f) to=(%.2f, %.2f) ", map.c_str(), plan.from.x,
                 plan.from.y, plan.to.x, plan.to.y);
@@ -69,17 +78,19 @@ int planOnSlamMap(const std::string& map, const std::string& from, const std::st
 }
 
 void usage() {
-    std::cerr << "usage: devslam-nav WORLD.ini|random:CATEGORY:SEED [options]\n"
-                 "  --config FILE   navigation INI (default config_ini/nav_reactive.ini)\n"
-                 "  --method NAME   holonomic method: CHolonomicVFHPlus (default), CHolonomicND,\n"
-                 "                  CHolonomicVFF, CHolonomicFullEval\n"
-                 "  --png FILE      picture of the run (default nav_<world>.png)\n"
-                 "  --navlog DIR    also write MRPT's navlog into DIR\n"
-                 "  --verbose       MRPT navigator messages (DEBUG level)\n"
-                 "       devslam-nav --map GRIDMAP --to X,Y [--from X,Y] [--config FILE] [--png FILE]\n"
-                 "  the global route (A* and waypoints, [global_planner] of --config) on a map\n"
-                 "  devslam-run built (its map_grid.gridmap: x forward, y left, metres, the\n"
-                 "  camera's start at 0,0, the default --from); picture in --png (plan.png)\n";
+    std::cerr
+        << "usage: devslam-nav WORLD.ini|random:CATEGORY:SEED [options]\n"
+           "  --config FILE   navigation INI (default config_ini/nav_reactive.ini)\n"
+           "  --method NAME   holonomic method: CHolonomicVFHPlus (default), CHolonomicND,\n"
+           "                  CHolonomicVFF, CHolonomicFullEval\n"
+           "  --png FILE      picture of the run (default out/devslam-nav/nav_<world>.png)\n"
+           "  --navlog DIR    also write MRPT's navlog into DIR\n"
+           "  --verbose       MRPT navigator messages (DEBUG level)\n"
+           "       devslam-nav --map GRIDMAP --to X,Y [--from X,Y] [--config FILE] [--png FILE]\n"
+           "  the global route (A* and waypoints, [global_planner] of --config) on a map\n"
+           "  devslam-run built (its map_grid.gridmap: x forward, y left, metres, the\n"
+           "  camera's start at 0,0, the default --from); picture in --png\n"
+           "  (default out/devslam-nav/plan.png)\n";
 }
 }  // namespace
 
@@ -149,7 +160,8 @@ int main(int argc, char** argv) {
             eo.log_directory = navlog;
         }
         const auto r = devslam::sim::runEpisode(world, *ini, nav_opts, eo);
-        if (png.empty()) png = "nav_" + world.name + ".png";
+        if (png.empty()) png = kDefaultDir + "/nav_" + world.name + ".png";
+        makeParentDirectory(png);
         devslam::sim::writeEpisodePng(world, r, png, world.name + " / " + method);
         std::printf(
             "world=%s method=%s result=%s time=%.2f s path=%.2f m astar=%.2f m "
