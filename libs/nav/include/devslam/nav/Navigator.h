@@ -38,7 +38,7 @@ struct NavigatorOptions {
     double robot_radius = 0.25;  ///< [m] circle used for the PTG robot polygon (16 sides)
     /// [m] extra room kept from people: the robot interface surrounds each sensed point it
     /// knows to be on a person with a ring of points this far out (SimRobot; 0 = off).
-    double person_margin = 0.0;
+    double person_margin = 0.10;
     bool log_file = false;       ///< write an MRPT .reactivenavlog
     std::string log_directory = "reactivenav.logs";
     std::string ptg_cache_directory = "";  ///< "" = a folder in the system temp dir
