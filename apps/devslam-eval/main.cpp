@@ -1,5 +1,6 @@
 // devslam-eval: ATE and RPE of an estimated trajectory against ground truth, computed as
 // the TUM RGB-D benchmark tools do (evaluate_ate.py, evaluate_rpe.py --fixed_delta).
+#include <devslam/core/Parse.h>
 #include <devslam/eval/Metrics.h>
 #include <devslam/eval/Report.h>
 #include <devslam/io/TrajectoryIO.h>
@@ -27,11 +28,11 @@ options:
   --no-rpe          ATE only
 )";
 
-double number(const std::string& opt, const char* v) {
-    char* end = nullptr;
-    const double x = std::strtod(v, &end);
-    if (end == v || *end != '\0')
-        throw std::invalid_argument(opt + ": '" + v + "' is not a number");
+/// A finite number (core::parseNumber refuses "nan" and "inf"); `positive`: also > 0.
+double number(const std::string& opt, const char* v, bool positive = false) {
+    const double x = devslam::core::parseNumber(v, opt);
+    if (positive && !(x > 0))
+        throw std::invalid_argument(opt + ": must be > 0, got '" + std::string(v) + "'");
     return x;
 }
 
@@ -54,13 +55,13 @@ int main(int argc, char** argv) {
                 std::cout << kUsage;
                 return 0;
             } else if (a == "--max-dt")
-                ao.max_dt = number(a, value());
+                ao.max_dt = number(a, value(), true);
             else if (a == "--offset")
                 ao.offset = ro.offset = number(a, value());
             else if (a == "--scale")
-                ao.scale = number(a, value());
+                ao.scale = number(a, value(), true);
             else if (a == "--delta")
-                ro.delta = number(a, value());
+                ro.delta = number(a, value(), true);
             else if (a == "--delta-unit") {
                 const std::string u = value();
                 if (u != "s" && u != "f")

@@ -139,13 +139,18 @@ int main(int argc, char** argv) {
             if (i + 1 < argc && a == "--threads")
                 threads = int(devslam::core::parseInteger(argv[++i], "--threads", 1, 256));
             else if (i + 1 < argc && a == "--frames")
-                n_frames = int(devslam::core::parseInteger(argv[++i], "--frames", 2, 100000));
+                // its synthetic sequences are made in memory, whole
+                n_frames = int(devslam::core::parseInteger(argv[++i], "--frames", 2, 1000));
             else if (i + 1 < argc && a == "--results")
                 results = argv[++i];
             else if (i + 1 < argc && a == "--config")
                 filter_ini = argv[++i];
             else {
-                std::cerr << "usage: devslam-filter-bench [--threads N] [--frames N] "
+                const bool known =
+                    a == "--threads" || a == "--frames" || a == "--results" || a == "--config";
+                std::cerr << "devslam-filter-bench: "
+                          << (known ? a + " needs a value" : "unknown argument '" + a + "'")
+                          << "\nusage: devslam-filter-bench [--threads N] [--frames N] "
                              "[--config INI] [--results FILE|none]\n";
                 return 2;
             }
@@ -155,8 +160,12 @@ int main(int argc, char** argv) {
         return 2;
     }
     try {
-        // Read before the detectors' minutes of work, so a bad file stops the bench at once.
-        const auto filter_cfg = core::loadFilterConfig(filter_ini);
+        // Read, and its values checked by building the filter once, before the detectors'
+        // minutes of work, so a bad file stops the bench at once.
+        std::string filter_source;
+        const auto filter_cfg = core::loadFilterConfig(filter_ini, &filter_source);
+        core::namingSource(filter_source,
+                           [&] { (void)dynamic::makeFilterFromConfig(*filter_cfg); });
         cv::setNumThreads(threads);
         std::ostringstream md;
         md << "## Person detection and dynamic-object filter (`devslam-filter-bench`)\n\n"

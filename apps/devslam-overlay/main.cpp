@@ -143,10 +143,12 @@ int main(int argc, char** argv) {
     try {
         cv::setNumThreads(threads);
         // A filter INI, or a SLAM INI naming one ([run] filter_config, filter_overrides).
-        auto cfg = core::loadFilterConfig(config);
+        std::string filter_source;
+        auto cfg = core::loadFilterConfig(config, &filter_source);
         std::optional<dynamic::MaskMode> mode_override;
         if (!mode.empty()) mode_override = dynamic::parseMaskMode(mode);
-        auto filter = dynamic::makeFilterFromConfig(*cfg, mode_override);
+        auto filter = core::namingSource(
+            filter_source, [&] { return dynamic::makeFilterFromConfig(*cfg, mode_override); });
         fs::create_directories(out_dir);
 
         std::vector<dynamic::SyntheticFrame> synth;
@@ -154,6 +156,12 @@ int main(int argc, char** argv) {
         bool fixed_camera = false;  // video: the camera's motion is known to be the identity
         if (input.rfind("synthetic:", 0) == 0) {
             dynamic::SyntheticOptions so;
+            // The whole sequence is made in memory before the first overlay.
+            if (frames > 1000)
+                throw std::invalid_argument(
+                    "--frames: a synthetic sequence has at most 1000 "
+                    "frames, got " +
+                    std::to_string(frames));
             so.n_frames = frames > 0 ? frames : 30;
             const std::string kind = input.substr(10);
             if (kind == "walking")

@@ -17,7 +17,7 @@ class TruthMask final : public MaskSource {
     TruthMask(eval::PersonTruth truth, int margin) : truth_(std::move(truth)), margin_(margin) {}
     MaskStep step(const core::Frame& frame, const std::optional<Eigen::Isometry3d>&) override {
         MaskStep s;
-        s.mask = truth_.walkerMask(frame.timestamp, margin_);
+        s.mask = truth_.walkerMask(frame.timestamp, margin_, frame.bgr.size());
         return s;
     }
     void reset() override {}
@@ -80,16 +80,23 @@ std::unique_ptr<MaskSource> makeMaskSource(const std::string& mode,
         throw std::invalid_argument("unknown mode '" + mode +
                                     "' (known: none, all_persons, dynamic, truth)");
     if (mode == "truth") {
+#ifdef DEVSLAM_HAVE_DYNAMIC
+        // The whole section, as the other modes read it: a mistyped key is an error here too.
+        dynamic::DynamicObjectFilter::Options o;
+        o.loadFromConfig(cfg);
+        const int margin = o.mask_margin;
+#else
+        const int margin = core::readInt(cfg, "dynamic_filter", "mask_margin", 10);
+        if (margin < 0)
+            throw std::invalid_argument("[dynamic_filter] mask_margin: must be >= 0, got " +
+                                        std::to_string(margin));
+#endif
         auto truth = eval::PersonTruth::open(input);
         if (!truth)
             throw std::invalid_argument(
                 "mode 'truth' needs the renderer's person truth (persons.txt and labels/), "
                 "which '" +
                 input + "' does not have");
-        const int margin = core::readInt(cfg, "dynamic_filter", "mask_margin", 10);
-        if (margin < 0)
-            throw std::invalid_argument("[dynamic_filter] mask_margin: must be >= 0, got " +
-                                        std::to_string(margin));
         return std::make_unique<TruthMask>(std::move(*truth), margin);
     }
 #ifdef DEVSLAM_HAVE_DYNAMIC

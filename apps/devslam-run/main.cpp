@@ -132,9 +132,7 @@ Loaded loadConfig(const Args& a, const std::vector<std::string>& extra_sets = {}
                            {"mode", "filter_config", "filter_overrides", "async_filter"}, a.config);
     const bool set = !a.sets.empty() || !extra_sets.empty();
     l.config_source = a.config + (set ? " with --set" : "");
-    l.filter_source = core::filterIniPath(*l.cfg, a.config);
-    if (!l.cfg->read_string("run", "filter_overrides", "").empty())
-        l.filter_source += " with " + a.config + " [run] filter_overrides";
+    l.filter_source = core::filterSource(*l.cfg, a.config);
     if (set)
         l.filter_source +=
             l.filter_source.find(" with ") == std::string::npos ? " with --set" : " and --set";

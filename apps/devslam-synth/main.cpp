@@ -73,7 +73,7 @@ int cutTexture(const std::vector<std::string>& a) {
     if (a.size() != 4) throw std::invalid_argument("--cut-texture needs IMAGE X,Y,W,H OUT.png");
     const cv::Mat img = cv::imread(a[1], cv::IMREAD_COLOR);
     if (img.empty()) throw std::runtime_error("cannot read '" + a[1] + "'");
-    const auto v = render::parseNumberList(a[2], "--cut-texture box", 4);
+    const auto v = core::parseNumberList(a[2], "--cut-texture box", 4);
     const cv::Rect box{int(v[0]), int(v[1]), int(v[2]), int(v[3])};
     const cv::Mat rgba = render::cutPersonTexture(img, box);
     if (!cv::imwrite(a[3], rgba)) throw std::runtime_error("cannot write '" + a[3] + "'");

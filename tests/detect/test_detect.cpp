@@ -223,6 +223,22 @@ TEST(DetectHog, FindsThePersonAndNotTheDog) {
     EXPECT_TRUE(det->detect(readImage("data/images/dog.jpg")).empty());
 }
 
+// A scale that would leave no image (cv::resize asserts on it) or a huge one is refused when
+// the INI is read, naming the key.
+TEST(DetectHog, ResizeOutOfRangeIsRejected) {
+    for (const double r : {0.001, 0.0, 100.0}) {
+        mrpt::config::CConfigFileMemory cfg;
+        cfg.write("detector", "detector", std::string("hog"));
+        cfg.write("detector", "resize", r);
+        try {
+            (void)detect::makeDetector(cfg);
+            ADD_FAILURE() << "resize " << r << " was accepted";
+        } catch (const std::invalid_argument& e) {
+            EXPECT_STREQ(e.what(), "[detector] resize: must be in [0.1, 4]");
+        }
+    }
+}
+
 TEST(Detect, WrongImageTypeThrows) {
     detect::HogDetector hog({});
     EXPECT_THROW((void)hog.detect(cv::Mat(10, 10, CV_8UC1)), std::invalid_argument);

@@ -63,6 +63,12 @@ TEST(DevslamOverlay, BadInputIsNamed) {
     auto r = runApp("devslam-overlay", "--input synthetic:walking --config " + ini + out);
     EXPECT_EQ(r.rc, 1) << r.out;
     EXPECT_NE(r.out.find(ini + ": unknown section [dynamic_filtr]"), std::string::npos) << r.out;
+    // A bad value names the file it came from.
+    std::ofstream(ini) << "[detector]\ndetector = hog\n[dynamic_filter]\nlk_window = 4\n";
+    r = runApp("devslam-overlay", "--input synthetic:walking --config " + ini + out);
+    EXPECT_EQ(r.rc, 1) << r.out;
+    EXPECT_NE(r.out.find(ini + " [dynamic_filter] lk_window: must be odd"), std::string::npos)
+        << r.out;
 
     r = runApp("devslam-overlay", "--input synthetic:walking --mode moving" + out);
     EXPECT_EQ(r.rc, 1) << r.out;
@@ -75,6 +81,12 @@ TEST(DevslamOverlay, BadInputIsNamed) {
     r = runApp("devslam-overlay", "--input " + d.str("nowhere") + out);
     EXPECT_EQ(r.rc, 1) << r.out;
     EXPECT_NE(r.out.find("nowhere"), std::string::npos) << r.out;
+
+    r = runApp("devslam-overlay", "--input synthetic:walking --frames 5000" + out);
+    EXPECT_EQ(r.rc, 1) << r.out;
+    EXPECT_NE(r.out.find("--frames: a synthetic sequence has at most 1000 frames"),
+              std::string::npos)
+        << r.out;
 
     r = runApp("devslam-overlay", "--input synthetic:walking --every 0" + out);
     EXPECT_EQ(r.rc, 2) << r.out;
@@ -93,6 +105,14 @@ TEST(DevslamFilterBench, BadConfigStopsItBeforeAnyWork) {
     EXPECT_NE(r.out.find(ini + ": unknown section [detectr]"), std::string::npos) << r.out;
     std::ifstream in(results);
     EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), "# Results\n");
+    // So does a bad value, named with its file.
+    std::ofstream(ini) << "[detector]\ndetector = hog\n[dynamic_filter]\nlk_window = 4\n";
+    r = runApp("devslam-filter-bench", "--config " + ini + " --results " + results);
+    EXPECT_EQ(r.rc, 1) << r.out;
+    EXPECT_NE(r.out.find(ini + " [dynamic_filter] lk_window: must be odd"), std::string::npos)
+        << r.out;
+    std::ifstream in2(results);
+    EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in2), {}), "# Results\n");
 
     std::ofstream(ini) << "[run]\nfilter_config = nowhere.ini\n";
     r = runApp("devslam-filter-bench", "--config " + ini);
@@ -102,4 +122,8 @@ TEST(DevslamFilterBench, BadConfigStopsItBeforeAnyWork) {
     r = runApp("devslam-filter-bench", "--frames 1");
     EXPECT_EQ(r.rc, 2) << r.out;
     EXPECT_NE(r.out.find("--frames"), std::string::npos) << r.out;
+    r = runApp("devslam-filter-bench", "--threads");
+    EXPECT_EQ(r.rc, 2) << r.out;
+    EXPECT_NE(r.out.find("devslam-filter-bench: --threads needs a value"), std::string::npos)
+        << r.out;
 }

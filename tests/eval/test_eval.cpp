@@ -251,6 +251,21 @@ TEST(Report, TableJsonPlotAndApp) {
     std::ifstream err(dir / "err.txt");
     const std::string msg((std::istreambuf_iterator<char>(err)), std::istreambuf_iterator<char>());
     EXPECT_NE(msg.find("bad.txt line 1: expected"), std::string::npos) << msg;
+    // Options that are no number, or no usable one, are named ("inf" would associate every
+    // pose with every other).
+    for (const auto& [opt, says] : std::vector<std::pair<std::string, std::string>>{
+             {"--max-dt inf", "--max-dt: expected a number, got 'inf'"},
+             {"--scale nan", "--scale: expected a number, got 'nan'"},
+             {"--max-dt 0", "--max-dt: must be > 0, got '0'"},
+             {"--delta -1", "--delta: must be > 0, got '-1'"}}) {
+        const std::string c = std::string(DEVSLAM_BIN_DIR) + "/devslam-eval " +
+                              (dir / "gt.txt").string() + " " + (dir / "est.txt").string() + " " +
+                              opt + " > /dev/null 2> " + (dir / "err.txt").string();
+        EXPECT_NE(std::system(c.c_str()), 0) << opt;
+        std::ifstream e(dir / "err.txt");
+        const std::string m((std::istreambuf_iterator<char>(e)), std::istreambuf_iterator<char>());
+        EXPECT_NE(m.find(says), std::string::npos) << opt << ": " << m;
+    }
     std::filesystem::remove_all(dir);
 }
 
@@ -331,6 +346,17 @@ TEST(MaskScore, PersonTruthOfAFolder) {
     EXPECT_EQ(s.moving_masked, 0u);
     EXPECT_THROW(truth->score(cv::Mat(), 2.0, 1, s), std::runtime_error);  // no entry
     EXPECT_THROW((void)truth->walkerMask(2.0, 0), std::runtime_error);
+    // Labels of another size than the frame: named, not an OpenCV size assertion.
+    try {
+        truth->score(cv::Mat(30, 20, CV_8UC1, cv::Scalar(0)), 1.0, 1, s);
+        ADD_FAILURE() << "no error";
+    } catch (const std::runtime_error& e) {
+        EXPECT_NE(std::string(e.what()).find("labels/1.000000.png' are 20x20, the frame is 20x30"),
+                  std::string::npos)
+            << e.what();
+    }
+    EXPECT_THROW((void)truth->walkerMask(1.0, 0, cv::Size(20, 30)), std::runtime_error);
+    EXPECT_EQ(truth->walkerMask(1.0, 0, cv::Size(20, 20)).size(), cv::Size(20, 20));
     {
         std::ofstream p(dir / "persons.txt");
         p << "1.0 1 p walking 0 0 10 10 100\n";  // bad state

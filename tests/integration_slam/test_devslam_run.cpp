@@ -103,6 +103,10 @@ TEST(DevslamRun, BadInputIsReported) {
     EXPECT_EQ(r.rc, 1);
     EXPECT_NE(r.out.find("needs the renderer's person truth"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("fr1_xyz_first37"), std::string::npos) << r.out;
+    // it reads [dynamic_filter] as the other modes do: a mistyped key is named
+    r = run("--set dynamic_filter.mask_margn=3 --mode truth --quiet --out ''");
+    EXPECT_EQ(r.rc, 1);
+    EXPECT_NE(r.out.find("[dynamic_filter]: unknown key 'mask_margn'"), std::string::npos) << r.out;
     r = run("--frobnicate");
     EXPECT_EQ(r.rc, 1);
     EXPECT_NE(r.out.find("usage"), std::string::npos);

@@ -189,7 +189,25 @@ TEST(NavConfig, UnknownKeyIsReported) {
         (void)NavigatorOptions::fromConfig(m, "x.ini");
         FAIL() << "a negative person_margin was accepted";
     } catch (const std::invalid_argument& e) {
-        EXPECT_NE(std::string(e.what()).find("person_margin"), std::string::npos) << e.what();
+        EXPECT_STREQ(e.what(), "x.ini [navigator] person_margin: must be in [0, 2] m");
+    }
+    // Values of the planner's and the replanner's sections, and MRPT's ref_distance, name the
+    // file as well.
+    mrpt::config::CConfigFileMemory g;
+    g.write("global_planner", "robot_radius", -1.0);
+    try {
+        (void)NavigatorOptions::fromConfig(g, "x.ini");
+        FAIL() << "a negative robot_radius was accepted";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_STREQ(e.what(), "x.ini [global_planner] robot_radius: must be > 0 m");
+    }
+    mrpt::config::CConfigFileMemory r;
+    r.write("CAbstractPTGBasedReactive", "ref_distance", 0.0);
+    try {
+        (void)NavigatorOptions::fromConfig(r, "x.ini");
+        FAIL() << "ref_distance 0 was accepted";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_STREQ(e.what(), "x.ini [CAbstractPTGBasedReactive] ref_distance: must be > 0 m");
     }
     // A mistyped section: its keys would all be ignored.
     mrpt::config::CConfigFileMemory s;

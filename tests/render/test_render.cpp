@@ -734,6 +734,15 @@ TEST(Scenario, ShippedFilesLoadAndTyposAreReported) {
                   "[person_2] gesture_pivot: must be [across down]");
     expectMessage([&] { (void)loadScenario(base, {"person_2.gesture_period=0"}); },
                   "[person_2] gesture_period: must be > 0 [s]");
+    // The camera's sections name the file too, and are checked when loaded, not at the render.
+    expectMessage([&] { (void)loadScenario(base, {"trajectory.typ=xyz"}); },
+                  tmp.str("s.ini") + " [trajectory]: unknown key 'typ'");
+    expectMessage([&] { (void)loadScenario(base, {"trajectory.look_at=[0.6 2.5 0.2]"}); },
+                  tmp.str("s.ini") + " [trajectory] look_at: straight above or below position");
+    expectMessage([&] { (void)loadScenario(base, {"camera.dist=[0 0 x 0 0]"}); },
+                  tmp.str("s.ini") + " [camera] dist: 'x' is not a number");
+    expectMessage([&] { (void)loadScenario(base, {"camera.dist=[0 0 0 0]"}); },
+                  "[camera] dist: must have 5 values");
     // room_set: written over the room file's [room] and [box_*] settings, checked like them.
     const auto withRoomSet = [&](const std::string& items) {
         return withEdit(text, "n_frames        = 60", "n_frames = 60\nroom_set = " + items);

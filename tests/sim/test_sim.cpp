@@ -88,6 +88,23 @@ TEST(World, BadEntriesNameTheKey) {
     } catch (const std::invalid_argument& e) {
         EXPECT_STREQ(e.what(), "w.ini [world] timeout: expected a number, got '12x'");
     }
+    // "nan" and "inf" read as numbers, and a NaN passes every range check after: refused.
+    const std::string head =
+        "[world]\nx_min=0\nx_max=5\ny_min=0\ny_max=5\n[robot]\nstart_x=1\nstart_y=1\n"
+        "[goal]\nx=4\ny=4\n";
+    for (const auto& [entry, says] : std::vector<std::pair<std::string, std::string>>{
+             {"[obstacles]\nb = box nan 2 0.5 0.5 0\n",
+              "w.ini [obstacles] b: 'nan' is not a finite number"},
+             {"[pedestrians]\np = random 0.5 0.2 0 inf 2\n",
+              "w.ini [pedestrians] p: 'inf' is not a finite number"}}) {
+        const mrpt::config::CConfigFileMemory c2(head + entry);
+        try {
+            (void)parseWorld(c2, "w.ini");
+            ADD_FAILURE() << entry << " was accepted";
+        } catch (const std::invalid_argument& e) {
+            EXPECT_STREQ(e.what(), says.c_str());
+        }
+    }
     // The simulator's seed is 32 bits: a larger one is an error, not silently cut.
     const mrpt::config::CConfigFileMemory big(
         "[world]\nx_min=0\nx_max=5\ny_min=0\ny_max=5\nseed = 4294967296\n[robot]\nstart_x=1\n"

@@ -1,5 +1,6 @@
 #include <devslam/core/Camera.h>
 #include <devslam/core/Config.h>
+#include <devslam/core/Parse.h>
 
 #include <mrpt/config/CConfigFileBase.h>
 #include <mrpt/img/TCamera.h>
@@ -68,10 +69,13 @@ CameraIntrinsics CameraIntrinsics::fromConfig(const mrpt::config::CConfigFileBas
     K.cy = core::readDouble(c, s, "cy", K.cy, !has_preset);
     K.width = core::readInt(c, s, "width", K.width);
     K.height = core::readInt(c, s, "height", K.height);
-    std::vector<double> d(K.dist.begin(), K.dist.end());
-    c.read_vector(s, "dist", d, d);
-    requireValue(d.size() == 5, s, "dist", "must have 5 values k1 k2 p1 p2 k3");
-    std::copy(d.begin(), d.end(), K.dist.begin());
+    // Not MRPT's read_vector: its std::stod says only "stod" for "0 x 0" and reads "0.1x" as 0.1.
+    const std::string dist_text = c.read_string(s, "dist", "");
+    if (!dist_text.empty()) {
+        const auto d = parseNumberList(dist_text, "[" + s + "] dist");
+        requireValue(d.size() == 5, s, "dist", "must have 5 values k1 k2 p1 p2 k3");
+        std::copy(d.begin(), d.end(), K.dist.begin());
+    }
     requireValue(K.fx > 0 && K.fy > 0, s, "fx/fy", "must be > 0");
     requireValue(K.width > 0 && K.height > 0, s, "width/height", "must be > 0");
     requireValue(K.cx >= 0 && K.cx < K.width && K.cy >= 0 && K.cy < K.height, s, "cx/cy",

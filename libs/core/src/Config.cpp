@@ -109,6 +109,13 @@ std::string filterIniPath(const mrpt::config::CConfigFileBase& cfg, const std::s
                                         : (fs::path(path).parent_path() / fc).string();
 }
 
+std::string filterSource(const mrpt::config::CConfigFileBase& cfg, const std::string& path) {
+    std::string s = filterIniPath(cfg, path);
+    if (!cfg.read_string("run", "filter_overrides", "").empty())
+        s += " with " + path + " [run] filter_overrides";
+    return s;
+}
+
 const std::vector<std::string>& filterSections() {
     static const std::vector<std::string> sections{"detector", "dynamic_filter"};
     return sections;
@@ -129,8 +136,10 @@ std::unique_ptr<mrpt::config::CConfigFileMemory> loadFilterIni(
     return out;
 }
 
-std::unique_ptr<mrpt::config::CConfigFileMemory> loadFilterConfig(const std::string& path) {
+std::unique_ptr<mrpt::config::CConfigFileMemory> loadFilterConfig(const std::string& path,
+                                                                  std::string* source) {
     const auto ini = loadIni(path);
+    if (source) *source = filterSource(*ini, path);
     // A SLAM INI's own sections are devslam-run's to check; loadFilterIni checks the file
     // its [run] filter_config names.
     if (!ini->sectionExists("run")) requireKnownSections(*ini, filterSections(), path);

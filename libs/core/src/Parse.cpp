@@ -5,6 +5,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <sstream>
 #include <stdexcept>
 
 namespace devslam::core {
@@ -71,6 +72,28 @@ bool parseBool(const std::string& text, const std::string& what) {
     if (t == "true" || t == "yes" || t == "on" || t == "1") return true;
     if (t == "false" || t == "no" || t == "off" || t == "0") return false;
     fail(what, "true or false", text);
+}
+
+std::vector<double> parseNumberList(const std::string& text, const std::string& what,
+                                    std::size_t expected) {
+    std::string t = text;
+    for (char& c : t)
+        if (c == '[' || c == ']' || c == ',' || c == ';') c = ' ';
+    std::istringstream ss(t);
+    std::vector<double> out;
+    std::string tok;
+    while (ss >> tok) {
+        char* end = nullptr;
+        errno = 0;
+        const double v = std::strtod(tok.c_str(), &end);
+        if (end != tok.c_str() + tok.size() || errno == ERANGE || !std::isfinite(v))
+            throw std::invalid_argument(what + ": '" + tok + "' is not a number");
+        out.push_back(v);
+    }
+    if (expected > 0 && out.size() != expected)
+        throw std::invalid_argument(what + ": expected " + std::to_string(expected) +
+                                    " numbers, got " + std::to_string(out.size()));
+    return out;
 }
 
 }  // namespace devslam::core

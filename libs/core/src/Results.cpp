@@ -34,7 +34,13 @@ void replaceResultsSection(const std::string& path, const std::string& name,
         begin + "\n" + markdown + (markdown.empty() || markdown.back() == '\n' ? "" : "\n") + end;
     const auto b = text.find(begin);
     const auto e = text.find(end);
-    if (b != std::string::npos && e != std::string::npos && e > b) {
+    if ((b == std::string::npos) != (e == std::string::npos) || (b != std::string::npos && e < b))
+        // Appending a new block here would, on the next run, replace everything from the old
+        // marker to the new one: the sections between would be lost.
+        throw std::runtime_error("results file '" + path + "': section '" + name + "' needs '" +
+                                 begin + "' and, after it, '" + end +
+                                 "' (edited by hand?); nothing was written");
+    if (b != std::string::npos) {
         text.replace(b, e + end.size() - b, block);
     } else {
         if (!text.empty() && text.back() != '\n') text += '\n';

@@ -26,7 +26,9 @@ void HogDetector::Options::loadFromConfig(const mrpt::config::CConfigFileBase& c
                        "must be a positive multiple of 8 (HOG cell size)");
     core::requireValue(scale > 1.0, s, "scale", "must be > 1");
     core::requireValue(group_threshold >= 0, s, "group_threshold", "must be >= 0");
-    core::requireValue(resize > 0.0, s, "resize", "must be > 0");
+    // A tiny scale leaves no image (cv::resize fails on an empty size); a large one grows it
+    // by its square in memory and time. People must be ~128/resize px tall to be found.
+    core::requireValue(resize >= 0.1 && resize <= 4.0, s, "resize", "must be in [0.1, 4]");
 }
 
 void HogDetector::Options::saveToConfig(mrpt::config::CConfigFileBase& c,

@@ -108,7 +108,7 @@ std::optional<PersonTruth> PersonTruth::open(const std::string& folder) {
     return t;
 }
 
-PersonTruth::FrameTruth PersonTruth::frame(double timestamp) const {
+PersonTruth::FrameTruth PersonTruth::frame(double timestamp, cv::Size expected) const {
     char stamp[64];
     std::snprintf(stamp, sizeof stamp, "%.6f", timestamp);
     const auto it = persons_.find(stamp);
@@ -120,18 +120,23 @@ PersonTruth::FrameTruth PersonTruth::frame(double timestamp) const {
     if (f.labels.empty() || f.labels.type() != CV_8UC1)
         throw std::runtime_error("cannot read person labels '" + label_path +
                                  "' (expected an 8-bit one-channel PNG)");
+    if (!expected.empty() && f.labels.size() != expected)
+        throw std::runtime_error(
+            "person labels '" + label_path + "' are " + std::to_string(f.labels.cols) + "x" +
+            std::to_string(f.labels.rows) + ", the frame is " + std::to_string(expected.width) +
+            "x" + std::to_string(expected.height));
     f.persons = &it->second;
     return f;
 }
 
 void PersonTruth::score(const cv::Mat& mask, double timestamp, int min_pixels, MaskScore& score,
                         const std::vector<FilterBox>& boxes) const {
-    const auto f = frame(timestamp);
+    const auto f = frame(timestamp, mask.size());
     score.add(mask, f.labels, *f.persons, min_pixels, timestamp, boxes);
 }
 
-cv::Mat PersonTruth::walkerMask(double timestamp, int margin) const {
-    const auto f = frame(timestamp);
+cv::Mat PersonTruth::walkerMask(double timestamp, int margin, cv::Size frame_size) const {
+    const auto f = frame(timestamp, frame_size);
     cv::Mat mask = cv::Mat::zeros(f.labels.size(), CV_8UC1);
     for (const auto& p : *f.persons)
         if (p.moving) mask |= f.labels == p.id;

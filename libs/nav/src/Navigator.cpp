@@ -51,10 +51,9 @@ void copyConfig(const mrpt::config::CConfigFileBase& from, mrpt::config::CConfig
         for (const auto& k : keys) to.write(s, k, from.read_string(s, k, "", false));
     }
 }
-}  // namespace
 
-NavigatorOptions NavigatorOptions::fromConfig(const mrpt::config::CConfigFileBase& c,
-                                              const std::string& source) {
+NavigatorOptions readNavigatorOptions(const mrpt::config::CConfigFileBase& c,
+                                      const std::string& source) {
     // Ours, then those MRPT's reactive navigator and its holonomic methods read.
     core::requireKnownSections(
         c,
@@ -83,7 +82,20 @@ NavigatorOptions NavigatorOptions::fromConfig(const mrpt::config::CConfigFileBas
                        "must be in [0, 2] m");
     o.planner.loadFromConfigFile(c, "global_planner", source);
     o.replan.loadFromConfigFile(c, "replan", source);
+    // Read again by the Navigator, from the same INI; checked here, where the file is known
+    // (MRPT would only fail deep inside its waypoint decimation).
+    if (c.keyExists("CAbstractPTGBasedReactive", "ref_distance"))
+        core::requireValue(
+            core::readDouble(c, "CAbstractPTGBasedReactive", "ref_distance", 0.0) > 0,
+            "CAbstractPTGBasedReactive", "ref_distance", "must be > 0 m");
     return o;
+}
+}  // namespace
+
+NavigatorOptions NavigatorOptions::fromConfig(const mrpt::config::CConfigFileBase& c,
+                                              const std::string& source) {
+    // A bad value's message names the file ("nav.ini [navigator] nav_period: ...").
+    return core::namingSource(source, [&] { return readNavigatorOptions(c, source); });
 }
 
 const char* toString(NavState s) {

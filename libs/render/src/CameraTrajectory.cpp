@@ -1,6 +1,6 @@
 #include <devslam/core/Config.h>
+#include <devslam/core/Parse.h>
 #include <devslam/render/CameraTrajectory.h>
-#include <devslam/render/Scenario.h>
 
 #include <mrpt/config/CConfigFileBase.h>
 #include <mrpt/math/CMatrixFixed.h>
@@ -24,7 +24,7 @@ Eigen::Vector3d readVec3(const mrpt::config::CConfigFileBase& cfg, const std::st
                          const std::string& key, const Eigen::Vector3d& def) {
     const std::string txt = cfg.read_string(s, key, "");
     if (txt.empty()) return def;
-    const auto v = parseNumberList(txt, "[" + s + "] " + key, 3);
+    const auto v = core::parseNumberList(txt, "[" + s + "] " + key, 3);
     return {v[0], v[1], v[2]};
 }
 
@@ -102,8 +102,7 @@ void TrajectoryOptions::loadFromConfig(const mrpt::config::CConfigFileBase& cfg,
     core::requireKnownKeys(
         cfg, s,
         {"type", "position", "look_at", "amplitude", "period", "rot_amplitude_deg", "rot_period",
-         "azimuth_amplitude_deg", "elevation_amplitude_deg", "azimuth_period", "elevation_period"},
-        "trajectory");
+         "azimuth_amplitude_deg", "elevation_amplitude_deg", "azimuth_period", "elevation_period"});
     setDefaultsFor(parseTrajectoryType(cfg.read_string(s, "type", toString(type))));
     position = readVec3(cfg, s, "position", position);
     look_at = readVec3(cfg, s, "look_at", look_at);
@@ -125,6 +124,12 @@ void TrajectoryOptions::loadFromConfig(const mrpt::config::CConfigFileBase& cfg,
                        "periods must be > 0 [s]");
     core::requireValue((look_at - position).norm() > 1e-3, s, "look_at",
                        "must differ from position");
+    // lookAtPose levels the camera's roll on the horizontal: a vertical view has none.
+    core::requireValue(
+        (look_at - position).normalized().cross(Eigen::Vector3d::UnitZ()).norm() >= 1e-6, s,
+        "look_at",
+        "straight above or below position: the view needs a "
+        "horizontal part to level the camera");
 }
 
 mrpt::poses::CPose3D lookAtPose(const Eigen::Vector3d& eye, const Eigen::Vector3d& target) {

@@ -1,4 +1,5 @@
 #include <devslam/core/Config.h>
+#include <devslam/core/Parse.h>
 #include <devslam/render/Scenario.h>
 
 #include <mrpt/config/CConfigFileBase.h>
@@ -58,7 +59,7 @@ Eigen::Vector3d vec3(const mrpt::config::CConfigFileBase& cfg, const std::string
         if (required) throw std::invalid_argument(src + " [" + s + "]: missing key '" + key + "'");
         return def;
     }
-    const auto v = parseNumberList(txt, src + " [" + s + "] " + key, 3);
+    const auto v = core::parseNumberList(txt, src + " [" + s + "] " + key, 3);
     return {v[0], v[1], v[2]};
 }
 
@@ -160,10 +161,10 @@ PersonSpec loadPerson(const mrpt::config::CConfigFileBase& cfg, const std::strin
     p.gesture_deg = core::readDouble(cfg, s, "gesture_deg", p.gesture_deg);
     p.gesture_period = core::readDouble(cfg, s, "gesture_period", p.gesture_period);
     if (p.gestures()) {
-        const auto r = parseNumberList(cfg.read_string(s, "gesture_region", "", true),
-                                       where + " gesture_region", 4);
-        const auto c = parseNumberList(cfg.read_string(s, "gesture_pivot", "", true),
-                                       where + " gesture_pivot", 2);
+        const auto r = core::parseNumberList(cfg.read_string(s, "gesture_region", "", true),
+                                             where + " gesture_region", 4);
+        const auto c = core::parseNumberList(cfg.read_string(s, "gesture_pivot", "", true),
+                                             where + " gesture_pivot", 2);
         p.gesture_region = {r[0], r[1], r[2], r[3]};
         p.gesture_pivot = {c[0], c[1]};
         const auto unit = [](double v) { return v >= 0 && v <= 1; };
@@ -175,7 +176,7 @@ PersonSpec loadPerson(const mrpt::config::CConfigFileBase& cfg, const std::strin
         core::requireValue(unit(c[0]) && unit(c[1]), s, "gesture_pivot",
                            "must be [across down], fractions of the photo in [0, 1]");
     }
-    const auto xy = parseNumberList(cfg.read_string(s, "path", "", true), where + " path");
+    const auto xy = core::parseNumberList(cfg.read_string(s, "path", "", true), where + " path");
     if (xy.size() < 2 || xy.size() % 2)
         throw std::invalid_argument(where + " path: need x y pairs");
     for (std::size_t i = 0; i < xy.size(); i += 2) p.path.emplace_back(xy[i], xy[i + 1]);
@@ -195,32 +196,6 @@ PersonSpec loadPerson(const mrpt::config::CConfigFileBase& cfg, const std::strin
 }
 
 }  // namespace
-
-std::vector<double> parseNumberList(const std::string& text, const std::string& what,
-                                    std::size_t expected) {
-    std::string t = text;
-    for (char& c : t)
-        if (c == '[' || c == ']' || c == ',' || c == ';') c = ' ';
-    std::istringstream ss(t);
-    std::vector<double> out;
-    std::string tok;
-    while (ss >> tok) {
-        std::size_t used = 0;
-        double v = 0;
-        try {
-            v = std::stod(tok, &used);
-        } catch (const std::exception&) {
-            used = 0;
-        }
-        if (used != tok.size() || !std::isfinite(v))
-            throw std::invalid_argument(what + ": '" + tok + "' is not a number");
-        out.push_back(v);
-    }
-    if (expected > 0 && out.size() != expected)
-        throw std::invalid_argument(what + ": expected " + std::to_string(expected) +
-                                    " numbers, got " + std::to_string(out.size()));
-    return out;
-}
 
 namespace {
 

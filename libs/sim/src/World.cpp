@@ -39,6 +39,10 @@ std::vector<double> parseNumbers(const std::vector<std::string>& words, size_t f
         } catch (const std::exception&) {
             fail(source, section, key, "'" + words[i] + "' is not a number");
         }
+        // std::stod takes "nan" and "inf"; neither is a place or a size, and a NaN passes
+        // every range check after this one.
+        if (!std::isfinite(v.back()))
+            fail(source, section, key, "'" + words[i] + "' is not a finite number");
     }
     return v;
 }

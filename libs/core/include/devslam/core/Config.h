@@ -78,12 +78,17 @@ void applyOverrides(mrpt::config::CConfigFileMemory& cfg, const std::vector<std:
 /// The filter's INI named on a command line (`--config` of devslam-overlay and
 /// devslam-filter-bench): a filter INI, which may hold only [detector] and [dynamic_filter],
 /// or a SLAM INI (one with [run]), read through loadFilterIni. Throws naming the file when a
-/// section is unknown or neither filter section is there.
+/// section is unknown or neither filter section is there. `source`, when given, receives
+/// filterSource's name for what was read, for messages about its values (namingSource).
 [[nodiscard]] std::unique_ptr<mrpt::config::CConfigFileMemory> loadFilterConfig(
-    const std::string& path);
+    const std::string& path, std::string* source = nullptr);
 /// The file loadFilterIni reads for the config `cfg` read from `path`.
 [[nodiscard]] std::string filterIniPath(const mrpt::config::CConfigFileBase& cfg,
                                         const std::string& path);
+/// What a bad filter value came from, for messages: filterIniPath, and "with <path> [run]
+/// filter_overrides" when the config overrides some of its keys.
+[[nodiscard]] std::string filterSource(const mrpt::config::CConfigFileBase& cfg,
+                                       const std::string& path);
 
 /// Strict typed reads of one key (core/Parse.h rules; MRPT strips a trailing `//` comment
 /// first). A missing key gives `def`, or throws when `required`; a value that does not

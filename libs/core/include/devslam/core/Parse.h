@@ -9,8 +9,10 @@
 ///   ratio = devslam::core::parseNumber(value, "[tracker] match_ratio");
 ///   on = devslam::core::parseBool(value, "[local_ba] enabled");
 
+#include <cstddef>
 #include <limits>
 #include <string>
+#include <vector>
 
 namespace devslam::core {
 
@@ -29,5 +31,12 @@ namespace devslam::core {
 /// true/yes/on/1 or false/no/off/0, in any letter case. Throws std::invalid_argument
 /// "<what>: expected true or false, got '<text>'".
 [[nodiscard]] bool parseBool(const std::string& text, const std::string& what);
+
+/// Finite numbers written "[a b c]", "a b c" or "a, b, c" (MRPT writes vectors in
+/// brackets). Throws std::invalid_argument "<what>: 'x' is not a number" on a bad or
+/// non-finite token, and "<what>: expected N numbers, got M" when `expected` (if > 0) does
+/// not match the count.
+[[nodiscard]] std::vector<double> parseNumberList(const std::string& text, const std::string& what,
+                                                  std::size_t expected = 0);
 
 }  // namespace devslam::core

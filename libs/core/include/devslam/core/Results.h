@@ -12,7 +12,8 @@
 namespace devslam::core {
 
 /// Replaces (or appends) the named section; creates the file with a title if missing.
-/// Throws std::runtime_error if the file cannot be written, or std::invalid_argument if
+/// Throws std::runtime_error, writing nothing, if the file has only one of the section's
+/// markers or its END before its BEGIN, or if the file cannot be written; std::invalid_argument if
 /// `name` is empty or contains characters other than [a-z0-9_-].
 void replaceResultsSection(const std::string& path, const std::string& name,
                            const std::string& markdown);

@@ -79,21 +79,22 @@ class PersonTruth {
     /// reading them: what open() checks first.
     [[nodiscard]] static bool available(const std::string& folder);
     /// Adds the frame at `timestamp` to `score`. Throws naming the file when the frame has
-    /// no truth (a missing label image or persons.txt entry).
+    /// no truth (a missing label image or persons.txt entry), or when a non-empty `mask` and
+    /// the label image differ in size.
     void score(const cv::Mat& mask, double timestamp, int min_pixels, MaskScore& score,
                const std::vector<FilterBox>& boxes = {}) const;
     /// The ideal dynamic mask of the frame at `timestamp`: every visible pixel of the
     /// walking people, dilated by `margin` px (CV_8UC1, 255 = dynamic). devslam-run's
     /// diagnostic mode `truth` feeds it to the SLAM: the bound the filter can approach.
-    /// Throws like score().
-    [[nodiscard]] cv::Mat walkerMask(double timestamp, int margin) const;
+    /// Throws like score(); `frame_size`, when given, must be the label image's.
+    [[nodiscard]] cv::Mat walkerMask(double timestamp, int margin, cv::Size frame_size = {}) const;
 
   private:
     struct FrameTruth {
         cv::Mat labels;
         const std::vector<PersonEntry>* persons = nullptr;
     };
-    [[nodiscard]] FrameTruth frame(double timestamp) const;
+    [[nodiscard]] FrameTruth frame(double timestamp, cv::Size expected = {}) const;
     std::string folder_;
     std::map<std::string, std::vector<PersonEntry>> persons_;
 };

@@ -92,9 +92,4 @@ struct Scenario {
 [[nodiscard]] Scenario loadScenario(const std::string& path,
                                     const std::vector<std::string>& overrides = {});
 
-/// Parses "[a b c]" / "a, b, c" into numbers; throws naming `what` on a bad token or when
-/// `expected` (if > 0) does not match the count.
-[[nodiscard]] std::vector<double> parseNumberList(const std::string& text, const std::string& what,
-                                                  std::size_t expected = 0);
-
 }  // namespace devslam::render
