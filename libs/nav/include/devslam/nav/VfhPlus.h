@@ -39,7 +39,7 @@ struct VfhPlusOptions {
     double tau_low = 0.35;             ///< [-] below: free (binary histogram)
     double tau_high = 0.55;            ///< [-] above: blocked; in between keeps previous
     double min_free_distance = 0.10;   ///< [norm] closer obstacles always block the sector
-    double mask_distance = 0.15;       ///< [norm] blocked sectors closer limit turning past them
+    double mask_distance = 0.05;       ///< [norm] blocked sectors closer limit turning past them
     int wide_valley_sectors = 16;      ///< [sectors] s_max
     double mu1 = 5.0;                  ///< [-] weight: distance to target direction
     double mu2 = 2.0;                  ///< [-] weight: distance to current heading
