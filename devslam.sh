@@ -15,6 +15,7 @@ JOBS=${JOBS:-2}
 # Everything comes from Debian's archive; nothing is downloaded at build or run time.
 PACKAGES=(build-essential cmake pkg-config
   libmrpt-dev mrpt-apps mrpt-common libopencv-dev opencv-doc libbullet-dev libeigen3-dev zlib1g-dev
+  libboost-dev
   libgtest-dev libgmock-dev libbenchmark-dev)
 
 setup() {

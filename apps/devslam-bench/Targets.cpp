@@ -2,6 +2,7 @@
 
 #include <devslam/core/Config.h>
 #include <devslam/core/Parse.h>
+#include <devslam/core/Stats.h>
 
 #include <mrpt/config/CConfigFileBase.h>
 
@@ -110,6 +111,26 @@ InputTally tallyInputs(const Target& t, const std::vector<SequenceInputs>& input
         for (const auto seed : in.seeds) count(in.name, seed);
     }
     return n;
+}
+
+PairedRatio pairedRatio(const Target& t, const std::string& sequence,
+                        const std::vector<SequenceInputs>& inputs, const FigureOf& figure) {
+    PairedRatio r;
+    if (t.figure.find('/') == std::string::npos) return r;
+    std::vector<double> logs;
+    for (const auto& in : inputs) {
+        if (in.name != sequence) continue;
+        for (const auto seed : in.seeds) {
+            const double v = figure(in.name, t.mode, t.figure, seed);
+            if (std::isfinite(v) && v > 0) logs.push_back(std::log(v));
+        }
+    }
+    const auto m = core::meanInterval95(logs);
+    r.count = m.count;
+    r.geomean = std::exp(m.mean);
+    r.lo = std::exp(m.lo);
+    r.hi = std::exp(m.hi);
+    return r;
 }
 
 }  // namespace devslam::bench

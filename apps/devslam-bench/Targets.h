@@ -73,4 +73,20 @@ struct InputTally {
 [[nodiscard]] InputTally tallyInputs(const Target& t, const std::vector<SequenceInputs>& inputs,
                                      const FigureOf& figure);
 
+/// For a ratio target (ate/<mode>) on one sequence: the geometric mean of its per-render
+/// ratios and that mean's 95 % confidence interval (Student's t on the ratios' logarithms; the
+/// two modes run on the same renders, so the ratios are paired samples). An interval that
+/// holds 1 says the renders do not tell the two modes apart, however the median falls.
+/// count: renders with both figures; NaN where the target is no ratio or none has them, NaN
+/// bounds below two renders.
+struct PairedRatio {
+    std::size_t count = 0;
+    double geomean = std::numeric_limits<double>::quiet_NaN();
+    double lo = std::numeric_limits<double>::quiet_NaN();
+    double hi = std::numeric_limits<double>::quiet_NaN();
+};
+[[nodiscard]] PairedRatio pairedRatio(const Target& t, const std::string& sequence,
+                                      const std::vector<SequenceInputs>& inputs,
+                                      const FigureOf& figure);
+
 }  // namespace devslam::bench

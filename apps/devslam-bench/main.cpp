@@ -124,7 +124,10 @@ Bench readBench(const std::string& path) {
         }
     }
     b.repeats = core::readInt(*cfg, "bench", "repeats", b.repeats);
-    b.max_frames = std::size_t(core::readInt(*cfg, "bench", "max_frames", 0));
+    const int max_frames = core::readInt(*cfg, "bench", "max_frames", 0);
+    core::requireValue(max_frames >= 0, "bench", "max_frames",
+                       "must be >= 0 (0 = whole sequences)");
+    b.max_frames = std::size_t(max_frames);
     b.out_dir = cfg->read_string("bench", "out_dir", b.out_dir);
     b.slam_config = resolve(cfg->read_string("bench", "slam_config", b.slam_config), base);
     core::requireValue(b.repeats >= 1 && b.repeats <= 100, "bench", "repeats", "must be 1..100");
@@ -168,6 +171,12 @@ Bench readBench(const std::string& path) {
         q.repeats = core::readInt(*cfg, s, "repeats", 0);
         core::requireValue(q.repeats >= 0 && q.repeats <= 100, s, "repeats",
                            "must be 1..100 (0 or missing = [bench] repeats)");
+        // The name is the runs' and renders' folder: two sequences of one name would write
+        // over each other's runs and mix them in one row.
+        for (const auto& other : b.sequences)
+            if (other.name == q.name)
+                throw std::invalid_argument(where + " name: '" + q.name +
+                                            "' is already the name of an earlier sequence");
         b.sequences.push_back(q);
     }
     if (b.sequences.empty()) throw std::invalid_argument(path + ": no [sequence_*] section");
@@ -524,27 +533,37 @@ int run(int argc, char** argv) {
         for (const auto& q : b.sequences) inputs.push_back({q.name, q.seeds});
         std::ofstream csv(fs::path(b.out_dir) / "targets.csv");
         csv << "target,sequence,mode,figure,op,value,measured,measured_on,met,inputs_met,"
-               "inputs\n";
+               "inputs,paired_geomean,paired_lo95,paired_hi95\n";
         targets_md << "**Targets** (bench.ini `[targets]`, checked on the medians of the tables "
                       "below; `*`: every sequence with the figure, the worst one shown; ate in "
                       "m, masked as fractions of the people's frames; *renders meeting it*: "
                       "each render's own figure, a ratio of two modes on the same render, a "
-                      "real sequence counting as one)\n\n"
-                      "| target | measured | met | renders meeting it |\n|---|---|---|---|\n";
+                      "real sequence counting as one; *per-render ratio*: for a ratio, the "
+                      "geometric mean of the renders' own ratios and its 95 % confidence "
+                      "interval (Student's t on their logarithms), an interval holding 1 "
+                      "meaning the renders do not tell the two modes apart)\n\n"
+                      "| target | measured | met | renders meeting it | per-render ratio "
+                      "[95 % CI] |\n|---|---|---|---|---|\n";
         int met = 0;
         for (const auto& t : b.targets) {
             const auto c = bench::check(t, inputs, figureOf);
             const auto n = bench::tallyInputs(t, inputs, figureOf);
+            const auto p = bench::pairedRatio(t, c.sequence, inputs, figureOf);
             met += c.met;
             const int prec = t.figure == "fps" ? 1 : t.figure == "ate" ? 5 : 3;
             targets_md << "| " << t.key << ": " << t.text() << " | " << fmt(c.measured, prec)
                        << (t.sequence == "*" && !c.sequence.empty() ? " (" + c.sequence + ")"
-                                                                      : std::string())
-                       << " | " << (c.met ? "yes" : "**no**") << " | " << n.met << " of "
-                       << n.of << " |\n";
-            csv << t.key << "," << t.sequence << "," << t.mode << "," << t.figure << ","
-                << t.op << "," << t.value << "," << fmt(c.measured, 6) << "," << c.sequence
-                << "," << (c.met ? 1 : 0) << "," << n.met << "," << n.of << "\n";
+                                                                    : std::string())
+                       << " | " << (c.met ? "yes" : "**no**") << " | " << n.met << " of " << n.of
+                       << " | "
+                       << (p.count >= 2
+                               ? fmt(p.geomean, 3) + " [" + fmt(p.lo, 3) + ", " + fmt(p.hi, 3) + "]"
+                               : std::string())
+                       << " |\n";
+            csv << t.key << "," << t.sequence << "," << t.mode << "," << t.figure << "," << t.op
+                << "," << t.value << "," << fmt(c.measured, 6) << "," << c.sequence << ","
+                << (c.met ? 1 : 0) << "," << n.met << "," << n.of << "," << fmt(p.geomean, 6) << ","
+                << fmt(p.lo, 6) << "," << fmt(p.hi, 6) << "\n";
         }
         targets_md << "\n" << met << " of " << b.targets.size() << " targets met.\n\n";
     }

@@ -116,7 +116,7 @@ TEST(DevslamBench, TwoFrameSmokeRunOfTheWholeCommand) {
     EXPECT_NE(results.find("| a_fps: short dynamic fps >= 0.001 | "), std::string::npos)
         << results;
     EXPECT_NE(results.find("| b_fps: * dynamic fps >= 1e+09 | "), std::string::npos) << results;
-    EXPECT_NE(results.find("| c_ratio: fr1 dynamic ate/none <= 1e+09 | n/a | **no** | 0 of 0 |"),
+    EXPECT_NE(results.find("| c_ratio: fr1 dynamic ate/none <= 1e+09 | n/a | **no** | 0 of 0 |  |"),
               std::string::npos)
         << results;
     // Each render counted on its own figure: both renders of short meet a_fps; b_fps is
@@ -135,9 +135,11 @@ TEST(DevslamBench, TwoFrameSmokeRunOfTheWholeCommand) {
     const auto endsWith = [](const std::string& a, const std::string& b) {
         return a.size() >= b.size() && a.compare(a.size() - b.size(), b.size(), b) == 0;
     };
-    EXPECT_TRUE(endsWith(row("a_fps"), ",1,2,2")) << targets;  // met, 2 of 2 renders
-    EXPECT_TRUE(endsWith(row("b_fps"), ",0,0,3")) << targets;
-    EXPECT_EQ(row("c_ratio"), "c_ratio,fr1,dynamic,ate/none,<=,1e+09,n/a,,0,0,0") << targets;
+    EXPECT_TRUE(endsWith(row("a_fps"), ",1,2,2,n/a,n/a,n/a")) << targets;  // met, 2 of 2 renders
+    EXPECT_TRUE(endsWith(row("b_fps"), ",0,0,3,n/a,n/a,n/a")) << targets;
+    // No paired ratio: fps is no ratio, and fr1 is one input without an ATE here.
+    EXPECT_EQ(row("c_ratio"), "c_ratio,fr1,dynamic,ate/none,<=,1e+09,n/a,,0,0,0,n/a,n/a,n/a")
+        << targets;
     EXPECT_NE(results.find(" (seed 5), "), std::string::npos) << results;
     EXPECT_NE(results.find("Sequences: short is scenario `short_walking` with `devslam-synth "
                            "--set person_1.speed=0.5 --set person_2.sway_deg=1 --set "
@@ -194,6 +196,25 @@ TEST(BenchTargets, MediansDecideRendersAreCountedOneByOne) {
     // A figure no input has is counted nowhere.
     const Target none{"k", "s", "truth", "ate", "<=", 1.0};
     EXPECT_EQ(devslam::bench::tallyInputs(none, inputs, figure).of, 0);
+
+    // The renders' own ratios, 0.5, 1.5 and 2.5: their geometric mean and its 95 % interval
+    // (Student's t, 2 dof, on the logarithms), which holds 1: these renders tie the modes.
+    const auto p = devslam::bench::pairedRatio(ratio, "s", inputs, figure);
+    EXPECT_EQ(p.count, 3u);
+    EXPECT_NEAR(p.geomean, std::cbrt(0.5 * 1.5 * 2.5), 1e-12);
+    const std::vector<double> logs = {std::log(0.5), std::log(1.5), std::log(2.5)};
+    const double mean = (logs[0] + logs[1] + logs[2]) / 3;
+    double ss = 0;
+    for (const double x : logs) ss += (x - mean) * (x - mean);
+    const double half = 4.302652729911275 * std::sqrt(ss / 2 / 3);  // t(0.975, 2 dof)
+    EXPECT_NEAR(p.lo, std::exp(mean - half), 1e-9);
+    EXPECT_NEAR(p.hi, std::exp(mean + half), 1e-9);
+    EXPECT_LT(p.lo, 1.0);
+    EXPECT_GT(p.hi, 1.0);
+    // A real sequence (one input, no renders), a plain figure: no paired ratio.
+    EXPECT_EQ(devslam::bench::pairedRatio(ratio, "r", inputs, figure).count, 0u);
+    const Target plain{"k", "s", "dynamic", "ate", "<=", 2.0};
+    EXPECT_TRUE(std::isnan(devslam::bench::pairedRatio(plain, "s", inputs, figure).geomean));
 }
 
 // A bad bench INI stops the bench before anything runs, naming the file, section and key.
@@ -226,10 +247,14 @@ TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
         {real + "[sequense_b]\n" + fr1,
          "bench.ini: unknown section [sequense_b] (known: bench, sequence_*, targets)"},
         {real + "seed = 5\n", "seed"},
+        {"[bench]\nmax_frames = -1\n" + real, "bench.ini [bench] max_frames: must be >= 0"},
+        {real + "[sequence_b]\nname = a\n" + fr1,
+         "bench.ini [sequence_b] name: 'a' is already the name of an earlier sequence"},
         {real + "set = person_1.speed=1\n", "[sequence_a] set: only a synthetic sequence"},
         {synth + "set = person_1.speed=1 speed=2\n",
          "[sequence_a] set item 'speed=2': expected SECTION.KEY=VALUE"},
-        {synth + "set = person_2.path=[3.5 2.8\n", "[sequence_a] set 'person_2.path=[3.5 2.8': a '[' is not closed"},
+        {synth + "set = person_2.path=[3.5 2.8\n",
+         "[sequence_a] set 'person_2.path=[3.5 2.8': a '[' is not closed"},
         // A key the scenario does not know stops the bench at the render, before any run.
         {synth + "set = person_1.sped=1\n", "sped"},
         {real + "[targets]\nx = a dynamic ate <=\n",

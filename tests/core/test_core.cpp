@@ -279,6 +279,41 @@ TEST(Config, NamingSourcePrefixesFieldOnlyErrors) {
                  std::runtime_error);
 }
 
+// A section is replaced in place, others are kept; broken markers stop it before it writes
+// (appending would make the next run replace every section between the two BEGINs).
+TEST(Results, SectionsAreReplacedInPlaceAndBrokenMarkersRefused) {
+    const std::string path = devslam::test::scratchPath("devslam_results").string() + ".md";
+    std::filesystem::remove(path);
+    const auto read = [&] {
+        std::ifstream in(path);
+        return std::string(std::istreambuf_iterator<char>(in), {});
+    };
+    replaceResultsSection(path, "a", "one");
+    replaceResultsSection(path, "b", "two\n");
+    replaceResultsSection(path, "a", "three");
+    const std::string text = read();
+    EXPECT_NE(text.find("<!-- BEGIN a -->\nthree\n<!-- END a -->"), std::string::npos) << text;
+    EXPECT_EQ(text.find("one"), std::string::npos) << text;
+    EXPECT_LT(text.find("BEGIN a"), text.find("BEGIN b")) << text;  // in place, b kept after it
+    EXPECT_NE(text.find("<!-- BEGIN b -->\ntwo\n<!-- END b -->"), std::string::npos) << text;
+    EXPECT_THROW(replaceResultsSection(path, "A b", "x"), std::invalid_argument);
+    // a's END removed by hand: refused, the file as it was.
+    std::string broken = text;
+    broken.erase(broken.find("<!-- END a -->"), std::string("<!-- END a -->").size());
+    std::ofstream(path, std::ios::trunc) << broken;
+    try {
+        replaceResultsSection(path, "a", "four");
+        ADD_FAILURE() << "no error";
+    } catch (const std::runtime_error& e) {
+        EXPECT_NE(std::string(e.what()).find(path + "': section 'a' needs '<!-- BEGIN a -->' "
+                                                    "and, after it, '<!-- END a -->'"),
+                  std::string::npos)
+            << e.what();
+    }
+    EXPECT_EQ(read(), broken);
+    std::filesystem::remove(path);
+}
+
 TEST(Results, MeasuredOnLineNamesTheHostAndItsSimdLevel) {
     const std::string line = measuredOnLine();
     EXPECT_NE(line.find(" UTC, "), std::string::npos) << line;
@@ -327,6 +362,27 @@ TEST(Stats, InterquartileMean) {
     steps.insert(steps.end(), 9, 0.02);
     EXPECT_DOUBLE_EQ(median(steps), 0.0);
     EXPECT_NEAR(interquartileMean(steps), 0.008, 1e-12);
+}
+
+// The 95 % interval of a mean from a few samples is Student's, not the normal 1.96 sigma.
+TEST(Stats, MeanInterval95UsesStudentsT) {
+    const auto m = meanInterval95({1, 2, 3, 4, 5});
+    EXPECT_EQ(m.count, 5u);
+    EXPECT_DOUBLE_EQ(m.mean, 3);
+    // s = sqrt(2.5); t(0.975, 4 dof) = 2.7764451051977987 (tables: 2.776)
+    const double half = 2.7764451051977987 * std::sqrt(2.5) / std::sqrt(5.0);
+    EXPECT_NEAR(m.lo, 3 - half, 1e-9);
+    EXPECT_NEAR(m.hi, 3 + half, 1e-9);
+    // Two samples: t(0.975, 1 dof) = 12.706, the interval is wide.
+    const auto two = meanInterval95({1, 3});
+    EXPECT_NEAR(two.hi - two.mean, 12.706204736174707 * std::sqrt(2.0) / std::sqrt(2.0), 1e-9);
+    // One value: its mean, no interval; none: nothing.
+    const auto one = meanInterval95({7});
+    EXPECT_DOUBLE_EQ(one.mean, 7);
+    EXPECT_TRUE(std::isnan(one.lo) && std::isnan(one.hi));
+    const auto none = meanInterval95({});
+    EXPECT_EQ(none.count, 0u);
+    EXPECT_TRUE(std::isnan(none.mean));
 }
 
 TEST(Pose, TumQuaternionRoundTrip) {

@@ -1,5 +1,7 @@
 #include <devslam/core/Stats.h>
 
+#include <boost/math/distributions/students_t.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <numeric>
@@ -42,6 +44,22 @@ Summary summarize(const std::vector<double>& v) {
     s.min = *mn;
     s.max = *mx;
     return s;
+}
+
+MeanInterval meanInterval95(const std::vector<double>& v) {
+    MeanInterval m;
+    m.count = v.size();
+    if (v.empty()) return m;
+    const auto n = static_cast<double>(v.size());
+    m.mean = std::accumulate(v.begin(), v.end(), 0.0) / n;
+    if (v.size() < 2) return m;
+    double ss = 0;
+    for (double x : v) ss += (x - m.mean) * (x - m.mean);
+    const double half =
+        boost::math::quantile(boost::math::students_t(n - 1), 0.975) * std::sqrt(ss / (n - 1) / n);
+    m.lo = m.mean - half;
+    m.hi = m.mean + half;
+    return m;
 }
 
 }  // namespace devslam::core
