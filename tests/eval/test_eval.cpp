@@ -420,6 +420,12 @@ TEST(Plot, LegendGoesToTheCornerWithoutData) {
         xs.push_back(1.0), ys.push_back(0.025 * i);  // right edge, bottom to top
     }
     cv::Mat canvas(400, 400, CV_8UC3, cv::Scalar(255, 255, 255));
+    // A trajectory 5e12 m out with no extent: its tick step is below the coordinates' float
+    // spacing; the axes are drawn and the call returns (it used to loop for ever).
+    eval::Plot far(cv::Rect(0, 0, 400, 400), "t", "x [m]", "y [m]");
+    far.fit({5e12}, {5e12});
+    far.axes(canvas);
+    canvas.setTo(cv::Scalar(255, 255, 255));
     eval::Plot p(cv::Rect(0, 0, 400, 400), "t", "x [m]", "y [m]");
     p.fit({0.0, 1.0}, {0.0, 1.0});
     p.axes(canvas);

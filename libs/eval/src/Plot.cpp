@@ -84,14 +84,19 @@ void Plot::axes(cv::Mat& c) const {
     const auto font = kFont;
     char buf[32];
     const double sx = niceStep(x1_ - x0_, 6), sy = niceStep(y1_ - y0_, 6);
-    for (double x = std::ceil(x0_ / sx) * sx; x <= x1_; x += sx) {
+    // Ticks by index, at most 64: "x += step" stops advancing where the step is below the
+    // float spacing of x (coordinates far from 0 with a tiny range) and would never end.
+    const double x_first = std::ceil(x0_ / sx) * sx, y_first = std::ceil(y0_ / sy) * sy;
+    for (int i = 0; i < 64 && x_first + i * sx <= x1_; ++i) {
+        const double x = x_first + i * sx;
         const cv::Point p = toPixel(x, y0_);
         cv::line(c, p, p + cv::Point(0, 5), kInk);
         cv::line(c, {p.x, inner_.y}, {p.x, p.y}, cv::Scalar(225, 225, 225));
         std::snprintf(buf, sizeof buf, "%.3g", std::abs(x) < 1e-12 ? 0.0 : x);
         cv::putText(c, buf, p + cv::Point(-15, 20), font, 0.4, kInk, 1, cv::LINE_AA);
     }
-    for (double y = std::ceil(y0_ / sy) * sy; y <= y1_; y += sy) {
+    for (int i = 0; i < 64 && y_first + i * sy <= y1_; ++i) {
+        const double y = y_first + i * sy;
         const cv::Point p = toPixel(x0_, y);
         cv::line(c, p, p - cv::Point(5, 0), kInk);
         cv::line(c, p, {inner_.x + inner_.width, p.y}, cv::Scalar(225, 225, 225));
