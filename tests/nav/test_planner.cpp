@@ -8,6 +8,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
+#include <tuple>
+#include <vector>
 
 using namespace devslam::nav;
 using mrpt::math::TPoint2D;
@@ -175,51 +178,31 @@ TEST(NavConfig, EveryNavIniLoads) {
 }
 
 TEST(NavConfig, UnknownKeyIsReported) {
-    mrpt::config::CConfigFileMemory c;
-    c.write("navigator", "nav_perod", 0.1);
-    try {
-        (void)NavigatorOptions::fromConfig(c, "x.ini");
-        FAIL();
-    } catch (const std::invalid_argument& e) {
-        EXPECT_NE(std::string(e.what()).find("nav_perod"), std::string::npos);
-    }
-    mrpt::config::CConfigFileMemory m;
-    m.write("navigator", "person_margin", -0.1);
-    try {
-        (void)NavigatorOptions::fromConfig(m, "x.ini");
-        FAIL() << "a negative person_margin was accepted";
-    } catch (const std::invalid_argument& e) {
-        EXPECT_STREQ(e.what(), "x.ini [navigator] person_margin: must be in [0, 2] m");
-    }
+    // The message of reading one INI holding `section.key = value`, "" when it is accepted.
+    const auto errorOf = [](const std::vector<std::tuple<std::string, std::string, double>>& kv) {
+        mrpt::config::CConfigFileMemory c;
+        for (const auto& [section, key, value] : kv) c.write(section, key, value);
+        try {
+            (void)NavigatorOptions::fromConfig(c, "x.ini");
+        } catch (const std::invalid_argument& e) {
+            return std::string(e.what());
+        }
+        return std::string();
+    };
+    EXPECT_NE(errorOf({{"navigator", "nav_perod", 0.1}}).find("nav_perod"), std::string::npos);
+    EXPECT_EQ(errorOf({{"navigator", "person_margin", -0.1}}),
+              "x.ini [navigator] person_margin: must be in [0, 2] m");
     // Values of the planner's and the replanner's sections, and MRPT's ref_distance, name the
     // file as well.
-    mrpt::config::CConfigFileMemory g;
-    g.write("global_planner", "robot_radius", -1.0);
-    try {
-        (void)NavigatorOptions::fromConfig(g, "x.ini");
-        FAIL() << "a negative robot_radius was accepted";
-    } catch (const std::invalid_argument& e) {
-        EXPECT_STREQ(e.what(), "x.ini [global_planner] robot_radius: must be > 0 m");
-    }
-    mrpt::config::CConfigFileMemory r;
-    r.write("CAbstractPTGBasedReactive", "ref_distance", 0.0);
-    try {
-        (void)NavigatorOptions::fromConfig(r, "x.ini");
-        FAIL() << "ref_distance 0 was accepted";
-    } catch (const std::invalid_argument& e) {
-        EXPECT_STREQ(e.what(), "x.ini [CAbstractPTGBasedReactive] ref_distance: must be > 0 m");
-    }
+    EXPECT_EQ(errorOf({{"global_planner", "robot_radius", -1.0}}),
+              "x.ini [global_planner] robot_radius: must be > 0 m");
+    EXPECT_EQ(errorOf({{"CAbstractPTGBasedReactive", "ref_distance", 0.0}}),
+              "x.ini [CAbstractPTGBasedReactive] ref_distance: must be > 0 m");
     // A mistyped section: its keys would all be ignored.
-    mrpt::config::CConfigFileMemory s;
-    s.write("navigator", "nav_period", 0.1);
-    s.write("CHolonomicVFHPlu", "mu1", 6.0);
-    try {
-        (void)NavigatorOptions::fromConfig(s, "x.ini");
-        FAIL() << "[CHolonomicVFHPlu] was accepted";
-    } catch (const std::invalid_argument& e) {
-        EXPECT_NE(std::string(e.what()).find("x.ini: unknown section [CHolonomicVFHPlu] (known: "
-                                             "navigator, global_planner, replan,"),
-                  std::string::npos)
-            << e.what();
-    }
+    const std::string section =
+        errorOf({{"navigator", "nav_period", 0.1}, {"CHolonomicVFHPlu", "mu1", 6.0}});
+    EXPECT_NE(section.find("x.ini: unknown section [CHolonomicVFHPlu] (known: navigator, "
+                           "global_planner, replan,"),
+              std::string::npos)
+        << section;
 }
