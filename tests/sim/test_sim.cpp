@@ -105,6 +105,18 @@ TEST(World, BadEntriesNameTheKey) {
             EXPECT_STREQ(e.what(), says.c_str());
         }
     }
+    // A world whose grid would not fit in memory (MRPT counts cells in 32 bits) is refused.
+    const mrpt::config::CConfigFileMemory huge(
+        "[world]\nx_min=0\nx_max=10000\ny_min=0\ny_max=10000\n[robot]\nstart_x=1\n"
+        "start_y=1\n[goal]\nx=4\ny=4\n");
+    try {
+        (void)parseWorld(huge, "w.ini");
+        ADD_FAILURE() << "a 10 km world at 5 cm was accepted";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_STREQ(e.what(),
+                     "w.ini [world] grid_resolution: bounds 10000 x 10000 m at 0.05 m "
+                     "make 4e+10 grid cells (at most 1e8)");
+    }
     // The simulator's seed is 32 bits: a larger one is an error, not silently cut.
     const mrpt::config::CConfigFileMemory big(
         "[world]\nx_min=0\nx_max=5\ny_min=0\ny_max=5\nseed = 4294967296\n[robot]\nstart_x=1\n"

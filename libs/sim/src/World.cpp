@@ -198,6 +198,16 @@ void validateWorld(const WorldSpec& w) {
         fail(src, "world", "x_min", "bounds must satisfy x_min < x_max and y_min < y_max");
     if (w.grid_resolution <= 0 || w.grid_resolution > 0.5)
         fail(src, "world", "grid_resolution", "must be in (0, 0.5] m");
+    // The occupancy grid holds every cell of the bounds; MRPT counts them in 32 bits.
+    constexpr double kMaxCells = 1e8;
+    const double cells =
+        (w.x_max - w.x_min) / w.grid_resolution * ((w.y_max - w.y_min) / w.grid_resolution);
+    if (cells > kMaxCells) {
+        std::ostringstream m;
+        m << "bounds " << w.x_max - w.x_min << " x " << w.y_max - w.y_min << " m at "
+          << w.grid_resolution << " m make " << cells << " grid cells (at most 1e8)";
+        fail(src, "world", "grid_resolution", m.str());
+    }
     if (w.time_step <= 0 || w.time_step > 0.1)
         fail(src, "world", "time_step", "must be in (0, 0.1] s");
     if (w.timeout <= 0) fail(src, "world", "timeout", "must be > 0 s");
