@@ -83,7 +83,8 @@ NavigatorOptions readNavigatorOptions(const mrpt::config::CConfigFileBase& c,
     o.planner.loadFromConfigFile(c, "global_planner", source);
     o.replan.loadFromConfigFile(c, "replan", source);
     // Read again by the Navigator, from the same INI; checked here, where the file is known
-    // (MRPT would only fail deep inside its waypoint decimation).
+    // (the route's waypoints are spaced by 0.9 x ref_distance: decimateWaypoints would only
+    // fail at the first plan, naming no key).
     if (c.keyExists("CAbstractPTGBasedReactive", "ref_distance"))
         core::requireValue(
             core::readDouble(c, "CAbstractPTGBasedReactive", "ref_distance", 0.0) > 0,
