@@ -23,16 +23,19 @@ std::string trimmed(const std::string& s) {
     throw std::invalid_argument(what + ": expected " + expected + ", got '" + text + "'");
 }
 
+/// `t` read in full as one finite number (no trailing characters, no overflow, no nan/inf).
+bool readFinite(const std::string& t, double& v) {
+    char* end = nullptr;
+    errno = 0;
+    v = std::strtod(t.c_str(), &end);
+    return !t.empty() && end == t.c_str() + t.size() && errno != ERANGE && std::isfinite(v);
+}
+
 }  // namespace
 
 double parseNumber(const std::string& text, const std::string& what) {
-    const std::string t = trimmed(text);
-    if (t.empty()) fail(what, "a number", text);
-    char* end = nullptr;
-    errno = 0;
-    const double v = std::strtod(t.c_str(), &end);
-    if (end != t.c_str() + t.size() || errno == ERANGE || !std::isfinite(v))
-        fail(what, "a number", text);
+    double v = 0;
+    if (!readFinite(trimmed(text), v)) fail(what, "a number", text);
     return v;
 }
 
@@ -83,10 +86,8 @@ std::vector<double> parseNumberList(const std::string& text, const std::string& 
     std::vector<double> out;
     std::string tok;
     while (ss >> tok) {
-        char* end = nullptr;
-        errno = 0;
-        const double v = std::strtod(tok.c_str(), &end);
-        if (end != tok.c_str() + tok.size() || errno == ERANGE || !std::isfinite(v))
+        double v = 0;
+        if (!readFinite(tok, v))
             throw std::invalid_argument(what + ": '" + tok + "' is not a number");
         out.push_back(v);
     }
