@@ -139,8 +139,8 @@ int main(int argc, char** argv) {
             if (i + 1 < argc && a == "--threads")
                 threads = int(devslam::core::parseInteger(argv[++i], "--threads", 1, 256));
             else if (i + 1 < argc && a == "--frames")
-                // its synthetic sequences are made in memory, whole
-                n_frames = int(devslam::core::parseInteger(argv[++i], "--frames", 2, 1000));
+                n_frames = int(devslam::core::parseInteger(argv[++i], "--frames", 2,
+                                                           dynamic::kMaxSyntheticFrames));
             else if (i + 1 < argc && a == "--results")
                 results = argv[++i];
             else if (i + 1 < argc && a == "--config")

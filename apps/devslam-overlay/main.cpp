@@ -157,11 +157,10 @@ int main(int argc, char** argv) {
         if (input.rfind("synthetic:", 0) == 0) {
             dynamic::SyntheticOptions so;
             // The whole sequence is made in memory before the first overlay.
-            if (frames > 1000)
-                throw std::invalid_argument(
-                    "--frames: a synthetic sequence has at most 1000 "
-                    "frames, got " +
-                    std::to_string(frames));
+            if (frames > dynamic::kMaxSyntheticFrames)
+                throw std::invalid_argument("--frames: a synthetic sequence has at most " +
+                                            std::to_string(dynamic::kMaxSyntheticFrames) +
+                                            " frames, got " + std::to_string(frames));
             so.n_frames = frames > 0 ? frames : 30;
             const std::string kind = input.substr(10);
             if (kind == "walking")

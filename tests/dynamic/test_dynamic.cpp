@@ -132,6 +132,11 @@ TEST(DynamicSynthetic, TruthIsConsistent) {
     so.n_frames = 3;
     const auto seq = dynamic::makeSyntheticSequence(so, wallTexture(), personSprite());
     ASSERT_EQ(seq.size(), 3u);
+    // The whole sequence is held in memory: more frames than the bound are refused.
+    dynamic::SyntheticOptions many = so;
+    many.n_frames = dynamic::kMaxSyntheticFrames + 1;
+    EXPECT_THROW((void)dynamic::makeSyntheticSequence(many, wallTexture(), personSprite()),
+                 std::invalid_argument);
     ASSERT_TRUE(seq[1].person_box.has_value());
     // The person billboard is nearer than the wall, and the box holds its depth.
     const cv::Rect2f b = *seq[1].person_box;

@@ -27,8 +27,9 @@ std::vector<SyntheticFrame> makeSyntheticSequence(const SyntheticOptions& o,
                                                   const cv::Mat& person_bgr) {
     if (wall_bgr.type() != CV_8UC3 || person_bgr.type() != CV_8UC3)
         throw std::invalid_argument("synthetic sequence: textures must be CV_8UC3");
-    if (o.n_frames < 1 || o.fps <= 0)
-        throw std::invalid_argument("synthetic sequence: n_frames >= 1 and fps > 0 needed");
+    if (o.n_frames < 1 || o.n_frames > kMaxSyntheticFrames || o.fps <= 0)
+        throw std::invalid_argument("synthetic sequence: n_frames 1.." +
+                                    std::to_string(kMaxSyntheticFrames) + " and fps > 0 needed");
     core::CameraIntrinsics K;  // 640x480, fx = fy = 525 (fr1-like)
     const double dt = 1.0 / o.fps;
     std::mt19937 rng(o.seed);

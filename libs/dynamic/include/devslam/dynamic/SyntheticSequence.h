@@ -20,8 +20,11 @@ namespace devslam::dynamic {
 
 enum class PersonMotion { None, Static, Walking };
 
+/// The most frames makeSyntheticSequence makes: the whole sequence is held in memory.
+inline constexpr int kMaxSyntheticFrames = 1000;
+
 struct SyntheticOptions {
-    int n_frames = 30;
+    int n_frames = 30;  ///< 1..kMaxSyntheticFrames
     PersonMotion person = PersonMotion::Walking;
     double person_speed = 1.2;  ///< [m/s] walking speed along person_direction
     /// walking direction in the world (= first camera) frame: x right, z forward; only its
