@@ -2,6 +2,7 @@
 #include <devslam/core/Camera.h>
 #include <devslam/core/Config.h>
 #include <devslam/core/Frame.h>
+#include <devslam/core/GzFile.h>
 #include <devslam/core/Parse.h>
 #include <devslam/core/Pose.h>
 #include <devslam/core/Results.h>
@@ -335,6 +336,18 @@ TEST(Association, NearestPairsNeverReused) {
     // Unsorted input, offset applied to b.
     EXPECT_EQ(associate({2.0, 1.0}, {0.5, 1.5}, 0.02, 0.5), (std::vector<P>{{1, 0}, {0, 1}}));
     EXPECT_TRUE(associate({1.0}, {}, 0.02).empty());
+}
+
+TEST(GzFile, InnermostMessageSkipsEmptyMessages) {
+    const std::string nested =
+        "==== MRPT exception ====\nFile: a.cpp\nMessage: outer\n"
+        "File: b.cpp\nMessage:   inner text\nCallstack:\n";
+    EXPECT_EQ(innermostMessage(nested), "inner text");
+    EXPECT_EQ(innermostMessage("plain first line\nsecond"), "plain first line");
+    // An empty innermost message keeps the last non-empty one (and must not throw).
+    EXPECT_EQ(innermostMessage(nested + "Message:"), "inner text");
+    EXPECT_EQ(innermostMessage(nested + "Message:   \nmore"), "inner text");
+    EXPECT_EQ(innermostMessage("Message:"), "Message:");
 }
 
 TEST(Stats, MatchesNumpy) {

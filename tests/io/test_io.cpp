@@ -7,6 +7,7 @@
 #include <devslam/io/VideoReader.h>
 
 #include <gtest/gtest.h>
+#include <mrpt/obs/CObservation3DRangeScan.h>
 
 #include "Scratch.h"
 
@@ -325,6 +326,37 @@ TEST(Rawlog, TruncatedFileReportsWhatWasRead) {
     writeText(path, "garbage");
     expectError([&] { io::RawlogReader r(path); }, "cannot decode object 0 at byte 0");
     expectError([&] { io::RawlogReader r(d.str("none.rawlog")); }, "rawlog file not found");
+}
+
+TEST(Rawlog, LaterObservationsNameTheFileAndObservation) {
+    // The reader decodes only observation 0's images up front; a damaged later one must still
+    // be named (file and observation), not surface as a bare MRPT or OpenCV message.
+    TempDir d;
+    io::TumReader tum(kTum);
+    io::RawlogWriterOptions wo;
+    wo.external_images = true;
+    const std::string path = d.str("ext.rawlog");
+    {
+        io::RawlogWriter w(path, wo);
+        for (std::size_t i = 0; i < 3; ++i) w.write(tum.read(i));
+        w.close();
+    }
+    ASSERT_TRUE(fs::remove(d.str("ext_Images/frame_2_rgb.png")));
+    io::RawlogReader r(path);
+    ASSERT_EQ(r.size(), 3u);
+    EXPECT_TRUE(r.next());
+    EXPECT_TRUE(r.next());
+    expectError([&] { (void)r.next(); }, R"(ext\.rawlog observation 2: )");
+
+    // A colour image of four channels: named, not an OpenCV assertion from cvtColor.
+    mrpt::obs::CObservation3DRangeScan o;
+    o.hasIntensityImage = true;
+    o.intensityImage =
+        mrpt::img::CImage(cv::Mat(4, 4, CV_8UC4, cv::Scalar::all(9)), mrpt::img::DEEP_COPY);
+    o.hasRangeImage = true;
+    o.rangeImage_setSize(4, 4);
+    expectError([&] { (void)io::frameFromObservation(o, "obs 7"); },
+                R"(obs 7: colour image has 4 channels)");
 }
 
 TEST(Rawlog, ReadsMrptsOwnOpenNiObservation) {

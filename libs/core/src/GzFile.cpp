@@ -25,6 +25,7 @@ std::string innermostMessage(const std::string& what) {
     for (std::size_t p = what.find("Message:"); p != std::string::npos;
          p = what.find("Message:", p + 1)) {
         const std::size_t b = what.find_first_not_of(' ', p + 8);
+        if (b == std::string::npos || what[b] == '\n') continue;  // an empty "Message:"
         best = what.substr(b, what.find('\n', b) - b);
     }
     return best;

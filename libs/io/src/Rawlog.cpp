@@ -100,8 +100,11 @@ core::Frame frameFromObservation(const CObservation3DRangeScan& o, const std::st
     const cv::Mat& img = o.intensityImage.asCvMatRef();
     if (img.channels() == 3)
         f.bgr = img.clone();  // CImage colour is BGR
-    else
+    else if (img.channels() == 1)
         cv::cvtColor(img, f.bgr, cv::COLOR_GRAY2BGR);
+    else
+        throw std::runtime_error(what + ": colour image has " + std::to_string(img.channels()) +
+                                 " channels (1 or 3 expected)");
     if (f.bgr.depth() != CV_8U)
         throw std::runtime_error(what + ": colour image must be 8 bits per channel");
 
@@ -233,8 +236,17 @@ std::optional<core::Frame> RawlogReader::next() {
     if (!o) return std::nullopt;
     const std::string what = path_ + " observation " + std::to_string(n_read_);
     mrpt::img::CImage::setImagesPathBase(rawlogImagesDir(path_));
-    o->load();
-    core::Frame f = frameFromObservation(*o, what);
+    core::Frame f;
+    try {
+        o->load();  // external images are read here: a missing file throws from MRPT
+        f = frameFromObservation(*o, what);
+    } catch (const std::exception& e) {
+        o->unload();
+        const std::string msg = e.what();
+        // frameFromObservation's own errors already start with `what`.
+        if (msg.rfind(what, 0) == 0) throw;
+        throw std::runtime_error(what + ": " + core::innermostMessage(msg));
+    }
     o->unload();
     if (opts_.intrinsics) f.K = *opts_.intrinsics;
     f.index = n_read_++;

@@ -17,8 +17,8 @@ namespace devslam::core {
 /// "cannot open", ...).
 [[nodiscard]] std::string gzipDamage(const std::string& path);
 
-/// The innermost "Message:" line of an MRPT exception text (its first line when it has
-/// none).
+/// The innermost non-empty "Message:" line of an MRPT exception text (its first line when
+/// it has none).
 [[nodiscard]] std::string innermostMessage(const std::string& what);
 
 }  // namespace devslam::core
