@@ -341,12 +341,16 @@ TEST(Rawlog, LaterObservationsNameTheFileAndObservation) {
         for (std::size_t i = 0; i < 3; ++i) w.write(tum.read(i));
         w.close();
     }
-    ASSERT_TRUE(fs::remove(d.str("ext_Images/frame_2_rgb.png")));
+    ASSERT_TRUE(fs::remove(d.str("ext_Images/frame_1_rgb.png")));
     io::RawlogReader r(path);
     ASSERT_EQ(r.size(), 3u);
     EXPECT_TRUE(r.next());
-    EXPECT_TRUE(r.next());
-    expectError([&] { (void)r.next(); }, R"(ext\.rawlog observation 2: )");
+    expectError([&] { (void)r.next(); }, R"(ext\.rawlog observation 1: )");
+    // The reader goes on after the bad observation, and counts it.
+    const auto third = r.next();
+    ASSERT_TRUE(third);
+    EXPECT_EQ(third->index, 2u);
+    EXPECT_FALSE(r.next());
 
     // A colour image of four channels: named, not an OpenCV assertion from cvtColor.
     mrpt::obs::CObservation3DRangeScan o;

@@ -234,7 +234,9 @@ std::optional<core::Frame> RawlogReader::next() {
     bool sf = false, ob = false;
     auto o = stream_->next(opts_.sensor_label, skipped, sf, ob);
     if (!o) return std::nullopt;
-    const std::string what = path_ + " observation " + std::to_string(n_read_);
+    // Counted before decoding: after a bad observation the next call names the one after it.
+    const std::size_t index = n_read_++;
+    const std::string what = path_ + " observation " + std::to_string(index);
     mrpt::img::CImage::setImagesPathBase(rawlogImagesDir(path_));
     core::Frame f;
     try {
@@ -249,7 +251,7 @@ std::optional<core::Frame> RawlogReader::next() {
     }
     o->unload();
     if (opts_.intrinsics) f.K = *opts_.intrinsics;
-    f.index = n_read_++;
+    f.index = index;
     return f;
 }
 

@@ -59,7 +59,8 @@ class RgbdReader {
   public:
     virtual ~RgbdReader() = default;
     /// The next frame, or std::nullopt at the end. Throws std::runtime_error naming the file
-    /// (and line or observation index) when the data is damaged.
+    /// (and line or observation index) when the data is damaged; the frame that threw is
+    /// passed, so the next call reads the one after it.
     [[nodiscard]] virtual std::optional<core::Frame> next() = 0;
     /// Number of frames if known up front (TUM: yes; rawlog: counted while opening).
     [[nodiscard]] virtual std::optional<std::size_t> size() const = 0;
