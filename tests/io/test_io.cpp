@@ -341,16 +341,28 @@ TEST(Rawlog, LaterObservationsNameTheFileAndObservation) {
         for (std::size_t i = 0; i < 3; ++i) w.write(tum.read(i));
         w.close();
     }
-    ASSERT_TRUE(fs::remove(d.str("ext_Images/frame_1_rgb.png")));
-    io::RawlogReader r(path);
-    ASSERT_EQ(r.size(), 3u);
-    EXPECT_TRUE(r.next());
-    expectError([&] { (void)r.next(); }, R"(ext\.rawlog observation 1: )");
-    // The reader goes on after the bad observation, and counts it.
-    const auto third = r.next();
-    ASSERT_TRUE(third);
-    EXPECT_EQ(third->index, 2u);
-    EXPECT_FALSE(r.next());
+    // A file that is there but does not decode is found when its frame is read.
+    writeText(d.str("ext_Images/frame_1_rgb.png"), "not a png");
+    {
+        io::RawlogReader r(path);
+        ASSERT_EQ(r.size(), 3u);
+        EXPECT_TRUE(r.next());
+        expectError([&] { (void)r.next(); }, R"(ext\.rawlog observation 1: )");
+        // The reader goes on after the bad observation, and counts it.
+        const auto third = r.next();
+        ASSERT_TRUE(third);
+        EXPECT_EQ(third->index, 2u);
+        EXPECT_FALSE(r.next());
+    }
+    // A missing one is damage found at open: the frames before it stay usable.
+    ASSERT_TRUE(fs::remove(d.str("ext_Images/frame_2_rgb.png")));
+    expectError([&] { io::RawlogReader r(path); },
+                R"(ext\.rawlog: observation 2: external file '.*frame_2_rgb\.png' not found )"
+                R"(after 2 RGB-D observations)");
+    io::ReaderOptions allow;
+    allow.allow_damaged = true;
+    io::RawlogReader partial(path, allow);
+    EXPECT_EQ(partial.size(), 2u);
 
     // A colour image of four channels: named, not an OpenCV assertion from cvtColor.
     mrpt::obs::CObservation3DRangeScan o;

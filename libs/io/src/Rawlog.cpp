@@ -88,6 +88,21 @@ cv::Mat registerDepth(const CObservation3DRangeScan& o, const cv::Mat& depth, in
     return out;
 }
 
+// The first externally stored file of `o` that is not there ("" when none is missing).
+// MRPT opens them only when a frame is read; checking at open makes a missing one damage
+// found up front, as a TUM folder's missing image is.
+std::string missingExternalFile(const CObservation3DRangeScan& o) {
+    if (o.hasIntensityImage && o.intensityImage.isExternallyStored()) {
+        const std::string p = o.intensityImage.getExternalStorageFileAbsolutePath();
+        if (!fs::is_regular_file(p)) return p;
+    }
+    if (o.hasRangeImage && o.rangeImage_isExternallyStored()) {
+        const std::string p = o.rangeImage_getExternalStorageFileAbsolutePath("");
+        if (!fs::is_regular_file(p)) return p;
+    }
+    return "";
+}
+
 }  // namespace
 
 core::Frame frameFromObservation(const CObservation3DRangeScan& o, const std::string& what) {
@@ -200,6 +215,9 @@ RawlogReader::RawlogReader(std::string path, ReaderOptions opts)
     try {
         Stream s(path_);
         while (auto o = s.next(opts_.sensor_label, skipped, saw_sf, saw_obs)) {
+            if (const std::string m = missingExternalFile(*o); !m.empty())
+                throw std::runtime_error("observation " + std::to_string(n_frames_) +
+                                         ": external file '" + m + "' not found");
             if (n_frames_ == 0) {
                 o->load();
                 K_ = frameFromObservation(*o, path_ + " observation 0").K;
