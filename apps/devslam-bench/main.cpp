@@ -48,7 +48,8 @@ const std::string kRoot = DEVSLAM_SOURCE_DIR;
 const char* kUsage =
     "usage: devslam-bench [--config INI] [--repeats N] [--max-frames N] [--out DIR]\n"
     "                     [--results FILE] [--bin DIR] [--reuse-runs]\n"
-    "--reuse-runs: keep the run.json of runs already in the output folder (resume a bench)\n"
+    "--reuse-runs: keep the run.json of runs already in the output folder (resume a bench);\n"
+    "              a run that stopped at a frame it could not read is run again\n"
     "defaults: --config " DEVSLAM_SOURCE_DIR
     "/config_ini/bench.ini, repeats and out from the INI,\n"
     "          --results " DEVSLAM_SOURCE_DIR
@@ -257,7 +258,9 @@ RunFigures readRun(const std::string& json_path) {
     f.static_masked = get("mask_truth", "static_masked");
     f.moving_instances = get("mask_truth", "moving_instances");
     f.static_instances = get("mask_truth", "static_instances");
-    f.ok = true;
+    // A run that stopped at a frame it could not read covers part of the input only.
+    f.ok = js.find("\"read_error\": \"") == std::string::npos ||
+           js.find("\"read_error\": \"\"") != std::string::npos;
     return f;
 }
 
@@ -368,7 +371,7 @@ int run(int argc, char** argv) {
                               << (in.seed ? " seed " + seed : std::string()) << " run " << r + 1
                               << "\n"
                               << std::flush;
-                    const bool have = reuse && fs::exists(dir / "run.json");
+                    const bool have = reuse && readRun((dir / "run.json").string()).ok;
                     const int rc = have ? 0 : std::system(cmd.c_str());
                     reused += have;
                     RunFigures f = rc == 0 ? readRun((dir / "run.json").string()) : RunFigures{};

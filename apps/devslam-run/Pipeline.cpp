@@ -147,7 +147,14 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
         // Reading/decoding the next frame is not part of the pipeline time.
         const auto t_read = Clock::now();
         const double cpu_read = processCpuMs();
-        std::optional<core::Frame> nxt = within(n + 1) ? reader.next() : std::nullopt;
+        std::optional<core::Frame> nxt;
+        try {
+            if (within(n + 1)) nxt = reader.next();
+        } catch (const std::exception& e) {
+            // A frame damaged in a way the reader cannot see at open (an image that does not
+            // decode): stop here and keep what was computed, instead of losing the whole run.
+            rep.read_error = e.what();
+        }
         if (nxt) nxt->index = n + 1;
         fl.read_ms = msSince(t_read);
         fl.read_cpu_ms = processCpuMs() - cpu_read;
@@ -349,6 +356,8 @@ std::string formatSummary(const RunReport& r) {
     std::ostringstream o;
     o << "input      : " << r.input << "\n";
     if (!r.input_damage.empty()) o << "left out   : " << r.input_damage << "\n";
+    if (!r.read_error.empty())
+        o << "STOPPED    : after " << r.frames << " frames: " << r.read_error << "\n";
     o << "mode       : " << r.mode << " (" << r.mask_source
       << (r.async_filter ? ", filter one frame ahead in a second thread" : "") << ")\n"
       << "camera     : " << r.camera << "\n"
@@ -441,12 +450,12 @@ std::string toJson(const RunReport& r) {
         return e;
     };
     o << "{\n  \"input\": \"" << esc(r.input) << "\",\n  \"input_damage\": \""
-      << esc(r.input_damage) << "\",\n  \"mode\": \"" << r.mode << "\",\n  \"mask_source\": \""
-      << esc(r.mask_source) << "\",\n  \"frames\": " << r.frames
-      << ",\n  \"keyframes\": " << r.keyframes << ",\n  \"landmarks\": " << r.landmarks
-      << ",\n  \"local_ba_runs\": " << r.ba_runs << ",\n  \"local_ba_rejected\": " << r.ba_rejected
-      << ",\n  \"loops_closed\": " << r.loops << ",\n  \"lost_frames\": " << r.lost.size()
-      << ",\n  \"lost_frame_indices\": [";
+      << esc(r.input_damage) << "\",\n  \"read_error\": \"" << esc(r.read_error)
+      << "\",\n  \"mode\": \"" << r.mode << "\",\n  \"mask_source\": \"" << esc(r.mask_source)
+      << "\",\n  \"frames\": " << r.frames << ",\n  \"keyframes\": " << r.keyframes
+      << ",\n  \"landmarks\": " << r.landmarks << ",\n  \"local_ba_runs\": " << r.ba_runs
+      << ",\n  \"local_ba_rejected\": " << r.ba_rejected << ",\n  \"loops_closed\": " << r.loops
+      << ",\n  \"lost_frames\": " << r.lost.size() << ",\n  \"lost_frame_indices\": [";
     for (std::size_t i = 0; i < r.lost.size(); ++i) o << (i ? ", " : "") << r.lost[i];
     o << "],\n  \"median_fps\": " << num(r.median_fps, 2)
       << ",\n  \"median_cpu_ms\": " << num(r.median_cpu_ms, 3)

@@ -71,6 +71,9 @@ struct LoopReport {
 struct RunReport {
     std::string input, mode, camera, mask_source;
     std::string input_damage;  ///< what of the input was unreadable and left out ("" = none)
+    /// A frame that failed to read during the run ("" = none): the run stopped there and its
+    /// outputs hold the frames before it.
+    std::string read_error;
     bool async_filter = false;
     std::size_t frames = 0, keyframes = 0, landmarks = 0, loops = 0;
     std::vector<std::size_t> lost;  ///< frame indices without a tracked pose

@@ -183,6 +183,13 @@ int runOnce(const Args& a) {
     rc.score_masks = a.replay <= 0;
     const auto rep = run::runSequence(*reader, rc, *l.cfg, *l.filter_cfg);
     std::cout << run::formatSummary(rep);
+    if (!rep.read_error.empty()) {
+        std::cerr << "devslam-run: " << rep.read_error << "\ndevslam-run: stopped after "
+                  << rep.frames << " frames"
+                  << (a.out.empty() ? std::string() : "; " + a.out + " holds their results")
+                  << "\n";
+        return 1;
+    }
     return 0;
 }
 
@@ -218,6 +225,8 @@ int runBench(const Args& a) {
             auto reader = io::openRgbd(a.input, l.reader);
             const auto rc = runConfig(a, l, mode);
             const auto rep = run::runSequence(*reader, rc, *l.cfg, *l.filter_cfg);
+            if (!rep.read_error.empty())  // a bench over part of the input would mislead
+                throw std::runtime_error(rep.read_error);
             if (rep.ate) {
                 ate.push_back(rep.ate->trans.rmse);
                 ate_max.push_back(rep.ate->trans.max);

@@ -161,6 +161,40 @@ TEST(DevslamRun, TruncatedRawlogRunsOnItsIntactPartWhenAsked) {
     fs::remove_all(dir);
 }
 
+// A frame whose image is there but does not decode is found only when it is read: the run
+// stops there, keeps (writes) the frames before it, names the file and exits with 1.
+TEST(DevslamRun, AnUndecodableFrameMidRunKeepsTheFramesBeforeIt) {
+    const fs::path dir = devslam::test::scratchPath("devslam_run_undecodable");
+    fs::remove_all(dir);
+    const std::string convert = std::string(DEVSLAM_BIN_DIR) + "/devslam-convert " +
+                                DEVSLAM_SOURCE_DIR + "/data/tum/fr1_xyz_first37 " +
+                                (dir / "seq").string() + " --max-frames 8 > /dev/null 2>&1";
+    ASSERT_EQ(std::system(convert.c_str()), 0) << convert;
+    std::ifstream list(dir / "seq" / "rgb.txt");
+    std::string line, image;
+    for (int k = 0; k <= 5 && std::getline(list, line);)
+        if (!line.empty() && line[0] != '#' && k++ == 5) image = line.substr(line.find(' ') + 1);
+    ASSERT_FALSE(image.empty());
+    std::ofstream(dir / "seq" / image) << "not a png";
+
+    const auto r = run("--input " + (dir / "seq").string() + " --mode dynamic --quiet --out " +
+                       (dir / "run").string());
+    EXPECT_EQ(r.rc, 1) << r.out;
+    EXPECT_NE(r.out.find(image + ": cannot decode colour image"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("stopped after 5 frames; " + (dir / "run").string() + " holds their"),
+              std::string::npos)
+        << r.out;
+    EXPECT_NE(r.out.find("STOPPED    : after 5 frames"), std::string::npos) << r.out;
+    EXPECT_EQ(lines(dir / "run" / "trajectory.txt"), 5u);
+    std::ifstream js(dir / "run" / "run.json");
+    std::stringstream ss;
+    ss << js.rdbuf();
+    EXPECT_NE(ss.str().find("\"read_error\": \"" + (dir / "seq" / image).string()),
+              std::string::npos)
+        << ss.str().substr(0, 400);
+    fs::remove_all(dir);
+}
+
 // The filter one frame ahead in a second thread (async_filter, the shipped setting) must
 // give the sequential run's result: its ego-motion prior is the constant-velocity
 // prediction instead of the tracker's, which on these slow real frames changes nothing.
