@@ -258,7 +258,7 @@ std::optional<core::Frame> RawlogReader::next() {
     mrpt::img::CImage::setImagesPathBase(rawlogImagesDir(path_));
     core::Frame f;
     try {
-        o->load();  // external images are read here: a missing file throws from MRPT
+        o->load();  // external images are decoded here (their presence was checked at open)
         f = frameFromObservation(*o, what);
     } catch (const std::exception& e) {
         o->unload();
