@@ -8,6 +8,7 @@
 #include <devslam/io/TumWriter.h>
 
 #include <iostream>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -25,7 +26,8 @@ options:
   --label TEXT        sensor label of the observations (default RGBD)
   --max-frames N      stop after N frames
   --allow-damaged     a damaged input (a rawlog cut short by a crash or a full disk, a TUM
-                      folder missing images): convert what is intact, say what was left out
+                      folder missing images, a frame whose image does not decode): convert
+                      what is intact, say what was left out
 )";
 
 bool endsWith(const std::string& s, const std::string& suffix) {
@@ -78,23 +80,36 @@ int main(int argc, char** argv) {
         const std::size_t total = std::min(reader->size().value_or(0), max_frames);
         devslam::core::ProgressBar bar("converting", total);
         std::size_t n = 0;
-        if (endsWith(pos[1], ".rawlog")) {
-            devslam::io::RawlogWriter out(pos[1], wo);
+        // A frame the reader finds bad only when it reads it (an image that is there but
+        // does not decode) stops the conversion with the frames before it written, or, with
+        // --allow-damaged, is left out and the rest converted. The readers pass such a frame.
+        std::string stopped;
+        std::vector<std::string> undecodable;
+        const auto convertAll = [&](auto& out) {
             while (n < max_frames) {
-                auto f = reader->next();
+                std::optional<devslam::core::Frame> f;
+                try {
+                    f = reader->next();
+                } catch (const std::exception& e) {
+                    if (!ro.allow_damaged) {
+                        stopped = e.what();
+                        break;
+                    }
+                    undecodable.push_back(e.what());
+                    continue;
+                }
                 if (!f) break;
                 out.write(*f);
                 bar.update(++n);
             }
+        };
+        if (endsWith(pos[1], ".rawlog")) {
+            devslam::io::RawlogWriter out(pos[1], wo);
+            convertAll(out);
             out.close();
         } else {
             devslam::io::TumWriter out(pos[1], "converted by devslam-convert from " + pos[0]);
-            while (n < max_frames) {
-                auto f = reader->next();
-                if (!f) break;
-                out.write(*f);
-                bar.update(++n);
-            }
+            convertAll(out);
             if (auto gt = reader->groundTruth()) out.writeGroundTruth(*gt);
             out.close();
         }
@@ -102,6 +117,16 @@ int main(int argc, char** argv) {
         std::cout << "wrote " << n << " frames to " << pos[1] << "\n";
         if (const std::string lost = reader->damage(); !lost.empty())
             std::cout << "left out (damaged input): " << lost << "\n";
+        if (!undecodable.empty())
+            std::cout << "left out (frames that do not decode): " << undecodable.size()
+                      << ", the first: " << undecodable.front() << "\n";
+        if (!stopped.empty()) {
+            std::cerr << "devslam-convert: " << stopped << "\ndevslam-convert: stopped there; "
+                      << pos[1] << " holds the " << n
+                      << " frames before it (--allow-damaged leaves such frames out and "
+                         "converts the rest)\n";
+            return 1;
+        }
         return 0;
     } catch (const devslam::io::DamagedInput& e) {
         std::cerr << "devslam-convert: " << e.what() << "\n";

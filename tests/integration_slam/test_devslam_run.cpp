@@ -192,6 +192,22 @@ TEST(DevslamRun, AnUndecodableFrameMidRunKeepsTheFramesBeforeIt) {
     EXPECT_NE(ss.str().find("\"read_error\": \"" + (dir / "seq" / image).string()),
               std::string::npos)
         << ss.str().substr(0, 400);
+
+    // devslam-convert keeps the frames before it, or with --allow-damaged all but that one.
+    auto c = devslam::test::runApp("devslam-convert",
+                                   (dir / "seq").string() + " " + (dir / "part").string());
+    EXPECT_EQ(c.rc, 1) << c.out;
+    EXPECT_NE(c.out.find("holds the 5 frames before it"), std::string::npos) << c.out;
+    EXPECT_EQ(lines(dir / "part" / "rgb.txt"), 5u);
+    c = devslam::test::runApp(
+        "devslam-convert",
+        (dir / "seq").string() + " " + (dir / "rest.rawlog").string() + " --allow-damaged");
+    EXPECT_EQ(c.rc, 0) << c.out;
+    EXPECT_NE(c.out.find("left out (frames that do not decode): 1, the first: " +
+                         (dir / "seq" / image).string()),
+              std::string::npos)
+        << c.out;
+    EXPECT_NE(c.out.find("wrote 7 frames"), std::string::npos) << c.out;
     fs::remove_all(dir);
 }
 
