@@ -146,6 +146,23 @@ TEST(DevslamBench, TwoFrameSmokeRunOfTheWholeCommand) {
                            "'person_2.path=[3.5 2.8]'`."),
               std::string::npos)
         << results;
+
+    // --reuse-runs keeps whole runs and runs again one that stopped at a frame it could not
+    // read (devslam-run's run.json then names it in read_error).
+    const fs::path stopped = tmp / "out/runs/fr1/dynamic/r0/run.json";
+    std::string js = readFile(stopped);
+    const std::string key = "\"read_error\": \"\"";
+    ASSERT_NE(js.find(key), std::string::npos) << js.substr(0, 300);
+    js.replace(js.find(key), key.size(), "\"read_error\": \"x.png: cannot decode\"");
+    std::ofstream(stopped) << js;
+    ASSERT_EQ(
+        std::system((cmd.substr(0, cmd.find(" > ")) + " --reuse-runs" + cmd.substr(cmd.find(" > ")))
+                        .c_str()),
+        0)
+        << readFile(tmp / "log.txt");
+    EXPECT_NE(readFile(tmp / "RESULTS.md").find("10 of 11 runs were kept"), std::string::npos)
+        << readFile(tmp / "RESULTS.md");
+    EXPECT_NE(readFile(stopped).find(key), std::string::npos);
     fs::remove_all(tmp);
 }
 
