@@ -371,10 +371,12 @@ int run(int argc, char** argv) {
                               << (in.seed ? " seed " + seed : std::string()) << " run " << r + 1
                               << "\n"
                               << std::flush;
-                    const bool have = reuse && readRun((dir / "run.json").string()).ok;
+                    const std::string json = (dir / "run.json").string();
+                    RunFigures f = reuse ? readRun(json) : RunFigures{};
+                    const bool have = f.ok;  // a whole run made earlier: kept
                     const int rc = have ? 0 : std::system(cmd.c_str());
                     reused += have;
-                    RunFigures f = rc == 0 ? readRun((dir / "run.json").string()) : RunFigures{};
+                    if (!have) f = rc == 0 ? readRun(json) : RunFigures{};
                     f.seed = in.seed;
                     f.dir = dir;
                     if (!f.ok)
