@@ -152,6 +152,18 @@ TEST(Parse, NumbersAreReadInFullOrRejected) {
         EXPECT_NE(invalidArgument([&] { (void)parseNumber(bad, "x"); }), "") << bad;
 }
 
+TEST(Parse, NumberListsNameTheBadToken) {
+    EXPECT_EQ(parseNumberList("[1 2.5, -3]", "x"), (std::vector<double>{1, 2.5, -3}));
+    EXPECT_TRUE(parseNumberList("  ", "x").empty());
+    EXPECT_EQ(invalidArgument([] { (void)parseNumberList("1 2m", "[a] k"); }),
+              "[a] k: '2m' is not a number");
+    for (const char* t : {"nan", "-inf", "1e400"})
+        EXPECT_EQ(invalidArgument([&] { (void)parseNumberList(std::string("1 ") + t, "[a] k"); }),
+                  std::string("[a] k: '") + t + "' is not a finite number");
+    EXPECT_EQ(invalidArgument([] { (void)parseNumberList("1 2", "[a] k", 3); }),
+              "[a] k: expected 3 numbers, got 2");
+}
+
 TEST(Parse, IntegersAreWholeAndInRange) {
     EXPECT_EQ(parseInteger("42", "x"), 42);
     EXPECT_EQ(parseInteger("+7", "x"), 7);

@@ -87,8 +87,14 @@ std::vector<double> parseNumberList(const std::string& text, const std::string& 
     std::string tok;
     while (ss >> tok) {
         double v = 0;
-        if (!readFinite(tok, v))
-            throw std::invalid_argument(what + ": '" + tok + "' is not a number");
+        if (!readFinite(tok, v)) {
+            // "nan", "inf" and "1e400" read in full, but are no place, size or time.
+            char* end = nullptr;
+            std::strtod(tok.c_str(), &end);
+            const bool whole = end == tok.c_str() + tok.size();
+            throw std::invalid_argument(what + ": '" + tok + "' is not a " +
+                                        (whole ? "finite number" : "number"));
+        }
         out.push_back(v);
     }
     if (expected > 0 && out.size() != expected)

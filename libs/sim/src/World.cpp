@@ -1,4 +1,5 @@
 #include <devslam/core/Config.h>
+#include <devslam/core/Parse.h>
 #include <devslam/sim/World.h>
 
 #include <mrpt/config/CConfigFileBase.h>
@@ -27,24 +28,13 @@ std::vector<std::string> splitWords(const std::string& s) {
     return out;
 }
 
+/// The numbers after the first `from` words (an obstacle's or pedestrian's kind).
 std::vector<double> parseNumbers(const std::vector<std::string>& words, size_t from,
                                  const std::string& source, const std::string& section,
                                  const std::string& key) {
-    std::vector<double> v;
-    for (size_t i = from; i < words.size(); i++) {
-        try {
-            size_t used = 0;
-            v.push_back(std::stod(words[i], &used));
-            if (used != words[i].size()) throw std::invalid_argument("trailing characters");
-        } catch (const std::exception&) {
-            fail(source, section, key, "'" + words[i] + "' is not a number");
-        }
-        // std::stod takes "nan" and "inf"; neither is a place or a size, and a NaN passes
-        // every range check after this one.
-        if (!std::isfinite(v.back()))
-            fail(source, section, key, "'" + words[i] + "' is not a finite number");
-    }
-    return v;
+    std::string rest;
+    for (size_t i = from; i < words.size(); i++) rest += words[i] + " ";
+    return core::parseNumberList(rest, source + " [" + section + "] " + key);
 }
 
 }  // namespace

@@ -33,9 +33,9 @@ namespace devslam::core {
 [[nodiscard]] bool parseBool(const std::string& text, const std::string& what);
 
 /// Finite numbers written "[a b c]", "a b c" or "a, b, c" (MRPT writes vectors in
-/// brackets). Throws std::invalid_argument "<what>: 'x' is not a number" on a bad or
-/// non-finite token, and "<what>: expected N numbers, got M" when `expected` (if > 0) does
-/// not match the count.
+/// brackets). Throws std::invalid_argument "<what>: 'x' is not a number" on a bad token,
+/// "<what>: 'inf' is not a finite number" on nan, inf or an overflowing one, and "<what>: expected
+/// N numbers, got M" when `expected` (if > 0) does not match the count.
 [[nodiscard]] std::vector<double> parseNumberList(const std::string& text, const std::string& what,
                                                   std::size_t expected = 0);
 
