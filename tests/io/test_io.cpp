@@ -354,6 +354,18 @@ TEST(Rawlog, LaterObservationsNameTheFileAndObservation) {
         EXPECT_EQ(third->index, 2u);
         EXPECT_FALSE(r.next());
     }
+    // An external depth file cut short (a crash, a full disk): MRPT's reader fills the depth
+    // image up to the cut and leaves the rest unset without a word.
+    const std::string depth2 = d.str("ext_Images/frame_2_depth.bin");
+    fs::resize_file(depth2, fs::file_size(depth2) / 2);
+    {
+        io::RawlogReader r(path);
+        EXPECT_TRUE(r.next());
+        expectError([&] { (void)r.next(); }, R"(ext\.rawlog observation 1: )");  // the PNG
+        expectError([&] { (void)r.next(); },
+                    R"(ext\.rawlog observation 2: external depth file '.*frame_2_depth\.bin' is )"
+                    R"(damaged \(unexpected end of file\))");
+    }
     // A missing one is damage found at open: the frames before it stay usable.
     ASSERT_TRUE(fs::remove(d.str("ext_Images/frame_2_rgb.png")));
     expectError([&] { io::RawlogReader r(path); },

@@ -259,6 +259,16 @@ std::optional<core::Frame> RawlogReader::next() {
     core::Frame f;
     try {
         o->load();  // external images are decoded here (their presence was checked at open)
+        // MRPT reads an external depth file with a plain gz read that stops quietly at a cut
+        // end, leaving the rest of the depth image unset (zeros or old memory); zlib finds it.
+        if (o->hasRangeImage && o->rangeImage_isExternallyStored()) {
+            const std::string p = o->rangeImage_getExternalStorageFileAbsolutePath("");
+            if (std::string gz = core::gzipDamage(p); !gz.empty()) {
+                if (gz.rfind(p + ": ", 0) == 0) gz.erase(0, p.size() + 2);  // zlib names it too
+                throw std::runtime_error(what + ": external depth file '" + p + "' is damaged (" +
+                                         gz + ")");
+            }
+        }
         f = frameFromObservation(*o, what);
     } catch (const std::exception& e) {
         o->unload();
