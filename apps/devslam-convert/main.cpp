@@ -7,6 +7,7 @@
 #include <devslam/io/RgbdReader.h>
 #include <devslam/io/TumWriter.h>
 
+#include <filesystem>
 #include <iostream>
 #include <optional>
 #include <stdexcept>
@@ -33,6 +34,20 @@ options:
 bool endsWith(const std::string& s, const std::string& suffix) {
     return s.size() >= suffix.size() &&
            s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+/// The writers open their output before the first frame is read: an output that is the
+/// input (or holds another sequence) would be emptied before it was read.
+void refuseOverwritingInput(const std::string& in, const std::string& out) {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    if (fs::exists(out) && fs::equivalent(in, out, ec))
+        throw std::invalid_argument("OUTPUT '" + out + "' is the input '" + in +
+                                    "': writing it would destroy what is read; name another");
+    if (!endsWith(out, ".rawlog") && fs::exists(fs::path(out) / "rgb.txt"))
+        throw std::invalid_argument("OUTPUT '" + out +
+                                    "' already holds a TUM sequence (rgb.txt); remove it or name "
+                                    "another folder");
 }
 
 }  // namespace
@@ -75,6 +90,7 @@ int main(int argc, char** argv) {
             std::cerr << kUsage;
             return 2;
         }
+        refuseOverwritingInput(pos[0], pos[1]);
         auto reader = devslam::io::openRgbd(pos[0], ro);
         std::cerr << "reading " << reader->describe() << "\n";
         const std::size_t total = std::min(reader->size().value_or(0), max_frames);

@@ -208,6 +208,22 @@ TEST(DevslamRun, AnUndecodableFrameMidRunKeepsTheFramesBeforeIt) {
               std::string::npos)
         << c.out;
     EXPECT_NE(c.out.find("wrote 7 frames"), std::string::npos) << c.out;
+
+    // An output that is the input, or a folder that holds a sequence, is refused before
+    // anything is written: the writers would empty them before they were read.
+    const auto size = fs::file_size(dir / "rest.rawlog");
+    c = devslam::test::runApp(
+        "devslam-convert", (dir / "rest.rawlog").string() + " " + (dir / "rest.rawlog").string());
+    EXPECT_EQ(c.rc, 1) << c.out;
+    EXPECT_NE(c.out.find("is the input"), std::string::npos) << c.out;
+    EXPECT_EQ(fs::file_size(dir / "rest.rawlog"), size);
+    for (const char* out : {"seq", "part"}) {
+        c = devslam::test::runApp("devslam-convert",
+                                  (dir / "rest.rawlog").string() + " " + (dir / out).string());
+        EXPECT_EQ(c.rc, 1) << c.out;
+        EXPECT_NE(c.out.find("already holds a TUM sequence (rgb.txt)"), std::string::npos) << c.out;
+    }
+    EXPECT_EQ(lines(dir / "part" / "rgb.txt"), 5u);
     fs::remove_all(dir);
 }
 
