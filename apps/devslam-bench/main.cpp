@@ -8,6 +8,7 @@
 //
 //   devslam-bench                                   # config_ini/bench.ini
 //   devslam-bench --config INI [--repeats N] [--max-frames N] [--out DIR] [--results FILE]
+//                 [--render-jobs N]
 
 #include <devslam/core/Config.h>
 #include <devslam/core/Parse.h>
@@ -24,18 +25,22 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <optional>
 
+#include <sys/wait.h>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <mutex>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace fs = std::filesystem;
@@ -47,9 +52,11 @@ const std::string kRoot = DEVSLAM_SOURCE_DIR;
 
 const char* kUsage =
     "usage: devslam-bench [--config INI] [--repeats N] [--max-frames N] [--out DIR]\n"
-    "                     [--results FILE] [--bin DIR] [--reuse-runs]\n"
+    "                     [--results FILE] [--bin DIR] [--reuse-runs] [--render-jobs N]\n"
     "--reuse-runs: keep the run.json of runs already in the output folder (resume a bench);\n"
     "              a run that stopped at a frame it could not read is run again\n"
+    "--render-jobs N: renders made at once (default: [bench] render_jobs, else the CPU's\n"
+    "              threads); the SLAM runs, whose FPS is measured, always run one at a time\n"
     "defaults: --config " DEVSLAM_SOURCE_DIR
     "/config_ini/bench.ini, repeats and out from the INI,\n"
     "          --results " DEVSLAM_SOURCE_DIR
@@ -91,6 +98,7 @@ struct Bench {
     std::vector<std::string> modes{"none", "all_persons", "dynamic"};
     int repeats = 5;
     std::size_t max_frames = 0;
+    int render_jobs = 0;  ///< renders made at once; 0 = the CPU's threads
     std::string out_dir = "out/bench";
     std::string slam_config = kRoot + "/config_ini/slam_synthetic.ini";
     std::vector<Sequence> sequences;
@@ -113,8 +121,9 @@ Bench readBench(const std::string& path) {
     auto cfg = core::loadIni(path);
     Bench b;
     const std::string base = fs::absolute(path).parent_path().string();
-    core::requireKnownKeys(*cfg, "bench",
-                           {"modes", "repeats", "max_frames", "out_dir", "slam_config"}, path);
+    core::requireKnownKeys(
+        *cfg, "bench", {"modes", "repeats", "max_frames", "render_jobs", "out_dir", "slam_config"},
+        path);
     const std::string modes = cfg->read_string("bench", "modes", "");
     if (!modes.empty()) {
         b.modes.clear();
@@ -129,6 +138,9 @@ Bench readBench(const std::string& path) {
     core::requireValue(max_frames >= 0, "bench", "max_frames",
                        "must be >= 0 (0 = whole sequences)");
     b.max_frames = std::size_t(max_frames);
+    b.render_jobs = core::readInt(*cfg, "bench", "render_jobs", 0);
+    core::requireValue(b.render_jobs >= 0 && b.render_jobs <= 64, "bench", "render_jobs",
+                       "must be 0..64 (0 = the CPU's threads)");
     b.out_dir = cfg->read_string("bench", "out_dir", b.out_dir);
     b.slam_config = resolve(cfg->read_string("bench", "slam_config", b.slam_config), base);
     core::requireValue(b.repeats >= 1 && b.repeats <= 100, "bench", "repeats", "must be 1..100");
@@ -278,11 +290,80 @@ std::string quote(const std::string& s) {
     return q + "'";
 }
 
+/// The last `n` lines of the text file `path`, each ending in a newline ("" if unreadable).
+std::string lastLines(const std::string& path, std::size_t n) {
+    std::ifstream in(path);
+    std::vector<std::string> lines;
+    for (std::string l; std::getline(in, l);) {
+        // devslam-synth's progress line redraws itself with '\r': keep its last state.
+        l = l.substr(l.find_last_of('\r') == std::string::npos ? 0 : l.find_last_of('\r') + 1);
+        if (!l.empty()) lines.push_back(l);
+    }
+    std::string out;
+    for (std::size_t k = lines.size() > n ? lines.size() - n : 0; k < lines.size(); ++k)
+        out += "  " + lines[k] + "\n";
+    return out;
+}
+
+/// One devslam-synth call of the bench: its command line, the log its output goes to.
+struct RenderJob {
+    std::string what;  ///< "walking_xyz seed 11", for messages
+    std::string cmd;
+    std::string log;
+};
+
+/// Runs the render commands, `jobs` at a time, each with its output in its log, and says
+/// when each starts and ends. After a failure no new render starts; the ones running finish,
+/// and the first failure is thrown, naming its log.
+void runRenders(const std::vector<RenderJob>& renders, int jobs) {
+    std::mutex mu;
+    std::size_t next = 0, finished = 0;
+    std::string failure;
+    const auto say = [&](const std::string& line) {
+        std::cout << line << "\n" << std::flush;  // under `mu`
+    };
+    const auto worker = [&] {
+        for (;;) {
+            std::size_t i = 0;
+            {
+                std::lock_guard<std::mutex> lock(mu);
+                if (next == renders.size() || !failure.empty()) return;
+                i = next++;
+                say("render (if changed) " + renders[i].what + ": " + renders[i].cmd + " > " +
+                    quote(renders[i].log));
+            }
+            const auto t0 = std::chrono::steady_clock::now();
+            const int rc =
+                std::system((renders[i].cmd + " > " + quote(renders[i].log) + " 2>&1").c_str());
+            const double s =
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+            std::lock_guard<std::mutex> lock(mu);
+            ++finished;
+            if (rc != 0) {
+                if (failure.empty())
+                    failure = "devslam-synth failed for " + renders[i].what + " (exit " +
+                              std::to_string(WIFEXITED(rc) ? WEXITSTATUS(rc) : rc) + "):\n" +
+                              lastLines(renders[i].log, 5) + "(whole output: " + renders[i].log +
+                              ")";
+                say("  render " + renders[i].what + " FAILED, see " + renders[i].log);
+            } else {
+                say("  [" + std::to_string(finished) + "/" + std::to_string(renders.size()) +
+                    " renders] " + renders[i].what + " ready (" + fmt(s, 0) + " s)");
+            }
+        }
+    };
+    std::vector<std::thread> pool;
+    for (int k = 1; k < std::min<int>(jobs, int(renders.size())); ++k) pool.emplace_back(worker);
+    worker();
+    for (auto& t : pool) t.join();
+    if (!failure.empty()) throw std::runtime_error(failure);
+}
+
 int run(int argc, char** argv) {
     std::string config = kRoot + "/config_ini/bench.ini", out_override,
                 results = kRoot + "/docs/RESULTS.md";
     std::string bin = fs::absolute(argv[0]).parent_path().string();
-    int repeats = 0;
+    int repeats = 0, render_jobs = 0;
     bool reuse = false;
     std::size_t max_frames = 0;
     for (int i = 1; i < argc; ++i) {
@@ -305,6 +386,8 @@ int run(int argc, char** argv) {
             bin = value();
         else if (k == "--reuse-runs")
             reuse = true;
+        else if (k == "--render-jobs")
+            render_jobs = int(core::parseInteger(value(), "--render-jobs", 1, 64));
         else if (k == "-h" || k == "--help") {
             std::cout << kUsage;
             return 0;
@@ -323,21 +406,27 @@ int run(int argc, char** argv) {
 
     // 1. Synthetic sequences: render the missing ones, and those whose scenario, room, seed,
     //    frame count or renderer changed since (devslam-synth --if-changed, render.txt).
+    //    Renders are not timed, so `render_jobs` of them run at once; the SLAM runs below,
+    //    whose FPS is measured, run one at a time.
+    std::vector<RenderJob> renders;
     for (const auto& q : b.sequences) {
         if (q.scenario.empty()) continue;
         for (const auto& in : inputsOf(q, b.out_dir)) {
-            std::string cmd = quote(bin + "/devslam-synth") + " " + quote(q.scenario) + " -o " +
-                              quote(in.path) + " --if-changed";
-            if (in.seed) cmd += " --seed " + std::to_string(*in.seed);
-            for (const auto& item : q.sets) cmd += " --set " + quote(item);
-            if (b.max_frames) cmd += " --frames " + std::to_string(b.max_frames);
-            std::cout << "render (if changed) " << q.name << ": " << cmd << "\n" << std::flush;
-            if (std::system(cmd.c_str()) != 0)
-                throw std::runtime_error(
-                    "devslam-synth failed for " + q.name +
-                    (in.seed ? " (seed " + std::to_string(*in.seed) + ")" : std::string()));
+            RenderJob j;
+            j.what = q.name + (in.seed ? " seed " + std::to_string(*in.seed) : std::string());
+            j.log = in.path + ".log";
+            fs::create_directories(fs::path(in.path).parent_path());
+            j.cmd = quote(bin + "/devslam-synth") + " " + quote(q.scenario) + " -o " +
+                    quote(in.path) + " --if-changed";
+            if (in.seed) j.cmd += " --seed " + std::to_string(*in.seed);
+            for (const auto& item : q.sets) j.cmd += " --set " + quote(item);
+            if (b.max_frames) j.cmd += " --frames " + std::to_string(b.max_frames);
+            renders.push_back(j);
         }
     }
+    if (render_jobs == 0) render_jobs = b.render_jobs;
+    if (render_jobs == 0) render_jobs = int(std::max(1u, std::thread::hardware_concurrency()));
+    runRenders(renders, render_jobs);
 
     // 2. SLAM runs.
     std::map<std::pair<std::string, std::string>, std::vector<RunFigures>> runs;

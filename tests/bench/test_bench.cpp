@@ -70,6 +70,10 @@ TEST(DevslamBench, TwoFrameSmokeRunOfTheWholeCommand) {
     for (const char* render : {"out/synth/short_seed5", "out/synth/short_seed6"}) {
         EXPECT_TRUE(fs::exists(tmp / render / "persons.txt")) << render;
         EXPECT_EQ(countLines(readFile(tmp / render / "groundtruth.txt")), 2u) << render;
+        // Renders run side by side, each with its output in its own log.
+        EXPECT_NE(readFile(tmp / (std::string(render) + ".log")).find("frames 2 (30 Hz)"),
+                  std::string::npos)
+            << render;
     }
     EXPECT_EQ(readFile(tmp / "out/synth/short_seed5/groundtruth.txt"),
               readFile(tmp / "out/synth/short_seed6/groundtruth.txt"));
@@ -265,6 +269,7 @@ TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
          "bench.ini: unknown section [sequense_b] (known: bench, sequence_*, targets)"},
         {real + "seed = 5\n", "seed"},
         {"[bench]\nmax_frames = -1\n" + real, "bench.ini [bench] max_frames: must be >= 0"},
+        {"[bench]\nrender_jobs = -1\n" + real, "bench.ini [bench] render_jobs: must be 0..64"},
         {real + "[sequence_b]\nname = a\n" + fr1,
          "bench.ini [sequence_b] name: 'a' is already the name of an earlier sequence"},
         {real + "set = person_1.speed=1\n", "[sequence_a] set: only a synthetic sequence"},
@@ -273,7 +278,10 @@ TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
         {synth + "set = person_2.path=[3.5 2.8\n",
          "[sequence_a] set 'person_2.path=[3.5 2.8': a '[' is not closed"},
         // A key the scenario does not know stops the bench at the render, before any run.
-        {synth + "set = person_1.sped=1\n", "sped"},
+        // devslam-synth's own message reaches the bench's output (its log holds all of it).
+        {synth + "set = person_1.sped=1\n",
+         "devslam-synth failed for a (exit 1):\n  devslam-synth: " + root +
+             "/sim_worlds/synth/short_walking.ini [person_1]: unknown key 'sped'"},
         {real + "[targets]\nx = a dynamic ate <=\n",
          "[targets] x: expected 'SEQUENCE MODE FIGURE OP VALUE'"},
         {real + "[targets]\nx = b dynamic ate <= 1\n", "unknown sequence 'b'"},
