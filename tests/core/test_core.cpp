@@ -207,7 +207,7 @@ TEST(Config, OverrideListsKeepBracketedValuesWhole) {
 
 TEST(Config, SectionsComeInTheFilesOrder) {
     const std::string path = devslam::test::scratchPath("devslam_order").string() + ".ini";
-    std::ofstream(path) << "[zeta]\na = 1\n  [alpha]\nb = 2\n[mid]\n[alpha]\nc = 3\n";
+    std::ofstream(path) << "[zeta]\na = 1\n  [alpha]\nb = 2\n[mid]\n";
     const auto cfg = loadIni(path);
     std::vector<std::string> sorted;
     cfg->getAllSections(sorted);
@@ -217,13 +217,45 @@ TEST(Config, SectionsComeInTheFilesOrder) {
     // A file that cannot be read again still gives every section, in MRPT's order.
     EXPECT_EQ(sectionsInFileOrder(*cfg, path + ".gone"), sorted);
     const std::string keys = devslam::test::scratchPath("devslam_keys").string() + ".ini";
-    std::ofstream(keys) << "[t]\nzz = 1\n  b=2   // comment = x\n[u]\na = 0\n[t]\na = 3\n";
+    std::ofstream(keys) << "[t]\nzz = 1\n  b=2   // comment = x\na = 3\n[u]\na = 0\n";
     EXPECT_EQ(keysInFileOrder(*loadIni(keys), keys, "t"),
               (std::vector<std::string>{"zz", "b", "a"}));
     EXPECT_EQ(keysInFileOrder(*loadIni(keys), keys + ".gone", "t"),
               (std::vector<std::string>{"a", "b", "zz"}));
     std::filesystem::remove(path);
     std::filesystem::remove(keys);
+}
+
+// MRPT keeps the last of a repeated key (names in any letter case) and merges a repeated
+// section into the first, silently: both are refused with the two lines.
+TEST(Config, RepeatedKeysAndSectionsAreRefused) {
+    const std::string path = devslam::test::scratchPath("devslam_repeat").string() + ".ini";
+    const auto error = [&](const std::string& text) {
+        std::ofstream(path) << text;
+        try {
+            (void)loadIni(path);
+        } catch (const std::exception& e) {
+            return std::string(e.what());
+        }
+        return std::string();
+    };
+    EXPECT_EQ(error("[goal]\nx = 3\ny = 2\nx = 5\n"),
+              path + " line 4: [goal] x repeated (first at line 2)");
+    EXPECT_EQ(error("[goal]\nx = 3\n  X=5 // again\n"),
+              path + " line 3: [goal] X repeated (first at line 2)");
+    EXPECT_EQ(error("[a]\nk = 1\n[b]\n[A]\nj = 2\n"),
+              path + " line 4: section [A] repeated (first at line 1)");
+    // Not repeats: one key in two sections, comments, a value continued on the next lines.
+    EXPECT_EQ(error("[a]\nk = 1\n# k = 2\n; k = 3\n// k = 4\n[b]\nk = 5\nf = \\\n"
+                    "  var k := 1; \\\n  k = 2\n"),
+              "");
+    EXPECT_EQ(loadIni(path)->read_string("b", "k", ""), "5");
+    std::filesystem::remove(path);
+    EXPECT_EQ(error(""), "");  // an empty INI is no error
+    std::filesystem::remove(path);
+    std::filesystem::create_directories(path);
+    EXPECT_EQ(error("x"), "INI file '" + path + "' is a folder");
+    std::filesystem::remove_all(path);
 }
 
 TEST(Config, UnknownSectionsAndKeysBeforeAnySectionAreErrors) {

@@ -6,17 +6,74 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <sstream>
 #include <stdexcept>
 
 namespace devslam::core {
 
+namespace {
+std::string lowered(std::string s) {
+    for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return s;
+}
+
+/// MRPT keeps the last of a repeated key (its names ignore letter case) and merges a repeated
+/// section into the first, both without a word: a pasted line or section would silently
+/// replace a value the reader of the file sees first (a goal, an obstacle, a gain). Refused,
+/// naming both lines. Comment lines (#, ;, //) and lines without '=' are not keys.
+void refuseRepeats(const std::string& text, const std::string& path) {
+    std::map<std::string, int> sections;
+    std::map<std::pair<std::string, std::string>, int> keys;
+    std::istringstream in(text);
+    std::string section;
+    int n = 0;
+    bool continued = false;  // the line before ended in '\': this one is part of its value
+    for (std::string line; std::getline(in, line);) {
+        ++n;
+        const auto last = line.find_last_not_of(" \t\r");
+        const bool continuation = continued;
+        continued = last != std::string::npos && line[last] == '\\';
+        if (continuation) continue;
+        const auto a = line.find_first_not_of(" \t\r");
+        if (a == std::string::npos || line[a] == '#' || line[a] == ';' ||
+            line.compare(a, 2, "//") == 0)
+            continue;
+        if (line[a] == '[') {
+            const auto b = line.find(']', a);
+            if (b == std::string::npos) continue;
+            section = line.substr(a + 1, b - a - 1);
+            const auto [at, fresh] = sections.emplace(lowered(section), n);
+            if (!fresh)
+                throw std::invalid_argument(
+                    path + " line " + std::to_string(n) + ": section " + line.substr(a, b - a + 1) +
+                    " repeated (first at line " + std::to_string(at->second) + ")");
+            continue;
+        }
+        const auto eq = line.find('=', a);
+        if (eq == std::string::npos) continue;
+        const auto e = line.find_last_not_of(" \t", eq == 0 ? 0 : eq - 1);
+        if (eq == a || e == std::string::npos || e < a) continue;
+        const std::string key = line.substr(a, e - a + 1);
+        const auto [at, fresh] = keys.emplace(std::pair{lowered(section), lowered(key)}, n);
+        if (!fresh)
+            throw std::invalid_argument(path + " line " + std::to_string(n) + ": [" + section +
+                                        "] " + key + " repeated (first at line " +
+                                        std::to_string(at->second) + ")");
+    }
+}
+}  // namespace
+
 std::unique_ptr<mrpt::config::CConfigFileMemory> loadIni(const std::string& path) {
+    // An ifstream opens a folder and then reads nothing: an empty INI, all defaults.
+    if (std::filesystem::is_directory(path))
+        throw std::runtime_error("INI file '" + path + "' is a folder");
     std::ifstream in(path);
     if (!in) throw std::runtime_error("cannot open INI file '" + path + "'");
     std::stringstream ss;
     ss << in.rdbuf();
     if (in.bad()) throw std::runtime_error("cannot read INI file '" + path + "'");
+    refuseRepeats(ss.str(), path);
     return std::make_unique<mrpt::config::CConfigFileMemory>(ss.str());
 }
 
