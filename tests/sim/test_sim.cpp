@@ -102,6 +102,25 @@ TEST(World, BadEntriesNameTheKey) {
     EXPECT_NE(errorOf("[world]\nx_min=0\nx_max=5\ny_min=0\ny_max=5\nseed = 4294967296\n[robot]\n"
                       "start_x=1\nstart_y=1\n[goal]\nx=4\ny=4\n"),
               "");
+    // Runs that would take hours or tens of GB are refused before they start.
+    EXPECT_EQ(errorOf("[world]\nx_min=0\nx_max=5\ny_min=0\ny_max=5\ntimeout=1e7\n[robot]\n"
+                      "start_x=1\nstart_y=1\n[goal]\nx=4\ny=4\n"),
+              "w.ini [world] timeout: timeout 1e+07 s at time_step 0.01 s makes 1e+09 physics "
+              "steps (at most 1e6)");
+    EXPECT_NE(errorOf(head + "[laser]\nrays = 2000000000\n").find("2 <= rays <= 100000"),
+              std::string::npos);
+    // People: none may start on the robot or in an obstacle, or walk through one (they are
+    // kinematic); brushing past an edge is allowed.
+    const std::string box = "[obstacles]\nb1 = box 3 2 1 1\n";
+    EXPECT_EQ(errorOf(head + "[pedestrians]\np = scripted 0.5 0.2 0 1.2 1.1 4 1\n"),
+              "w.ini [pedestrians] p: starts at (1.2, 1.1), on the robot (its start is within "
+              "the two radii)");
+    EXPECT_EQ(errorOf(head + box + "[pedestrians]\np = random 0.5 0.2 0 3.2 2.1\n"),
+              "w.ini [pedestrians] p: starts at (3.2, 2.1), inside obstacle 'b1'");
+    EXPECT_EQ(errorOf(head + box + "[pedestrians]\np = scripted 0.5 0.2 0 1 3 2 3 4 1.5\n"),
+              "w.ini [pedestrians] p: its path from (2, 3) to (4, 1.5) runs through obstacle "
+              "'b1'");
+    EXPECT_EQ(errorOf(head + box + "[pedestrians]\np = scripted 0.5 0.2 0 2 2.5 4 2.5\n"), "");
     // A mistyped section would drop all of its keys without a word.
     EXPECT_EQ(errorOf(head + "[obstacle]\nbox_1 = box 2 2 0.5 0.5 0\n"),
               "w.ini: unknown section [obstacle] (known: world, robot, goal, laser, obstacles, "

@@ -201,14 +201,22 @@ void validateWorld(const WorldSpec& w) {
     if (w.time_step <= 0 || w.time_step > 0.1)
         fail(src, "world", "time_step", "must be in (0, 0.1] s");
     if (w.timeout <= 0) fail(src, "world", "timeout", "must be > 0 s");
+    // A run steps the physics timeout / time_step times with nothing printed on the way.
+    constexpr double kMaxSteps = 1e6;
+    if (w.timeout / w.time_step > kMaxSteps) {
+        std::ostringstream m;
+        m << "timeout " << w.timeout << " s at time_step " << w.time_step << " s makes "
+          << w.timeout / w.time_step << " physics steps (at most 1e6)";
+        fail(src, "world", "timeout", m.str());
+    }
     if (w.robot.radius <= 0) fail(src, "robot", "radius", "must be > 0 m");
     if (w.robot.max_v <= 0 || w.robot.max_w <= 0 || w.robot.max_acc <= 0 ||
         w.robot.max_ang_acc <= 0)
         fail(src, "robot", "max_v", "speed and acceleration limits must be > 0");
-    if (w.laser.range <= 0 || w.laser.rays < 2 || w.laser.rate <= 0 || w.laser.noise_std < 0 ||
-        w.laser.fov <= 0 || w.laser.fov > 2 * M_PI + 1e-9)
+    if (w.laser.range <= 0 || w.laser.rays < 2 || w.laser.rays > 100000 || w.laser.rate <= 0 ||
+        w.laser.noise_std < 0 || w.laser.fov <= 0 || w.laser.fov > 2 * M_PI + 1e-9)
         fail(src, "laser", "",
-             "range > 0, rays >= 2, rate_hz > 0, noise_std >= 0, 0 < fov_deg <= 360");
+             "range > 0, 2 <= rays <= 100000, rate_hz > 0, noise_std >= 0, 0 < fov_deg <= 360");
     if (w.goal_tolerance <= 0) fail(src, "goal", "tolerance", "must be > 0 m");
     auto inside = [&](const mrpt::math::TPoint2D& p) {
         return p.x > w.x_min && p.x < w.x_max && p.y > w.y_min && p.y < w.y_max;
@@ -228,10 +236,40 @@ void validateWorld(const WorldSpec& w) {
             fail(src, "robot", "start_x",
                  "the robot starts inside or touching obstacle '" + o.name + "'");
     }
+    const auto statics = staticObstacles(w);
+    const auto at = [](const mrpt::math::TPoint2D& q) {
+        std::ostringstream m;
+        m << "(" << q.x << ", " << q.y << ")";
+        return m.str();
+    };
     for (const auto& p : w.pedestrians) {
         if (p.path.empty()) fail(src, "pedestrians", p.name, "no position given");
         for (const auto& q : p.path)
             if (!inside(q)) fail(src, "pedestrians", p.name, "a point is outside the world bounds");
+        const auto& p0 = p.path.front();
+        if (std::hypot(p0.x - w.robot.start.x, p0.y - w.robot.start.y) < p.radius + w.robot.radius)
+            fail(src, "pedestrians", p.name,
+                 "starts at " + at(p0) + ", on the robot (its start is within the two radii)");
+        // The simulated people are kinematic: a scripted one walks through whatever lies on
+        // its path (brushing past an edge is allowed), and a random walker never leaves an
+        // obstacle it starts in. Both are mistakes in the world file.
+        const std::size_t legs = p.mode == Pedestrian::Mode::Scripted ? p.path.size() - 1 : 0;
+        for (const auto& o : statics) {
+            if (distanceToObstacle(o, p0) < 0)
+                fail(src, "pedestrians", p.name,
+                     "starts at " + at(p0) + ", inside obstacle '" + o.name + "'");
+            for (std::size_t k = 0; k < legs; ++k) {
+                const auto &a = p.path[k], &b = p.path[k + 1];
+                const int n = 1 + static_cast<int>(std::hypot(b.x - a.x, b.y - a.y) / 0.02);
+                for (int i = 0; i <= n; ++i) {
+                    const double u = double(i) / n;
+                    if (distanceToObstacle(o, {a.x + u * (b.x - a.x), a.y + u * (b.y - a.y)}) < 0)
+                        fail(src, "pedestrians", p.name,
+                             "its path from " + at(a) + " to " + at(b) +
+                                 " runs through obstacle '" + o.name + "'");
+                }
+            }
+        }
     }
 }
 
