@@ -743,6 +743,17 @@ TEST(Scenario, ShippedFilesLoadAndTyposAreReported) {
                   tmp.str("s.ini") + " [camera] dist: 'x' is not a number");
     expectMessage([&] { (void)loadScenario(base, {"camera.dist=[0 0 0 0]"}); },
                   "[camera] dist: must have 5 values");
+    // Names the key, and refuses what would take gigabytes before the first frame.
+    expectMessage([&] { (void)loadScenario(base, {"camera.preset=fr9"}); },
+                  tmp.str("s.ini") + " [camera] preset: unknown camera preset 'fr9'");
+    expectMessage([&] { (void)loadScenario(base, {"trajectory.type=spiral"}); },
+                  tmp.str("s.ini") + " [trajectory] type: unknown trajectory type 'spiral'");
+    expectMessage([&] { (void)loadScenario(base, {"camera.width=16000"}); },
+                  tmp.str("s.ini") + " [camera] width/height: must be 1..4096 [px]");
+    expectMessage([&] { (void)loadScenario(base, {"scenario.n_frames=0"}); },
+                  tmp.str("s.ini") + " [scenario] n_frames: must be >= 1");
+    expectMessage([&] { (void)loadScenario(base, {"scenario.room=nowhere.ini"}); },
+                  tmp.str("s.ini") + " [scenario] room: no such file '");
     // room_set: written over the room file's [room] and [box_*] settings, checked like them.
     const auto withRoomSet = [&](const std::string& items) {
         return withEdit(text, "n_frames        = 60", "n_frames = 60\nroom_set = " + items);
@@ -751,6 +762,9 @@ TEST(Scenario, ShippedFilesLoadAndTyposAreReported) {
     EXPECT_DOUBLE_EQ(set.room.wall_blur, 3.0);
     EXPECT_EQ(set.room.overrides.size(), 2u);
     for (const auto& b : set.room.boxes) EXPECT_DOUBLE_EQ(b.blur, b.name == "box_desk" ? 5 : 0);
+    expectMessage([&] { (void)loadScenario(withRoomSet("room.size=[10000,10000,2.8]")); },
+                  "[room] size: a room of 10000 x 10000 x 2.8 m in panels of 1.1 x 0.8 m has "
+                  "2.2742e+08 panels (at most 5000)");
     expectMessage([&] { (void)loadScenario(withRoomSet("box_dsk.blur=5")); },
                   "room_set item 'box_dsk.blur=5': the room file has no [box_dsk] section");
     expectMessage([&] { (void)loadScenario(withRoomSet("box_desk.blurr=5")); },

@@ -62,7 +62,13 @@ CameraIntrinsics CameraIntrinsics::fromConfig(const mrpt::config::CConfigFileBas
     CameraIntrinsics K;
     const std::string preset = c.read_string(s, "preset", "");
     const bool has_preset = !preset.empty();
-    if (has_preset) K = fromPreset(preset);
+    if (has_preset) {
+        try {
+            K = fromPreset(preset);
+        } catch (const std::invalid_argument& e) {
+            throw std::invalid_argument("[" + s + "] preset: " + e.what());
+        }
+    }
     K.fx = core::readDouble(c, s, "fx", K.fx, !has_preset);
     K.fy = core::readDouble(c, s, "fy", K.fy, !has_preset);
     K.cx = core::readDouble(c, s, "cx", K.cx, !has_preset);
@@ -77,7 +83,10 @@ CameraIntrinsics CameraIntrinsics::fromConfig(const mrpt::config::CConfigFileBas
         std::copy(d.begin(), d.end(), K.dist.begin());
     }
     requireValue(K.fx > 0 && K.fy > 0, s, "fx/fy", "must be > 0");
-    requireValue(K.width > 0 && K.height > 0, s, "width/height", "must be > 0");
+    // An image buffer per frame (and the renderer's framebuffer) is width x height: 16000^2
+    // took 8 GB before anything was drawn.
+    requireValue(K.width > 0 && K.height > 0 && K.width <= 4096 && K.height <= 4096, s,
+                 "width/height", "must be 1..4096 [px]");
     requireValue(K.cx >= 0 && K.cx < K.width && K.cy >= 0 && K.cy < K.height, s, "cx/cy",
                  "must lie inside the image");
     return K;

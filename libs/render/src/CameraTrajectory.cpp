@@ -103,7 +103,11 @@ void TrajectoryOptions::loadFromConfig(const mrpt::config::CConfigFileBase& cfg,
         cfg, s,
         {"type", "position", "look_at", "amplitude", "period", "rot_amplitude_deg", "rot_period",
          "azimuth_amplitude_deg", "elevation_amplitude_deg", "azimuth_period", "elevation_period"});
-    setDefaultsFor(parseTrajectoryType(cfg.read_string(s, "type", toString(type))));
+    try {
+        setDefaultsFor(parseTrajectoryType(cfg.read_string(s, "type", toString(type))));
+    } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument("[" + s + "] type: " + e.what());
+    }
     position = readVec3(cfg, s, "position", position);
     look_at = readVec3(cfg, s, "look_at", look_at);
     amplitude = readVec3(cfg, s, "amplitude", amplitude);

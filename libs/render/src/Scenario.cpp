@@ -103,6 +103,16 @@ void readRoom(const std::string& path, RoomSpec& room) {
     core::requireValue(room.size.minCoeff() > 0.5, "room", "size", "each side > 0.5 [m]");
     core::requireValue(room.panel_width > 0.05 && room.panel_height > 0.05, "room",
                        "panel_width", "panels must be > 0.05 m");
+    {  // Every panel holds a photo crop of its own: a 10 km room ran out of memory.
+        const auto n = [](double len, double panel) { return std::ceil(len / panel); };
+        const double X = room.size.x(), Y = room.size.y(), Z = room.size.z();
+        const double pw = room.panel_width, ph = room.panel_height;
+        const double panels = 2 * (n(X, pw) + n(Y, pw)) * n(Z, ph) + 2 * n(X, pw) * n(Y, ph);
+        std::ostringstream m;
+        m << "a room of " << X << " x " << Y << " x " << Z << " m in panels of " << pw << " x "
+          << ph << " m has " << panels << " panels (at most 5000)";
+        core::requireValue(panels <= 5000, "room", "size", m.str());
+    }
     room.wall_blur = core::readDouble(*cfg, s, "wall_blur", 0.0);
     room.floor_blur = core::readDouble(*cfg, s, "floor_blur", 0.0);
     core::requireValue(room.wall_blur >= 0 && room.wall_blur <= 100, "room",
@@ -217,6 +227,9 @@ Scenario readScenario(const std::string& path, const std::vector<std::string>& o
                        "must be in (0, 1000] [Hz]");
     const double duration = core::readDouble(*cfg, s, "duration", 0.0);
     const int n = core::readInt(*cfg, s, "n_frames", 0);
+    core::requireValue(!cfg->keyExists(s, "duration") || duration > 0, s, "duration",
+                       "must be > 0 [s]");
+    core::requireValue(!cfg->keyExists(s, "n_frames") || n > 0, s, "n_frames", "must be >= 1");
     if ((duration > 0) == (n > 0))
         throw std::invalid_argument(
             path + " [scenario]: give exactly one of 'duration' [s] or 'n_frames'");
@@ -247,6 +260,8 @@ Scenario readScenario(const std::string& path, const std::vector<std::string>& o
         room = (fs::path(dirOf(path)) / room).lexically_normal().string();
     sc.room.overrides = core::overrideItems(cfg->read_string(s, "room_set", ""),
                                             path + " [" + s + "] room_set");
+    if (!fs::is_regular_file(room))
+        throw std::invalid_argument(path + " [scenario] room: no such file '" + room + "'");
     try {
         loadRoom(room, sc.room);
     } catch (const std::invalid_argument& e) {
