@@ -191,7 +191,10 @@ int main(int argc, char** argv) {
                 std::stringstream ss(next());
                 std::string m;
                 while (std::getline(ss, m, ','))
-                    if (!m.empty()) a.methods.push_back(m);
+                    if (!m.empty()) {
+                        devslam::nav::requireHolonomicMethod(m, "--methods");
+                        a.methods.push_back(m);
+                    }
             } else if (s == "-h" || s == "--help") {
                 usage();
                 return 0;

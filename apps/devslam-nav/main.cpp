@@ -3,6 +3,7 @@
 // with --navlog, MRPT's .reactivenavlog (open it with MRPT's navlog-viewer).
 // devslam-nav --map GRIDMAP --to X,Y: the global route on a map devslam-run built.
 #include <devslam/core/Config.h>
+#include <devslam/core/GzFile.h>
 #include <devslam/core/Parse.h>
 #include <devslam/nav/CHolonomicVFHPlus.h>
 #include <devslam/nav/MapPlan.h>
@@ -51,6 +52,19 @@ void makeParentDirectory(const std::string& file) {
     if (!parent.empty()) std::filesystem::create_directories(parent);
 }
 
+/// Runs `write` (a picture into `png`, after its folder is made); an error names --png and
+/// the file, and is thrown after the result was printed, so that it loses nothing.
+template <class Write>
+void writePicture(const std::string& png, Write&& write) {
+    try {
+        makeParentDirectory(png);
+        write();
+    } catch (const std::exception& e) {
+        throw std::runtime_error("--png '" + png + "': cannot write the picture: " +
+                                 devslam::core::innermostMessage(e.what()));
+    }
+}
+
 /// devslam-nav --map: A* and waypoints on a SLAM grid, one result line and a picture.
 int planOnSlamMap(const std::string& map, const std::string& from, const std::string& to,
                   const std::string& config, std::string png) {
@@ -61,20 +75,24 @@ int planOnSlamMap(const std::string& map, const std::string& from, const std::st
     const auto plan = devslam::nav::planOnMap(grid, parsePoint(from, "--from"),
                                               parsePoint(to, "--to"), opts);
     if (png.empty()) png = kDefaultDir + "/plan.png";
-    makeParentDirectory(png);
-    devslam::nav::writeMapPlanPng(grid, plan, png, std::filesystem::path(map).filename().string());
     std::printf("map=%s from=(%.2f, %.2f) to=(%.2f, %.2f) ", map.c_str(), plan.from.x,
                 plan.from.y, plan.to.x, plan.to.y);
     if (!plan.path) {
         std::printf("result=no_path png=%s\n", png.c_str());
-        return 1;
+    } else {
+        std::printf(
+            "result=path length=%.2f m waypoints=%zu min_clearance=%.3f m "
+            "unknown=%.0f%% png=%s\n",
+            plan.path->length, plan.waypoints.size(), plan.min_clearance,
+            100.0 * plan.unknown_fraction, png.c_str());
+        for (const auto& w : plan.waypoints) std::printf("waypoint %.2f %.2f\n", w.x, w.y);
     }
-    std::printf("result=path length=%.2f m waypoints=%zu min_clearance=%.3f m unknown=%.0f%% "
-                "png=%s\n",
-                plan.path->length, plan.waypoints.size(), plan.min_clearance,
-                100.0 * plan.unknown_fraction, png.c_str());
-    for (const auto& w : plan.waypoints) std::printf("waypoint %.2f %.2f\n", w.x, w.y);
-    return 0;
+    std::fflush(stdout);
+    writePicture(png, [&] {
+        devslam::nav::writeMapPlanPng(grid, plan, png,
+                                      std::filesystem::path(map).filename().string());
+    });
+    return plan.path ? 0 : 1;
 }
 
 void usage() {
@@ -146,8 +164,11 @@ int main(int argc, char** argv) {
         return 2;
     }
     try {
+        // Known before minutes of work: the picture's format (OpenCV picks it by the name).
+        if (!png.empty() && (png.size() < 4 || png.compare(png.size() - 4, 4, ".png") != 0))
+            throw std::invalid_argument("--png '" + png + "': the picture's name must end in .png");
         if (!map.empty()) return planOnSlamMap(map, from, to, config, png);
-        devslam::nav::registerNavClasses();
+        devslam::nav::requireHolonomicMethod(method, "--method");
         const auto world = loadOrGenerate(world_path);
         const auto ini = devslam::core::loadIni(config);
         auto nav_opts = devslam::nav::NavigatorOptions::fromConfig(*ini, config);
@@ -161,8 +182,7 @@ int main(int argc, char** argv) {
         }
         const auto r = devslam::sim::runEpisode(world, *ini, nav_opts, eo);
         if (png.empty()) png = kDefaultDir + "/nav_" + world.name + ".png";
-        makeParentDirectory(png);
-        devslam::sim::writeEpisodePng(world, r, png, world.name + " / " + method);
+        // The result first: a picture that cannot be written must not lose it.
         std::printf(
             "world=%s method=%s result=%s time=%.2f s path=%.2f m astar=%.2f m "
             "min_clearance_static=%.3f m min_clearance_people=%.3f m collisions_static=%d "
@@ -173,6 +193,10 @@ int main(int argc, char** argv) {
             r.person_collisions, r.replans, png.c_str(),
             navlog.empty() ? "" : " navlog=", navlog.c_str());
         if (!r.reason.empty()) std::printf("reason: %s\n", r.reason.c_str());
+        std::fflush(stdout);
+        writePicture(png, [&] {
+            devslam::sim::writeEpisodePng(world, r, png, world.name + " / " + method);
+        });
         return r.outcome == devslam::sim::Outcome::Success ? 0 : 1;
     } catch (const std::exception& e) {
         std::cerr << "devslam-nav: " << e.what() << "\n";

@@ -8,6 +8,7 @@
 #include <devslam/sim/World.h>
 
 #include <gtest/gtest.h>
+
 #include <mrpt/core/Clock.h>
 #include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/kinematics/CVehicleSimul_DiffDriven.h>
@@ -22,6 +23,8 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
+#include <tuple>
 
 namespace {
 const std::string kSrc = DEVSLAM_SOURCE_DIR;
@@ -153,6 +156,29 @@ TEST(IntegrationNav, AppsSmokeTest) {
     const std::string bad = bin + "/devslam-nav " + kSrc +
                             "/tests/sim/data/obstacle_on_goal.ini > " + out + "/bad.txt 2>&1";
     EXPECT_EQ(WEXITSTATUS(std::system(bad.c_str())), 2);
+    // An unknown method or a picture of another format: refused before the run. A picture
+    // that cannot be written is an error after the result line, which is kept.
+    const auto nav = [&](const std::string& args) {
+        const std::string c = bin + "/devslam-nav " + kSrc + "/sim_worlds/paper_fig6.ini " + args +
+                              " > " + out + "/o.txt 2>&1";
+        const int rc = WEXITSTATUS(std::system(c.c_str()));
+        std::ifstream in(out + "/o.txt");
+        return std::pair{rc, std::string(std::istreambuf_iterator<char>(in), {})};
+    };
+    auto [rc, text] = nav("--method CHolonomicVHF");
+    EXPECT_EQ(rc, 2);
+    EXPECT_NE(text.find("--method: unknown holonomic method 'CHolonomicVHF'"), std::string::npos)
+        << text;
+    std::tie(rc, text) = nav("--png " + out + "/fig6.jpgx");
+    EXPECT_EQ(rc, 2);
+    EXPECT_NE(text.find("the picture's name must end in .png"), std::string::npos) << text;
+    EXPECT_EQ(text.find("result="), std::string::npos) << text;
+    std::tie(rc, text) = nav("--png /proc/devslam_no/fig6.png");
+    EXPECT_EQ(rc, 2);
+    EXPECT_NE(text.find("result=success"), std::string::npos) << text;
+    EXPECT_NE(text.find("--png '/proc/devslam_no/fig6.png': cannot write the picture"),
+              std::string::npos)
+        << text;
     // bench smoke test: one method, one world per category, RESULTS.md untouched
     const std::string bench =
         bin + "/devslam-nav-bench --per-category 1 --methods CHolonomicVFHPlus --png-dir " + out +

@@ -181,6 +181,9 @@ TEST(NavConfig, UnknownKeyIsReported) {
     // The message of reading one INI holding `section.key = value`, "" when it is accepted.
     const auto errorOf = [](const std::vector<std::tuple<std::string, std::string, double>>& kv) {
         mrpt::config::CConfigFileMemory c;
+        // MRPT's navigator's own two sections, which every navigation INI must have.
+        c.write("CAbstractPTGBasedReactive", "robotMax_V_mps", 0.6);
+        c.write("CReactiveNavigationSystem", "PTG_COUNT", 3);
         for (const auto& [section, key, value] : kv) c.write(section, key, value);
         try {
             (void)NavigatorOptions::fromConfig(c, "x.ini");
@@ -205,4 +208,37 @@ TEST(NavConfig, UnknownKeyIsReported) {
                            "global_planner, replan,"),
               std::string::npos)
         << section;
+    // A holonomic method MRPT does not know, or no section for MRPT's navigator: named here,
+    // before a run (MRPT would stop it with a stack trace).
+    mrpt::config::CConfigFileMemory c(
+        "[CAbstractPTGBasedReactive]\nref_distance = 2\n[CReactiveNavigationSystem]\n"
+        "PTG_COUNT = 1\n[navigator]\nholonomic_method = CHolonomicVHF\n");
+    EXPECT_THROW(
+        {
+            try {
+                (void)NavigatorOptions::fromConfig(c, "x.ini");
+            } catch (const std::invalid_argument& e) {
+                EXPECT_EQ(std::string(e.what()),
+                          "x.ini [navigator] holonomic_method: unknown holonomic method "
+                          "'CHolonomicVHF' (known: CHolonomicVFHPlus, CHolonomicND, "
+                          "CHolonomicFullEval, CHolonomicVFF)");
+                throw;
+            }
+        },
+        std::invalid_argument);
+    c.write("navigator", "holonomic_method", "CHolonomicND");
+    EXPECT_NO_THROW((void)NavigatorOptions::fromConfig(c, "x.ini"));
+    const mrpt::config::CConfigFileMemory empty("[navigator]\nnav_period = 0.1\n");
+    EXPECT_THROW(
+        {
+            try {
+                (void)NavigatorOptions::fromConfig(empty, "x.ini");
+            } catch (const std::invalid_argument& e) {
+                EXPECT_EQ(std::string(e.what()),
+                          "x.ini: no [CAbstractPTGBasedReactive] section (MRPT's navigator needs "
+                          "it; see config_ini/nav_reactive.ini)");
+                throw;
+            }
+        },
+        std::invalid_argument);
 }

@@ -19,6 +19,14 @@ void registerNavClasses() {
     (void)done;
 }
 
+void requireHolonomicMethod(const std::string& name, const std::string& what) {
+    registerNavClasses();
+    if (!mrpt::nav::CAbstractHolonomicReactiveMethod::Factory(name))
+        throw std::invalid_argument(what + ": unknown holonomic method '" + name +
+                                    "' (known: CHolonomicVFHPlus, CHolonomicND, "
+                                    "CHolonomicFullEval, CHolonomicVFF)");
+}
+
 CHolonomicVFHPlus::CHolonomicVFHPlus(const mrpt::config::CConfigFileBase* cfg)
     : CAbstractHolonomicReactiveMethod("CHolonomicVFHPlus") {
     if (cfg) initialize(*cfg);

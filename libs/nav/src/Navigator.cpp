@@ -62,6 +62,13 @@ NavigatorOptions readNavigatorOptions(const mrpt::config::CConfigFileBase& c,
          "CHolonomicND", "CHolonomicVFF", "CHolonomicFullEval",
          "CMultiObjectiveMotionOptimizerBase", "CMultiObjMotionOpt_Scalarization"},
         source);
+    // MRPT's navigator needs these two (the PTGs and the robot); the Navigator checks again
+    // for options made in code, where no file is known.
+    for (const char* needed : {"CAbstractPTGBasedReactive", "CReactiveNavigationSystem"})
+        if (!c.sectionExists(needed))
+            throw std::invalid_argument(source + ": no [" + needed +
+                                        "] section (MRPT's navigator needs it; see "
+                                        "config_ini/nav_reactive.ini)");
     NavigatorOptions o;
     const std::string s = "navigator";
     core::requireKnownKeys(c, s,
@@ -72,6 +79,7 @@ NavigatorOptions readNavigatorOptions(const mrpt::config::CConfigFileBase& c,
     o.waypoint_allowed_distance =
         core::readDouble(c, s, "waypoint_allowed_distance", o.waypoint_allowed_distance);
     o.holonomic_method = c.read_string(s, "holonomic_method", o.holonomic_method);
+    requireHolonomicMethod(o.holonomic_method, "[" + s + "] holonomic_method");
     o.robot_radius = core::readDouble(c, s, "robot_radius", o.robot_radius);
     o.person_margin = core::readDouble(c, s, "person_margin", o.person_margin);
     o.log_file = core::readBool(c, s, "log_file", o.log_file);

@@ -61,4 +61,9 @@ class CHolonomicVFHPlus : public mrpt::nav::CAbstractHolonomicReactiveMethod {
 /// call once from main() (or a test) before creating a navigator.
 void registerNavClasses();
 
+/// Throws std::invalid_argument "<what>: unknown holonomic method 'X' (known: ...)" unless
+/// MRPT's factory makes a holonomic method of that class name (MRPT's navigator would
+/// otherwise stop with a stack trace once the run has started). Registers ours first.
+void requireHolonomicMethod(const std::string& name, const std::string& what);
+
 }  // namespace devslam::nav
