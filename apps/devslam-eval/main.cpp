@@ -84,21 +84,34 @@ int main(int argc, char** argv) {
             std::cerr << kUsage;
             return 2;
         }
+        if (!plot.empty() && (plot.size() < 4 || plot.compare(plot.size() - 4, 4, ".png") != 0))
+            throw std::invalid_argument("--plot '" + plot + "': the plot's name must end in .png");
         const auto gt = devslam::io::readTumTrajectory(pos[0]);
         auto est = devslam::io::readTumTrajectory(pos[1]);
         const auto ate = devslam::eval::computeAte(gt, est, ao);
         std::optional<devslam::eval::RpeResult> r;
+        std::string rpe_error;  // the ATE stands without it: written, then the error said
         if (rpe) {
             if (ao.scale != 1.0)
                 for (auto& p : est)
                     p.pose.setFromValues(ao.scale * p.pose.x(), ao.scale * p.pose.y(),
                                          ao.scale * p.pose.z(), p.pose.yaw(), p.pose.pitch(),
                                          p.pose.roll());
-            r = devslam::eval::computeRpe(gt, est, ro);
+            try {
+                r = devslam::eval::computeRpe(gt, est, ro);
+            } catch (const std::invalid_argument& e) {
+                rpe_error = e.what();
+            }
         }
         std::cout << devslam::eval::formatTable(&ate, r ? &*r : nullptr, &ro);
         if (!json.empty()) devslam::eval::writeJson(json, &ate, r ? &*r : nullptr, &ro);
         if (!plot.empty()) devslam::eval::plotAte(plot, ate, title.empty() ? pos[1] : title);
+        if (!rpe_error.empty()) {
+            std::cerr << "devslam-eval: " << rpe_error
+                      << "\ndevslam-eval: the ATE above is written; for the RPE of a short "
+                         "run use a smaller --delta (or --delta-unit f), or --no-rpe\n";
+            return 1;
+        }
         return 0;
     } catch (const std::exception& e) {
         std::cerr << "devslam-eval: " << e.what() << "\n";

@@ -172,6 +172,9 @@ TEST(Rpe, ReproducesEvaluateRpeQuirks) {
     const auto r = eval::computeRpe(line, rotated, o);
     EXPECT_NEAR(r.rot.max, 0, 1e-9);
     EXPECT_NEAR(r.trans.max, 0.5 * std::hypot(1 - std::cos(0.2), std::sin(0.2)), 1e-9);
+    // Half a frame would pair every pose with itself (error 0): whole frames only, as there.
+    o.delta = 0.5;
+    EXPECT_THROW((void)eval::computeRpe(line, rotated, o), std::invalid_argument);
 }
 
 // The real fr1_xyz ground truth (100 Hz motion capture), subsampled and perturbed by known
@@ -257,7 +260,10 @@ TEST(Report, TableJsonPlotAndApp) {
              {"--max-dt inf", "--max-dt: expected a number, got 'inf'"},
              {"--scale nan", "--scale: expected a number, got 'nan'"},
              {"--max-dt 0", "--max-dt: must be > 0, got '0'"},
-             {"--delta -1", "--delta: must be > 0, got '-1'"}}) {
+             {"--delta -1", "--delta: must be > 0, got '-1'"},
+             {"--delta 0.5 --delta-unit f",
+              "RPE: a delta in frames must be a whole number, got 0.5"},
+             {"--plot x.jpgx", "--plot 'x.jpgx': the plot's name must end in .png"}}) {
         const std::string c = std::string(DEVSLAM_BIN_DIR) + "/devslam-eval " +
                               (dir / "gt.txt").string() + " " + (dir / "est.txt").string() + " " +
                               opt + " > /dev/null 2> " + (dir / "err.txt").string();
@@ -266,6 +272,23 @@ TEST(Report, TableJsonPlotAndApp) {
         const std::string m((std::istreambuf_iterator<char>(e)), std::istreambuf_iterator<char>());
         EXPECT_NE(m.find(says), std::string::npos) << opt << ": " << m;
     }
+    // An estimate too short for the RPE keeps its ATE: printed and written, then the error.
+    const core::Trajectory three(est.begin(), est.begin() + 3);  // 0.6 s, RPE over 1 s
+    io::writeTumTrajectory((dir / "short.txt").string(), three);
+    std::filesystem::remove(dir / "e.json");
+    const std::string sh = std::string(DEVSLAM_BIN_DIR) + "/devslam-eval " +
+                           (dir / "gt.txt").string() + " " + (dir / "short.txt").string() +
+                           " --json " + (dir / "e.json").string() + " > " +
+                           (dir / "out.txt").string() + " 2> " + (dir / "err.txt").string();
+    EXPECT_EQ(WEXITSTATUS(std::system(sh.c_str())), 1);
+    const auto text = [&](const char* f) {
+        std::ifstream t(dir / f);
+        return std::string((std::istreambuf_iterator<char>(t)), std::istreambuf_iterator<char>());
+    };
+    EXPECT_NE(text("out.txt").find("ATE translation"), std::string::npos) << text("out.txt");
+    EXPECT_NE(text("e.json").find("\"ate\""), std::string::npos) << text("e.json");
+    EXPECT_NE(text("err.txt").find("RPE: no pose pair"), std::string::npos) << text("err.txt");
+    EXPECT_NE(text("err.txt").find("the ATE above is written"), std::string::npos);
     std::filesystem::remove_all(dir);
 }
 

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 
 namespace devslam::eval {
@@ -91,6 +92,10 @@ RpeResult computeRpe(const core::Trajectory& gt, const core::Trajectory& est,
     if (gt.size() < 2 || est.size() < 2)
         throw std::invalid_argument("RPE: need at least 2 poses in each trajectory");
     if (!(opts.delta > 0)) throw std::invalid_argument("RPE: delta must be > 0");
+    // evaluate_rpe.py takes whole frames; half a frame pairs each pose with itself (error 0).
+    if (opts.delta_in_frames && opts.delta != std::floor(opts.delta))
+        throw std::invalid_argument("RPE: a delta in frames must be a whole number, got " +
+                                    (std::ostringstream() << opts.delta).str());
     std::vector<double> sg, se;
     for (const auto& p : gt) sg.push_back(p.t);
     for (const auto& p : est) se.push_back(p.t);
