@@ -96,6 +96,9 @@ Args parse(int argc, char** argv) {
         } else
             throw std::invalid_argument("unknown argument '" + k + "'\n" + kUsage);
     }
+    // Found now, not when the run's results are written.
+    if (!a.out.empty() && std::filesystem::exists(a.out) && !std::filesystem::is_directory(a.out))
+        throw std::invalid_argument("--out '" + a.out + "': a file is there, not a folder");
     return a;
 }
 
@@ -139,6 +142,10 @@ Loaded loadConfig(const Args& a, const std::vector<std::string>& extra_sets = {}
     l.async_filter = core::namingSource(
         l.config_source, [&] { return core::readBool(*l.cfg, "run", "async_filter", true); });
     l.mode = a.mode.empty() ? l.cfg->read_string("run", "mode", "dynamic") : a.mode;
+    if (l.mode != "none" && l.mode != "all_persons" && l.mode != "dynamic" && l.mode != "truth")
+        throw std::invalid_argument((a.mode.empty() ? l.config_source + " [run] mode" : "--mode") +
+                                    ": unknown mode '" + l.mode +
+                                    "' (known: none, all_persons, dynamic, truth)");
     // [run] filter_config / filter_overrides: the filter's INI, with "section.key=value ..."
     // overrides (so a SLAM config can pick e.g. the detection interval without copying it).
     l.filter_cfg = core::loadFilterIni(*l.cfg, a.config);

@@ -97,6 +97,25 @@ TEST(DevslamRun, BadInputIsReported) {
     r = run("--set trackr.fine_radius=3 --mode none --quiet --out ''");
     EXPECT_EQ(r.rc, 1);
     EXPECT_NE(r.out.find("--set: unknown section [trackr]"), std::string::npos) << r.out;
+    // the INI's mode, its camera preset, a folder given as the INI: named with the key or file
+    std::ofstream(ini) << "[run]\nmode = dynamc\n";
+    r = run("--config " + ini.string() + " --quiet --out ''");
+    EXPECT_EQ(r.rc, 1);
+    EXPECT_NE(r.out.find(ini.string() + " [run] mode: unknown mode 'dynamc'"), std::string::npos)
+        << r.out;
+    r = run("--set dataset.camera=freiburg9 --mode none --quiet --out ''");
+    EXPECT_EQ(r.rc, 1);
+    EXPECT_NE(r.out.find("[dataset] camera: unknown camera preset 'freiburg9'"), std::string::npos)
+        << r.out;
+    r = run("--config " + ini.parent_path().string() + " --mode none --quiet --out ''");
+    EXPECT_EQ(r.rc, 1);
+    EXPECT_NE(r.out.find("' is a folder"), std::string::npos) << r.out;
+    // an --out that is a file is refused before the run, not when its results are written
+    r = run("--mode none --quiet --out " + ini.string());
+    EXPECT_EQ(r.rc, 1);
+    EXPECT_NE(r.out.find("--out '" + ini.string() + "': a file is there, not a folder"),
+              std::string::npos)
+        << r.out;
     fs::remove(ini);
     // the diagnostic truth mask needs a rendered folder's person truth
     r = run("--mode truth --quiet --out ''");

@@ -23,7 +23,11 @@ void ReaderOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, const
     sensor_label = c.read_string(s, "sensor_label", sensor_label);
     core::requireValue(max_dt > 0, s, "max_dt", "must be > 0 s");
     core::requireValue(tum_depth_scale > 0, s, "tum_depth_scale", "must be > 0");
-    if (camera != "auto") (void)core::CameraIntrinsics::fromPreset(camera);  // throws if unknown
+    try {
+        if (camera != "auto") (void)core::CameraIntrinsics::fromPreset(camera);
+    } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument("[" + s + "] camera: " + e.what() + " or auto");
+    }
 }
 
 std::unique_ptr<RgbdReader> openRgbd(const std::string& path, const ReaderOptions& opts) {
