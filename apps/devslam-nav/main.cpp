@@ -199,7 +199,8 @@ int main(int argc, char** argv) {
         });
         return r.outcome == devslam::sim::Outcome::Success ? 0 : 1;
     } catch (const std::exception& e) {
-        std::cerr << "devslam-nav: " << e.what() << "\n";
+        // MRPT's exceptions carry banners and a stack trace around their message.
+        std::cerr << "devslam-nav: " << devslam::core::innermostMessage(e.what()) << "\n";
         return 2;
     }
 }

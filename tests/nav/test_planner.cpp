@@ -177,13 +177,75 @@ TEST(NavConfig, EveryNavIniLoads) {
     EXPECT_GT(v.mu1, v.mu2 + v.mu3);
 }
 
+/// config_ini/nav_reactive.ini in memory, to be changed by a test.
+mrpt::config::CConfigFileMemory shippedNavIni() {
+    const auto shipped =
+        devslam::core::loadIni(std::string(DEVSLAM_SOURCE_DIR) + "/config_ini/nav_reactive.ini");
+    std::string text;
+    shipped->getContent(text);
+    return mrpt::config::CConfigFileMemory(text);
+}
+
+// MRPT reads its own sections leniently ("fast" is 0, a mistyped key is ignored); they are
+// checked against the keys MRPT's parameter structures write, with the file named.
+TEST(NavConfig, MrptSectionsAreReadStrictly) {
+    const auto errorOf = [&](const std::string& section, const std::string& key,
+                             const std::string& value) {
+        auto c = shippedNavIni();
+        c.write(section, key, value);
+        try {
+            (void)NavigatorOptions::fromConfig(c, "x.ini");
+        } catch (const std::invalid_argument& e) {
+            return std::string(e.what());
+        }
+        return std::string();
+    };
+    EXPECT_EQ(errorOf("navigator", "nav_period", "0.1"), "");  // the shipped file passes
+    EXPECT_EQ(errorOf("CAbstractPTGBasedReactive", "robotMax_V_mps", "fast"),
+              "x.ini [CAbstractPTGBasedReactive] robotMax_V_mps: 'fast' is not a number");
+    EXPECT_EQ(errorOf("CAbstractNavigator", "alarm_seems_not_approaching_target_timeout", "15s"),
+              "x.ini [CAbstractNavigator] alarm_seems_not_approaching_target_timeout: '15s' is "
+              "not a number");
+    EXPECT_EQ(errorOf("CAbstractPTGBasedReactive", "use_delays_model", "maybe"),
+              "x.ini [CAbstractPTGBasedReactive] use_delays_model: expected true or false, got "
+              "'maybe'");
+    EXPECT_NE(errorOf("CAbstractPTGBasedReactive", "secure_distanse_start", "0.05")
+                  .find("x.ini [CAbstractPTGBasedReactive]: unknown key 'secure_distanse_start' "
+                        "(MRPT's navigator knows: "),
+              std::string::npos);
+    EXPECT_EQ(errorOf("CHolonomicND", "factorWeights", "1 0.5 x 0.4"),
+              "x.ini [CHolonomicND] factorWeights: 'x' is not a number");
+    EXPECT_EQ(errorOf("CHolonomicVFHPlus", "window", "0.6x"),
+              "x.ini [CHolonomicVFHPlus] window: expected a number, got '0.6x'");
+    // The PTGs: their count, classes and each class's own keys.
+    EXPECT_EQ(errorOf("CReactiveNavigationSystem", "PTG0_v_max_mps", "0.6m"),
+              "x.ini [CReactiveNavigationSystem] PTG0_v_max_mps: '0.6m' is not a number");
+    const std::string k = errorOf("CReactiveNavigationSystem", "PTG1_K", "1");  // C has K
+    EXPECT_EQ(k.rfind("x.ini [CReactiveNavigationSystem]: unknown key 'PTG1_K' (MRPT's "
+                      "navigator knows: ",
+                      0),
+              0u)
+        << k;
+    for (const char* known :
+         {"PTG0_K,", "PTG1_cte_a0v_deg,", "PTG_COUNT,", "RobotModel_shape2D_xs"})
+        EXPECT_NE(k.find(known), std::string::npos) << known;
+    EXPECT_EQ(errorOf("CReactiveNavigationSystem", "PTG_COUNT", "0"),
+              "x.ini [CReactiveNavigationSystem] PTG_COUNT: must be 1..32, got 0");
+    EXPECT_EQ(errorOf("CReactiveNavigationSystem", "PTG_COUNT", "4"),
+              "x.ini [CReactiveNavigationSystem] PTG3_Type: missing (PTG_COUNT is 4)");
+    EXPECT_EQ(errorOf("CReactiveNavigationSystem", "PTG0_Type", "CPTG_Spiral"),
+              "x.ini [CReactiveNavigationSystem] PTG0_Type: unknown PTG class 'CPTG_Spiral'");
+    EXPECT_EQ(errorOf("CReactiveNavigationSystem", "PTG0_num_paths", "0"),
+              "x.ini [CReactiveNavigationSystem] PTG0_num_paths: must be > 0");
+    // Formulas are text; the numbered score keys are known by their pattern.
+    EXPECT_EQ(errorOf("CMultiObjectiveMotionOptimizerBase", "score7_name", "extra"), "");
+    EXPECT_NE(errorOf("CMultiObjectiveMotionOptimizerBase", "scor7_name", "extra"), "");
+}
+
 TEST(NavConfig, UnknownKeyIsReported) {
     // The message of reading one INI holding `section.key = value`, "" when it is accepted.
     const auto errorOf = [](const std::vector<std::tuple<std::string, std::string, double>>& kv) {
-        mrpt::config::CConfigFileMemory c;
-        // MRPT's navigator's own two sections, which every navigation INI must have.
-        c.write("CAbstractPTGBasedReactive", "robotMax_V_mps", 0.6);
-        c.write("CReactiveNavigationSystem", "PTG_COUNT", 3);
+        auto c = shippedNavIni();
         for (const auto& [section, key, value] : kv) c.write(section, key, value);
         try {
             (void)NavigatorOptions::fromConfig(c, "x.ini");
@@ -210,9 +272,8 @@ TEST(NavConfig, UnknownKeyIsReported) {
         << section;
     // A holonomic method MRPT does not know, or no section for MRPT's navigator: named here,
     // before a run (MRPT would stop it with a stack trace).
-    mrpt::config::CConfigFileMemory c(
-        "[CAbstractPTGBasedReactive]\nref_distance = 2\n[CReactiveNavigationSystem]\n"
-        "PTG_COUNT = 1\n[navigator]\nholonomic_method = CHolonomicVHF\n");
+    auto c = shippedNavIni();
+    c.write("navigator", "holonomic_method", "CHolonomicVHF");
     EXPECT_THROW(
         {
             try {

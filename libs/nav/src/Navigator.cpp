@@ -2,6 +2,8 @@
 #include <devslam/nav/CHolonomicVFHPlus.h>
 #include <devslam/nav/Navigator.h>
 
+#include "MrptSections.h"
+
 #include <mrpt/maps/CSimplePointsMap.h>
 #include <mrpt/nav/reactive/CReactiveNavigationSystem.h>
 #include <mrpt/poses/CPose2D.h>
@@ -88,6 +90,7 @@ NavigatorOptions readNavigatorOptions(const mrpt::config::CConfigFileBase& c,
     core::requireValue(o.robot_radius > 0, s, "robot_radius", "must be > 0 m");
     core::requireValue(o.person_margin >= 0 && o.person_margin <= 2.0, s, "person_margin",
                        "must be in [0, 2] m");
+    checkMrptSections(c, source);
     o.planner.loadFromConfigFile(c, "global_planner", source);
     o.replan.loadFromConfigFile(c, "replan", source);
     // Read again by the Navigator, from the same INI; checked here, where the file is known

@@ -1,0 +1,195 @@
+#include "MrptSections.h"
+
+#include <devslam/core/Config.h>
+#include <devslam/core/GzFile.h>
+#include <devslam/core/Parse.h>
+#include <devslam/nav/VfhPlus.h>
+
+#include <mrpt/config/CConfigFileMemory.h>
+#include <mrpt/nav/holonomic/CHolonomicFullEval.h>
+#include <mrpt/nav/holonomic/CHolonomicND.h>
+#include <mrpt/nav/holonomic/CHolonomicVFF.h>
+#include <mrpt/nav/reactive/CAbstractPTGBasedReactive.h>
+#include <mrpt/nav/reactive/CMultiObjMotionOpt_Scalarization.h>
+#include <mrpt/nav/reactive/CReactiveNavigationSystem.h>
+#include <mrpt/nav/reactive/CWaypointsNavigator.h>
+#include <mrpt/nav/tpspace/CParameterizedTrajectoryGenerator.h>
+#include <mrpt/rtti/CObject.h>
+
+#include <algorithm>
+#include <cctype>
+#include <map>
+#include <regex>
+#include <sstream>
+#include <stdexcept>
+
+namespace devslam::nav {
+namespace {
+
+std::string lowered(std::string s) {
+    for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return s;
+}
+
+std::string trimmed(const std::string& s) {
+    const auto a = s.find_first_not_of(" \t");
+    if (a == std::string::npos) return "";
+    return s.substr(a, s.find_last_not_of(" \t") - a + 1);
+}
+
+/// What MRPT's default of a key tells about its values.
+enum class Kind { Numbers, Bool, Text };
+
+/// Known keys of one section: name as MRPT writes it, and the kind of its value.
+using Keys = std::map<std::string, std::pair<std::string, Kind>>;  // lowered name -> ...
+
+/// The keys `save` writes into a section (MRPT's saveToConfigFile pads names and appends a
+/// `// comment`, which its own getAllKeys keeps: the text is read line by line here).
+template <class Save>
+Keys savedKeys(Save&& save, const std::string& prefix = "") {
+    mrpt::config::CConfigFileMemory m;
+    save(m, "s");
+    std::string text;
+    m.getContent(text);
+    Keys keys;
+    std::istringstream in(text);
+    for (std::string line; std::getline(in, line);) {
+        const auto eq = line.find('=');
+        if (eq == std::string::npos || line[0] == '#' || line[0] == '[') continue;
+        const std::string name = prefix + trimmed(line.substr(0, eq));
+        std::string value = line.substr(eq + 1);
+        value = trimmed(value.substr(0, value.find("//")));
+        Kind kind = Kind::Text;
+        if (value == "true" || value == "false")
+            kind = Kind::Bool;
+        else if (!value.empty()) {
+            try {
+                if (!core::parseNumberList(value, "").empty()) kind = Kind::Numbers;
+            } catch (const std::invalid_argument&) {
+            }
+        }
+        if (!name.empty()) keys[lowered(name)] = {name, kind};
+    }
+    return keys;
+}
+
+/// Checks the keys of `section` against `known` (plus those `pattern` matches, as text).
+void checkSection(const mrpt::config::CConfigFileBase& c, const std::string& section,
+                  const Keys& known, const std::string& source,
+                  const std::regex* pattern = nullptr) {
+    std::vector<std::string> keys;
+    c.getAllKeys(section, keys);
+    for (const auto& key : keys) {
+        const std::string where = source + " [" + section + "] " + key;
+        const auto it = known.find(lowered(key));
+        if (it == known.end()) {
+            if (pattern && std::regex_match(key, *pattern)) continue;
+            std::string list;
+            for (const auto& [k, v] : known) list += (list.empty() ? "" : ", ") + v.first;
+            throw std::invalid_argument(source + " [" + section + "]: unknown key '" + key +
+                                        "' (MRPT's navigator knows: " + list + ")");
+        }
+        const std::string value = c.read_string(section, key, "");
+        if (it->second.second == Kind::Numbers) {
+            if (core::parseNumberList(value, where).empty())
+                throw std::invalid_argument(where + ": expected a number, got '" + value + "'");
+        } else if (it->second.second == Kind::Bool) {
+            (void)core::parseBool(value, where);
+        }
+    }
+}
+
+}  // namespace
+
+void checkMrptSections(const mrpt::config::CConfigFileBase& c, const std::string& source) {
+    using namespace mrpt::nav;
+    const auto save = [](const auto& params) {
+        return savedKeys([&](auto& m, const std::string& s) { params.saveToConfigFile(m, s); });
+    };
+    if (c.sectionExists("CAbstractNavigator"))
+        checkSection(c, "CAbstractNavigator", save(CAbstractNavigator::TAbstractNavigatorParams()),
+                     source);
+    if (c.sectionExists("CWaypointsNavigator"))
+        checkSection(c, "CWaypointsNavigator",
+                     save(CWaypointsNavigator::TWaypointsNavigatorParams()), source);
+    if (c.sectionExists("CAbstractPTGBasedReactive"))
+        checkSection(c, "CAbstractPTGBasedReactive",
+                     save(CAbstractPTGBasedReactive::TAbstractPTGNavigatorParams()), source);
+    if (c.sectionExists("CHolonomicND"))
+        checkSection(c, "CHolonomicND", save(CHolonomicND::TOptions()), source);
+    if (c.sectionExists("CHolonomicFullEval"))
+        checkSection(c, "CHolonomicFullEval", save(CHolonomicFullEval::TOptions()), source);
+    if (c.sectionExists("CHolonomicVFF"))
+        checkSection(c, "CHolonomicVFF", save(CHolonomicVFF::TOptions()), source);
+    if (c.sectionExists("CMultiObjMotionOpt_Scalarization"))
+        checkSection(c, "CMultiObjMotionOpt_Scalarization",
+                     save(CMultiObjMotionOpt_Scalarization::TParams()), source);
+    if (c.sectionExists("CMultiObjectiveMotionOptimizerBase")) {
+        // Numbered lists of exprtk formulas: names only.
+        static const std::regex scores("score[0-9]+_(name|formula)|movement_assert[0-9]+",
+                                       std::regex::icase);
+        Keys base;
+        base["scores_to_normalize"] = {"scores_to_normalize", Kind::Text};
+        checkSection(c, "CMultiObjectiveMotionOptimizerBase", base, source, &scores);
+    }
+    // Ours: its own strict reader names the file.
+    if (c.sectionExists("CHolonomicVFHPlus")) {
+        VfhPlusOptions v;
+        v.loadFromConfigFile(c, "CHolonomicVFHPlus", source);
+    }
+
+    // The PTGs: how many, of which class, and each class's own keys with its prefix.
+    const std::string s = "CReactiveNavigationSystem";
+    if (!c.sectionExists(s)) return;
+    Keys known = save(CReactiveNavigationSystem::TReactiveNavigatorParams());
+    for (const char* k : {"PTG_COUNT", "RobotModel_shape2D_xs", "RobotModel_shape2D_ys",
+                          "RobotModel_circular_shape_radius"})
+        known[lowered(k)] = {k, Kind::Numbers};
+    const int n = core::namingSource(source, [&] { return core::readInt(c, s, "PTG_COUNT", 0); });
+    if (n < 1 || n > 32)
+        throw std::invalid_argument(source + " [" + s + "] PTG_COUNT: must be 1..32, got " +
+                                    std::to_string(n));
+    for (int i = 0; i < n; ++i) {
+        const std::string prefix = "PTG" + std::to_string(i) + "_";
+        const std::string type = c.read_string(s, prefix + "Type", "");
+        if (type.empty())
+            throw std::invalid_argument(source + " [" + s + "] " + prefix +
+                                        "Type: missing (PTG_COUNT is " + std::to_string(n) + ")");
+        // Its keys first (a junk value would make MRPT take "fast" as 0), then MRPT makes it.
+        const auto ptg_known = savedKeys(
+            [&](auto& m, const std::string&) {
+                mrpt::rtti::registerAllPendingClasses();
+                const auto ptg = std::dynamic_pointer_cast<CParameterizedTrajectoryGenerator>(
+                    mrpt::rtti::classFactory(type));
+                if (!ptg)
+                    throw std::invalid_argument(source + " [" + s + "] " + prefix +
+                                                "Type: unknown PTG class '" + type + "'");
+                ptg->saveToConfigFile(m, "s");
+            },
+            prefix);
+        known.insert(ptg_known.begin(), ptg_known.end());
+        known[lowered(prefix + "Type")] = {prefix + "Type", Kind::Text};
+    }
+    checkSection(c, s, known, source);
+    // Values MRPT asserts on only when the navigator starts (num_paths 0, resolution 0, ...).
+    for (int i = 0; i < n; ++i) {
+        const std::string prefix = "PTG" + std::to_string(i) + "_";
+        core::namingSource(source, [&] {
+            for (const char* k :
+                 {"num_paths", "resolution", "refDistance", "v_max_mps", "w_max_dps"})
+                if (c.keyExists(s, prefix + k))
+                    core::requireValue(core::readDouble(c, s, prefix + k, 0.0) > 0, s, prefix + k,
+                                       "must be > 0");
+        });
+        try {
+            (void)CParameterizedTrajectoryGenerator::CreatePTG(
+                c.read_string(s, prefix + "Type", ""), c, s, prefix);
+        } catch (const std::exception& e) {
+            throw std::invalid_argument(
+                source + " [" + s + "] " + prefix +
+                "*: MRPT refuses this PTG: " + core::innermostMessage(e.what()));
+        }
+    }
+}
+
+}  // namespace devslam::nav
