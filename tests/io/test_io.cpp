@@ -328,6 +328,34 @@ TEST(Rawlog, TruncatedFileReportsWhatWasRead) {
     expectError([&] { io::RawlogReader r(d.str("none.rawlog")); }, "rawlog file not found");
 }
 
+// A rawlog cut after it was opened (the scan at open found it whole) is an error naming the
+// file, not a quiet early end that would pass for a shorter sequence.
+TEST(Rawlog, FileCutAfterOpeningIsAnError) {
+    TempDir d;
+    io::TumReader tum(kTum);
+    const std::string path = d.str("cut.rawlog");
+    {
+        io::RawlogWriter w(path, {});
+        for (std::size_t i = 0; i < 6; ++i) w.write(tum.read(i));
+        w.close();
+    }
+    io::RawlogReader r(path);
+    ASSERT_EQ(r.size(), 6u);
+    fs::resize_file(path, fs::file_size(path) / 2);
+    std::size_t read = 0;
+    try {
+        while (r.next()) ++read;
+        FAIL() << "the cut file ended quietly after " << read << " frames";
+    } catch (const std::runtime_error& e) {
+        const std::string m = e.what();
+        EXPECT_EQ(m.rfind(path + ": ", 0), 0u) << m;
+        EXPECT_NE(m.find(" of the 6 RGB-D observations it held when opened (changed since?)"),
+                  std::string::npos)
+            << m;
+    }
+    EXPECT_LT(read, 6u);
+}
+
 TEST(Rawlog, LaterObservationsNameTheFileAndObservation) {
     // The reader decodes only observation 0's images up front; a damaged later one must still
     // be named (file and observation), not surface as a bare MRPT or OpenCV message.

@@ -250,8 +250,20 @@ std::optional<core::Frame> RawlogReader::next() {
     if (n_read_ >= n_frames_) return std::nullopt;
     std::size_t skipped = 0;
     bool sf = false, ob = false;
-    auto o = stream_->next(opts_.sensor_label, skipped, sf, ob);
-    if (!o) return std::nullopt;
+    // The scan at open counted n_frames_ intact observations: a file that ends or breaks
+    // before them was changed since (cut, or written over while it was read).
+    const auto changed = [&](const std::string& what) {
+        return std::runtime_error(path_ + ": " + what + " after " + std::to_string(n_read_) +
+                                  " of the " + std::to_string(n_frames_) +
+                                  " RGB-D observations it held when opened (changed since?)");
+    };
+    CObservation3DRangeScan::Ptr o;
+    try {
+        o = stream_->next(opts_.sensor_label, skipped, sf, ob);
+    } catch (const std::exception& e) {
+        throw changed(e.what());
+    }
+    if (!o) throw changed("ended");
     // Counted before decoding: after a bad observation the next call names the one after it.
     const std::size_t index = n_read_++;
     const std::string what = path_ + " observation " + std::to_string(index);
