@@ -129,7 +129,17 @@ Bench readBench(const std::string& path) {
         b.modes.clear();
         std::istringstream ss(modes);
         for (std::string m; ss >> m;) {
-            if (m != "truth") (void)dynamic::parseMaskMode(m);  // throws with the known names
+            if (m != "truth") {
+                try {
+                    (void)dynamic::parseMaskMode(m);  // throws with the known names
+                } catch (const std::invalid_argument& e) {
+                    throw std::invalid_argument("[bench] modes: " + std::string(e.what()) +
+                                                " or truth");
+                }
+            }
+            // Runs are kept in <out>/runs/SEQ/MODE: a mode twice would run into one folder.
+            if (std::find(b.modes.begin(), b.modes.end(), m) != b.modes.end())
+                throw std::invalid_argument("[bench] modes: '" + m + "' is listed twice");
             b.modes.push_back(m);
         }
     }
@@ -156,6 +166,23 @@ Bench readBench(const std::string& path) {
         q.path = resolve(cfg->read_string(s, "path", ""), base);
         q.slam_config = resolve(cfg->read_string(s, "slam_config", ""), base);
         if (q.slam_config.empty()) q.slam_config = b.slam_config;
+        // Found now, not as every run of the sequence failing after minutes of work.
+        if (!fs::is_regular_file(q.slam_config))
+            throw std::invalid_argument(
+                path + " [" + (cfg->keyExists(s, "slam_config") ? s : std::string("bench")) +
+                "] slam_config: no such file '" + q.slam_config + "'");
+        if (!q.path.empty() && !fs::exists(q.path))
+            throw std::invalid_argument(path + " [" + s + "] path: no such file or folder '" +
+                                        q.path + "'");
+        // The name is a folder and a file name prefix, and a cell of runs.csv.
+        if (q.name.empty() ||
+            q.name.find_first_not_of(
+                "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789"
+                "_.-") != std::string::npos ||
+            q.name == "." || q.name == "..")
+            throw std::invalid_argument(path + " [" + s + "] name: '" + q.name +
+                                        "' (letters, digits, '_', '.', '-' only: it names "
+                                        "folders, files and a CSV column)");
         if (q.scenario.empty() == q.path.empty() && !(q.path.size() && q.scenario.size()))
             throw std::invalid_argument(path + " [" + s +
                                         "]: give 'path' (a TUM folder) or 'scenario' (synthetic)");
@@ -442,6 +469,7 @@ int run(int argc, char** argv) {
                          ? std::size_t(repeatsOf(q)) * inputsOf(q, b.out_dir).size()
                          : 0;
     std::size_t done = 0, reused = 0;
+    std::vector<std::string> failed;  // logs of the runs that failed
     for (const auto& q : b.sequences)
         for (const auto& m : b.modes)
             for (const auto& in : inputsOf(q, b.out_dir))
@@ -468,9 +496,13 @@ int run(int argc, char** argv) {
                     if (!have) f = rc == 0 ? readRun(json) : RunFigures{};
                     f.seed = in.seed;
                     f.dir = dir;
-                    if (!f.ok)
-                        std::cerr << "  devslam-run failed (exit " << rc << "), see "
-                                  << (dir / "log.txt") << "\n";
+                    if (!f.ok) {
+                        failed.push_back((dir / "log.txt").string());
+                        std::cerr << "  devslam-run failed (exit "
+                                  << (WIFEXITED(rc) ? WEXITSTATUS(rc) : rc) << "):\n"
+                                  << lastLines((dir / "log.txt").string(), 3)
+                                  << "  (whole output: " << (dir / "log.txt").string() << ")\n";
+                    }
                     runs[{q.name, m}].push_back(f);
                     all_csv << q.name << "," << m << "," << seed << "," << r << ","
                             << fmt(f.ate_rmse, 6) << "," << fmt(f.ate_mean, 6) << ","
@@ -744,8 +776,16 @@ int run(int argc, char** argv) {
         std::ofstream f(fs::path(b.out_dir) / "tables.md");
         f << md.str();
     }
-    if (!results.empty()) core::replaceResultsSection(results, "bench", md.str());
     std::cout << md.str();
+    if (!failed.empty()) {
+        // The tables count them as failed runs; a results file keeps its last whole bench.
+        std::cerr << "devslam-bench: " << failed.size() << " of " << total
+                  << " runs failed (the first: " << failed.front() << "); "
+                  << (results.empty() ? std::string("") : results + " left as it was; ")
+                  << "--reuse-runs runs only those again\n";
+        return 1;
+    }
+    if (!results.empty()) core::replaceResultsSection(results, "bench", md.str());
     return 0;
 }
 

@@ -270,6 +270,16 @@ TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
         {real + "seed = 5\n", "seed"},
         {"[bench]\nmax_frames = -1\n" + real, "bench.ini [bench] max_frames: must be >= 0"},
         {"[bench]\nrender_jobs = -1\n" + real, "bench.ini [bench] render_jobs: must be 0..64"},
+        {"[bench]\nmodes = none Dynamic\n" + real,
+         "bench.ini [bench] modes: unknown mask mode 'Dynamic'"},
+        {"[bench]\nmodes = none dynamic none\n" + real,
+         "bench.ini [bench] modes: 'none' is listed twice"},
+        {"[sequence_a]\npath = " + root + "/data/tum/no_such_folder\n",
+         "bench.ini [sequence_a] path: no such file or folder '"},
+        {real + "slam_config = nowhere.ini\n", "bench.ini [sequence_a] slam_config: no such file"},
+        {"[bench]\nslam_config = /nowhere.ini\n" + synth,
+         "bench.ini [bench] slam_config: no such file '/nowhere.ini'"},
+        {real + "name = fr1/xyz\n", "bench.ini [sequence_a] name: 'fr1/xyz' (letters, digits"},
         {real + "[sequence_b]\nname = a\n" + fr1,
          "bench.ini [sequence_b] name: 'a' is already the name of an earlier sequence"},
         {real + "set = person_1.speed=1\n", "[sequence_a] set: only a synthetic sequence"},
@@ -293,6 +303,27 @@ TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
     for (const auto& [ini, msg] : cases)
         EXPECT_NE(refused(ini).find(msg), std::string::npos)
             << ini << "\n" << readFile(tmp / "log.txt");
+    // A run that fails (here: a folder that is no TUM sequence) is counted and named; the
+    // results file keeps its last whole bench, and the exit status says so.
+    fs::create_directories(tmp / "not_tum");
+    std::ofstream(tmp / "RESULTS.md") << "# Results\n";
+    std::ofstream(tmp / "bench.ini")
+        << "[bench]\nmodes = none\nrepeats = 1\n[sequence_a]\npath = " << (tmp / "not_tum").string()
+        << "\n";
+    const std::string cmd = "'" + bin + "/devslam-bench' --config '" +
+                            (tmp / "bench.ini").string() + "' --out '" + (tmp / "out").string() +
+                            "' --results '" + (tmp / "RESULTS.md").string() + "' > '" +
+                            (tmp / "log.txt").string() + "' 2>&1";
+    EXPECT_EQ(WEXITSTATUS(std::system(cmd.c_str())), 1);
+    const std::string log = readFile(tmp / "log.txt");
+    EXPECT_NE(log.find("devslam-run failed (exit 1):\n  devslam-run: "), std::string::npos) << log;
+    EXPECT_NE(log.find("folder has no rgb.txt"), std::string::npos) << log;
+    EXPECT_NE(log.find("1 of 1 runs failed (the first: "), std::string::npos) << log;
+    EXPECT_NE(log.find("RESULTS.md left as it was; --reuse-runs runs only those again"),
+              std::string::npos)
+        << log;
+    EXPECT_EQ(readFile(tmp / "RESULTS.md"), "# Results\n");
+    EXPECT_TRUE(fs::exists(tmp / "out/tables.md"));
     fs::remove_all(tmp);
 }
 
