@@ -146,7 +146,14 @@ int main(int argc, char** argv) {
         std::string filter_source;
         auto cfg = core::loadFilterConfig(config, &filter_source);
         std::optional<dynamic::MaskMode> mode_override;
-        if (!mode.empty()) mode_override = dynamic::parseMaskMode(mode);
+        if (!mode.empty()) {
+            try {
+                mode_override = dynamic::parseMaskMode(mode);
+            } catch (const std::invalid_argument& e) {
+                std::cerr << "devslam-overlay: --mode: " << e.what() << "\n" << kUsage;
+                return 2;
+            }
+        }
         auto filter = core::namingSource(
             filter_source, [&] { return dynamic::makeFilterFromConfig(*cfg, mode_override); });
         fs::create_directories(out_dir);
@@ -209,7 +216,16 @@ int main(int argc, char** argv) {
             if (k % static_cast<std::size_t>(every) == 0) {
                 char name[64];
                 std::snprintf(name, sizeof name, "overlay_%05zu.png", k);
-                cv::imwrite((fs::path(out_dir) / name).string(), drawOverlay(*f, out));
+                const std::string file = (fs::path(out_dir) / name).string();
+                bool ok = false;
+                try {
+                    ok = cv::imwrite(file, drawOverlay(*f, out));
+                } catch (const cv::Exception&) {
+                }
+                if (!ok)
+                    throw std::runtime_error("cannot write " + file + " (" +
+                                             std::to_string(written) +
+                                             " overlays written before it)");
                 ++written;
             }
             bar.update(++k);

@@ -71,8 +71,18 @@ TEST(DevslamOverlay, BadInputIsNamed) {
         << r.out;
 
     r = runApp("devslam-overlay", "--input synthetic:walking --mode moving" + out);
+    EXPECT_EQ(r.rc, 2) << r.out;  // a bad option, as --every 0
+    EXPECT_NE(r.out.find("--mode: unknown mask mode 'moving'"), std::string::npos) << r.out;
+
+    // An overlay that cannot be written stops it, naming the file (it said "wrote 3").
+    std::filesystem::create_directories(d.str("o") + "/overlay_00002.png");
+    r = runApp("devslam-overlay", "--input synthetic:walking --frames 4" + out);
     EXPECT_EQ(r.rc, 1) << r.out;
-    EXPECT_NE(r.out.find("moving"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("cannot write " + d.str("o") +
+                         "/overlay_00002.png (2 overlays written "
+                         "before it)"),
+              std::string::npos)
+        << r.out;
 
     r = runApp("devslam-overlay", "--input synthetic:running" + out);
     EXPECT_EQ(r.rc, 1) << r.out;
