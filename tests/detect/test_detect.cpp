@@ -12,7 +12,9 @@
 
 #include <filesystem>
 #include <fstream>
-
+#include <string>
+#include <tuple>
+#include <vector>
 
 using namespace devslam;
 namespace fs = std::filesystem;
@@ -223,18 +225,25 @@ TEST(DetectHog, FindsThePersonAndNotTheDog) {
     EXPECT_TRUE(det->detect(readImage("data/images/dog.jpg")).empty());
 }
 
-// A scale that would leave no image (cv::resize asserts on it) or a huge one is refused when
-// the INI is read, naming the key.
-TEST(DetectHog, ResizeOutOfRangeIsRejected) {
-    for (const double r : {0.001, 0.0, 100.0}) {
+// A scale that would leave no image (cv::resize asserts on it) or a huge one, and a score
+// threshold no box can pass (scores lie in (0, 1)), are refused when the INI is read, naming
+// the key.
+TEST(DetectHog, ResizeOrMinScoreOutOfRangeIsRejected) {
+    const std::vector<std::tuple<std::string, double, std::string>> cases = {
+        {"resize", 0.001, "[detector] resize: must be in [0.1, 4]"},
+        {"resize", 0.0, "[detector] resize: must be in [0.1, 4]"},
+        {"resize", 100.0, "[detector] resize: must be in [0.1, 4]"},
+        {"min_score", 7.0, "[detector] min_score: must be in [0, 1]"},
+        {"min_score", -3.0, "[detector] min_score: must be in [0, 1]"}};
+    for (const auto& [key, value, message] : cases) {
         mrpt::config::CConfigFileMemory cfg;
         cfg.write("detector", "detector", std::string("hog"));
-        cfg.write("detector", "resize", r);
+        cfg.write("detector", key, value);
         try {
             (void)detect::makeDetector(cfg);
-            ADD_FAILURE() << "resize " << r << " was accepted";
+            ADD_FAILURE() << key << " " << value << " was accepted";
         } catch (const std::invalid_argument& e) {
-            EXPECT_STREQ(e.what(), "[detector] resize: must be in [0.1, 4]");
+            EXPECT_EQ(std::string(e.what()), message);
         }
     }
 }

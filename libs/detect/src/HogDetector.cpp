@@ -26,6 +26,8 @@ void HogDetector::Options::loadFromConfig(const mrpt::config::CConfigFileBase& c
                        "must be a positive multiple of 8 (HOG cell size)");
     core::requireValue(scale > 1.0, s, "scale", "must be > 1");
     core::requireValue(group_threshold >= 0, s, "group_threshold", "must be >= 0");
+    // A box's score is the logistic of its SVM margin, in (0, 1): 7 would drop every box.
+    core::requireValue(min_score >= 0 && min_score <= 1, s, "min_score", "must be in [0, 1]");
     // A tiny scale leaves no image (cv::resize fails on an empty size); a large one grows it
     // by its square in memory and time. People must be ~128/resize px tall to be found.
     core::requireValue(resize >= 0.1 && resize <= 4.0, s, "resize", "must be in [0.1, 4]");
