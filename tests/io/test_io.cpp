@@ -78,6 +78,18 @@ TEST(TumReader, ReadsShippedFramesLikeAssociatePy) {
     EXPECT_EQ(r.groundTruth()->size(), 3000u);
     const core::Frame f = r.read(0);
     EXPECT_NEAR(f.timestamp, 1305031102.175304, 1e-6);
+    // The depth image's own stamp (depth.txt), for the SLAM's depth-time compensation; a
+    // TUM copy keeps it (the name and the list's stamp).
+    ASSERT_TRUE(f.depth_timestamp.has_value());
+    EXPECT_NEAR(*f.depth_timestamp, 1305031102.160407, 1e-6);
+    {
+        TempDir d;
+        copyTumSubset(d.str("copy"), 2);
+        const auto g = io::TumReader(d.str("copy")).read(0);
+        ASSERT_TRUE(g.depth_timestamp.has_value());
+        EXPECT_NEAR(*g.depth_timestamp, 1305031102.160407, 1e-6);
+        EXPECT_NE(g.depth_source.find("1305031102.160407.png"), std::string::npos);
+    }
     EXPECT_EQ(f.bgr.type(), CV_8UC3);
     EXPECT_EQ(f.depth.type(), CV_32FC1);
     EXPECT_EQ(f.bgr.size(), cv::Size(640, 480));

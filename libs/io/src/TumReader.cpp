@@ -145,6 +145,7 @@ core::Frame TumReader::read(std::size_t i) const {
     core::Frame f;
     f.index = i;
     f.timestamp = r.t;
+    f.depth_timestamp = d.t;
     f.K = K_;
     loadTumImages(folder_ + "/" + r.file, folder_ + "/" + d.file, opts_.tum_depth_scale, f);
     if (f.K.width != f.bgr.cols || f.K.height != f.bgr.rows) {

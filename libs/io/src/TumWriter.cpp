@@ -60,16 +60,18 @@ void TumWriter::write(const core::Frame& f) {
             << "# fx fy cx cy [px], width height [px], dist = k1 k2 p1 p2 k3 (OpenCV order)\n"
             << cam.getContent();
     }
-    char stamp[32];
+    char stamp[32], depth_stamp[32];
     std::snprintf(stamp, sizeof stamp, "%.6f", f.timestamp);
+    // A depth image with its own stamp (a TUM source) keeps it, as TUM names and lists it.
+    std::snprintf(depth_stamp, sizeof depth_stamp, "%.6f", f.depth_timestamp.value_or(f.timestamp));
     const std::string rgb = std::string("rgb/") + stamp + ".png";
-    const std::string depth = std::string("depth/") + stamp + ".png";
+    const std::string depth = std::string("depth/") + depth_stamp + ".png";
     if (!cv::imwrite(folder_ + "/" + rgb, f.bgr))
         throw std::runtime_error("cannot write '" + folder_ + "/" + rgb + "'");
     if (!cv::imwrite(folder_ + "/" + depth, f.rawDepth16()))
         throw std::runtime_error("cannot write '" + folder_ + "/" + depth + "'");
     std::fprintf(rgb_list_.get(), "%s %s\n", stamp, rgb.c_str());
-    std::fprintf(depth_list_.get(), "%s %s\n", stamp, depth.c_str());
+    std::fprintf(depth_list_.get(), "%s %s\n", depth_stamp, depth.c_str());
     ++count_;
 }
 

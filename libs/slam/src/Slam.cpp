@@ -43,12 +43,7 @@ void MappingOptions::saveToConfig(mrpt::config::CConfigFileBase& c, const std::s
 }
 
 std::optional<double> depthStamp(const core::Frame& frame) {
-    const std::string stem = std::filesystem::path(frame.depth_source).stem().string();
-    if (stem.empty() || frame.depth_source == frame.rgb_source) return std::nullopt;
-    char* end = nullptr;
-    const double t = std::strtod(stem.c_str(), &end);
-    if (end != stem.c_str() + stem.size() || !(t > 1e8)) return std::nullopt;
-    return t;
+    return frame.depth_timestamp;
 }
 
 void compensateDepthTime(FrameFeatures& f, const Eigen::Isometry3d& T_prev_cur, double dt_prev,

@@ -11,6 +11,7 @@
 #include <opencv2/core/mat.hpp>
 
 #include <cstddef>
+#include <optional>
 #include <string>
 
 namespace devslam::core {
@@ -26,6 +27,9 @@ struct Frame {
     double depth_scale = 5000.0;
     std::string rgb_source;    ///< where the colour image came from (for messages, converters)
     std::string depth_source;  ///< where the depth image came from
+    /// [s] when the depth image was taken apart from the colour image (TUM: its depth.txt
+    /// stamp, up to 20 ms off); unset when both share `timestamp` (rawlogs, renders).
+    std::optional<double> depth_timestamp;
 
     [[nodiscard]] bool hasDepth(int u, int v) const {
         return u >= 0 && v >= 0 && u < depth.cols && v < depth.rows && depth.at<float>(v, u) > 0.f;

@@ -54,8 +54,10 @@ struct MappingOptions {
                       const std::string& section = "mapping") const;
 };
 
-/// Stamp of the depth image when its file name is a TUM stamp ("depth/1305031102.160407.png");
-/// std::nullopt otherwise (rawlogs: depth and colour share the observation's stamp).
+/// Stamp of the depth image when it has its own (a TUM folder's depth.txt: Frame's
+/// depth_timestamp); std::nullopt otherwise (rawlogs: depth and colour share the
+/// observation's stamp). Before, it was read from the depth file's name, so that a folder
+/// whose stamps were shifted (names kept) lost the compensation without a word.
 [[nodiscard]] std::optional<double> depthStamp(const core::Frame& frame);
 
 /// Moves the back-projected points of `f` from the depth image's time to the colour
