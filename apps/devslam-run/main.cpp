@@ -180,6 +180,11 @@ run::RunConfig runConfig(const Args& a, const Loaded& l, const std::string& mode
 
 int runOnce(const Args& a) {
     auto l = loadConfig(a);
+    // The replay gives its frames new stamps, and the truth mask is looked up by stamp.
+    if (a.replay > 0 && l.mode == "truth")
+        throw std::invalid_argument(
+            "--replay with mode truth: the renderer's person truth is found by the frames' "
+            "stamps, which the replay makes anew; replay another mode");
     auto reader = openInput(a.input, l.reader, a.replay);
     if (const std::string lost = reader->damage(); !lost.empty())
         std::cerr << "devslam-run: WARNING: running on the intact part of the input only: " << lost

@@ -122,6 +122,10 @@ TEST(DevslamRun, BadInputIsReported) {
     EXPECT_EQ(r.rc, 1);
     EXPECT_NE(r.out.find("needs the renderer's person truth"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("fr1_xyz_first37"), std::string::npos) << r.out;
+    // a replay makes new stamps, by which the truth is found: refused before any frame
+    r = run("--mode truth --replay 2 --quiet --out ''");
+    EXPECT_EQ(r.rc, 1);
+    EXPECT_NE(r.out.find("--replay with mode truth"), std::string::npos) << r.out;
     // it reads [dynamic_filter] as the other modes do: a mistyped key is named
     r = run("--set dynamic_filter.mask_margn=3 --mode truth --quiet --out ''");
     EXPECT_EQ(r.rc, 1);
