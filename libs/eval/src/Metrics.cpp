@@ -36,6 +36,12 @@ AteResult computeAte(const core::Trajectory& gt, const core::Trajectory& est,
     for (const auto& p : est) te.push_back(p.t);
     // evaluate_ate.py: associate(gt, est, offset, max_difference) with the offset on est.
     const auto pairs = core::associate(tg, te, opts.max_dt, opts.offset);
+    // The alignment needs three points; with fewer poses than that the files are fine.
+    if (pairs.size() < 3 && pairs.size() == std::min(est.size(), gt.size()))
+        throw std::invalid_argument("ATE: " + std::to_string(pairs.size()) +
+                                    " associated poses, the alignment needs at least 3 (" +
+                                    std::to_string(est.size()) + " estimated, " +
+                                    std::to_string(gt.size()) + " in the ground truth)");
     if (pairs.size() < 3)
         throw std::invalid_argument(
             "ATE: only " + std::to_string(pairs.size()) + " of " + std::to_string(est.size()) +
