@@ -416,14 +416,27 @@ std::string formatSummary(const RunReport& r) {
     if (r.rpe_frame)
         o << "RPE (1 f)  : trans RMSE " << num(r.rpe_frame->trans.rmse, 4) << " m, rot RMSE "
           << num(r.rpe_frame->rot.rmse, 3) << " deg (" << r.rpe_frame->n_pairs << " pairs)\n";
-    if (r.mask_score) {
+    if (r.mask_score && r.mode == "none") {
+        o << "masks      : none (mode none)\n";
+    } else if (r.mask_score) {
         const auto& m = *r.mask_score;
-        o << "masks      : walking people masked in " << num(100.0 * m.movingRecall(), 1)
-          << " % of " << m.moving_instances << " person-frames ("
-          << num(100.0 * m.movingAreaRecall(), 1) << " % of their area), static people in "
-          << num(100.0 * m.staticMasked(), 1) << " % of " << m.static_instances << "; "
-          << num(100.0 * m.precision(), 1)
-          << " % of the masked area is on walking people (renderer truth)\n";
+        o << "masks      : ";
+        if (m.moving_instances > 0)
+            o << "walking people masked in " << num(100.0 * m.movingRecall(), 1) << " % of "
+              << m.moving_instances << " person-frames (" << num(100.0 * m.movingAreaRecall(), 1)
+              << " % of their area), ";
+        else
+            o << "no walking people, ";
+        if (m.static_instances > 0)
+            o << "static people in " << num(100.0 * m.staticMasked(), 1) << " % of "
+              << m.static_instances << "; ";
+        else
+            o << "no static people; ";
+        if (m.masked_px > 0)
+            o << num(100.0 * m.precision(), 1)
+              << " % of the masked area is on walking people (renderer truth)\n";
+        else
+            o << "nothing masked (renderer truth)\n";
         const std::size_t missed = m.moving_instances - m.moving_masked;
         if (missed > 0)
             o << "             of the " << missed << " walker-frames not masked, "

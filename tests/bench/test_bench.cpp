@@ -77,6 +77,13 @@ TEST(DevslamBench, TwoFrameSmokeRunOfTheWholeCommand) {
     }
     EXPECT_EQ(readFile(tmp / "out/synth/short_seed5/groundtruth.txt"),
               readFile(tmp / "out/synth/short_seed6/groundtruth.txt"));
+    // Each run's summary is in its log; a run without masks says so rather than scoring them.
+    EXPECT_NE(readFile(tmp / "out/runs/short/none/seed5_r0/log.txt")
+                  .find("masks      : none (mode none)"),
+              std::string::npos);
+    EXPECT_NE(readFile(tmp / "out/runs/short/dynamic/seed5_r0/log.txt")
+                  .find("masks      : walking people masked in "),
+              std::string::npos);
     // The sequence's `set` items reached devslam-synth (its render.txt records them).
     const std::string render_txt = readFile(tmp / "out/synth/short_seed5/render.txt");
     EXPECT_NE(render_txt.find("set person_1.speed=0.5"), std::string::npos) << render_txt;
