@@ -162,7 +162,12 @@ TEST(DetectYolo, CorruptWeightsGiveAClearError) {
     std::ofstream(half, std::ios::binary).write(bytes.data(), bytes.size() / 2);
     const std::string tiny = (dir / "tiny.weights").string();
     std::ofstream(tiny, std::ios::binary) << "not a darknet weights file";
-    for (const auto& w : {half, tiny}) {
+    // 30 kB short: under 1 % of the file, which the size check used to allow.
+    const std::string short_by_30k = (dir / "short.weights").string();
+    std::ofstream(short_by_30k, std::ios::binary).write(bytes.data(), bytes.size() - 30000);
+    const std::string folder = (dir / "folder.weights").string();
+    fs::create_directories(folder);
+    for (const auto& w : {half, tiny, short_by_30k, folder}) {
         detect::YoloDetector::Options o;
         o.weights = w;
         try {
