@@ -164,6 +164,13 @@ TEST(Parse, NumberListsNameTheBadToken) {
               "[a] k: expected 3 numbers, got 2");
 }
 
+TEST(Parse, ExtensionsInAnyCase) {
+    EXPECT_TRUE(endsWithNoCase("a/b.PNG", ".png"));
+    EXPECT_TRUE(endsWithNoCase("b.png", ".png"));
+    EXPECT_FALSE(endsWithNoCase("b.jpgx", ".png"));
+    EXPECT_FALSE(endsWithNoCase("png", ".png"));
+}
+
 TEST(Parse, IntegersAreWholeAndInRange) {
     EXPECT_EQ(parseInteger("42", "x"), 42);
     EXPECT_EQ(parseInteger("+7", "x"), 7);
@@ -245,6 +252,15 @@ TEST(Config, RepeatedKeysAndSectionsAreRefused) {
               path + " line 3: [goal] X repeated (first at line 2)");
     EXPECT_EQ(error("[a]\nk = 1\n[b]\n[A]\nj = 2\n"),
               path + " line 4: section [A] repeated (first at line 1)");
+    EXPECT_EQ(error("[a]\nk = 1\n[ a ]\nj = 2\n"),  // MRPT trims the name
+              path + " line 3: section [ a ] repeated (first at line 1)");
+    // MRPT's @define: keys are compared as MRPT reads them.
+    EXPECT_EQ(error("@define P PTG0\n[a]\n${P}_K = 1\n@define P PTG2\n${P}_K = -1\n"), "");
+    EXPECT_EQ(error("@define P PTG0\n[a]\n${P}_K = 1\nPTG0_K = 2\n"),
+              path + " line 4: [a] PTG0_K repeated (first at line 3)");
+    // A '\\' followed by blanks ends its line: MRPT joins only at a '\\' right at the end.
+    EXPECT_EQ(error("[a]\nk = 1 \\  \nk = 2\n"),
+              path + " line 3: [a] k repeated (first at line 2)");
     // Not repeats: one key in two sections, comments, a value continued on the next lines.
     EXPECT_EQ(error("[a]\nk = 1\n# k = 2\n; k = 3\n// k = 4\n[b]\nk = 5\nf = \\\n"
                     "  var k := 1; \\\n  k = 2\n"),

@@ -25,24 +25,45 @@ std::string lowered(std::string s) {
 void refuseRepeats(const std::string& text, const std::string& path) {
     std::map<std::string, int> sections;
     std::map<std::pair<std::string, std::string>, int> keys;
+    std::map<std::string, std::string> defines;  // MRPT's "@define NAME VALUE", used as ${NAME}
+    const auto expand = [&](std::string s) {
+        for (const auto& [name, value] : defines)
+            for (auto p = s.find("${" + name + "}"); p != std::string::npos;
+                 p = s.find("${" + name + "}"))
+                s.replace(p, name.size() + 3, value);
+        return s;
+    };
+    const auto trim = [](const std::string& s) {
+        const auto a = s.find_first_not_of(" \t");
+        return a == std::string::npos ? std::string()
+                                      : s.substr(a, s.find_last_not_of(" \t") - a + 1);
+    };
     std::istringstream in(text);
     std::string section;
     int n = 0;
     bool continued = false;  // the line before ended in '\': this one is part of its value
     for (std::string line; std::getline(in, line);) {
         ++n;
-        const auto last = line.find_last_not_of(" \t\r");
+        if (!line.empty() && line.back() == '\r') line.pop_back();
         const bool continuation = continued;
-        continued = last != std::string::npos && line[last] == '\\';
+        continued = !line.empty() && line.back() == '\\';  // MRPT joins only there
         if (continuation) continue;
-        const auto a = line.find_first_not_of(" \t\r");
+        const auto a = line.find_first_not_of(" \t");
         if (a == std::string::npos || line[a] == '#' || line[a] == ';' ||
             line.compare(a, 2, "//") == 0)
             continue;
+        if (line[a] == '@') {  // a directive: only @define matters for names
+            std::istringstream d(line.substr(a));
+            std::string word, name, value;
+            d >> word >> name;
+            std::getline(d, value);
+            if (word == "@define" && !name.empty()) defines[name] = trim(value);
+            continue;
+        }
         if (line[a] == '[') {
             const auto b = line.find(']', a);
             if (b == std::string::npos) continue;
-            section = line.substr(a + 1, b - a - 1);
+            section = trim(expand(line.substr(a + 1, b - a - 1)));  // MRPT trims the name
             const auto [at, fresh] = sections.emplace(lowered(section), n);
             if (!fresh)
                 throw std::invalid_argument(
@@ -51,10 +72,9 @@ void refuseRepeats(const std::string& text, const std::string& path) {
             continue;
         }
         const auto eq = line.find('=', a);
-        if (eq == std::string::npos) continue;
-        const auto e = line.find_last_not_of(" \t", eq == 0 ? 0 : eq - 1);
-        if (eq == a || e == std::string::npos || e < a) continue;
-        const std::string key = line.substr(a, e - a + 1);
+        if (eq == std::string::npos || eq == a) continue;
+        const std::string key = trim(expand(line.substr(a, eq - a)));
+        if (key.empty() || key.find("${") != std::string::npos) continue;  // not resolvable here
         const auto [at, fresh] = keys.emplace(std::pair{lowered(section), lowered(key)}, n);
         if (!fresh)
             throw std::invalid_argument(path + " line " + std::to_string(n) + ": [" + section +

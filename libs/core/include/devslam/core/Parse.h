@@ -39,4 +39,8 @@ namespace devslam::core {
 [[nodiscard]] std::vector<double> parseNumberList(const std::string& text, const std::string& what,
                                                   std::size_t expected = 0);
 
+/// Whether `text` ends in `suffix`, letters compared in any case: a file name's extension
+/// (OpenCV picks an image's format by it, ".PNG" as ".png").
+[[nodiscard]] bool endsWithNoCase(const std::string& text, const std::string& suffix);
+
 }  // namespace devslam::core
