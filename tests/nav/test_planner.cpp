@@ -207,10 +207,32 @@ TEST(NavConfig, MrptSectionsAreReadStrictly) {
     };
     EXPECT_EQ(errorOf("navigator", "nav_period", "0.1"), "");  // the shipped file passes
     EXPECT_EQ(errorOf("CAbstractPTGBasedReactive", "robotMax_V_mps", "fast"),
-              "x.ini [CAbstractPTGBasedReactive] robotMax_V_mps: 'fast' is not a number");
+              "x.ini [CAbstractPTGBasedReactive] robotMax_V_mps: expected a number, got 'fast'");
     EXPECT_EQ(errorOf("CAbstractNavigator", "alarm_seems_not_approaching_target_timeout", "15s"),
-              "x.ini [CAbstractNavigator] alarm_seems_not_approaching_target_timeout: '15s' is "
-              "not a number");
+              "x.ini [CAbstractNavigator] alarm_seems_not_approaching_target_timeout: expected a "
+              "number, got '15s'");
+    // One number where MRPT reads one (it takes the first of a list), whole where it reads
+    // an integer (it cuts 121.7 to 121).
+    EXPECT_EQ(errorOf("CAbstractPTGBasedReactive", "robotMax_V_mps", "0.3 5"),
+              "x.ini [CAbstractPTGBasedReactive] robotMax_V_mps: expected a number, got '0.3 5'");
+    EXPECT_EQ(errorOf("CReactiveNavigationSystem", "PTG0_num_paths", "121.7"),
+              "x.ini [CReactiveNavigationSystem] PTG0_num_paths: expected an integer, got '121.7'");
+    // MRPT's read_bool reads "on" as false (not true/false/yes/no: an integer, 0).
+    EXPECT_EQ(errorOf("CAbstractPTGBasedReactive", "enable_obstacle_filtering", "on"),
+              "x.ini [CAbstractPTGBasedReactive] enable_obstacle_filtering: expected true or "
+              "false, got 'on'");
+    EXPECT_EQ(errorOf("CAbstractPTGBasedReactive", "enable_obstacle_filtering", "yes"), "");
+    // Numbered keys MRPT reads as many of as another key says, and the obstacle filter's.
+    EXPECT_EQ(errorOf("CHolonomicFullEval", "PHASE4_FACTORS", "[1]"), "");
+    EXPECT_EQ(errorOf("CHolonomicFullEval", "PHASE4_THRESHOLD", "0.7x"),
+              "x.ini [CHolonomicFullEval] PHASE4_THRESHOLD: expected a number, got '0.7x'");
+    EXPECT_EQ(errorOf("CReactiveNavigationSystem", "PTG0_shape_x0", "0.2"),  // known, no y0
+              "x.ini [CReactiveNavigationSystem] PTG0_*: MRPT refuses this PTG: Error: mismatch "
+              "between number of pts in {x,y} defining robot shape");
+    EXPECT_EQ(errorOf("CPointCloudFilterByDistance", "min_dist", "0.1"), "");
+    EXPECT_NE(
+        errorOf("CPointCloudFilterByDistance", "min_dst", "0.1").find("unknown key 'min_dst'"),
+        std::string::npos);
     EXPECT_EQ(errorOf("CAbstractPTGBasedReactive", "use_delays_model", "maybe"),
               "x.ini [CAbstractPTGBasedReactive] use_delays_model: expected true or false, got "
               "'maybe'");
@@ -224,7 +246,7 @@ TEST(NavConfig, MrptSectionsAreReadStrictly) {
               "x.ini [CHolonomicVFHPlus] window: expected a number, got '0.6x'");
     // The PTGs: their count, classes and each class's own keys.
     EXPECT_EQ(errorOf("CReactiveNavigationSystem", "PTG0_v_max_mps", "0.6m"),
-              "x.ini [CReactiveNavigationSystem] PTG0_v_max_mps: '0.6m' is not a number");
+              "x.ini [CReactiveNavigationSystem] PTG0_v_max_mps: expected a number, got '0.6m'");
     const std::string k = errorOf("CReactiveNavigationSystem", "PTG1_K", "1");  // C has K
     EXPECT_EQ(k.rfind("x.ini [CReactiveNavigationSystem]: unknown key 'PTG1_K' (MRPT's "
                       "navigator knows: ",

@@ -6,6 +6,7 @@
 #include <devslam/nav/VfhPlus.h>
 
 #include <mrpt/config/CConfigFileMemory.h>
+#include <mrpt/maps/CPointCloudFilterByDistance.h>
 #include <mrpt/nav/holonomic/CHolonomicFullEval.h>
 #include <mrpt/nav/holonomic/CHolonomicND.h>
 #include <mrpt/nav/holonomic/CHolonomicVFF.h>
@@ -37,8 +38,10 @@ std::string trimmed(const std::string& s) {
     return s.substr(a, s.find_last_not_of(" \t") - a + 1);
 }
 
-/// What MRPT's default of a key tells about its values.
-enum class Kind { Numbers, Bool, Text };
+/// What MRPT's default of a key tells about its values: one integer ("3"), one number
+/// ("0.600000"), a list of numbers ("[0 2]", "1.00 0.50"), a boolean, or text (formulas,
+/// class names), which is not checked.
+enum class Kind { Integer, Number, Numbers, Bool, Text };
 
 /// Known keys of one section: name as MRPT writes it, and the kind of its value.
 using Keys = std::map<std::string, std::pair<std::string, Kind>>;  // lowered name -> ...
@@ -60,11 +63,16 @@ Keys savedKeys(Save&& save, const std::string& prefix = "") {
         std::string value = line.substr(eq + 1);
         value = trimmed(value.substr(0, value.find("//")));
         Kind kind = Kind::Text;
-        if (value == "true" || value == "false")
+        if (value == "true" || value == "false") {
             kind = Kind::Bool;
-        else if (!value.empty()) {
+        } else if (!value.empty()) {
             try {
-                if (!core::parseNumberList(value, "").empty()) kind = Kind::Numbers;
+                const auto v = core::parseNumberList(value, "");
+                const bool list = v.size() > 1 || value.find('[') != std::string::npos;
+                kind = list                                              ? Kind::Numbers
+                       : value.find_first_of(".eE") == std::string::npos ? Kind::Integer
+                                                                         : Kind::Number;
+                if (v.empty()) kind = Kind::Text;
             } catch (const std::invalid_argument&) {
             }
         }
@@ -73,28 +81,58 @@ Keys savedKeys(Save&& save, const std::string& prefix = "") {
     return keys;
 }
 
-/// Checks the keys of `section` against `known` (plus those `pattern` matches, as text).
+/// Keys known by a pattern (numbered ones, whose count is another key's value).
+struct Pattern {
+    std::regex re;
+    Kind kind;
+};
+
+/// Checks the keys of `section` against `known`, and those `patterns` match.
 void checkSection(const mrpt::config::CConfigFileBase& c, const std::string& section,
                   const Keys& known, const std::string& source,
-                  const std::regex* pattern = nullptr) {
+                  const std::vector<Pattern>& patterns = {}) {
     std::vector<std::string> keys;
     c.getAllKeys(section, keys);
     for (const auto& key : keys) {
         const std::string where = source + " [" + section + "] " + key;
-        const auto it = known.find(lowered(key));
-        if (it == known.end()) {
-            if (pattern && std::regex_match(key, *pattern)) continue;
-            std::string list;
-            for (const auto& [k, v] : known) list += (list.empty() ? "" : ", ") + v.first;
-            throw std::invalid_argument(source + " [" + section + "]: unknown key '" + key +
-                                        "' (MRPT's navigator knows: " + list + ")");
+        Kind kind = Kind::Text;
+        if (const auto it = known.find(lowered(key)); it != known.end()) {
+            kind = it->second.second;
+        } else {
+            const auto p = std::find_if(patterns.begin(), patterns.end(), [&](const Pattern& q) {
+                return std::regex_match(key, q.re);
+            });
+            if (p == patterns.end()) {
+                std::string list;
+                for (const auto& [k, v] : known) list += (list.empty() ? "" : ", ") + v.first;
+                throw std::invalid_argument(source + " [" + section + "]: unknown key '" + key +
+                                            "' (MRPT's navigator knows: " + list + ")");
+            }
+            kind = p->kind;
         }
         const std::string value = c.read_string(section, key, "");
-        if (it->second.second == Kind::Numbers) {
-            if (core::parseNumberList(value, where).empty())
-                throw std::invalid_argument(where + ": expected a number, got '" + value + "'");
-        } else if (it->second.second == Kind::Bool) {
-            (void)core::parseBool(value, where);
+        switch (kind) {
+            case Kind::Integer:
+                (void)core::parseInteger(value, where);
+                break;
+            case Kind::Number:
+                (void)core::parseNumber(value, where);
+                break;
+            case Kind::Numbers:
+                if (core::parseNumberList(value, where).empty())
+                    throw std::invalid_argument(where + ": expected numbers, got '" + value + "'");
+                break;
+            case Kind::Bool: {
+                // MRPT's read_bool knows true/false/yes/no and reads anything else as an
+                // integer ("on" as false): only what it reads as meant.
+                const std::string v = lowered(trimmed(value));
+                if (v != "true" && v != "false" && v != "yes" && v != "no" && v != "1" && v != "0")
+                    throw std::invalid_argument(where + ": expected true or false, got '" + value +
+                                                "'");
+                break;
+            }
+            case Kind::Text:
+                break;
         }
     }
 }
@@ -117,8 +155,13 @@ void checkMrptSections(const mrpt::config::CConfigFileBase& c, const std::string
                      save(CAbstractPTGBasedReactive::TAbstractPTGNavigatorParams()), source);
     if (c.sectionExists("CHolonomicND"))
         checkSection(c, "CHolonomicND", save(CHolonomicND::TOptions()), source);
-    if (c.sectionExists("CHolonomicFullEval"))
-        checkSection(c, "CHolonomicFullEval", save(CHolonomicFullEval::TOptions()), source);
+    if (c.sectionExists("CHolonomicFullEval"))  // as many PHASE<i>_* as PHASE_COUNT says
+        checkSection(c, "CHolonomicFullEval", save(CHolonomicFullEval::TOptions()), source,
+                     {{std::regex("PHASE[0-9]+_FACTORS", std::regex::icase), Kind::Numbers},
+                      {std::regex("PHASE[0-9]+_THRESHOLD", std::regex::icase), Kind::Number}});
+    if (c.sectionExists("CPointCloudFilterByDistance"))  // with enable_obstacle_filtering
+        checkSection(c, "CPointCloudFilterByDistance",
+                     save(mrpt::maps::CPointCloudFilterByDistance::TOptions()), source);
     if (c.sectionExists("CHolonomicVFF"))
         checkSection(c, "CHolonomicVFF", save(CHolonomicVFF::TOptions()), source);
     if (c.sectionExists("CMultiObjMotionOpt_Scalarization"))
@@ -126,11 +169,12 @@ void checkMrptSections(const mrpt::config::CConfigFileBase& c, const std::string
                      save(CMultiObjMotionOpt_Scalarization::TParams()), source);
     if (c.sectionExists("CMultiObjectiveMotionOptimizerBase")) {
         // Numbered lists of exprtk formulas: names only.
-        static const std::regex scores("score[0-9]+_(name|formula)|movement_assert[0-9]+",
-                                       std::regex::icase);
         Keys base;
         base["scores_to_normalize"] = {"scores_to_normalize", Kind::Text};
-        checkSection(c, "CMultiObjectiveMotionOptimizerBase", base, source, &scores);
+        checkSection(
+            c, "CMultiObjectiveMotionOptimizerBase", base, source,
+            {{std::regex("score[0-9]+_(name|formula)|movement_assert[0-9]+", std::regex::icase),
+              Kind::Text}});
     }
     // Ours: its own strict reader names the file.
     if (c.sectionExists("CHolonomicVFHPlus")) {
@@ -142,9 +186,11 @@ void checkMrptSections(const mrpt::config::CConfigFileBase& c, const std::string
     const std::string s = "CReactiveNavigationSystem";
     if (!c.sectionExists(s)) return;
     Keys known = save(CReactiveNavigationSystem::TReactiveNavigatorParams());
-    for (const char* k : {"PTG_COUNT", "RobotModel_shape2D_xs", "RobotModel_shape2D_ys",
-                          "RobotModel_circular_shape_radius"})
-        known[lowered(k)] = {k, Kind::Numbers};
+    for (const auto& [k, kind] : {std::pair{"PTG_COUNT", Kind::Integer},
+                                  {"RobotModel_shape2D_xs", Kind::Numbers},
+                                  {"RobotModel_shape2D_ys", Kind::Numbers},
+                                  {"RobotModel_circular_shape_radius", Kind::Number}})
+        known[lowered(k)] = {k, kind};
     const int n = core::namingSource(source, [&] { return core::readInt(c, s, "PTG_COUNT", 0); });
     if (n < 1 || n > 32)
         throw std::invalid_argument(source + " [" + s + "] PTG_COUNT: must be 1..32, got " +
@@ -170,7 +216,9 @@ void checkMrptSections(const mrpt::config::CConfigFileBase& c, const std::string
         known.insert(ptg_known.begin(), ptg_known.end());
         known[lowered(prefix + "Type")] = {prefix + "Type", Kind::Text};
     }
-    checkSection(c, s, known, source);
+    // A PTG's own robot shape (the Navigator replaces it with RobotModel_shape2D_*).
+    checkSection(c, s, known, source,
+                 {{std::regex("PTG[0-9]+_shape_[xy][0-9]+", std::regex::icase), Kind::Number}});
     // Values MRPT asserts on only when the navigator starts (num_paths 0, resolution 0, ...).
     for (int i = 0; i < n; ++i) {
         const std::string prefix = "PTG" + std::to_string(i) + "_";

@@ -62,7 +62,8 @@ NavigatorOptions readNavigatorOptions(const mrpt::config::CConfigFileBase& c,
         {"navigator", "global_planner", "replan", "CAbstractNavigator", "CWaypointsNavigator",
          "CAbstractPTGBasedReactive", "CReactiveNavigationSystem", "CHolonomicVFHPlus",
          "CHolonomicND", "CHolonomicVFF", "CHolonomicFullEval",
-         "CMultiObjectiveMotionOptimizerBase", "CMultiObjMotionOpt_Scalarization"},
+         "CMultiObjectiveMotionOptimizerBase", "CMultiObjMotionOpt_Scalarization",
+         "CPointCloudFilterByDistance"},
         source);
     // MRPT's navigator needs these two (the PTGs and the robot); the Navigator checks again
     // for options made in code, where no file is known.
