@@ -46,9 +46,10 @@ std::optional<core::Frame> ReplayReader::next() {
     core::Frame f = frames_[order_[next_]];
     f.bgr = f.bgr.clone();  // consumers may modify their frame
     f.depth = f.depth.clone();
-    // Depth stamp offset is kept relative to the new colour stamp (depth_source names the
-    // original file, so depth-time compensation is disabled for replayed passes > 0).
-    if (stamps_[next_] != f.timestamp) f.depth_source = f.rgb_source;
+    // Passes after the first get new stamps and no depth stamp, so depth-time compensation
+    // is off for them (as it was when it read the stamp from the depth file's name, which
+    // the replay cannot change; the long-run figures in RESULTS.md were made so).
+    if (stamps_[next_] != f.timestamp) f.depth_timestamp.reset();
     f.timestamp = stamps_[next_];
     f.index = next_;
     ++next_;
