@@ -368,10 +368,11 @@ void runRenders(const std::vector<RenderJob>& renders, int jobs) {
             ++finished;
             if (rc != 0) {
                 if (failure.empty())
-                    failure = "devslam-synth failed for " + renders[i].what + " (exit " +
-                              std::to_string(WIFEXITED(rc) ? WEXITSTATUS(rc) : rc) + "):\n" +
-                              lastLines(renders[i].log, 5) + "(whole output: " + renders[i].log +
-                              ")";
+                    failure = "devslam-synth failed for " + renders[i].what + " (" +
+                              (WIFSIGNALED(rc) ? "killed by signal " + std::to_string(WTERMSIG(rc))
+                                               : "exit " + std::to_string(WEXITSTATUS(rc))) +
+                              "):\n" + lastLines(renders[i].log, 5) +
+                              "(whole output: " + renders[i].log + ")";
                 say("  render " + renders[i].what + " FAILED, see " + renders[i].log);
             } else {
                 say("  [" + std::to_string(finished) + "/" + std::to_string(renders.size()) +
@@ -452,7 +453,8 @@ int run(int argc, char** argv) {
         }
     }
     if (render_jobs == 0) render_jobs = b.render_jobs;
-    if (render_jobs == 0) render_jobs = int(std::max(1u, std::thread::hardware_concurrency()));
+    if (render_jobs == 0)  // each render holds a sequence's images in memory: at most 8
+        render_jobs = int(std::clamp(std::thread::hardware_concurrency(), 1u, 8u));
     runRenders(renders, render_jobs);
 
     // 2. SLAM runs.
@@ -498,8 +500,12 @@ int run(int argc, char** argv) {
                     f.dir = dir;
                     if (!f.ok) {
                         failed.push_back((dir / "log.txt").string());
-                        std::cerr << "  devslam-run failed (exit "
-                                  << (WIFEXITED(rc) ? WEXITSTATUS(rc) : rc) << "):\n"
+                        std::cerr << "  devslam-run failed ("
+                                  << (WIFSIGNALED(rc)
+                                          ? "killed by signal " + std::to_string(WTERMSIG(rc))
+                                      : rc == 0 ? std::string("no readable run.json")
+                                                : "exit " + std::to_string(WEXITSTATUS(rc)))
+                                  << "):\n"
                                   << lastLines((dir / "log.txt").string(), 3)
                                   << "  (whole output: " << (dir / "log.txt").string() << ")\n";
                     }

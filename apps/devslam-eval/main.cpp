@@ -84,7 +84,7 @@ int main(int argc, char** argv) {
             std::cerr << kUsage;
             return 2;
         }
-        if (!plot.empty() && (plot.size() < 4 || plot.compare(plot.size() - 4, 4, ".png") != 0))
+        if (!plot.empty() && !devslam::core::endsWithNoCase(plot, ".png"))
             throw std::invalid_argument("--plot '" + plot + "': the plot's name must end in .png");
         const auto gt = devslam::io::readTumTrajectory(pos[0]);
         auto est = devslam::io::readTumTrajectory(pos[1]);

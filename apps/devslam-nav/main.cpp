@@ -165,7 +165,7 @@ int main(int argc, char** argv) {
     }
     try {
         // Known before minutes of work: the picture's format (OpenCV picks it by the name).
-        if (!png.empty() && (png.size() < 4 || png.compare(png.size() - 4, 4, ".png") != 0))
+        if (!png.empty() && !devslam::core::endsWithNoCase(png, ".png"))
             throw std::invalid_argument("--png '" + png + "': the picture's name must end in .png");
         if (!map.empty()) return planOnSlamMap(map, from, to, config, png);
         devslam::nav::requireHolonomicMethod(method, "--method");
