@@ -423,6 +423,7 @@ int run(int argc, char** argv) {
             throw std::invalid_argument("unknown option '" + k + "'\n" + kUsage);
     }
     Bench b = loadBench(config);
+    if (!results.empty()) core::checkResultsSection(results, "bench");  // before hours of work
     if (repeats > 0) {  // for every sequence, also those with their own `repeats`
         b.repeats = repeats;
         for (auto& q : b.sequences) q.repeats = 0;

@@ -145,7 +145,14 @@ int main(int argc, char** argv) {
                 results = argv[++i];
             else if (i + 1 < argc && a == "--config")
                 filter_ini = argv[++i];
-            else {
+            else if (a == "-h" || a == "--help") {
+                std::cout << "usage: devslam-filter-bench [--threads N] [--frames N] "
+                             "[--config INI] [--results FILE|none]\n"
+                             "  the detectors and the dynamic-object filter on synthetic and "
+                             "shipped frames;\n  writes the 'detect' section of --results "
+                             "(default docs/RESULTS.md)\n";
+                return 0;
+            } else {
                 const bool known =
                     a == "--threads" || a == "--frames" || a == "--results" || a == "--config";
                 std::cerr << "devslam-filter-bench: "
@@ -166,6 +173,7 @@ int main(int argc, char** argv) {
         const auto filter_cfg = core::loadFilterConfig(filter_ini, &filter_source);
         core::namingSource(filter_source,
                            [&] { (void)dynamic::makeFilterFromConfig(*filter_cfg); });
+        if (results != "none") core::checkResultsSection(results, "detect");
         cv::setNumThreads(threads);
         std::ostringstream md;
         md << "## Person detection and dynamic-object filter (`devslam-filter-bench`)\n\n"

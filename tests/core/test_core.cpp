@@ -372,6 +372,14 @@ TEST(Results, SectionsAreReplacedInPlaceAndBrokenMarkersRefused) {
             << e.what();
     }
     EXPECT_EQ(read(), broken);
+    // The same checks, before a command's work, writing nothing.
+    EXPECT_THROW(checkResultsSection(path, "a"), std::runtime_error);
+    EXPECT_NO_THROW(checkResultsSection(path, "b"));
+    EXPECT_THROW(checkResultsSection(path, "B c"), std::invalid_argument);
+    EXPECT_THROW(checkResultsSection(path + "_none/R.md", "b"), std::runtime_error);
+    EXPECT_THROW(checkResultsSection(std::filesystem::path(path).parent_path().string(), "b"),
+                 std::runtime_error);
+    EXPECT_EQ(read(), broken);
     std::filesystem::remove(path);
 }
 

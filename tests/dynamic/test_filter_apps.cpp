@@ -136,4 +136,12 @@ TEST(DevslamFilterBench, BadConfigStopsItBeforeAnyWork) {
     EXPECT_EQ(r.rc, 2) << r.out;
     EXPECT_NE(r.out.find("devslam-filter-bench: --threads needs a value"), std::string::npos)
         << r.out;
+    // A results file whose markers are broken is found before the detectors' work.
+    std::ofstream(results) << "# Results\n<!-- END detect -->\n";
+    r = runApp("devslam-filter-bench", "--results " + results);
+    EXPECT_EQ(r.rc, 1) << r.out;
+    EXPECT_NE(r.out.find("section 'detect' needs"), std::string::npos) << r.out;
+    r = runApp("devslam-filter-bench", "--help");
+    EXPECT_EQ(r.rc, 0) << r.out;
+    EXPECT_NE(r.out.find("usage: devslam-filter-bench"), std::string::npos) << r.out;
 }

@@ -2,8 +2,11 @@
 
 #include <opencv2/core/utility.hpp>
 
+#include <cerrno>
 #include <chrono>
+#include <cstring>
 #include <ctime>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -11,11 +14,16 @@
 
 namespace devslam::core {
 
-void replaceResultsSection(const std::string& path, const std::string& name,
-                           const std::string& markdown) {
+namespace {
+/// The results file's text with `name`'s block replaced by (or appended as) `block`;
+/// throws as replaceResultsSection says, before anything is written.
+std::string withSection(const std::string& path, const std::string& name,
+                        const std::string& markdown) {
     if (name.empty() ||
         name.find_first_not_of("abcdefghijklmnopqrstuvwxyz0123456789_-") != std::string::npos)
         throw std::invalid_argument("results section name '" + name + "' must match [a-z0-9_-]+");
+    if (std::filesystem::is_directory(path))
+        throw std::runtime_error("results file '" + path + "' is a folder");
     std::string text;
     {
         std::ifstream in(path);
@@ -46,9 +54,26 @@ void replaceResultsSection(const std::string& path, const std::string& name,
         if (!text.empty() && text.back() != '\n') text += '\n';
         text += "\n" + block + "\n";
     }
+    return text;
+}
+}  // namespace
+
+void checkResultsSection(const std::string& path, const std::string& name) {
+    (void)withSection(path, name, "");
+    const auto folder = std::filesystem::absolute(path).parent_path();
+    if (!std::filesystem::is_directory(folder))
+        throw std::runtime_error("results file '" + path + "': no folder '" + folder.string() +
+                                 "'");
+}
+
+void replaceResultsSection(const std::string& path, const std::string& name,
+                           const std::string& markdown) {
+    const std::string text = withSection(path, name, markdown);
     std::ofstream out(path, std::ios::trunc);
     out << text;
-    if (!out) throw std::runtime_error("cannot write results file '" + path + "'");
+    if (!out)
+        throw std::runtime_error("cannot write results file '" + path +
+                                 "': " + std::strerror(errno));
 }
 
 std::string measuredOnLine() {

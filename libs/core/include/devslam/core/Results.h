@@ -18,6 +18,10 @@ namespace devslam::core {
 void replaceResultsSection(const std::string& path, const std::string& name,
                            const std::string& markdown);
 
+/// What replaceResultsSection would throw for `path` and `name`, found before a command's
+/// work (a bad name, broken markers, a folder, a missing parent folder); writes nothing.
+void checkResultsSection(const std::string& path, const std::string& name);
+
 /// The current UTC date-time and host facts ("2026-11-21 06:00 UTC, 2 hardware threads,
 /// AMD EPYC (family 25 model 1), OpenCV SIMD AVX2") for a "measured on" line under each
 /// table. The SIMD level matters: OpenCV picks its kernels by it at run time, and the same
