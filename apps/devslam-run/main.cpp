@@ -54,6 +54,7 @@ struct Args {
     std::string section = "slam";   ///< RESULTS.md section written by --bench
     bool modes_only = false;        ///< --bench without the ablation and the long run
     bool allow_damaged = false;     ///< a damaged input: run on what is intact
+    bool out_given = false;         ///< --out was on the command line
 };
 
 Args parse(int argc, char** argv) {
@@ -70,9 +71,10 @@ Args parse(int argc, char** argv) {
             a.mode = value(i);
         else if (k == "--config")
             a.config = value(i);
-        else if (k == "--out")
+        else if (k == "--out") {
             a.out = value(i);
-        else if (k == "--results")
+            a.out_given = true;
+        } else if (k == "--results")
             a.results = value(i);
         else if (k == "--max-frames")
             a.max_frames = std::size_t(core::parseInteger(value(i), "--max-frames", 0));
@@ -99,6 +101,25 @@ Args parse(int argc, char** argv) {
     // Found now, not when the run's results are written.
     if (!a.out.empty() && std::filesystem::exists(a.out) && !std::filesystem::is_directory(a.out))
         throw std::invalid_argument("--out '" + a.out + "': a file is there, not a folder");
+    if (a.bench > 0) {
+        // Its table says it ran the INI as it is on every frame of the input, in all modes.
+        for (const auto& [given, option] : {std::pair{a.max_frames > 0, "--max-frames"},
+                                            {!a.sets.empty(), "--set"},
+                                            {!a.mode.empty(), "--mode"},
+                                            {a.replay > 0, "--replay"},
+                                            {a.out_given, "--out"},
+                                            {a.allow_damaged, "--allow-damaged"}})
+            if (given)
+                throw std::invalid_argument(std::string(option) +
+                                            " does not go with --bench, whose table is of the "
+                                            "INI as it is on the whole input, in every mode "
+                                            "(write another INI for other settings)");
+        // Its own sections only (another command's would be replaced), checked before the work.
+        if (a.section != "slam" && a.section != "slam-synthetic")
+            throw std::invalid_argument("--section '" + a.section +
+                                        "': devslam-run writes 'slam' or 'slam-synthetic'");
+        core::checkResultsSection(a.results, a.section);
+    }
     return a;
 }
 

@@ -122,6 +122,23 @@ TEST(DevslamRun, BadInputIsReported) {
     EXPECT_EQ(r.rc, 1);
     EXPECT_NE(r.out.find("needs the renderer's person truth"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("fr1_xyz_first37"), std::string::npos) << r.out;
+    // --bench's table is of the INI as it is, on the whole input, in its own section:
+    // options that change that, another command's section or a broken file are refused
+    // before the runs
+    r = run("--bench 1 --modes-only --max-frames 5 --results /dev/null/R.md");
+    EXPECT_EQ(r.rc, 1);
+    EXPECT_NE(r.out.find("--max-frames does not go with --bench"), std::string::npos) << r.out;
+    r = run("--bench 1 --modes-only --section nav --results /dev/null/R.md");
+    EXPECT_EQ(r.rc, 1);
+    EXPECT_NE(r.out.find("--section 'nav': devslam-run writes 'slam' or 'slam-synthetic'"),
+              std::string::npos)
+        << r.out;
+    std::ofstream(ini) << "# R\n<!-- END slam -->\n";
+    r = run("--bench 1 --modes-only --results " + ini.string());
+    EXPECT_EQ(r.rc, 1);
+    EXPECT_NE(r.out.find("section 'slam' needs"), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("bench none run"), std::string::npos) << "ran before refusing";
+    fs::remove(ini);
     // a replay makes new stamps, by which the truth is found: refused before any frame
     r = run("--mode truth --replay 2 --quiet --out ''");
     EXPECT_EQ(r.rc, 1);
