@@ -23,6 +23,7 @@
 #include <chrono>
 #include <cstdio>
 #include <ctime>
+#include <filesystem>
 #include <iostream>
 #include <map>
 #include <optional>
@@ -51,10 +52,25 @@ struct Args {
     std::optional<double> person_margin;  ///< [m] overrides [navigator] person_margin
 };
 
+/// "a,b": the --methods value that gives `methods`.
+std::string methodList(const std::vector<std::string>& methods) {
+    std::string s;
+    for (const auto& m : methods) s += (s.empty() ? "" : ",") + m;
+    return s;
+}
+
+/// The config as the results name it: relative to the repository when it lies in it.
+std::string shownConfig(const std::string& config) {
+    const auto rel = std::filesystem::absolute(config).lexically_normal().lexically_relative(
+        std::filesystem::path(DEVSLAM_SOURCE_DIR).lexically_normal());
+    return !rel.empty() && rel.begin()->string() != ".." ? rel.string() : config;
+}
+
 void usage() {
     std::cerr << "usage: devslam-nav-bench [options]\n"
                  "  --per-category N  worlds per category (default 50 -> 200 worlds)\n"
-                 "  --quick           smoke test: 2 worlds per category, RESULTS.md untouched\n"
+                 "  --quick           smoke test: 2 worlds per category, RESULTS.md untouched,\n"
+                 "                    pictures in out/devslam-nav-bench unless --png-dir\n"
                  "  --methods a,b     holonomic methods (default all four)\n"
                  "  --config FILE     navigation INI (default config_ini/nav_reactive.ini)\n"
                  "  --results FILE    RESULTS.md to update (default docs/RESULTS.md)\n"
@@ -161,7 +177,7 @@ void writeChart(const std::string& path, const std::vector<devslam::sim::Categor
 
 int main(int argc, char** argv) {
     Args a;
-    bool results_given = false;
+    bool results_given = false, per_category_given = false, png_dir_given = false;
     try {
         for (int i = 1; i < argc; i++) {
             const std::string s = argv[i];
@@ -169,19 +185,21 @@ int main(int argc, char** argv) {
                 if (i + 1 >= argc) throw std::invalid_argument("missing value after " + s);
                 return argv[++i];
             };
-            if (s == "--per-category")
+            if (s == "--per-category") {
                 a.per_category =
                     int(devslam::core::parseInteger(next(), "--per-category", 1, 100000));
-            else if (s == "--quick")
+                per_category_given = true;
+            } else if (s == "--quick")
                 a.quick = true;
             else if (s == "--config")
                 a.config = next();
             else if (s == "--results") {
                 a.results = next();
                 results_given = true;
-            } else if (s == "--png-dir")
+            } else if (s == "--png-dir") {
                 a.png_dir = next();
-            else if (s == "--person-margin")
+                png_dir_given = true;
+            } else if (s == "--person-margin")
                 a.person_margin = devslam::core::parseNumber(next(), "--person-margin");
             else if (s == "--seed")
                 a.seed = static_cast<uint32_t>(
@@ -193,6 +211,8 @@ int main(int argc, char** argv) {
                 while (std::getline(ss, m, ','))
                     if (!m.empty()) {
                         devslam::nav::requireHolonomicMethod(m, "--methods");
+                        if (std::find(a.methods.begin(), a.methods.end(), m) != a.methods.end())
+                            throw std::invalid_argument("--methods: " + m + " is listed twice");
                         a.methods.push_back(m);
                     }
             } else if (s == "-h" || s == "--help") {
@@ -201,7 +221,13 @@ int main(int argc, char** argv) {
             } else
                 throw std::invalid_argument("unknown option " + s);
         }
+        if (a.quick && per_category_given)
+            throw std::invalid_argument(
+                "--quick runs 2 worlds per category: not with "
+                "--per-category");
         if (a.quick) a.per_category = 2;
+        // A smoke test leaves the committed pictures alone, as it leaves RESULTS.md.
+        if (a.quick && !png_dir_given) a.png_dir = "out/devslam-nav-bench";
         if (a.methods.empty()) throw std::invalid_argument("--methods is empty");
     } catch (const std::exception& e) {
         std::cerr << "devslam-nav-bench: " << e.what() << "\n";
@@ -212,6 +238,8 @@ int main(int argc, char** argv) {
         a.results = std::string(DEVSLAM_SOURCE_DIR) + "/docs/RESULTS.md";
 
     try {
+        // A results file that cannot take the section is found before minutes of work.
+        if (!a.results.empty()) devslam::core::checkResultsSection(a.results, "nav");
         devslam::nav::registerNavClasses();
         const auto ini = devslam::core::loadIni(a.config);
         auto nav_opts = devslam::nav::NavigatorOptions::fromConfig(*ini, a.config);
@@ -221,7 +249,12 @@ int main(int argc, char** argv) {
             nav_opts.person_margin = *a.person_margin;
         }
         const auto cats = devslam::sim::allCategories();
-        mrpt::system::createDirectory(a.png_dir);
+        struct Picture {
+            devslam::sim::WorldSpec world;
+            devslam::sim::EpisodeResult run;
+            std::string method;
+        };
+        std::vector<Picture> pictures;  // the first world of each category, first method
 
         std::map<std::pair<int, std::string>, Tally> tally;
         std::map<std::string, std::vector<double>> step_ms;
@@ -264,11 +297,8 @@ int main(int argc, char** argv) {
                     if (!world.pedestrians.empty())
                         t.people_clearance.push_back(r.min_clearance_people);
                     for (double s : r.step_seconds) step_ms[m].push_back(1e3 * s);
-                    if (i == 0 && m == a.methods.front())
-                        devslam::sim::writeEpisodePng(
-                            world, r,
-                            a.png_dir + "/nav_bench_" + devslam::sim::toString(cats[c]) + ".png",
-                            world.name + " / " + m);
+                    if (i == 0 && m == a.methods.front())  // pictured after the results
+                        pictures.push_back({world, r, m});
                     bar.update(++done,
                                std::string(devslam::sim::toString(cats[c])) + " " + shortName(m));
                 }
@@ -286,7 +316,9 @@ int main(int argc, char** argv) {
            << "Command: `devslam-nav-bench --per-category " << a.per_category << " --seed "
            << a.seed
            << (a.person_margin ? " --person-margin " + num(*a.person_margin) : std::string())
-           << "` (config `config_ini/nav_reactive.ini`; people get " << num(nav_opts.person_margin)
+           << (a.methods.size() < 4 ? " --methods " + methodList(a.methods) : std::string())
+           << (a.quick ? " --quick" : "") << "` (config `" << shownConfig(a.config)
+           << "`; people get " << num(nav_opts.person_margin)
            << " m more room than walls, `person_margin`). " << a.per_category
            << " seeded random worlds "
            << "per category, " << a.per_category * cats.size()
@@ -347,11 +379,19 @@ int main(int argc, char** argv) {
            << num(wall, 0) << " s |\n\n"
            << devslam::core::measuredOnLine() << "\n";
         std::cout << md.str();
-        writeChart(a.png_dir + "/nav_bench_success.png", cats, a.methods, tally);
+        // The table first: pictures of a table that could not be written would not match it.
         if (!a.results.empty()) {
             devslam::core::replaceResultsSection(a.results, "nav", md.str());
             std::cerr << "devslam-nav-bench: updated section 'nav' of " << a.results << "\n";
         }
+        mrpt::system::createDirectory(a.png_dir);
+        for (std::size_t c = 0; c < pictures.size(); ++c)
+            devslam::sim::writeEpisodePng(
+                pictures[c].world, pictures[c].run,
+                a.png_dir + "/nav_bench_" + devslam::sim::toString(cats[c]) + ".png",
+                pictures[c].world.name + " / " + pictures[c].method);
+        writeChart(a.png_dir + "/nav_bench_success.png", cats, a.methods, tally);
+        std::cerr << "devslam-nav-bench: pictures in " << a.png_dir << "\n";
         return 0;
     } catch (const std::exception& e) {
         std::cerr << "devslam-nav-bench: " << e.what() << "\n";

@@ -188,5 +188,27 @@ TEST(IntegrationNav, AppsSmokeTest) {
     EXPECT_TRUE(mrpt::system::fileExists(out + "/RESULTS.md"));  // not the repository's
     const std::string md = mrpt::system::getFileSize(out + "/bench.md") > 0 ? "ok" : "";
     EXPECT_EQ(md, "ok");
+    // Refused before any run: a method twice, --quick with a count, a results file whose
+    // section markers are broken (no pictures are written for a table that is not).
+    const auto navBench = [&](const std::string& args) {
+        const std::string c = bin + "/devslam-nav-bench " + args + " --png-dir " + out +
+                              "/refused > " + out + "/o.txt 2>&1";
+        const int rc = WEXITSTATUS(std::system(c.c_str()));
+        std::ifstream in(out + "/o.txt");
+        return std::pair{rc, std::string(std::istreambuf_iterator<char>(in), {})};
+    };
+    std::tie(rc, text) = navBench("--quick --methods CHolonomicND,CHolonomicND");
+    EXPECT_EQ(rc, 2);
+    EXPECT_NE(text.find("--methods: CHolonomicND is listed twice"), std::string::npos) << text;
+    std::tie(rc, text) = navBench("--quick --per-category 50");
+    EXPECT_EQ(rc, 2);
+    EXPECT_NE(text.find("--quick runs 2 worlds per category"), std::string::npos) << text;
+    std::ofstream(out + "/broken.md") << "# R\n<!-- BEGIN nav -->\nold\n";
+    std::tie(rc, text) =
+        navBench("--per-category 1 --methods CHolonomicVFHPlus --results " + out + "/broken.md");
+    EXPECT_EQ(rc, 2);
+    EXPECT_NE(text.find("section 'nav' needs"), std::string::npos) << text;
+    EXPECT_EQ(text.find("nav-bench ["), std::string::npos) << "ran before refusing: " << text;
+    EXPECT_FALSE(mrpt::system::directoryExists(out + "/refused"));
     mrpt::system::deleteFilesInDirectory(out, true);
 }
