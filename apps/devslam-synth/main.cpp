@@ -158,16 +158,20 @@ int run(int argc, char** argv) {
         return 0;
     }
     const std::size_t n = frames > 0 ? std::min(frames, sc.n_frames) : sc.n_frames;
+    // A picture of the middle frame, for people; made first, as writeSequence writes
+    // render.txt last (a render stopped before it is made again by --if-changed).
+    const std::string prev = (fs::path(out_dir) / "preview.png").string();
+    {
+        render::SequenceRenderer r(sc);
+        const auto mid = r.render(n / 2);
+        fs::create_directories(out_dir);
+        if (!cv::imwrite(prev, preview(mid)))
+            throw std::runtime_error("cannot write '" + prev + "'");
+    }
     core::ProgressBar bar("render " + sc.name, n);
     const auto sum =
         render::writeSequence(sc, o, [&](std::size_t done, std::size_t) { bar.update(done); });
     bar.finish();
-
-    // A picture of the middle frame, for people.
-    render::SequenceRenderer r(sc);
-    const auto mid = r.render(n / 2);
-    const std::string prev = (fs::path(out_dir) / "preview.png").string();
-    cv::imwrite(prev, preview(mid));
 
     std::cout << "scenario " << sc.name << " -> " << out_dir << "\n"
               << "  frames " << sum.n_frames << " (" << sc.rate_hz << " Hz), intrinsics fx "

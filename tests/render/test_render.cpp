@@ -352,6 +352,23 @@ TEST(RenderSequence, RenderTxtTellsWhetherAFolderHoldsThisRender) {
                  std::runtime_error);
     EXPECT_FALSE(fs::exists(o.out_dir + "/render.txt"));
     EXPECT_FALSE(isRenderCurrent(sc, o));
+
+    // A rawlog is part of the render: asked for and not there (or into another file), the
+    // folder is not current; made with it, it is.
+    (void)writeSequence(sc, o);
+    WriteOptions with_rawlog = o;
+    with_rawlog.rawlog_path = tmp.str("seq.rawlog");
+    EXPECT_FALSE(isRenderCurrent(sc, with_rawlog)) << "no rawlog yet";
+    (void)writeSequence(sc, with_rawlog);
+    EXPECT_TRUE(isRenderCurrent(sc, with_rawlog));
+    EXPECT_FALSE(isRenderCurrent(sc, o)) << "rendered with a rawlog: another render.txt";
+    // Rendered again without labels: the labels of the render before are gone, not left to
+    // pass for this render's truth.
+    ASSERT_TRUE(fs::is_directory(o.out_dir + "/labels"));
+    WriteOptions no_labels = o;
+    no_labels.write_labels = false;
+    (void)writeSequence(sc, no_labels);
+    EXPECT_FALSE(fs::exists(o.out_dir + "/labels"));
 }
 
 // A seated person who moves a hand: the labelled pixels follow the hand (they differ between
@@ -752,6 +769,8 @@ TEST(Scenario, ShippedFilesLoadAndTyposAreReported) {
                   tmp.str("s.ini") + " [camera] width/height: must be 1..4096 [px]");
     expectMessage([&] { (void)loadScenario(base, {"scenario.n_frames=0"}); },
                   tmp.str("s.ini") + " [scenario] n_frames: must be >= 1");
+    expectMessage([&] { (void)loadScenario(base, {"person_9.speed=1"}); },  // a new person
+                  tmp.str("s.ini") + " [person_9] kind: missing");
     expectMessage([&] { (void)loadScenario(base, {"scenario.room=nowhere.ini"}); },
                   tmp.str("s.ini") + " [scenario] room: no such file '");
     // room_set: written over the room file's [room] and [box_*] settings, checked like them.

@@ -13,6 +13,14 @@
 namespace devslam::render {
 namespace fs = std::filesystem;
 namespace {
+/// A key that must be given: "[section] key: missing" (MRPT's own required read throws
+/// a stack trace that names neither).
+std::string requiredText(const mrpt::config::CConfigFileBase& c, const std::string& section,
+                         const std::string& key) {
+    const std::string v = c.read_string(section, key, "");
+    if (v.empty()) throw std::invalid_argument("[" + section + "] " + key + ": missing");
+    return v;
+}
 
 constexpr double kPi = 3.14159265358979323846;
 
@@ -119,9 +127,9 @@ void readRoom(const std::string& path, RoomSpec& room) {
                        "wall_blur", "must be 0..100 [px]");
     core::requireValue(room.floor_blur >= 0 && room.floor_blur <= 100, "room",
                        "floor_blur", "must be 0..100 [px]");
-    room.wall_textures = resolveImages(cfg->read_string(s, "wall_textures", "", true), base,
-                                       path + " [room] wall_textures");
-    room.floor_textures = resolveImages(cfg->read_string(s, "floor_textures", "", true), base,
+    room.wall_textures =
+        resolveImages(requiredText(*cfg, s, "wall_textures"), base, path + " [room] wall_textures");
+    room.floor_textures = resolveImages(requiredText(*cfg, s, "floor_textures"), base,
                                         path + " [room] floor_textures");
     for (const auto& b : sectionsWithPrefix(*cfg, "box_")) {
         core::requireKnownKeys(*cfg, b, {"base", "size", "yaw_deg", "textures", "blur"}, path);
@@ -132,8 +140,8 @@ void readRoom(const std::string& path, RoomSpec& room) {
         core::requireValue(box.size.minCoeff() > 0, b, "size",
                            "must be > 0 [m]");
         box.yaw = core::readDouble(*cfg, b, "yaw_deg", 0.0) * kPi / 180.0;
-        box.textures = resolveImages(cfg->read_string(b, "textures", "", true), base,
-                                     path + " [" + b + "] textures");
+        box.textures =
+            resolveImages(requiredText(*cfg, b, "textures"), base, path + " [" + b + "] textures");
         box.blur = core::readDouble(*cfg, b, "blur", 0.0);
         core::requireValue(box.blur >= 0 && box.blur <= 100, b, "blur",
                            "must be 0..100 [px]");
@@ -155,9 +163,9 @@ PersonSpec loadPerson(const mrpt::config::CConfigFileBase& cfg, const std::strin
     PersonSpec p;
     p.name = s;
     const std::string where = path + " [" + s + "]";
-    p.kind = parsePersonKind(cfg.read_string(s, "kind", "", true));
+    p.kind = parsePersonKind(requiredText(cfg, s, "kind"));
     const auto tex =
-        resolveImages(cfg.read_string(s, "texture", "", true), dirOf(path), where + " texture");
+        resolveImages(requiredText(cfg, s, "texture"), dirOf(path), where + " texture");
     if (tex.size() != 1) throw std::invalid_argument(where + " texture: need exactly one file");
     p.texture = tex.front();
     p.height = core::readDouble(cfg, s, "height", p.height);
@@ -171,9 +179,9 @@ PersonSpec loadPerson(const mrpt::config::CConfigFileBase& cfg, const std::strin
     p.gesture_deg = core::readDouble(cfg, s, "gesture_deg", p.gesture_deg);
     p.gesture_period = core::readDouble(cfg, s, "gesture_period", p.gesture_period);
     if (p.gestures()) {
-        const auto r = core::parseNumberList(cfg.read_string(s, "gesture_region", "", true),
+        const auto r = core::parseNumberList(requiredText(cfg, s, "gesture_region"),
                                              where + " gesture_region", 4);
-        const auto c = core::parseNumberList(cfg.read_string(s, "gesture_pivot", "", true),
+        const auto c = core::parseNumberList(requiredText(cfg, s, "gesture_pivot"),
                                              where + " gesture_pivot", 2);
         p.gesture_region = {r[0], r[1], r[2], r[3]};
         p.gesture_pivot = {c[0], c[1]};
@@ -186,7 +194,7 @@ PersonSpec loadPerson(const mrpt::config::CConfigFileBase& cfg, const std::strin
         core::requireValue(unit(c[0]) && unit(c[1]), s, "gesture_pivot",
                            "must be [across down], fractions of the photo in [0, 1]");
     }
-    const auto xy = core::parseNumberList(cfg.read_string(s, "path", "", true), where + " path");
+    const auto xy = core::parseNumberList(requiredText(cfg, s, "path"), where + " path");
     if (xy.size() < 2 || xy.size() % 2)
         throw std::invalid_argument(where + " path: need x y pairs");
     for (std::size_t i = 0; i < xy.size(); i += 2) p.path.emplace_back(xy[i], xy[i + 1]);
@@ -255,7 +263,7 @@ Scenario readScenario(const std::string& path, const std::vector<std::string>& o
             throw std::invalid_argument(path +
                                         " [camera]: the renderer is a pinhole, 'dist' must be 0");
 
-    std::string room = cfg->read_string(s, "room", "", true);
+    std::string room = requiredText(*cfg, s, "room");
     if (fs::path(room).is_relative())
         room = (fs::path(dirOf(path)) / room).lexically_normal().string();
     sc.room.overrides = core::overrideItems(cfg->read_string(s, "room_set", ""),

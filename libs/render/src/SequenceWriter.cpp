@@ -57,7 +57,10 @@ std::string renderSignature(const Scenario& sc, const WriteOptions& o) {
     for (const auto& file : {sc.source, sc.room.source})
         if (!file.empty()) s << "--- " << file << "\n" << iniSettings(file);
     for (const auto& item : sc.overrides) s << "set " << item << "\n";
-    // Texture contents are not hashed: their paths and sizes catch a replaced photo.
+    // Written in the same pass: a render without it, or into another file, is another render.
+    if (!o.rawlog_path.empty()) s << "rawlog " << fs::absolute(o.rawlog_path).string() << "\n";
+    // Texture contents are not hashed: their paths and sizes catch a replaced photo of
+    // another size, not one of the very same byte count.
     std::vector<std::string> textures = sc.room.wall_textures;
     textures.insert(textures.end(), sc.room.floor_textures.begin(), sc.room.floor_textures.end());
     for (const auto& b : sc.room.boxes)
@@ -73,6 +76,7 @@ std::string renderSignature(const Scenario& sc, const WriteOptions& o) {
 }
 
 bool isRenderCurrent(const Scenario& sc, const WriteOptions& o) {
+    if (!o.rawlog_path.empty() && !fs::is_regular_file(o.rawlog_path)) return false;
     std::ifstream f(signaturePath(o), std::ios::binary);
     if (!f) return false;
     std::ostringstream ss;
@@ -92,6 +96,8 @@ WriteSummary writeSequence(const Scenario& sc, const WriteOptions& o,
     std::unique_ptr<io::RawlogWriter> rawlog;
     if (!o.rawlog_path.empty())
         rawlog = std::make_unique<io::RawlogWriter>(o.rawlog_path, io::RawlogWriterOptions{});
+    // Another render's labels would pass for this one's truth (PersonTruth reads the folder).
+    fs::remove_all(fs::path(o.out_dir) / "labels");
     if (o.write_labels) fs::create_directories(fs::path(o.out_dir) / "labels");
 
     const std::string persons_path = (fs::path(o.out_dir) / "persons.txt").string();
