@@ -261,6 +261,10 @@ TEST(Config, RepeatedKeysAndSectionsAreRefused) {
     // A '\\' followed by blanks ends its line: MRPT joins only at a '\\' right at the end.
     EXPECT_EQ(error("[a]\nk = 1 \\  \nk = 2\n"),
               path + " line 3: [a] k repeated (first at line 2)");
+    // Lines MRPT would misread or drop without a word.
+    EXPECT_EQ(error("[navigator\nk = 1\n"), path + " line 1: '[navigator' has no ']'");
+    EXPECT_EQ(error("[a]\nk = 1\nspeed 3\n"),
+              path + " line 3: 'speed 3' is neither a [section] nor a key = value");
     // Not repeats: one key in two sections, comments, a value continued on the next lines.
     EXPECT_EQ(error("[a]\nk = 1\n# k = 2\n; k = 3\n// k = 4\n[b]\nk = 5\nf = \\\n"
                     "  var k := 1; \\\n  k = 2\n"),

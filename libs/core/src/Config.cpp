@@ -18,11 +18,13 @@ std::string lowered(std::string s) {
     return s;
 }
 
-/// MRPT keeps the last of a repeated key (its names ignore letter case) and merges a repeated
-/// section into the first, both without a word: a pasted line or section would silently
-/// replace a value the reader of the file sees first (a goal, an obstacle, a gain). Refused,
-/// naming both lines. Comment lines (#, ;, //) and lines without '=' are not keys.
-void refuseRepeats(const std::string& text, const std::string& path) {
+/// Lines MRPT reads otherwise than they look, without a word, refused naming the line:
+/// - a repeated key (names in any letter case; MRPT keeps the last) or section (MRPT merges
+///   it into the first): a pasted line or section would replace a value the reader of the
+///   file sees first (a goal, an obstacle, a gain); both lines are named;
+/// - a '[' without ']', and a line that is neither a section nor `key = value` (ignored).
+/// Comments (#, ;, //), @ directives and continued values ('\' at the end) are skipped.
+void refuseMisreadLines(const std::string& text, const std::string& path) {
     std::map<std::string, int> sections;
     std::map<std::pair<std::string, std::string>, int> keys;
     std::map<std::string, std::string> defines;  // MRPT's "@define NAME VALUE", used as ${NAME}
@@ -62,7 +64,9 @@ void refuseRepeats(const std::string& text, const std::string& path) {
         }
         if (line[a] == '[') {
             const auto b = line.find(']', a);
-            if (b == std::string::npos) continue;
+            if (b == std::string::npos)  // MRPT would make a section of it and the next line
+                throw std::invalid_argument(path + " line " + std::to_string(n) + ": '" +
+                                            trim(line) + "' has no ']'");
             section = trim(expand(line.substr(a + 1, b - a - 1)));  // MRPT trims the name
             const auto [at, fresh] = sections.emplace(lowered(section), n);
             if (!fresh)
@@ -72,7 +76,9 @@ void refuseRepeats(const std::string& text, const std::string& path) {
             continue;
         }
         const auto eq = line.find('=', a);
-        if (eq == std::string::npos || eq == a) continue;
+        if (eq == std::string::npos || eq == a)  // MRPT ignores such a line without a word
+            throw std::invalid_argument(path + " line " + std::to_string(n) + ": '" + trim(line) +
+                                        "' is neither a [section] nor a key = value");
         const std::string key = trim(expand(line.substr(a, eq - a)));
         if (key.empty() || key.find("${") != std::string::npos) continue;  // not resolvable here
         const auto [at, fresh] = keys.emplace(std::pair{lowered(section), lowered(key)}, n);
@@ -93,7 +99,7 @@ std::unique_ptr<mrpt::config::CConfigFileMemory> loadIni(const std::string& path
     std::stringstream ss;
     ss << in.rdbuf();
     if (in.bad()) throw std::runtime_error("cannot read INI file '" + path + "'");
-    refuseRepeats(ss.str(), path);
+    refuseMisreadLines(ss.str(), path);
     return std::make_unique<mrpt::config::CConfigFileMemory>(ss.str());
 }
 
