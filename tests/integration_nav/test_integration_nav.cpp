@@ -9,6 +9,8 @@
 
 #include <gtest/gtest.h>
 
+#include "Command.h"
+
 #include <mrpt/core/Clock.h>
 #include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/kinematics/CVehicleSimul_DiffDriven.h>
@@ -24,7 +26,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
-#include <tuple>
 
 namespace {
 const std::string kSrc = DEVSLAM_SOURCE_DIR;
@@ -159,26 +160,22 @@ TEST(IntegrationNav, AppsSmokeTest) {
     // An unknown method or a picture of another format: refused before the run. A picture
     // that cannot be written is an error after the result line, which is kept.
     const auto nav = [&](const std::string& args) {
-        const std::string c = bin + "/devslam-nav " + kSrc + "/sim_worlds/paper_fig6.ini " + args +
-                              " > " + out + "/o.txt 2>&1";
-        const int rc = WEXITSTATUS(std::system(c.c_str()));
-        std::ifstream in(out + "/o.txt");
-        return std::pair{rc, std::string(std::istreambuf_iterator<char>(in), {})};
+        return devslam::test::runApp("devslam-nav", kSrc + "/sim_worlds/paper_fig6.ini " + args);
     };
-    auto [rc, text] = nav("--method CHolonomicVHF");
-    EXPECT_EQ(rc, 2);
-    EXPECT_NE(text.find("--method: unknown holonomic method 'CHolonomicVHF'"), std::string::npos)
-        << text;
-    std::tie(rc, text) = nav("--png " + out + "/fig6.jpgx");
-    EXPECT_EQ(rc, 2);
-    EXPECT_NE(text.find("the picture's name must end in .png"), std::string::npos) << text;
-    EXPECT_EQ(text.find("result="), std::string::npos) << text;
-    std::tie(rc, text) = nav("--png /proc/devslam_no/fig6.png");
-    EXPECT_EQ(rc, 2);
-    EXPECT_NE(text.find("result=success"), std::string::npos) << text;
-    EXPECT_NE(text.find("--png '/proc/devslam_no/fig6.png': cannot write the picture"),
+    auto r = nav("--method CHolonomicVHF");
+    EXPECT_EQ(r.rc, 2);
+    EXPECT_NE(r.out.find("--method: unknown holonomic method 'CHolonomicVHF'"), std::string::npos)
+        << r.out;
+    r = nav("--png " + out + "/fig6.jpgx");
+    EXPECT_EQ(r.rc, 2);
+    EXPECT_NE(r.out.find("the picture's name must end in .png"), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("result="), std::string::npos) << r.out;
+    r = nav("--png /proc/devslam_no/fig6.png");
+    EXPECT_EQ(r.rc, 2);
+    EXPECT_NE(r.out.find("result=success"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("--png '/proc/devslam_no/fig6.png': cannot write the picture"),
               std::string::npos)
-        << text;
+        << r.out;
     // bench smoke test: one method, one world per category, RESULTS.md untouched
     const std::string bench =
         bin + "/devslam-nav-bench --per-category 1 --methods CHolonomicVFHPlus --png-dir " + out +
@@ -191,24 +188,19 @@ TEST(IntegrationNav, AppsSmokeTest) {
     // Refused before any run: a method twice, --quick with a count, a results file whose
     // section markers are broken (no pictures are written for a table that is not).
     const auto navBench = [&](const std::string& args) {
-        const std::string c = bin + "/devslam-nav-bench " + args + " --png-dir " + out +
-                              "/refused > " + out + "/o.txt 2>&1";
-        const int rc = WEXITSTATUS(std::system(c.c_str()));
-        std::ifstream in(out + "/o.txt");
-        return std::pair{rc, std::string(std::istreambuf_iterator<char>(in), {})};
+        return devslam::test::runApp("devslam-nav-bench", args + " --png-dir " + out + "/refused");
     };
-    std::tie(rc, text) = navBench("--quick --methods CHolonomicND,CHolonomicND");
-    EXPECT_EQ(rc, 2);
-    EXPECT_NE(text.find("--methods: CHolonomicND is listed twice"), std::string::npos) << text;
-    std::tie(rc, text) = navBench("--quick --per-category 50");
-    EXPECT_EQ(rc, 2);
-    EXPECT_NE(text.find("--quick runs 2 worlds per category"), std::string::npos) << text;
+    r = navBench("--quick --methods CHolonomicND,CHolonomicND");
+    EXPECT_EQ(r.rc, 2);
+    EXPECT_NE(r.out.find("--methods: CHolonomicND is listed twice"), std::string::npos) << r.out;
+    r = navBench("--quick --per-category 50");
+    EXPECT_EQ(r.rc, 2);
+    EXPECT_NE(r.out.find("--quick runs 2 worlds per category"), std::string::npos) << r.out;
     std::ofstream(out + "/broken.md") << "# R\n<!-- BEGIN nav -->\nold\n";
-    std::tie(rc, text) =
-        navBench("--per-category 1 --methods CHolonomicVFHPlus --results " + out + "/broken.md");
-    EXPECT_EQ(rc, 2);
-    EXPECT_NE(text.find("section 'nav' needs"), std::string::npos) << text;
-    EXPECT_EQ(text.find("nav-bench ["), std::string::npos) << "ran before refusing: " << text;
+    r = navBench("--per-category 1 --methods CHolonomicVFHPlus --results " + out + "/broken.md");
+    EXPECT_EQ(r.rc, 2);
+    EXPECT_NE(r.out.find("section 'nav' needs"), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("nav-bench ["), std::string::npos) << "ran before refusing: " << r.out;
     EXPECT_FALSE(mrpt::system::directoryExists(out + "/refused"));
     mrpt::system::deleteFilesInDirectory(out, true);
 }
