@@ -423,7 +423,6 @@ int run(int argc, char** argv) {
             throw std::invalid_argument("unknown option '" + k + "'\n" + kUsage);
     }
     Bench b = loadBench(config);
-    if (!results.empty()) core::checkResultsSection(results, "bench");  // before hours of work
     if (repeats > 0) {  // for every sequence, also those with their own `repeats`
         b.repeats = repeats;
         for (auto& q : b.sequences) q.repeats = 0;
@@ -431,6 +430,8 @@ int run(int argc, char** argv) {
     if (max_frames > 0) b.max_frames = max_frames;
     if (!out_override.empty()) b.out_dir = out_override;
     fs::create_directories(b.out_dir);
+    // Before hours of work (after the output folder is made: the results may go in it).
+    if (!results.empty()) core::checkResultsSection(results, "bench");
     const auto repeatsOf = [&](const Sequence& q) { return q.repeats > 0 ? q.repeats : b.repeats; };
 
     // 1. Synthetic sequences: render the missing ones, and those whose scenario, room, seed,

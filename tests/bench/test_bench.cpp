@@ -331,6 +331,14 @@ TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
         << log;
     EXPECT_EQ(readFile(tmp / "RESULTS.md"), "# Results\n");
     EXPECT_TRUE(fs::exists(tmp / "out/tables.md"));
+    // Results in the output folder the bench makes (docs/bench.md's "quick look").
+    std::ofstream(tmp / "bench.ini") << "[bench]\nmodes = none\nrepeats = 1\n[sequence_a]\n" << fr1;
+    const std::string fresh =
+        "'" + bin + "/devslam-bench' --config '" + (tmp / "bench.ini").string() +
+        "' --max-frames 2 --out '" + (tmp / "fresh").string() + "' --results '" +
+        (tmp / "fresh/R.md").string() + "' > '" + (tmp / "log.txt").string() + "' 2>&1";
+    EXPECT_EQ(std::system(fresh.c_str()), 0) << readFile(tmp / "log.txt");
+    EXPECT_NE(readFile(tmp / "fresh/R.md").find("<!-- BEGIN bench -->"), std::string::npos);
     fs::remove_all(tmp);
 }
 
