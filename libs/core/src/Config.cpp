@@ -13,11 +13,6 @@
 namespace devslam::core {
 
 namespace {
-std::string lowered(std::string s) {
-    for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    return s;
-}
-
 /// Lines MRPT reads otherwise than they look, without a word, refused naming the line:
 /// - a repeated key (names in any letter case; MRPT keeps the last) or section (MRPT merges
 ///   it into the first): a pasted line or section would replace a value the reader of the
@@ -34,11 +29,6 @@ void refuseMisreadLines(const std::string& text, const std::string& path) {
                  p = s.find("${" + name + "}"))
                 s.replace(p, name.size() + 3, value);
         return s;
-    };
-    const auto trim = [](const std::string& s) {
-        const auto a = s.find_first_not_of(" \t");
-        return a == std::string::npos ? std::string()
-                                      : s.substr(a, s.find_last_not_of(" \t") - a + 1);
     };
     std::istringstream in(text);
     std::string section;
@@ -59,16 +49,16 @@ void refuseMisreadLines(const std::string& text, const std::string& path) {
             std::string word, name, value;
             d >> word >> name;
             std::getline(d, value);
-            if (word == "@define" && !name.empty()) defines[name] = trim(value);
+            if (word == "@define" && !name.empty()) defines[name] = trimmed(value);
             continue;
         }
         if (line[a] == '[') {
             const auto b = line.find(']', a);
             if (b == std::string::npos)  // MRPT would make a section of it and the next line
                 throw std::invalid_argument(path + " line " + std::to_string(n) + ": '" +
-                                            trim(line) + "' has no ']'");
-            section = trim(expand(line.substr(a + 1, b - a - 1)));  // MRPT trims the name
-            const auto [at, fresh] = sections.emplace(lowered(section), n);
+                                            trimmed(line) + "' has no ']'");
+            section = trimmed(expand(line.substr(a + 1, b - a - 1)));  // MRPT trims the name
+            const auto [at, fresh] = sections.emplace(lowercase(section), n);
             if (!fresh)
                 throw std::invalid_argument(
                     path + " line " + std::to_string(n) + ": section " + line.substr(a, b - a + 1) +
@@ -77,11 +67,12 @@ void refuseMisreadLines(const std::string& text, const std::string& path) {
         }
         const auto eq = line.find('=', a);
         if (eq == std::string::npos || eq == a)  // MRPT ignores such a line without a word
-            throw std::invalid_argument(path + " line " + std::to_string(n) + ": '" + trim(line) +
+            throw std::invalid_argument(path + " line " + std::to_string(n) + ": '" +
+                                        trimmed(line) +
                                         "' is neither a [section] nor a key = value");
-        const std::string key = trim(expand(line.substr(a, eq - a)));
+        const std::string key = trimmed(expand(line.substr(a, eq - a)));
         if (key.empty() || key.find("${") != std::string::npos) continue;  // not resolvable here
-        const auto [at, fresh] = keys.emplace(std::pair{lowered(section), lowered(key)}, n);
+        const auto [at, fresh] = keys.emplace(std::pair{lowercase(section), lowercase(key)}, n);
         if (!fresh)
             throw std::invalid_argument(path + " line " + std::to_string(n) + ": [" + section +
                                         "] " + key + " repeated (first at line " +

@@ -9,14 +9,19 @@
 #include <stdexcept>
 
 namespace devslam::core {
-namespace {
-
-std::string trimmed(const std::string& s) {
+std::string trimmed(const std::string& text) {
     const auto blank = [](unsigned char c) { return std::isspace(c) != 0; };
-    const auto b = std::find_if_not(s.begin(), s.end(), blank);
-    const auto e = std::find_if_not(s.rbegin(), s.rend(), blank).base();
+    const auto b = std::find_if_not(text.begin(), text.end(), blank);
+    const auto e = std::find_if_not(text.rbegin(), text.rend(), blank).base();
     return b < e ? std::string(b, e) : std::string();
 }
+
+std::string lowercase(std::string text) {
+    for (char& c : text) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return text;
+}
+
+namespace {
 
 [[noreturn]] void fail(const std::string& what, const std::string& expected,
                        const std::string& text) {
@@ -69,9 +74,7 @@ long long parseInteger(const std::string& text, const std::string& what, long lo
 }
 
 bool parseBool(const std::string& text, const std::string& what) {
-    std::string t = trimmed(text);
-    std::transform(t.begin(), t.end(), t.begin(),
-                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    const std::string t = lowercase(trimmed(text));
     if (t == "true" || t == "yes" || t == "on" || t == "1") return true;
     if (t == "false" || t == "no" || t == "off" || t == "0") return false;
     fail(what, "true or false", text);
@@ -104,11 +107,8 @@ std::vector<double> parseNumberList(const std::string& text, const std::string& 
 }
 
 bool endsWithNoCase(const std::string& text, const std::string& suffix) {
-    if (text.size() < suffix.size()) return false;
-    return std::equal(suffix.begin(), suffix.end(), text.end() - suffix.size(), [](char a, char b) {
-        return std::tolower(static_cast<unsigned char>(a)) ==
-               std::tolower(static_cast<unsigned char>(b));
-    });
+    return text.size() >= suffix.size() &&
+           lowercase(text.substr(text.size() - suffix.size())) == lowercase(suffix);
 }
 
 }  // namespace devslam::core

@@ -3,6 +3,7 @@
 #include <devslam/detect/FastConvolution.h>
 
 #include <devslam/core/Config.h>
+#include <devslam/core/Parse.h>
 
 #include <mrpt/config/CConfigFileBase.h>
 #include <opencv2/imgproc.hpp>
@@ -36,13 +37,6 @@ std::vector<std::string> splitList(const std::string& s) {
         if (!item.empty()) out.push_back(item);
     }
     return out;
-}
-
-bool endsWith(const std::string& s, const std::string& suffix) {
-    if (s.size() < suffix.size()) return false;
-    std::string tail = s.substr(s.size() - suffix.size());
-    std::transform(tail.begin(), tail.end(), tail.begin(), ::tolower);
-    return tail == suffix;
 }
 
 std::vector<std::string> readNames(const std::string& path) {
@@ -134,7 +128,7 @@ void YoloDetector::Options::saveToConfig(mrpt::config::CConfigFileBase& c,
 
 YoloDetector::YoloDetector(const Options& opts) : opts_(opts) {
     const std::string model = resolveModelPath(opts_.model, "yolo model");
-    onnx_ = endsWith(model, ".onnx");
+    onnx_ = core::endsWithNoCase(model, ".onnx");
     names_ = readNames(resolveModelPath(opts_.names, "yolo class names"));
     for (const auto& c : opts_.classes) {
         const auto it = std::find(names_.begin(), names_.end(), c);

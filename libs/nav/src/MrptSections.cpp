@@ -27,24 +27,13 @@
 namespace devslam::nav {
 namespace {
 
-std::string lowered(std::string s) {
-    for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    return s;
-}
-
-std::string trimmed(const std::string& s) {
-    const auto a = s.find_first_not_of(" \t");
-    if (a == std::string::npos) return "";
-    return s.substr(a, s.find_last_not_of(" \t") - a + 1);
-}
-
 /// What MRPT's default of a key tells about its values: one integer ("3"), one number
 /// ("0.600000"), a list of numbers ("[0 2]", "1.00 0.50"), a boolean, or text (formulas,
 /// class names), which is not checked.
 enum class Kind { Integer, Number, Numbers, Bool, Text };
 
 /// Known keys of one section: name as MRPT writes it, and the kind of its value.
-using Keys = std::map<std::string, std::pair<std::string, Kind>>;  // lowered name -> ...
+using Keys = std::map<std::string, std::pair<std::string, Kind>>;  // lower-case name -> ...
 
 /// The keys `save` writes into a section (MRPT's saveToConfigFile pads names and appends a
 /// `// comment`, which its own getAllKeys keeps: the text is read line by line here).
@@ -59,9 +48,9 @@ Keys savedKeys(Save&& save, const std::string& prefix = "") {
     for (std::string line; std::getline(in, line);) {
         const auto eq = line.find('=');
         if (eq == std::string::npos || line[0] == '#' || line[0] == '[') continue;
-        const std::string name = prefix + trimmed(line.substr(0, eq));
+        const std::string name = prefix + core::trimmed(line.substr(0, eq));
         std::string value = line.substr(eq + 1);
-        value = trimmed(value.substr(0, value.find("//")));
+        value = core::trimmed(value.substr(0, value.find("//")));
         Kind kind = Kind::Text;
         if (value == "true" || value == "false") {
             kind = Kind::Bool;
@@ -76,7 +65,7 @@ Keys savedKeys(Save&& save, const std::string& prefix = "") {
             } catch (const std::invalid_argument&) {
             }
         }
-        if (!name.empty()) keys[lowered(name)] = {name, kind};
+        if (!name.empty()) keys[core::lowercase(name)] = {name, kind};
     }
     return keys;
 }
@@ -96,7 +85,7 @@ void checkSection(const mrpt::config::CConfigFileBase& c, const std::string& sec
     for (const auto& key : keys) {
         const std::string where = source + " [" + section + "] " + key;
         Kind kind = Kind::Text;
-        if (const auto it = known.find(lowered(key)); it != known.end()) {
+        if (const auto it = known.find(core::lowercase(key)); it != known.end()) {
             kind = it->second.second;
         } else {
             const auto p = std::find_if(patterns.begin(), patterns.end(), [&](const Pattern& q) {
@@ -125,7 +114,7 @@ void checkSection(const mrpt::config::CConfigFileBase& c, const std::string& sec
             case Kind::Bool: {
                 // MRPT's read_bool knows true/false/yes/no and reads anything else as an
                 // integer ("on" as false): only what it reads as meant.
-                const std::string v = lowered(trimmed(value));
+                const std::string v = core::lowercase(core::trimmed(value));
                 if (v != "true" && v != "false" && v != "yes" && v != "no" && v != "1" && v != "0")
                     throw std::invalid_argument(where + ": expected true or false, got '" + value +
                                                 "'");
@@ -190,7 +179,7 @@ void checkMrptSections(const mrpt::config::CConfigFileBase& c, const std::string
                                   {"RobotModel_shape2D_xs", Kind::Numbers},
                                   {"RobotModel_shape2D_ys", Kind::Numbers},
                                   {"RobotModel_circular_shape_radius", Kind::Number}})
-        known[lowered(k)] = {k, kind};
+        known[core::lowercase(k)] = {k, kind};
     const int n = core::namingSource(source, [&] { return core::readInt(c, s, "PTG_COUNT", 0); });
     if (n < 1 || n > 32)
         throw std::invalid_argument(source + " [" + s + "] PTG_COUNT: must be 1..32, got " +
@@ -214,7 +203,7 @@ void checkMrptSections(const mrpt::config::CConfigFileBase& c, const std::string
             },
             prefix);
         known.insert(ptg_known.begin(), ptg_known.end());
-        known[lowered(prefix + "Type")] = {prefix + "Type", Kind::Text};
+        known[core::lowercase(prefix + "Type")] = {prefix + "Type", Kind::Text};
     }
     // A PTG's own robot shape (the Navigator replaces it with RobotModel_shape2D_*).
     checkSection(c, s, known, source,

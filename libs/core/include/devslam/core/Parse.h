@@ -39,6 +39,12 @@ namespace devslam::core {
 [[nodiscard]] std::vector<double> parseNumberList(const std::string& text, const std::string& what,
                                                   std::size_t expected = 0);
 
+/// `text` without the blanks (std::isspace) at its ends.
+[[nodiscard]] std::string trimmed(const std::string& text);
+
+/// `text` in lower case (ASCII letters), for names read in any letter case.
+[[nodiscard]] std::string lowercase(std::string text);
+
 /// Whether `text` ends in `suffix`, letters compared in any case: a file name's extension
 /// (OpenCV picks an image's format by it, ".PNG" as ".png").
 [[nodiscard]] bool endsWithNoCase(const std::string& text, const std::string& suffix);
