@@ -224,7 +224,8 @@ void validateWorld(const WorldSpec& w) {
     if (!inside({w.robot.start.x, w.robot.start.y}))
         fail(src, "robot", "start_x", "start is outside the world bounds");
     if (!inside(w.goal)) fail(src, "goal", "x", "goal is outside the world bounds");
-    for (const auto& o : staticObstacles(w)) {
+    const auto statics = staticObstacles(w);
+    for (const auto& o : statics) {
         const double dg = distanceToObstacle(o, w.goal);
         if (dg <= 0) fail(src, "goal", "x", "the goal lies inside obstacle '" + o.name + "'");
         if (dg < w.robot.radius)
@@ -236,7 +237,6 @@ void validateWorld(const WorldSpec& w) {
             fail(src, "robot", "start_x",
                  "the robot starts inside or touching obstacle '" + o.name + "'");
     }
-    const auto statics = staticObstacles(w);
     const auto at = [](const mrpt::math::TPoint2D& q) {
         std::ostringstream m;
         m << "(" << q.x << ", " << q.y << ")";
