@@ -73,12 +73,16 @@ class FilterMask final : public MaskSource {
 #endif
 }  // namespace
 
-std::unique_ptr<MaskSource> makeMaskSource(const std::string& mode,
-                                           const mrpt::config::CConfigFileBase& cfg,
-                                           const std::string& input) {
+void requireMode(const std::string& mode) {
     if (mode != "none" && mode != "all_persons" && mode != "dynamic" && mode != "truth")
         throw std::invalid_argument("unknown mode '" + mode +
                                     "' (known: none, all_persons, dynamic, truth)");
+}
+
+std::unique_ptr<MaskSource> makeMaskSource(const std::string& mode,
+                                           const mrpt::config::CConfigFileBase& cfg,
+                                           const std::string& input) {
+    requireMode(mode);
     if (mode == "truth") {
 #ifdef DEVSLAM_HAVE_DYNAMIC
         // The whole section, as the other modes read it: a mistyped key is an error here too.

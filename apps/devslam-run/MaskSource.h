@@ -34,6 +34,10 @@ class MaskSource {
     [[nodiscard]] virtual std::string describe() const = 0;
 };
 
+/// Throws std::invalid_argument "unknown mode 'x' (known: none, all_persons, dynamic, truth)"
+/// unless `mode` is one makeMaskSource makes.
+void requireMode(const std::string& mode);
+
 /// mode: "none" | "all_persons" | "dynamic" | "truth". `cfg` holds [detector] and
 /// [dynamic_filter]. "truth" is a diagnostic: the renderer's walker pixels of `input` (a
 /// devslam-synth folder) dilated by [dynamic_filter] mask_margin, i.e. a perfect filter's

@@ -5,6 +5,7 @@
 //   devslam-run --input DIR|FILE.rawlog --mode none|all_persons|dynamic|truth
 //               --config config_ini/slam_tum_fr1.ini --out DIR
 //   devslam-run --bench 5                         # all modes x 5 runs -> docs/RESULTS.md
+#include "MaskSource.h"
 #include "Pipeline.h"
 #include "ReplayReader.h"
 
@@ -163,10 +164,12 @@ Loaded loadConfig(const Args& a, const std::vector<std::string>& extra_sets = {}
     l.async_filter = core::namingSource(
         l.config_source, [&] { return core::readBool(*l.cfg, "run", "async_filter", true); });
     l.mode = a.mode.empty() ? l.cfg->read_string("run", "mode", "dynamic") : a.mode;
-    if (l.mode != "none" && l.mode != "all_persons" && l.mode != "dynamic" && l.mode != "truth")
+    try {
+        run::requireMode(l.mode);
+    } catch (const std::invalid_argument& e) {
         throw std::invalid_argument((a.mode.empty() ? l.config_source + " [run] mode" : "--mode") +
-                                    ": unknown mode '" + l.mode +
-                                    "' (known: none, all_persons, dynamic, truth)");
+                                    ": " + e.what());
+    }
     // [run] filter_config / filter_overrides: the filter's INI, with "section.key=value ..."
     // overrides (so a SLAM config can pick e.g. the detection interval without copying it).
     l.filter_cfg = core::loadFilterIni(*l.cfg, a.config);
