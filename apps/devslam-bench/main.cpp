@@ -332,6 +332,12 @@ std::string lastLines(const std::string& path, std::size_t n) {
     return out;
 }
 
+/// How a child process ended, from std::system's status: "exit N" or "killed by signal N".
+std::string endedBy(int status) {
+    return WIFSIGNALED(status) ? "killed by signal " + std::to_string(WTERMSIG(status))
+                               : "exit " + std::to_string(WEXITSTATUS(status));
+}
+
 /// One devslam-synth call of the bench: its command line, the log its output goes to.
 struct RenderJob {
     std::string what;  ///< "walking_xyz seed 11", for messages
@@ -368,9 +374,7 @@ void runRenders(const std::vector<RenderJob>& renders, int jobs) {
             ++finished;
             if (rc != 0) {
                 if (failure.empty())
-                    failure = "devslam-synth failed for " + renders[i].what + " (" +
-                              (WIFSIGNALED(rc) ? "killed by signal " + std::to_string(WTERMSIG(rc))
-                                               : "exit " + std::to_string(WEXITSTATUS(rc))) +
+                    failure = "devslam-synth failed for " + renders[i].what + " (" + endedBy(rc) +
                               "):\n" + lastLines(renders[i].log, 5) +
                               "(whole output: " + renders[i].log + ")";
                 say("  render " + renders[i].what + " FAILED, see " + renders[i].log);
@@ -503,10 +507,7 @@ int run(int argc, char** argv) {
                     if (!f.ok) {
                         failed.push_back((dir / "log.txt").string());
                         std::cerr << "  devslam-run failed ("
-                                  << (WIFSIGNALED(rc)
-                                          ? "killed by signal " + std::to_string(WTERMSIG(rc))
-                                      : rc == 0 ? std::string("no readable run.json")
-                                                : "exit " + std::to_string(WEXITSTATUS(rc)))
+                                  << (rc == 0 ? std::string("no readable run.json") : endedBy(rc))
                                   << "):\n"
                                   << lastLines((dir / "log.txt").string(), 3)
                                   << "  (whole output: " << (dir / "log.txt").string() << ")\n";

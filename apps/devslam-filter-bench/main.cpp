@@ -34,6 +34,8 @@ using namespace devslam;
 
 namespace {
 const std::string kRoot = DEVSLAM_SOURCE_DIR;
+const char* kUsage =
+    "usage: devslam-filter-bench [--threads N] [--frames N] [--config INI] [--results FILE|none]\n";
 
 double msSince(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -146,9 +148,8 @@ int main(int argc, char** argv) {
             else if (i + 1 < argc && a == "--config")
                 filter_ini = argv[++i];
             else if (a == "-h" || a == "--help") {
-                std::cout << "usage: devslam-filter-bench [--threads N] [--frames N] "
-                             "[--config INI] [--results FILE|none]\n"
-                             "  the detectors and the dynamic-object filter on synthetic and "
+                std::cout << kUsage
+                          << "  the detectors and the dynamic-object filter on synthetic and "
                              "shipped frames;\n  writes the 'detect' section of --results "
                              "(default docs/RESULTS.md)\n";
                 return 0;
@@ -156,9 +157,8 @@ int main(int argc, char** argv) {
                 const bool known =
                     a == "--threads" || a == "--frames" || a == "--results" || a == "--config";
                 std::cerr << "devslam-filter-bench: "
-                          << (known ? a + " needs a value" : "unknown argument '" + a + "'")
-                          << "\nusage: devslam-filter-bench [--threads N] [--frames N] "
-                             "[--config INI] [--results FILE|none]\n";
+                          << (known ? a + " needs a value" : "unknown argument '" + a + "'") << "\n"
+                          << kUsage;
                 return 2;
             }
         }
