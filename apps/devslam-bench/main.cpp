@@ -27,6 +27,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <limits>
 #include <optional>
 
@@ -297,6 +298,9 @@ RunFigures readRun(const std::string& json_path) {
     f.static_masked = get("mask_truth", "static_masked");
     f.moving_instances = get("mask_truth", "moving_instances");
     f.static_instances = get("mask_truth", "static_instances");
+    // devslam-run writes 0 for a fraction of no instances; here it is undefined.
+    if (f.moving_instances == 0) f.moving_recall = f.moving_area_recall = NAN;
+    if (f.static_instances == 0) f.static_masked = NAN;
     // A run that stopped at a frame it could not read covers part of the input only.
     f.ok = js.find("\"read_error\": \"") == std::string::npos ||
            js.find("\"read_error\": \"\"") != std::string::npos;
@@ -477,6 +481,8 @@ int run(int argc, char** argv) {
                          ? std::size_t(repeatsOf(q)) * inputsOf(q, b.out_dir).size()
                          : 0;
     std::size_t done = 0, reused = 0;
+    // When the kept runs were made (their run.json files' times), for the RESULTS text.
+    std::optional<std::time_t> kept_from, kept_to;
     std::vector<std::string> failed;  // logs of the runs that failed
     for (const auto& q : b.sequences)
         for (const auto& m : b.modes)
@@ -501,6 +507,15 @@ int run(int argc, char** argv) {
                     const bool have = f.ok;  // a whole run made earlier: kept
                     const int rc = have ? 0 : std::system(cmd.c_str());
                     reused += have;
+                    if (have) {
+                        // file_time_type's clock is not system_clock before C++20.
+                        const auto written = std::chrono::system_clock::to_time_t(
+                            std::chrono::system_clock::now() +
+                            std::chrono::duration_cast<std::chrono::system_clock::duration>(
+                                fs::last_write_time(json) - fs::file_time_type::clock::now()));
+                        kept_from = std::min(kept_from.value_or(written), written);
+                        kept_to = std::max(kept_to.value_or(written), written);
+                    }
                     if (!have) f = rc == 0 ? readRun(json) : RunFigures{};
                     f.seed = in.seed;
                     f.dir = dir;
@@ -610,13 +625,23 @@ int run(int argc, char** argv) {
                 }
             }
             // none masks nothing and truth is the truth: no filter to score.
-            if (m == "none" || m == "truth" || std::isnan(med(v, &R::moving_recall))) continue;
-            const auto pct = [](double x) { return fmt(100 * x, 1) + " %"; };
-            t4 << "| " << q.name << " | " << m << " | " << pct(med(v, &R::moving_recall)) << " of "
-               << fmt(med(v, &R::moving_instances), 0) << " | "
-               << pct(med(v, &R::moving_area_recall)) << " | " << pct(med(v, &R::mask_precision))
-               << " | " << pct(med(v, &R::static_masked)) << " of "
-               << fmt(med(v, &R::static_instances), 0) << " |\n";
+            if (m == "none" || m == "truth" || std::isnan(med(v, &R::moving_instances))) continue;
+            const auto pct = [](double x) {
+                return std::isnan(x) ? std::string("n/a") : fmt(100 * x, 1) + " %";
+            };
+            // "x % of N" for N person-frames; a sequence without such people says so.
+            const auto ofInstances = [&](double RunFigures::*frac, double RunFigures::*count,
+                                         const char* none) {
+                const double n = med(v, count);
+                return n > 0 ? pct(med(v, frac)) + " of " + fmt(n, 0) : std::string(none);
+            };
+            const bool walkers = med(v, &R::moving_instances) > 0;
+            t4 << "| " << q.name << " | " << m << " | "
+               << ofInstances(&R::moving_recall, &R::moving_instances, "n/a (no walkers)") << " | "
+               << (walkers ? pct(med(v, &R::moving_area_recall)) : "n/a") << " | "
+               << pct(med(v, &R::mask_precision)) << " | "
+               << ofInstances(&R::static_masked, &R::static_instances, "n/a (no static people)")
+               << " |\n";
             c4 << q.name << "," << m << "," << fmt(med(v, &R::moving_recall), 4) << ","
                << fmt(med(v, &R::moving_area_recall), 4) << ","
                << fmt(med(v, &R::mask_precision), 4) << "," << fmt(med(v, &R::static_masked), 4)
@@ -738,7 +763,13 @@ int run(int argc, char** argv) {
        << " with `devslam-run`; the tables give medians over all runs of a sequence and mode. "
        << (reused ? std::to_string(reused) + " of " + std::to_string(total) +
                         " runs were kept from an earlier invocation that made them "
-                        "(`--reuse-runs`: their run.json, speed included, is from then). "
+                        "(`--reuse-runs`: their figures, speed included, are from their "
+                        "run.json files, written " +
+                        core::utcMinute(*kept_from) +
+                        (core::utcMinute(*kept_to) == core::utcMinute(*kept_from)
+                             ? std::string()
+                             : " to " + core::utcMinute(*kept_to)) +
+                        "). "
                   : std::string())
        << "Synthetic sequences are rendered by `devslam-synth` (exact ground truth; "
           "docs/render.md), each in the renders listed (`--seed`: the same scene and motion "

@@ -1,7 +1,7 @@
 // Two-frame smoke test of the whole devslam-bench command: renders a synthetic sequence in
-// two seeds, runs devslam-run in the three modes on both renders and on the shipped TUM
-// frames (plus the diagnostic truth mask on the synthetic one), scores the filter against
-// the person truth, and writes the tables and the RESULTS section.
+// two seeds and one without walkers, runs devslam-run in the three modes on the renders and
+// on the shipped TUM frames (plus the diagnostic truth mask on the synthetic ones), scores the
+// filter against the person truth, and writes the tables and the RESULTS section.
 #include "Targets.h"
 
 #include <gtest/gtest.h>
@@ -54,6 +54,8 @@ TEST(DevslamBench, TwoFrameSmokeRunOfTheWholeCommand) {
         << "/config_ini/slam_synthetic.ini\n"
            "[sequence_short]\nscenario = short_walking\nseeds = 5 6\n"
            "set = person_1.speed=0.5 person_2.sway_deg=1  person_2.path=[3.5 2.8]\n"
+           // Sitters only: its filter rows have no walkers to score.
+           "[sequence_sit]\nscenario = sitting_xyz\nseeds = 7\n"
            "[sequence_fr1]\npath = "
         << root << "/data/tum/fr1_xyz_first37\nslam_config = " << root
         << "/config_ini/slam_tum_fr1.ini\n"
@@ -91,16 +93,16 @@ TEST(DevslamBench, TwoFrameSmokeRunOfTheWholeCommand) {
     EXPECT_NE(render_txt.find("set person_2.path=[3.5 2.8]"), std::string::npos) << render_txt;
     EXPECT_NE(readFile(tmp / "out/synth/short_seed5/depth/1700000400.000000.png"),
               readFile(tmp / "out/synth/short_seed6/depth/1700000400.000000.png"));
-    // 4 modes on each render of the synthetic sequence, 3 on fr1 (no person truth for mode
+    // 4 modes on each render of the synthetic sequences, 3 on fr1 (no person truth for mode
     // truth), 1 repeat, every run succeeded.
     const std::string runs = readFile(tmp / "out/runs.csv");
-    EXPECT_EQ(countLines(runs), 1u + 8u + 3u) << runs;
+    EXPECT_EQ(countLines(runs), 1u + 8u + 4u + 3u) << runs;
     EXPECT_NE(runs.find("short,truth,5,0,"), std::string::npos) << runs;
     EXPECT_NE(runs.find("short,truth,6,0,"), std::string::npos) << runs;
     EXPECT_NE(runs.find("fr1,dynamic,,0,"), std::string::npos) << runs;
     EXPECT_EQ(runs.find("fr1,truth"), std::string::npos) << runs;
     const std::string ate = readFile(tmp / "out/table2_ate.csv");
-    EXPECT_EQ(countLines(ate), 1u + 7u);
+    EXPECT_EQ(countLines(ate), 1u + 4u + 4u + 3u);
     std::istringstream lines(ate);
     std::string line;
     std::getline(lines, line);  // header
@@ -109,17 +111,22 @@ TEST(DevslamBench, TwoFrameSmokeRunOfTheWholeCommand) {
             << line;
     for (const char* f : {"table1_rpe.csv", "table3_fps.csv", "filter_truth.csv", "tables.md"})
         EXPECT_TRUE(fs::exists(tmp / "out" / f)) << f;
-    EXPECT_EQ(countLines(readFile(tmp / "out/filter_truth.csv")),
-              1u + 2u);  // short x {all_persons, dynamic}
+    const std::string filter = readFile(tmp / "out/filter_truth.csv");
+    EXPECT_EQ(countLines(filter), 1u + 2u + 2u) << filter;  // {short, sit} x {all_persons, dynamic}
+    // A sequence without walkers has no walker figures (not "0 % of 0").
+    EXPECT_NE(filter.find("\nsit,dynamic,n/a,n/a,"), std::string::npos) << filter;
     const std::string results = readFile(tmp / "RESULTS.md");
     EXPECT_NE(results.find("Table 1: RPE"), std::string::npos);
     EXPECT_NE(results.find("Table 2: ATE"), std::string::npos);
     EXPECT_NE(results.find("Table 3: speed"), std::string::npos);
     // Sequences in the order bench.ini gives them (MRPT alone would sort them).
-    EXPECT_NE(results.find("short 2 renders (seed 5 6) x 1 run, fr1 1 run per mode"),
+    EXPECT_NE(results.find("short 2 renders (seed 5 6) x 1 run, sit 1 render (seed 7) x 1 run, fr1 "
+                           "1 run per mode"),
               std::string::npos)
         << results;
     EXPECT_NE(results.find("| short | dynamic | "), std::string::npos);
+    EXPECT_NE(results.find("| sit | dynamic | n/a (no walkers) | n/a | "), std::string::npos)
+        << results;
     EXPECT_NE(results.find("ATE RMSE (m) per render"), std::string::npos);
     // The targets, checked on the medians: one that every run meets, one that none can
     // ("*": the worst sequence shown), and one without a figure (two frames give no ATE),
@@ -131,9 +138,9 @@ TEST(DevslamBench, TwoFrameSmokeRunOfTheWholeCommand) {
               std::string::npos)
         << results;
     // Each render counted on its own figure: both renders of short meet a_fps; b_fps is
-    // missed on both and on fr1 (one input).
+    // missed on both, on sit's render and on fr1 (one input).
     EXPECT_NE(results.find(" | yes | 2 of 2 |"), std::string::npos) << results;
-    EXPECT_NE(results.find(" | **no** | 0 of 3 |"), std::string::npos) << results;
+    EXPECT_NE(results.find(" | **no** | 0 of 4 |"), std::string::npos) << results;
     EXPECT_NE(results.find("1 of 3 targets met."), std::string::npos) << results;
     const std::string targets = readFile(tmp / "out/targets.csv");
     EXPECT_EQ(countLines(targets), 1u + 3u) << targets;
@@ -147,14 +154,14 @@ TEST(DevslamBench, TwoFrameSmokeRunOfTheWholeCommand) {
         return a.size() >= b.size() && a.compare(a.size() - b.size(), b.size(), b) == 0;
     };
     EXPECT_TRUE(endsWith(row("a_fps"), ",1,2,2,n/a,n/a,n/a")) << targets;  // met, 2 of 2 renders
-    EXPECT_TRUE(endsWith(row("b_fps"), ",0,0,3,n/a,n/a,n/a")) << targets;
+    EXPECT_TRUE(endsWith(row("b_fps"), ",0,0,4,n/a,n/a,n/a")) << targets;
     // No paired ratio: fps is no ratio, and fr1 is one input without an ATE here.
     EXPECT_EQ(row("c_ratio"), "c_ratio,fr1,dynamic,ate/none,<=,1e+09,n/a,,0,0,0,n/a,n/a,n/a")
         << targets;
     EXPECT_NE(results.find(" (seed 5), "), std::string::npos) << results;
     EXPECT_NE(results.find("Sequences: short is scenario `short_walking` with `devslam-synth "
                            "--set person_1.speed=0.5 --set person_2.sway_deg=1 --set "
-                           "'person_2.path=[3.5 2.8]'`."),
+                           "'person_2.path=[3.5 2.8]'`; sit is scenario `sitting_xyz`."),
               std::string::npos)
         << results;
 
@@ -171,7 +178,12 @@ TEST(DevslamBench, TwoFrameSmokeRunOfTheWholeCommand) {
                         .c_str()),
         0)
         << readFile(tmp / "log.txt");
-    EXPECT_NE(readFile(tmp / "RESULTS.md").find("10 of 11 runs were kept"), std::string::npos)
+    // Their figures are from when their run.json files were written: the text says when.
+    EXPECT_NE(readFile(tmp / "RESULTS.md")
+                  .find("14 of 15 runs were kept from an earlier invocation that made them "
+                        "(`--reuse-runs`: their figures, speed included, are from their "
+                        "run.json files, written 20"),
+              std::string::npos)
         << readFile(tmp / "RESULTS.md");
     EXPECT_NE(readFile(stopped).find(key), std::string::npos);
     fs::remove_all(tmp);

@@ -76,10 +76,17 @@ void replaceResultsSection(const std::string& path, const std::string& name,
                                  "': " + std::strerror(errno));
 }
 
-std::string measuredOnLine() {
-    const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
+std::string utcMinute(std::time_t t) {
     char date[64];
-    std::strftime(date, sizeof date, "%Y-%m-%d %H:%M UTC", std::gmtime(&now));
+    std::tm utc{};
+    gmtime_r(&t, &utc);
+    std::strftime(date, sizeof date, "%Y-%m-%d %H:%M UTC", &utc);
+    return date;
+}
+
+std::string measuredOnLine() {
+    const std::string date =
+        utcMinute(std::chrono::system_clock::to_time_t(std::chrono::system_clock::now()));
     std::string cpu = "unknown CPU", family, model;
     std::ifstream info("/proc/cpuinfo");
     const auto value = [](const std::string& line) {

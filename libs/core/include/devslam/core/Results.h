@@ -7,6 +7,7 @@
 /// Usage:
 ///   devslam::core::replaceResultsSection("docs/RESULTS.md", "detect", markdown);
 
+#include <ctime>
 #include <string>
 
 namespace devslam::core {
@@ -27,5 +28,8 @@ void checkResultsSection(const std::string& path, const std::string& name);
 /// table. The SIMD level matters: OpenCV picks its kernels by it at run time, and the same
 /// code gives other trajectories with other kernels (docs/bench.md, "Limits").
 [[nodiscard]] std::string measuredOnLine();
+
+/// `t` as "2026-11-27 10:32 UTC", the form measuredOnLine() gives its date in.
+[[nodiscard]] std::string utcMinute(std::time_t t);
 
 }  // namespace devslam::core
