@@ -264,6 +264,13 @@ TEST(NavConfig, MrptSectionsAreReadStrictly) {
               "x.ini [CReactiveNavigationSystem] PTG0_Type: unknown PTG class 'CPTG_Spiral'");
     EXPECT_EQ(errorOf("CReactiveNavigationSystem", "PTG0_num_paths", "0"),
               "x.ini [CReactiveNavigationSystem] PTG0_num_paths: must be > 0");
+    // MRPT's other differential-drive PTGs read the same keys as C (K included): accepted.
+    for (const char* type : {"CPTG_DiffDrive_CC", "CPTG_DiffDrive_CCS", "CPTG_DiffDrive_CS"})
+        EXPECT_EQ(errorOf("CReactiveNavigationSystem", "PTG2_Type", type), "") << type;
+    // A holonomic PTG has no collision grid: the diff-drive keys are not its own.
+    EXPECT_NE(errorOf("CReactiveNavigationSystem", "PTG0_Type", "CPTG_Holo_Blend")
+                  .find("x.ini [CReactiveNavigationSystem]: unknown key 'PTG0_K'"),
+              std::string::npos);
     // Formulas are text; the numbered score keys are known by their pattern.
     EXPECT_EQ(errorOf("CMultiObjectiveMotionOptimizerBase", "score7_name", "extra"), "");
     EXPECT_NE(errorOf("CMultiObjectiveMotionOptimizerBase", "scor7_name", "extra"), "");
