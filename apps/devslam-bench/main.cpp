@@ -11,6 +11,7 @@
 //                 [--render-jobs N]
 
 #include <devslam/core/Config.h>
+#include <devslam/core/Interrupt.h>
 #include <devslam/core/Parse.h>
 #include <devslam/core/Results.h>
 #include <devslam/core/Stats.h>
@@ -301,9 +302,13 @@ RunFigures readRun(const std::string& json_path) {
     // devslam-run writes 0 for a fraction of no instances; here it is undefined.
     if (f.moving_instances == 0) f.moving_recall = f.moving_area_recall = NAN;
     if (f.static_instances == 0) f.static_masked = NAN;
-    // A run that stopped at a frame it could not read covers part of the input only.
-    f.ok = js.find("\"read_error\": \"") == std::string::npos ||
-           js.find("\"read_error\": \"\"") != std::string::npos;
+    // A run that stopped at a frame it could not read, or was interrupted, covers part of
+    // the input only.
+    const auto empty = [&](const std::string& key) {
+        return js.find("\"" + key + "\": \"") == std::string::npos ||
+               js.find("\"" + key + "\": \"\"") != std::string::npos;
+    };
+    f.ok = empty("read_error") && empty("interrupted");
     return f;
 }
 
@@ -342,6 +347,22 @@ std::string endedBy(int status) {
                                : "exit " + std::to_string(WEXITSTATUS(status));
 }
 
+/// Ctrl-C (or SIGTERM) reached the bench or the program it was running: the bench stops,
+/// keeping the renders and runs made (`--reuse-runs` resumes), and leaves RESULTS alone.
+struct Interrupted : std::runtime_error {
+    int sig;
+    explicit Interrupted(int s, const std::string& what) : std::runtime_error(what), sig(s) {}
+};
+
+/// The signal that stops the bench after a child ended with `status`, 0 = none: the bench's
+/// own (a SIGTERM sent to it alone), or the child's (Ctrl-C reaches the child, whose
+/// std::system the bench waits in with SIGINT ignored).
+int stopAfter(int status) {
+    if (const int sig = core::stopSignal()) return sig;
+    if (!core::endedByStopSignal(status)) return 0;
+    return WIFSIGNALED(status) ? WTERMSIG(status) : WEXITSTATUS(status) - 128;
+}
+
 /// One devslam-synth call of the bench: its command line, the log its output goes to.
 struct RenderJob {
     std::string what;  ///< "walking_xyz seed 11", for messages
@@ -356,6 +377,7 @@ void runRenders(const std::vector<RenderJob>& renders, int jobs) {
     std::mutex mu;
     std::size_t next = 0, finished = 0;
     std::string failure;
+    int stop = 0;  // the signal that interrupted a render
     const auto say = [&](const std::string& line) {
         std::cout << line << "\n" << std::flush;  // under `mu`
     };
@@ -364,7 +386,7 @@ void runRenders(const std::vector<RenderJob>& renders, int jobs) {
             std::size_t i = 0;
             {
                 std::lock_guard<std::mutex> lock(mu);
-                if (next == renders.size() || !failure.empty()) return;
+                if (next == renders.size() || !failure.empty() || core::stopSignal()) return;
                 i = next++;
                 say("render (if changed) " + renders[i].what + ": " + renders[i].cmd + " > " +
                     quote(renders[i].log));
@@ -376,7 +398,11 @@ void runRenders(const std::vector<RenderJob>& renders, int jobs) {
                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
             std::lock_guard<std::mutex> lock(mu);
             ++finished;
-            if (rc != 0) {
+            if (const int sig = stopAfter(rc); sig && !stop) {
+                stop = sig;
+                failure = "interrupted (" + core::signalName(sig) + ") while rendering " +
+                          renders[i].what + "; the renders made are kept";
+            } else if (rc != 0) {
                 if (failure.empty())
                     failure = "devslam-synth failed for " + renders[i].what + " (" + endedBy(rc) +
                               "):\n" + lastLines(renders[i].log, 5) +
@@ -392,6 +418,11 @@ void runRenders(const std::vector<RenderJob>& renders, int jobs) {
     for (int k = 1; k < std::min<int>(jobs, int(renders.size())); ++k) pool.emplace_back(worker);
     worker();
     for (auto& t : pool) t.join();
+    if (!stop && core::stopSignal()) {  // between two renders
+        stop = core::stopSignal();
+        failure = "interrupted (" + core::signalName(stop) + "); the renders made are kept";
+    }
+    if (stop) throw Interrupted(stop, failure);
     if (!failure.empty()) throw std::runtime_error(failure);
 }
 
@@ -505,7 +536,12 @@ int run(int argc, char** argv) {
                     const std::string json = (dir / "run.json").string();
                     RunFigures f = reuse ? readRun(json) : RunFigures{};
                     const bool have = f.ok;  // a whole run made earlier: kept
-                    const int rc = have ? 0 : std::system(cmd.c_str());
+                    const int rc = have || core::stopSignal() ? 0 : std::system(cmd.c_str());
+                    if (const int sig = stopAfter(rc))
+                        throw Interrupted(sig, "interrupted (" + core::signalName(sig) +
+                                                   ") during run " + std::to_string(done) + " of " +
+                                                   std::to_string(total) +
+                                                   "; the runs that finished are kept");
                     reused += have;
                     if (have) {
                         // file_time_type's clock is not system_clock before C++20.
@@ -832,8 +868,14 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
+    core::installStopHandler("devslam-bench");
     try {
         return run(argc, argv);
+    } catch (const Interrupted& e) {
+        std::cerr << "devslam-bench: " << e.what()
+                  << " (the same command with --reuse-runs resumes); the results file was "
+                     "left as it was\n";
+        return core::stopExitCode(e.sig);
     } catch (const std::exception& e) {
         std::cerr << "devslam-bench: " << e.what() << "\n";
         return 1;

@@ -1,6 +1,7 @@
 // devslam-convert: TUM RGB-D folder <-> MRPT rawlog of CObservation3DRangeScan.
 // Depth keeps the source's raw 16-bit units and colour is stored losslessly, so a
 // TUM -> rawlog -> TUM round trip is bit-exact in both images.
+#include <devslam/core/Interrupt.h>
 #include <devslam/core/Parse.h>
 #include <devslam/core/Progress.h>
 #include <devslam/io/Rawlog.h>
@@ -53,6 +54,7 @@ void refuseOverwritingInput(const std::string& in, const std::string& out) {
 }  // namespace
 
 int main(int argc, char** argv) {
+    devslam::core::installStopHandler("devslam-convert");
     try {
         std::vector<std::string> pos;
         devslam::io::ReaderOptions ro;
@@ -101,8 +103,11 @@ int main(int argc, char** argv) {
         // --allow-damaged, is left out and the rest converted. The readers pass such a frame.
         std::string stopped;
         std::vector<std::string> undecodable;
+        int interrupted = 0;  // the signal that stopped the conversion
         const auto convertAll = [&](auto& out) {
             while (n < max_frames) {
+                // Ctrl-C (core/Interrupt.h) ends the conversion here, the output closed whole.
+                if ((interrupted = devslam::core::stopSignal())) break;
                 std::optional<devslam::core::Frame> f;
                 try {
                     f = reader->next();
@@ -142,6 +147,11 @@ int main(int argc, char** argv) {
                       << " frames before it (--allow-damaged leaves such frames out and "
                          "converts the rest)\n";
             return 1;
+        }
+        if (interrupted) {
+            std::cerr << "devslam-convert: interrupted (" << devslam::core::signalName(interrupted)
+                      << "); " << pos[1] << " holds the " << n << " frames converted before it\n";
+            return devslam::core::stopExitCode(interrupted);
         }
         return 0;
     } catch (const devslam::io::DamagedInput& e) {

@@ -3,6 +3,7 @@
 #include "MaskSource.h"
 
 #include <devslam/core/Config.h>
+#include <devslam/core/Interrupt.h>
 #include <devslam/core/Pose.h>
 #include <devslam/core/Progress.h>
 #include <devslam/core/Stats.h>
@@ -149,7 +150,12 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
         const double cpu_read = processCpuMs();
         std::optional<core::Frame> nxt;
         try {
-            if (within(n + 1)) nxt = reader.next();
+            // Ctrl-C (core/Interrupt.h): end here as at the end of the input, keeping the
+            // frames done.
+            if (within(n + 1) && core::stopSignal())
+                rep.interrupted = core::signalName(core::stopSignal());
+            else if (within(n + 1))
+                nxt = reader.next();
         } catch (const std::exception& e) {
             // A frame damaged in a way the reader cannot see at open (an image that does not
             // decode): stop here and keep what was computed, instead of losing the whole run.
@@ -358,6 +364,9 @@ std::string formatSummary(const RunReport& r) {
     if (!r.input_damage.empty()) o << "left out   : " << r.input_damage << "\n";
     if (!r.read_error.empty())
         o << "STOPPED    : after " << r.frames << " frames: " << r.read_error << "\n";
+    if (!r.interrupted.empty())
+        o << "STOPPED    : after " << r.frames << " frames: interrupted (" << r.interrupted
+          << ")\n";
     o << "mode       : " << r.mode << " (" << r.mask_source
       << (r.async_filter ? ", filter one frame ahead in a second thread" : "") << ")\n"
       << "camera     : " << r.camera << "\n"
@@ -464,11 +473,12 @@ std::string toJson(const RunReport& r) {
     };
     o << "{\n  \"input\": \"" << esc(r.input) << "\",\n  \"input_damage\": \""
       << esc(r.input_damage) << "\",\n  \"read_error\": \"" << esc(r.read_error)
-      << "\",\n  \"mode\": \"" << r.mode << "\",\n  \"mask_source\": \"" << esc(r.mask_source)
-      << "\",\n  \"frames\": " << r.frames << ",\n  \"keyframes\": " << r.keyframes
-      << ",\n  \"landmarks\": " << r.landmarks << ",\n  \"local_ba_runs\": " << r.ba_runs
-      << ",\n  \"local_ba_rejected\": " << r.ba_rejected << ",\n  \"loops_closed\": " << r.loops
-      << ",\n  \"lost_frames\": " << r.lost.size() << ",\n  \"lost_frame_indices\": [";
+      << "\",\n  \"interrupted\": \"" << r.interrupted << "\",\n  \"mode\": \"" << r.mode
+      << "\",\n  \"mask_source\": \"" << esc(r.mask_source) << "\",\n  \"frames\": " << r.frames
+      << ",\n  \"keyframes\": " << r.keyframes << ",\n  \"landmarks\": " << r.landmarks
+      << ",\n  \"local_ba_runs\": " << r.ba_runs << ",\n  \"local_ba_rejected\": " << r.ba_rejected
+      << ",\n  \"loops_closed\": " << r.loops << ",\n  \"lost_frames\": " << r.lost.size()
+      << ",\n  \"lost_frame_indices\": [";
     for (std::size_t i = 0; i < r.lost.size(); ++i) o << (i ? ", " : "") << r.lost[i];
     o << "],\n  \"median_fps\": " << num(r.median_fps, 2)
       << ",\n  \"median_cpu_ms\": " << num(r.median_cpu_ms, 3)

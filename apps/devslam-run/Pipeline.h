@@ -74,6 +74,9 @@ struct RunReport {
     /// A frame that failed to read during the run ("" = none): the run stopped there and its
     /// outputs hold the frames before it.
     std::string read_error;
+    /// The signal (core/Interrupt.h) that stopped the run early ("SIGINT"; "" = none): its
+    /// outputs hold the frames before it.
+    std::string interrupted;
     bool async_filter = false;
     std::size_t frames = 0, keyframes = 0, landmarks = 0, loops = 0;
     std::vector<std::size_t> lost;  ///< frame indices without a tracked pose

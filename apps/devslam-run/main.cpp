@@ -10,6 +10,7 @@
 #include "ReplayReader.h"
 
 #include <devslam/core/Config.h>
+#include <devslam/core/Interrupt.h>
 #include <devslam/core/Parse.h>
 #include <devslam/core/Results.h>
 #include <devslam/core/Stats.h>
@@ -219,12 +220,16 @@ int runOnce(const Args& a) {
     rc.score_masks = a.replay <= 0;
     const auto rep = run::runSequence(*reader, rc, *l.cfg, *l.filter_cfg);
     std::cout << run::formatSummary(rep);
+    const std::string kept = a.out.empty() ? std::string() : "; " + a.out + " holds their results";
     if (!rep.read_error.empty()) {
         std::cerr << "devslam-run: " << rep.read_error << "\ndevslam-run: stopped after "
-                  << rep.frames << " frames"
-                  << (a.out.empty() ? std::string() : "; " + a.out + " holds their results")
-                  << "\n";
+                  << rep.frames << " frames" << kept << "\n";
         return 1;
+    }
+    if (!rep.interrupted.empty()) {
+        std::cerr << "devslam-run: interrupted (" << rep.interrupted << ") after " << rep.frames
+                  << " frames" << kept << "\n";
+        return core::stopExitCode(core::stopSignal());
     }
     return 0;
 }
@@ -263,6 +268,11 @@ int runBench(const Args& a) {
             const auto rep = run::runSequence(*reader, rc, *l.cfg, *l.filter_cfg);
             if (!rep.read_error.empty())  // a bench over part of the input would mislead
                 throw std::runtime_error(rep.read_error);
+            if (!rep.interrupted.empty()) {
+                std::cerr << "devslam-run: interrupted (" << rep.interrupted
+                          << "); the bench wrote nothing\n";
+                return core::stopExitCode(core::stopSignal());
+            }
             if (rep.ate) {
                 ate.push_back(rep.ate->trans.rmse);
                 ate_max.push_back(rep.ate->trans.max);
@@ -359,6 +369,7 @@ int runBench(const Args& a) {
 }  // namespace
 
 int main(int argc, char** argv) {
+    core::installStopHandler("devslam-run");
     try {
         const Args a = parse(argc, argv);
         return a.bench > 0 ? runBench(a) : runOnce(a);

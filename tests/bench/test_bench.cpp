@@ -6,10 +6,12 @@
 
 #include <gtest/gtest.h>
 
+#include "Command.h"
 #include "Scratch.h"
 
 #include <algorithm>
 #include <cmath>
+#include <csignal>
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
@@ -258,6 +260,46 @@ TEST(BenchTargets, MediansDecideRendersAreCountedOneByOne) {
 }
 
 // A bad bench INI stops the bench before anything runs, naming the file, section and key.
+// Ctrl-C during a bench reaches the bench and the devslam-run it waits for: the run stops
+// (or ends first), the bench stops after it, keeping the finished runs and leaving the
+// results file as it was, and the same command with --reuse-runs resumes.
+TEST(DevslamBench, CtrlCStopsTheBenchAndReuseRunsResumes) {
+    const std::string root = DEVSLAM_SOURCE_DIR;
+    const fs::path tmp = devslam::test::scratchPath("devslam_bench_ctrl_c");
+    fs::remove_all(tmp);
+    fs::create_directories(tmp);
+    std::ofstream(tmp / "bench.ini")
+        << "[bench]\nrepeats = 4\nmodes = none\n"
+        << "[sequence_fr1]\npath = " << root << "/data/tum/fr1_xyz_first37\nslam_config = " << root
+        << "/config_ini/slam_tum_fr1.ini\n";
+    std::ofstream(tmp / "RESULTS.md") << "# Results\n";
+    const std::string args = "--config " + (tmp / "bench.ini").string() + " --max-frames 3 --out " +
+                             (tmp / "out").string() + " --results " + (tmp / "RESULTS.md").string();
+    const auto r = devslam::test::signalAppWhen("devslam-bench", args, "[2/4]", SIGINT,
+                                                (tmp / "log.txt").string());
+    EXPECT_EQ(r.rc, 130) << r.out;
+    EXPECT_NE(r.out.find("devslam-bench: interrupted (SIGINT) during run "), std::string::npos)
+        << r.out;
+    EXPECT_NE(r.out.find("the results file was left as it was"), std::string::npos) << r.out;
+    EXPECT_EQ(readFile(tmp / "RESULTS.md"), "# Results\n");
+    // The runs that finished; an interrupted one says so in its run.json and runs again.
+    int finished = 0;
+    for (int k = 0; k < 4; ++k) {
+        const std::string js =
+            readFile(tmp / "out/runs/fr1/none" / ("r" + std::to_string(k)) / "run.json");
+        finished += !js.empty() && js.find("\"interrupted\": \"\"") != std::string::npos;
+    }
+    EXPECT_GE(finished, 1);
+    EXPECT_LE(finished, 3);
+    const auto resumed = devslam::test::runApp("devslam-bench", args + " --reuse-runs");
+    EXPECT_EQ(resumed.rc, 0) << resumed.out;
+    EXPECT_NE(readFile(tmp / "RESULTS.md")
+                  .find(std::to_string(finished) + " of 4 runs were kept from an earlier"),
+              std::string::npos)
+        << readFile(tmp / "RESULTS.md");
+    fs::remove_all(tmp);
+}
+
 TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
     const std::string root = DEVSLAM_SOURCE_DIR, bin = DEVSLAM_BIN_DIR;
     const fs::path tmp =

@@ -4,10 +4,16 @@
 //   const auto r = devslam::test::runApp("devslam-nav", "--map m.gridmap --to 1,0");
 //   EXPECT_EQ(r.rc, 0) << r.out;   // r.out: stdout and stderr together
 #include <array>
+#include <chrono>
+#include <csignal>
 #include <cstdio>
+#include <fstream>
+#include <sstream>
 #include <string>
+#include <thread>
 
 #include <sys/wait.h>
+#include <unistd.h>
 
 namespace devslam::test {
 
@@ -26,6 +32,47 @@ inline CommandResult runApp(const std::string& app, const std::string& args) {
     while (fgets(buf.data(), buf.size(), p)) r.out += buf.data();
     const int st = pclose(p);
     r.rc = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+    return r;
+}
+
+/// Ctrl-C at a terminal, simulated: runs `<app> <args>` in a process group of its own with
+/// its output in `log`, and once the output holds `when` (or after `timeout_s`) sends `sig` to
+/// the whole group (the app and the programs it runs). Returns its exit status and output
+/// once it has ended.
+inline CommandResult signalAppWhen(const std::string& app, const std::string& args,
+                                   const std::string& when, int sig, const std::string& log,
+                                   double timeout_s = 120) {
+    const std::string cmd =
+        "exec " + std::string(DEVSLAM_BIN_DIR) + "/" + app + " " + args + " > '" + log + "' 2>&1";
+    const auto output = [&] {
+        std::ifstream in(log);
+        std::stringstream ss;
+        ss << in.rdbuf();
+        return ss.str();
+    };
+    CommandResult r;
+    const pid_t pid = fork();
+    if (pid < 0) return r;
+    if (pid == 0) {
+        setpgid(0, 0);
+        execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
+        _exit(127);
+    }
+    setpgid(pid, pid);  // also here, so the group exists before the signal
+    const auto t0 = std::chrono::steady_clock::now();
+    int st = 0;
+    bool ended = false;  // before the signal (then it is not sent)
+    while (output().find(when) == std::string::npos &&
+           std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() <
+               timeout_s &&
+           !(ended = waitpid(pid, &st, WNOHANG) == pid))
+        std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    if (!ended) {
+        kill(-pid, sig);
+        ended = waitpid(pid, &st, 0) == pid;
+    }
+    if (ended) r.rc = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+    r.out = output();
     return r;
 }
 

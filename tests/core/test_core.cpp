@@ -3,6 +3,7 @@
 #include <devslam/core/Config.h>
 #include <devslam/core/Frame.h>
 #include <devslam/core/GzFile.h>
+#include <devslam/core/Interrupt.h>
 #include <devslam/core/Parse.h>
 #include <devslam/core/Pose.h>
 #include <devslam/core/Results.h>
@@ -17,7 +18,8 @@
 #include <limits>
 
 #include <cmath>
-
+#include <csignal>
+#include <cstdlib>
 
 using namespace devslam::core;
 
@@ -492,4 +494,30 @@ TEST(Frame, ValidateNamesTheProblem) {
     EXPECT_THROW(validateFrame(f, "x"), std::runtime_error);
     f.depth = cv::Mat(480, 640, CV_16UC1);
     EXPECT_THROW(validateFrame(f, "x"), std::runtime_error);
+}
+
+// The first SIGINT/SIGTERM is recorded and the program goes on; a child's std::system status
+// tells a stop by signal (killed by it, or exited 128 + it after finishing its step).
+TEST(Interrupt, FirstSignalIsRecordedAndChildStatusesAreRead) {
+    // A signal ignored at start stays ignored (a shell's background job's SIGINT).
+    std::signal(SIGINT, SIG_IGN);
+    devslam::core::installStopHandler("test_core");
+    devslam::core::clearStopSignal();
+    ASSERT_EQ(std::raise(SIGINT), 0);
+    EXPECT_EQ(devslam::core::stopSignal(), 0);
+    ASSERT_EQ(std::raise(SIGTERM), 0);
+    EXPECT_EQ(devslam::core::stopSignal(), SIGTERM);  // still running
+    devslam::core::clearStopSignal();
+    EXPECT_EQ(devslam::core::signalName(SIGINT), "SIGINT");
+    EXPECT_EQ(devslam::core::signalName(SIGTERM), "SIGTERM");
+    EXPECT_EQ(devslam::core::stopExitCode(SIGINT), 130);
+    std::signal(SIGINT, SIG_DFL);  // the children below inherit it
+    using devslam::core::endedByStopSignal;
+    EXPECT_TRUE(endedByStopSignal(std::system("kill -INT $$")));
+    EXPECT_TRUE(endedByStopSignal(std::system("kill -TERM $$")));
+    EXPECT_TRUE(endedByStopSignal(std::system("exit 130")));
+    EXPECT_TRUE(endedByStopSignal(std::system("exit 143")));
+    EXPECT_FALSE(endedByStopSignal(std::system("exit 0")));
+    EXPECT_FALSE(endedByStopSignal(std::system("exit 1")));
+    EXPECT_FALSE(endedByStopSignal(std::system("kill -KILL $$")));
 }

@@ -8,6 +8,7 @@
 #include <mrpt/opengl/COpenGLScene.h>
 #include <mrpt/serialization/CArchive.h>
 
+#include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -203,6 +204,41 @@ TEST(DevslamRun, TruncatedRawlogRunsOnItsIntactPartWhenAsked) {
 
 // A frame whose image is there but does not decode is found only when it is read: the run
 // stops there, keeps (writes) the frames before it, names the file and exits with 1.
+// Ctrl-C stops a run after the frame it is on: it writes its results for the frames done, as
+// at the end of its input, says so, and exits 130 (128 + SIGINT).
+TEST(DevslamRun, CtrlCStopsTheRunAndKeepsTheFramesDone) {
+    const fs::path dir = devslam::test::scratchPath("devslam_run_ctrl_c");
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    // 37000 frames (minutes); the signal comes once the progress shows frames done.
+    const auto r = devslam::test::signalAppWhen(
+        "devslam-run",
+        "--input " + std::string(DEVSLAM_SOURCE_DIR) +
+            "/data/tum/fr1_xyz_first37 --replay 1000 --mode none --out " + (dir / "run").string(),
+        " fps", SIGINT, (dir / "log.txt").string());
+    EXPECT_EQ(r.rc, 130) << r.out;
+    const auto at = r.out.find("devslam-run: interrupted (SIGINT) after ");
+    ASSERT_NE(at, std::string::npos) << r.out;
+    const std::size_t frames = std::stoul(r.out.substr(at + 40));
+    EXPECT_GT(frames, 0u);
+    EXPECT_LT(frames, 37000u);
+    EXPECT_NE(r.out.find(" frames; " + (dir / "run").string() + " holds their results"),
+              std::string::npos)
+        << r.out;
+    EXPECT_NE(r.out.find("STOPPED    : after " + std::to_string(frames) +
+                         " frames: interrupted (SIGINT)"),
+              std::string::npos)
+        << r.out;
+    EXPECT_EQ(lines(dir / "run" / "trajectory.txt"), frames);
+    std::ifstream js(dir / "run" / "run.json");
+    std::stringstream ss;
+    ss << js.rdbuf();
+    EXPECT_NE(ss.str().find("\"interrupted\": \"SIGINT\""), std::string::npos)
+        << ss.str().substr(0, 400);
+    EXPECT_NE(ss.str().find("\"frames\": " + std::to_string(frames) + ","), std::string::npos);
+    fs::remove_all(dir);
+}
+
 TEST(DevslamRun, AnUndecodableFrameMidRunKeepsTheFramesBeforeIt) {
     const fs::path dir = devslam::test::scratchPath("devslam_run_undecodable");
     fs::remove_all(dir);
