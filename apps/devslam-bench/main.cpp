@@ -355,12 +355,26 @@ struct Interrupted : std::runtime_error {
 };
 
 /// The signal that stops the bench after a child ended with `status`, 0 = none: the bench's
-/// own (a SIGTERM sent to it alone), or the child's (Ctrl-C reaches the child, whose
-/// std::system the bench waits in with SIGINT ignored).
+/// own (a signal sent to it alone, or the terminal's Ctrl-C, which reaches both), or the
+/// child's.
 int stopAfter(int status) {
     if (const int sig = core::stopSignal()) return sig;
-    if (!core::endedByStopSignal(status)) return 0;
-    return WIFSIGNALED(status) ? WTERMSIG(status) : WEXITSTATUS(status) - 128;
+    return core::stopSignalOf(status);
+}
+
+/// Why the run.json in `dir` cannot stand for the run `cmd` would make now ("" = it can):
+/// the run was made by another command line (its command.txt: another input, config, mode or
+/// frame count), or before a file it was made from changed (`deps`: the config, the render).
+std::string staleRun(const fs::path& dir, const std::string& cmd,
+                     const std::vector<fs::path>& deps) {
+    std::ifstream in(dir / "command.txt");
+    std::string made_by;
+    std::getline(in, made_by);
+    if (made_by != cmd) return "made by another command (command.txt)";
+    const auto made = fs::last_write_time(dir / "run.json");
+    for (const auto& d : deps)
+        if (fs::exists(d) && fs::last_write_time(d) > made) return d.string() + " changed since";
+    return "";
 }
 
 /// One devslam-synth call of the bench: its command line, the log its output goes to.
@@ -393,15 +407,18 @@ void runRenders(const std::vector<RenderJob>& renders, int jobs) {
             }
             const auto t0 = std::chrono::steady_clock::now();
             const int rc =
-                std::system((renders[i].cmd + " > " + quote(renders[i].log) + " 2>&1").c_str());
+                core::runCommand(renders[i].cmd + " > " + quote(renders[i].log) + " 2>&1");
             const double s =
                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
             std::lock_guard<std::mutex> lock(mu);
             ++finished;
-            if (const int sig = stopAfter(rc); sig && !stop) {
-                stop = sig;
-                failure = "interrupted (" + core::signalName(sig) + ") while rendering " +
-                          renders[i].what + "; the renders made are kept";
+            if (const int sig = stopAfter(rc)) {
+                if (!stop) {
+                    stop = sig;
+                    failure = "interrupted (" + core::signalName(sig) + ") while rendering " +
+                              renders[i].what + "; the renders made are kept";
+                }
+                say("  render " + renders[i].what + " interrupted");
             } else if (rc != 0) {
                 if (failure.empty())
                     failure = "devslam-synth failed for " + renders[i].what + " (" + endedBy(rc) +
@@ -500,7 +517,8 @@ int run(int argc, char** argv) {
 
     // 2. SLAM runs.
     std::map<std::pair<std::string, std::string>, std::vector<RunFigures>> runs;
-    std::ofstream all_csv(fs::path(b.out_dir) / "runs.csv");
+    // Written when every run is done: an interrupted bench leaves the last one's.
+    std::ostringstream all_csv;
     all_csv
         << "sequence,mode,seed,repeat,ate_rmse_m,ate_mean_m,ate_median_m,rpe_t_rmse_m,rpe_t_mean_m,"
            "rpe_t_median_m,rpe_r_rmse_deg,rpe_r_mean_deg,rpe_r_median_deg,fps_median,fps_mean,"
@@ -535,8 +553,25 @@ int run(int argc, char** argv) {
                               << std::flush;
                     const std::string json = (dir / "run.json").string();
                     RunFigures f = reuse ? readRun(json) : RunFigures{};
-                    const bool have = f.ok;  // a whole run made earlier: kept
-                    const int rc = have || core::stopSignal() ? 0 : std::system(cmd.c_str());
+                    if (f.ok) {  // a whole run made earlier: kept if it is this one
+                        std::vector<fs::path> deps = {q.slam_config};
+                        for (const char* made_from : {"render.txt", "rgb.txt"})
+                            if (fs::exists(fs::path(in.path) / made_from))
+                                deps.push_back(fs::path(in.path) / made_from);
+                        if (fs::is_regular_file(in.path)) deps.push_back(in.path);
+                        if (const std::string why = staleRun(dir, cmd, deps); !why.empty()) {
+                            std::cout << "  not kept: its run.json was " << why << "\n";
+                            f = RunFigures{};
+                        }
+                    }
+                    const bool have = f.ok;
+                    int rc = 0;
+                    if (!have && !core::stopSignal()) {
+                        // A run killed before it wrote its own must not leave an older one.
+                        fs::remove(json);
+                        std::ofstream(dir / "command.txt") << cmd << "\n";
+                        rc = core::runCommand(cmd);
+                    }
                     if (const int sig = stopAfter(rc))
                         throw Interrupted(sig, "interrupted (" + core::signalName(sig) +
                                                    ") during run " + std::to_string(done) + " of " +
@@ -572,6 +607,8 @@ int run(int argc, char** argv) {
                             << fmt(f.rpe_r_median, 4) << "," << fmt(f.fps_median, 2) << ","
                             << fmt(f.fps_mean, 2) << "," << fmt(f.lost, 0) << "\n";
                 }
+
+    std::ofstream(fs::path(b.out_dir) / "runs.csv") << all_csv.str();
 
     // 3. Medians over the runs (renders x repeats); the median-ATE run's plot is kept.
     const auto med = [&](const std::vector<RunFigures>& v, double RunFigures::*field) {
@@ -869,15 +906,18 @@ int run(int argc, char** argv) {
 
 int main(int argc, char** argv) {
     core::installStopHandler("devslam-bench");
+    int rc = 1;
     try {
-        return run(argc, argv);
+        rc = run(argc, argv);
     } catch (const Interrupted& e) {
         std::cerr << "devslam-bench: " << e.what()
                   << " (the same command with --reuse-runs resumes); the results file was "
                      "left as it was\n";
-        return core::stopExitCode(e.sig);
+        // Ended by the signal, as a shell expects of a program stopped by Ctrl-C.
+        core::exitBySignal(e.sig);
     } catch (const std::exception& e) {
         std::cerr << "devslam-bench: " << e.what() << "\n";
-        return 1;
     }
+    if (const int sig = core::stopSignal()) core::exitBySignal(sig);
+    return rc;
 }

@@ -53,8 +53,8 @@ void refuseOverwritingInput(const std::string& in, const std::string& out) {
 
 }  // namespace
 
-int main(int argc, char** argv) {
-    devslam::core::installStopHandler("devslam-convert");
+namespace {
+int convert(int argc, char** argv) {
     try {
         std::vector<std::string> pos;
         devslam::io::ReaderOptions ro;
@@ -106,8 +106,6 @@ int main(int argc, char** argv) {
         int interrupted = 0;  // the signal that stopped the conversion
         const auto convertAll = [&](auto& out) {
             while (n < max_frames) {
-                // Ctrl-C (core/Interrupt.h) ends the conversion here, the output closed whole.
-                if ((interrupted = devslam::core::stopSignal())) break;
                 std::optional<devslam::core::Frame> f;
                 try {
                     f = reader->next();
@@ -120,6 +118,9 @@ int main(int argc, char** argv) {
                     continue;
                 }
                 if (!f) break;
+                // Ctrl-C (core/Interrupt.h) ends the conversion before this frame, the output
+                // closed whole; one after the last frame leaves it whole.
+                if ((interrupted = devslam::core::stopSignal())) break;
                 out.write(*f);
                 bar.update(++n);
             }
@@ -151,7 +152,7 @@ int main(int argc, char** argv) {
         if (interrupted) {
             std::cerr << "devslam-convert: interrupted (" << devslam::core::signalName(interrupted)
                       << "); " << pos[1] << " holds the " << n << " frames converted before it\n";
-            return devslam::core::stopExitCode(interrupted);
+            return 1;
         }
         return 0;
     } catch (const devslam::io::DamagedInput& e) {
@@ -164,4 +165,13 @@ int main(int argc, char** argv) {
         std::cerr << "devslam-convert: " << e.what() << "\n";
         return 1;
     }
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+    devslam::core::installStopHandler("devslam-convert");
+    const int rc = convert(argc, argv);
+    // After Ctrl-C, with the output closed: end by the signal, so that a script stops too.
+    if (const int sig = devslam::core::stopSignal()) devslam::core::exitBySignal(sig);
+    return rc;
 }

@@ -135,6 +135,12 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
     auto within = [&](std::size_t i) { return rc.max_frames == 0 || i < rc.max_frames; };
     std::optional<core::Frame> cur = reader.next();
     if (cur) cur->index = 0;
+    // A Ctrl-C before the first frame (while the detector loads): no frame done, nothing
+    // written (an earlier run's results in the output folder stay as they are).
+    if (core::stopSignal()) {
+        rep.interrupted = core::signalName(core::stopSignal());
+        return rep;
+    }
     if (rc.async_filter && cur) launch(*cur, std::nullopt);
     while (cur && within(n)) {
         const auto t_iter = Clock::now();
@@ -150,16 +156,17 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
         const double cpu_read = processCpuMs();
         std::optional<core::Frame> nxt;
         try {
-            // Ctrl-C (core/Interrupt.h): end here as at the end of the input, keeping the
-            // frames done.
-            if (within(n + 1) && core::stopSignal())
-                rep.interrupted = core::signalName(core::stopSignal());
-            else if (within(n + 1))
-                nxt = reader.next();
+            if (within(n + 1)) nxt = reader.next();
         } catch (const std::exception& e) {
             // A frame damaged in a way the reader cannot see at open (an image that does not
             // decode): stop here and keep what was computed, instead of losing the whole run.
             rep.read_error = e.what();
+        }
+        // Ctrl-C (core/Interrupt.h): end before the next frame as at the end of the input,
+        // keeping the frames done. A signal after the last frame leaves the run whole.
+        if (nxt && core::stopSignal()) {
+            rep.interrupted = core::signalName(core::stopSignal());
+            nxt.reset();
         }
         if (nxt) nxt->index = n + 1;
         fl.read_ms = msSince(t_read);
@@ -279,6 +286,9 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
     if (!rc.out_dir.empty()) {
         namespace fs = std::filesystem;
         fs::create_directories(rc.out_dir);
+        // run.json comes last and says the outputs are whole: an earlier run's goes first,
+        // so that a run killed while writing leaves none beside its new files.
+        fs::remove(fs::path(rc.out_dir) / "run.json");
         auto out = [&](const std::string& name) {
             std::string p = (fs::path(rc.out_dir) / name).string();
             rep.outputs.push_back(p);
@@ -351,8 +361,13 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
             }
         }
         rep.peak_rss_mb = peakRssMb();
-        std::ofstream js(out("run.json"));
-        js << toJson(rep);
+        const std::string json = out("run.json");
+        {
+            std::ofstream js(json + ".part");
+            js << toJson(rep);
+            if (!js.flush()) throw std::runtime_error("cannot write '" + json + ".part'");
+        }
+        fs::rename(json + ".part", json);  // whole or not there
     }
     rep.peak_rss_mb = peakRssMb();
     return rep;

@@ -219,6 +219,11 @@ int runOnce(const Args& a) {
     rc.progress = !a.quiet;
     rc.score_masks = a.replay <= 0;
     const auto rep = run::runSequence(*reader, rc, *l.cfg, *l.filter_cfg);
+    if (!rep.interrupted.empty() && rep.frames == 0) {
+        std::cerr << "devslam-run: interrupted (" << rep.interrupted
+                  << ") before the first frame; nothing written\n";
+        return 1;
+    }
     std::cout << run::formatSummary(rep);
     const std::string kept = a.out.empty() ? std::string() : "; " + a.out + " holds their results";
     if (!rep.read_error.empty()) {
@@ -229,8 +234,11 @@ int runOnce(const Args& a) {
     if (!rep.interrupted.empty()) {
         std::cerr << "devslam-run: interrupted (" << rep.interrupted << ") after " << rep.frames
                   << " frames" << kept << "\n";
-        return core::stopExitCode(core::stopSignal());
+        return 1;
     }
+    if (core::stopSignal())  // it came during the last frame
+        std::cerr << "devslam-run: " << core::signalName(core::stopSignal())
+                  << " came after the last frame; the run is whole\n";
     return 0;
 }
 
@@ -238,6 +246,19 @@ std::string fmt(double v, int p) {
     char b[32];
     std::snprintf(b, sizeof b, "%.*f", p, v);
     return b;
+}
+
+/// A run of `--bench` stopped early (Ctrl-C): the bench writes nothing.
+struct BenchInterrupted : std::runtime_error {
+    using std::runtime_error::runtime_error;
+};
+
+/// `rep` when it covers the whole input; a bench over part of it would mislead.
+run::RunReport requireWhole(run::RunReport rep) {
+    if (!rep.read_error.empty()) throw std::runtime_error(rep.read_error);
+    if (!rep.interrupted.empty())
+        throw BenchInterrupted("interrupted (" + rep.interrupted + "); the bench wrote nothing");
+    return rep;
 }
 
 int runBench(const Args& a) {
@@ -266,13 +287,7 @@ int runBench(const Args& a) {
             auto reader = io::openRgbd(a.input, l.reader);
             const auto rc = runConfig(a, l, mode);
             const auto rep = run::runSequence(*reader, rc, *l.cfg, *l.filter_cfg);
-            if (!rep.read_error.empty())  // a bench over part of the input would mislead
-                throw std::runtime_error(rep.read_error);
-            if (!rep.interrupted.empty()) {
-                std::cerr << "devslam-run: interrupted (" << rep.interrupted
-                          << "); the bench wrote nothing\n";
-                return core::stopExitCode(core::stopSignal());
-            }
+            requireWhole(rep);
             if (rep.ate) {
                 ate.push_back(rep.ate->trans.rmse);
                 ate_max.push_back(rep.ate->trans.max);
@@ -328,7 +343,7 @@ int runBench(const Args& a) {
         auto l = loadConfig(a, sets);
         auto reader = io::openRgbd(a.input, l.reader);
         const auto rc = runConfig(a, l, "none");
-        const auto rep = run::runSequence(*reader, rc, *l.cfg, *l.filter_cfg);
+        const auto rep = requireWhole(run::runSequence(*reader, rc, *l.cfg, *l.filter_cfg));
         abl << "| " << name << " | " << (rep.ate ? fmt(rep.ate->trans.rmse, 4) : "-") << " | "
             << rep.keyframes << " | " << fmt(rep.median_fps, 1) << " |\n";
         std::cerr << "ablation " << name << ": ATE "
@@ -344,7 +359,7 @@ int runBench(const Args& a) {
         auto rc = runConfig(a, l, "dynamic");
         rc.max_frames = 0;       // every replayed frame
         rc.score_masks = false;  // replayed: timestamps are not the truth's
-        const auto rep = run::runSequence(reader, rc, *l.cfg, *l.filter_cfg);
+        const auto rep = requireWhole(run::runSequence(reader, rc, *l.cfg, *l.filter_cfg));
         mem << "\nLong run (memory): the input replayed forward/backward " << kPasses
             << " times (`devslam-run --replay " << kPasses << " --mode dynamic`): " << rep.frames
             << " frames, " << rep.keyframes << " keyframes, " << rep.landmarks << " landmarks, "
@@ -366,10 +381,7 @@ int runBench(const Args& a) {
     return 0;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
-    core::installStopHandler("devslam-run");
+int runMain(int argc, char** argv) {
     try {
         const Args a = parse(argc, argv);
         return a.bench > 0 ? runBench(a) : runOnce(a);
@@ -383,4 +395,14 @@ int main(int argc, char** argv) {
         std::cerr << "devslam-run: " << e.what() << "\n";
         return 1;
     }
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+    core::installStopHandler("devslam-run");
+    const int rc = runMain(argc, argv);
+    // Stopped by Ctrl-C, after writing what was done: end by the signal, so that a shell
+    // script running this stops too.
+    if (const int sig = core::stopSignal()) core::exitBySignal(sig);
+    return rc;
 }

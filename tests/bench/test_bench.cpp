@@ -297,6 +297,24 @@ TEST(DevslamBench, CtrlCStopsTheBenchAndReuseRunsResumes) {
                   .find(std::to_string(finished) + " of 4 runs were kept from an earlier"),
               std::string::npos)
         << readFile(tmp / "RESULTS.md");
+
+    // A SIGINT sent to the bench alone lets the run finish, then stops the bench. The runs of
+    // another command (here another frame count) are not kept: they run again.
+    const std::string other = args.substr(0, args.find(" --max-frames 3")) + " --max-frames 2" +
+                              args.substr(args.find(" --max-frames 3") + 15) + " --reuse-runs";
+    const auto alone = devslam::test::signalAppWhen("devslam-bench", other, "[2/4]", SIGINT,
+                                                    (tmp / "log2.txt").string(), false);
+    EXPECT_EQ(alone.rc, 130) << alone.out;
+    EXPECT_NE(alone.out.find("not kept: its run.json was made by another command (command.txt)"),
+              std::string::npos)
+        << alone.out;
+    const auto stop = alone.out.find("devslam-bench: interrupted (SIGINT) during run ");
+    ASSERT_NE(stop, std::string::npos) << alone.out;
+    const int last = std::stoi(alone.out.substr(stop + 47));
+    const std::string js =
+        readFile(tmp / "out/runs/fr1/none" / ("r" + std::to_string(last - 1)) / "run.json");
+    EXPECT_NE(js.find("\"interrupted\": \"\""), std::string::npos) << js.substr(0, 300);
+    EXPECT_NE(js.find("\"frames\": 2,"), std::string::npos) << js.substr(0, 300);
     fs::remove_all(tmp);
 }
 

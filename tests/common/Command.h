@@ -37,11 +37,12 @@ inline CommandResult runApp(const std::string& app, const std::string& args) {
 
 /// Ctrl-C at a terminal, simulated: runs `<app> <args>` in a process group of its own with
 /// its output in `log`, and once the output holds `when` (or after `timeout_s`) sends `sig` to
-/// the whole group (the app and the programs it runs). Returns its exit status and output
-/// once it has ended.
+/// the whole group (the app and the programs it runs), or with `group` false to the app
+/// alone. Returns its output and its status as a shell gives it (128 + N when killed by
+/// signal N) once it has ended.
 inline CommandResult signalAppWhen(const std::string& app, const std::string& args,
                                    const std::string& when, int sig, const std::string& log,
-                                   double timeout_s = 120) {
+                                   bool group = true, double timeout_s = 120) {
     const std::string cmd =
         "exec " + std::string(DEVSLAM_BIN_DIR) + "/" + app + " " + args + " > '" + log + "' 2>&1";
     const auto output = [&] {
@@ -68,10 +69,10 @@ inline CommandResult signalAppWhen(const std::string& app, const std::string& ar
            !(ended = waitpid(pid, &st, WNOHANG) == pid))
         std::this_thread::sleep_for(std::chrono::milliseconds(50));
     if (!ended) {
-        kill(-pid, sig);
+        kill(group ? -pid : pid, sig);
         ended = waitpid(pid, &st, 0) == pid;
     }
-    if (ended) r.rc = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+    if (ended) r.rc = WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);
     r.out = output();
     return r;
 }

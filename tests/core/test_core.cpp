@@ -17,9 +17,11 @@
 #include <fstream>
 #include <limits>
 
+#include <sys/wait.h>
 #include <cmath>
 #include <csignal>
 #include <cstdlib>
+#include <iostream>
 
 using namespace devslam::core;
 
@@ -510,7 +512,6 @@ TEST(Interrupt, FirstSignalIsRecordedAndChildStatusesAreRead) {
     devslam::core::clearStopSignal();
     EXPECT_EQ(devslam::core::signalName(SIGINT), "SIGINT");
     EXPECT_EQ(devslam::core::signalName(SIGTERM), "SIGTERM");
-    EXPECT_EQ(devslam::core::stopExitCode(SIGINT), 130);
     std::signal(SIGINT, SIG_DFL);  // the children below inherit it
     using devslam::core::endedByStopSignal;
     EXPECT_TRUE(endedByStopSignal(std::system("kill -INT $$")));
@@ -520,4 +521,24 @@ TEST(Interrupt, FirstSignalIsRecordedAndChildStatusesAreRead) {
     EXPECT_FALSE(endedByStopSignal(std::system("exit 0")));
     EXPECT_FALSE(endedByStopSignal(std::system("exit 1")));
     EXPECT_FALSE(endedByStopSignal(std::system("kill -KILL $$")));
+    EXPECT_EQ(devslam::core::stopSignalOf(std::system("exit 130")), SIGINT);
+    // runCommand: the shell execs the program, so the program is the caller's child, which
+    // a signal to the child reaches (std::system's shell would die of SIGTERM at once and
+    // leave the program running); the program's status comes back.
+    EXPECT_EQ(devslam::core::runCommand("sh -c 'test $PPID -eq " + std::to_string(getpid()) +
+                                        " && exit 3' > /dev/null"),
+              3 << 8);
+    EXPECT_EQ(devslam::core::stopSignalOf(devslam::core::runCommand("sh -c 'kill -TERM $$'")),
+              SIGTERM);
+}
+
+// exitBySignal ends the program by the signal itself (a shell sees it killed, not exit 130),
+// after flushing what it printed.
+TEST(Interrupt, ExitBySignalEndsByTheSignal) {
+    EXPECT_EXIT(
+        {
+            std::cout << "flushed";
+            devslam::core::exitBySignal(SIGINT);
+        },
+        testing::KilledBySignal(SIGINT), "");
 }

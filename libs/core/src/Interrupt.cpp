@@ -2,18 +2,28 @@
 
 #include <sys/wait.h>
 #include <unistd.h>
+#include <cerrno>
 #include <csignal>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <iostream>
 
 namespace devslam::core {
 namespace {
 volatile std::sig_atomic_t g_signal = 0;
 const char* g_program = "";
 std::size_t g_program_len = 0;
+constexpr int kStopSignals[] = {SIGINT, SIGTERM};
 
 extern "C" void onStopSignal(int sig) {
-    g_signal = sig;
-    // Only async-signal-safe calls here: write(2), nothing that allocates or locks.
+    // Only async-signal-safe calls here (sigaction, write), nothing that allocates or locks.
+    // The next signal of either kind takes the default action: the program ends at once.
+    struct sigaction dfl {};
+    dfl.sa_handler = SIG_DFL;
+    sigemptyset(&dfl.sa_mask);
+    for (const int s : kStopSignals) sigaction(s, &dfl, nullptr);
+    if (g_signal == 0) g_signal = sig;
     constexpr char msg[] =
         ": stopping after the current step, keeping what is done (again to quit at once)\n";
     ssize_t ignored = ::write(STDERR_FILENO, "\n", 1);
@@ -29,10 +39,10 @@ void installStopHandler(const char* program) {
     struct sigaction sa {};
     sa.sa_handler = onStopSignal;
     sigemptyset(&sa.sa_mask);
-    // SA_RESETHAND: the second signal takes the default action (the program ends at once);
+    for (const int s : kStopSignals) sigaddset(&sa.sa_mask, s);
     // SA_RESTART: reads and writes in progress go on instead of failing with EINTR.
-    sa.sa_flags = SA_RESETHAND | SA_RESTART;
-    for (const int sig : {SIGINT, SIGTERM}) {
+    sa.sa_flags = SA_RESTART;
+    for (const int sig : kStopSignals) {
         // A signal ignored at start stays ignored: a shell starts background jobs with SIGINT
         // ignored, so that Ctrl-C at the terminal is not theirs.
         struct sigaction old {};
@@ -60,11 +70,46 @@ std::string signalName(int sig) {
     }
 }
 
+void exitBySignal(int sig) {
+    std::cout.flush();
+    std::cerr.flush();
+    std::fflush(nullptr);
+    std::signal(sig, SIG_DFL);
+    sigset_t set;
+    sigemptyset(&set);
+    sigaddset(&set, sig);
+    sigprocmask(SIG_UNBLOCK, &set, nullptr);
+    std::raise(sig);
+    std::_Exit(128 + sig);  // not reached for SIGINT and SIGTERM
+}
+
 bool endedByStopSignal(int status) {
-    if (status == -1) return false;
-    if (WIFSIGNALED(status)) return WTERMSIG(status) == SIGINT || WTERMSIG(status) == SIGTERM;
-    return WIFEXITED(status) && (WEXITSTATUS(status) == stopExitCode(SIGINT) ||
-                                 WEXITSTATUS(status) == stopExitCode(SIGTERM));
+    return stopSignalOf(status) != 0;
+}
+
+int stopSignalOf(int status) {
+    if (status == -1) return 0;
+    if (WIFSIGNALED(status))
+        return WTERMSIG(status) == SIGINT || WTERMSIG(status) == SIGTERM ? WTERMSIG(status) : 0;
+    if (!WIFEXITED(status)) return 0;
+    const int code = WEXITSTATUS(status);
+    return code == 128 + SIGINT || code == 128 + SIGTERM ? code - 128 : 0;
+}
+
+int runCommand(const std::string& cmd) {
+    const std::string line = "exec " + cmd;
+    const pid_t pid = fork();
+    if (pid < 0) return -1;
+    if (pid == 0) {
+        // The child starts with the dispositions the program started with: exec resets
+        // handlers to the default, and a signal ignored at start is still ignored.
+        execl("/bin/sh", "sh", "-c", line.c_str(), static_cast<char*>(nullptr));
+        _exit(127);
+    }
+    int status = 0;
+    while (waitpid(pid, &status, 0) < 0)
+        if (errno != EINTR) return -1;
+    return status;
 }
 
 }  // namespace devslam::core

@@ -3,13 +3,15 @@
 ///
 /// After installStopHandler(), the first SIGINT or SIGTERM only records the signal and says
 /// on stderr that the job is finishing; the job polls stopSignal() between its steps (a frame,
-/// a run) and ends as it would at the end of its input, writing its results, then exits with
-/// stopExitCode(). A second signal ends the program at once (the default action).
+/// a run) and ends as it would at the end of its input, writing its results. Then it ends by
+/// the signal itself (exitBySignal), so that a shell script running it stops too (bash goes on
+/// after a child that merely exits 130). A second signal, of either kind, ends the program at
+/// once (the default action).
 ///
 ///   core::installStopHandler("devslam-run");
 ///   while (more() && !core::stopSignal()) step();
 ///   ...write results...
-///   if (const int sig = core::stopSignal()) return core::stopExitCode(sig);
+///   if (const int sig = core::stopSignal()) core::exitBySignal(sig);
 
 #include <string>
 
@@ -18,18 +20,25 @@ namespace devslam::core {
 /// Installs the handler for SIGINT and SIGTERM, except for one ignored at start (a background
 /// job's SIGINT); `program` prefixes its message (kept as a pointer: pass a string literal).
 void installStopHandler(const char* program);
-/// 0 while no stop was asked for, else the signal's number.
+/// 0 while no stop was asked for, else the first signal's number.
 [[nodiscard]] int stopSignal();
 /// "SIGINT", "SIGTERM", or "signal N".
 [[nodiscard]] std::string signalName(int sig);
-/// The shell's exit status for a program ended by `sig`: 128 + sig (130 for Ctrl-C).
-[[nodiscard]] constexpr int stopExitCode(int sig) {
-    return 128 + sig;
-}
-/// Whether a child's std::system status says it was stopped by SIGINT or SIGTERM: killed by
-/// it, or exited with stopExitCode (a child that finished its step first).
-[[nodiscard]] bool endedByStopSignal(int system_status);
-/// For tests: forget a recorded signal (the handler stays installed as it is).
+/// Flushes stdout and stderr and ends the program by `sig` with its default action (the
+/// shell then reports 128 + sig: 130 for Ctrl-C). Call it after every file is closed.
+[[noreturn]] void exitBySignal(int sig);
+/// Whether a child's exit status (waitpid's, std::system's) says it was stopped by SIGINT or
+/// SIGTERM: killed by it, or exited with 128 + it.
+[[nodiscard]] bool endedByStopSignal(int status);
+/// The signal a status of endedByStopSignal names (0 when none).
+[[nodiscard]] int stopSignalOf(int status);
+/// Runs one command line through /bin/sh, which execs it (so a signal sent to it reaches the
+/// program, not a shell that would die at once and orphan it), and waits for it; returns its
+/// waitpid status, -1 when it could not start. Unlike std::system, the caller keeps its own
+/// SIGINT handling meanwhile: a Ctrl-C reaches both, and a SIGINT sent to the caller alone
+/// is its own to handle. `cmd` is one simple command, redirections allowed.
+[[nodiscard]] int runCommand(const std::string& cmd);
+/// For tests: forget a recorded signal (the handlers are left as they are).
 void clearStopSignal();
 
 }  // namespace devslam::core
