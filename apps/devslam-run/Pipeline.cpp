@@ -422,6 +422,8 @@ std::string formatSummary(const RunReport& r) {
         std::snprintf(line, sizeof line, "  %-9s %8.2f / %8.2f\n", names[k], med[k], mean[k]);
         o << line;
     }
+    o << "finalize   : " << num(r.finalize_ms, 1)
+      << " ms once at the end (final BA and frame refinement; not in the FPS)\n";
     o << "memory     : peak RSS " << num(r.peak_rss_mb, 1) << " MB, map " << num(r.map_mb, 2)
       << " MB (" << num(r.bytes_per_keyframe / 1024.0, 1) << " KiB per keyframe)\n";
     if (r.ate) {

@@ -39,7 +39,7 @@ TEST(DevslamRun, WritesEveryOutputAndPrintsTheSummary) {
     const auto r = run("--mode none --quiet --out " + out.string());
     ASSERT_EQ(r.rc, 0) << r.out;
     for (const char* key : {"frames     : 32", "lost frames: 0", "ATE        : RMSE", "RPE (1 f)",
-                            "median", "tracking", "backend"})
+                            "median", "tracking", "backend", "finalize   : "})
         EXPECT_NE(r.out.find(key), std::string::npos) << key << "\n" << r.out;
     EXPECT_EQ(lines(out / "trajectory.txt"), 32u);
     EXPECT_GE(lines(out / "keyframes.txt"), 3u);
@@ -59,6 +59,8 @@ TEST(DevslamRun, WritesEveryOutputAndPrintsTheSummary) {
     ss << js.rdbuf();
     EXPECT_NE(ss.str().find("\"per_frame\""), std::string::npos);
     EXPECT_NE(ss.str().find("\"ate\""), std::string::npos);
+    // run.json is written whole under its own name (a .part file renamed).
+    EXPECT_FALSE(fs::exists(out / "run.json.part"));
     fs::remove_all(out);
 }
 

@@ -18,7 +18,11 @@ std::unique_ptr<PersonDetector> makeDetector(const mrpt::config::CConfigFileBase
     if (name == "yolo") {
         YoloDetector::Options o;
         o.loadFromConfig(cfg, section);
-        return std::make_unique<YoloDetector>(o);
+        try {
+            return std::make_unique<YoloDetector>(o);
+        } catch (const YoloDetector::UnknownClass& e) {
+            throw std::invalid_argument("[" + section + "] " + e.what());
+        }
     }
     if (name == "hog") {
         HogDetector::Options o;

@@ -133,7 +133,7 @@ YoloDetector::YoloDetector(const Options& opts) : opts_(opts) {
     for (const auto& c : opts_.classes) {
         const auto it = std::find(names_.begin(), names_.end(), c);
         if (it == names_.end())
-            throw std::invalid_argument("yolo: class '" + c + "' is not in '" + opts_.names + "'");
+            throw UnknownClass("classes: '" + c + "' is not in '" + opts_.names + "'");
         wanted_.push_back(static_cast<int>(it - names_.begin()));
     }
     std::string weights;

@@ -12,6 +12,8 @@
 
 #include <opencv2/dnn.hpp>
 
+#include <stdexcept>
+
 namespace devslam::detect {
 
 class YoloDetector final : public PersonDetector {
@@ -40,6 +42,14 @@ class YoloDetector final : public PersonDetector {
         void saveToConfig(mrpt::config::CConfigFileBase& cfg, const std::string& section) const;
     };
 
+    /// A class of Options::classes that the names file does not hold ("classes: 'persn' is
+    /// not in '.../coco.names'"; makeDetector adds the INI section).
+    struct UnknownClass : std::invalid_argument {
+        using std::invalid_argument::invalid_argument;
+    };
+
+    /// Throws UnknownClass, or std::runtime_error for a model, weights or names file that is
+    /// missing or does not load.
     explicit YoloDetector(const Options& opts);
     [[nodiscard]] std::vector<Detection> detect(const cv::Mat& bgr) override;
     [[nodiscard]] std::string name() const override;
