@@ -124,6 +124,15 @@ TEST(TumReader, MalformedListsNameFileAndLine) {
     std::getline(in, l1), std::getline(in, l2), std::getline(in, l3);
     in.close();
 
+    // A ground truth file that holds no pose, or a bad one, says how to run without it.
+    writeText(d.str("s/groundtruth.txt"), "# timestamp tx ty tz qx qy qz qw\n");
+    expectError([&] { io::TumReader r(d.str("s")); },
+                "groundtruth\\.txt: no poses \\(a folder without groundtruth\\.txt runs without "
+                "ATE\\)");
+    writeText(d.str("s/groundtruth.txt"), "1305031102.2 1 2 3\n");
+    expectError([&] { io::TumReader r(d.str("s")); },
+                "groundtruth\\.txt line 1: expected .* \\(a folder without groundtruth");
+    fs::remove(d.str("s/groundtruth.txt"));
     writeText(rgb, header + l1 + "\n" + "1305031102.2 rgb/a.png extra\n" + l3 + "\n");
     expectError([&] { io::TumReader r(d.str("s")); },
                 "rgb\\.txt line 5: expected 'timestamp filename'");

@@ -134,7 +134,14 @@ TumReader::TumReader(std::string folder, ReaderOptions opts)
                                 : "preset ros_default (no camera.ini, folder name names no camera)";
     }
     const std::string gt = folder_ + "/groundtruth.txt";
-    if (fs::exists(gt)) gt_ = readTumTrajectory(gt);
+    if (fs::exists(gt)) {
+        try {
+            gt_ = readTumTrajectory(gt);
+        } catch (const std::runtime_error& e) {
+            throw std::runtime_error(std::string(e.what()) +
+                                     " (a folder without groundtruth.txt runs without ATE)");
+        }
+    }
 }
 
 core::Frame TumReader::read(std::size_t i) const {
