@@ -362,19 +362,55 @@ int stopAfter(int status) {
     return core::stopSignalOf(status);
 }
 
-/// Why the run.json in `dir` cannot stand for the run `cmd` would make now ("" = it can):
-/// the run was made by another command line (its command.txt: another input, config, mode or
-/// frame count), or before a file it was made from changed (`deps`: the config, the render).
-std::string staleRun(const fs::path& dir, const std::string& cmd,
-                     const std::vector<fs::path>& deps) {
+/// What a run is made from, as its command.txt records it: the command line, then the
+/// content hash (core::fileHash) and path of each file it reads that the bench knows of.
+/// `hash` caches the hashes (a rawlog or the program is read once per bench).
+std::string provenance(const std::string& cmd, const std::vector<std::string>& files,
+                       std::map<std::string, std::string>& hash) {
+    std::string text = cmd + "\n";
+    for (const auto& f : files) {
+        auto it = hash.find(f);
+        if (it == hash.end()) it = hash.emplace(f, core::fileHash(f)).first;
+        text += (it->second.empty() ? "unreadable" : it->second) + " " + f + "\n";
+    }
+    return text;
+}
+
+/// The files a run of `input` with `slam_config` reads that decide its figures: the
+/// devslam-run program, the SLAM config and the filter config it names, the rawlog or the
+/// TUM folder's lists and truth (the images are not read: a rendered folder's render.txt
+/// stands for its images, docs/render.md).
+std::vector<std::string> runInputs(const std::string& bin, const std::string& slam_config,
+                                   const std::string& input) {
+    std::vector<std::string> files = {bin + "/devslam-run", slam_config};
+    const std::string filter = core::filterIniPath(*core::loadIni(slam_config), slam_config);
+    if (filter != slam_config) files.push_back(filter);
+    if (fs::is_regular_file(input)) {
+        files.push_back(input);
+    } else {
+        for (const char* f :
+             {"rgb.txt", "depth.txt", "groundtruth.txt", "camera.ini", "render.txt", "persons.txt"})
+            if (fs::exists(fs::path(input) / f)) files.push_back((fs::path(input) / f).string());
+    }
+    return files;
+}
+
+/// Why the whole run.json in `dir` cannot stand for the run whose provenance is `made_from`
+/// now ("" = it can): its command.txt names another command, or a file that has changed.
+std::string staleRun(const fs::path& dir, const std::string& made_from) {
     std::ifstream in(dir / "command.txt");
-    std::string made_by;
-    std::getline(in, made_by);
-    if (made_by != cmd) return "made by another command (command.txt)";
-    const auto made = fs::last_write_time(dir / "run.json");
-    for (const auto& d : deps)
-        if (fs::exists(d) && fs::last_write_time(d) > made) return d.string() + " changed since";
-    return "";
+    std::stringstream ss;
+    ss << in.rdbuf();
+    const std::string had = ss.str();
+    if (had == made_from) return "";
+    std::istringstream a(had), b(made_from);
+    std::string la, lb;
+    for (int line = 0; std::getline(b, lb); ++line)
+        if (!std::getline(a, la) || la != lb)
+            return line == 0 ? "made by another command (command.txt)"
+                             : "made from another " + lb.substr(lb.find(' ') + 1) +
+                                   " (its content changed since)";
+    return "made from other files (command.txt)";
 }
 
 /// One devslam-synth call of the bench: its command line, the log its output goes to.
@@ -412,12 +448,8 @@ void runRenders(const std::vector<RenderJob>& renders, int jobs) {
                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
             std::lock_guard<std::mutex> lock(mu);
             ++finished;
-            if (const int sig = stopAfter(rc)) {
-                if (!stop) {
-                    stop = sig;
-                    failure = "interrupted (" + core::signalName(sig) + ") while rendering " +
-                              renders[i].what + "; the renders made are kept";
-                }
+            // Said as the render itself ended; a signal to the bench alone lets it finish.
+            if (core::stopSignalOf(rc)) {
                 say("  render " + renders[i].what + " interrupted");
             } else if (rc != 0) {
                 if (failure.empty())
@@ -429,6 +461,12 @@ void runRenders(const std::vector<RenderJob>& renders, int jobs) {
                 say("  [" + std::to_string(finished) + "/" + std::to_string(renders.size()) +
                     " renders] " + renders[i].what + " ready (" + fmt(s, 0) + " s)");
             }
+            if (const int sig = stopAfter(rc); sig && !stop) {
+                stop = sig;
+                failure = "interrupted (" + core::signalName(sig) + ") while rendering " +
+                          renders[i].what + "; the renders that finished are kept" +
+                          (failure.empty() ? std::string() : "\nbefore that: " + failure);
+            }
         }
     };
     std::vector<std::thread> pool;
@@ -437,7 +475,8 @@ void runRenders(const std::vector<RenderJob>& renders, int jobs) {
     for (auto& t : pool) t.join();
     if (!stop && core::stopSignal()) {  // between two renders
         stop = core::stopSignal();
-        failure = "interrupted (" + core::signalName(stop) + "); the renders made are kept";
+        failure =
+            "interrupted (" + core::signalName(stop) + "); the renders that finished are kept";
     }
     if (stop) throw Interrupted(stop, failure);
     if (!failure.empty()) throw std::runtime_error(failure);
@@ -530,6 +569,7 @@ int run(int argc, char** argv) {
                          ? std::size_t(repeatsOf(q)) * inputsOf(q, b.out_dir).size()
                          : 0;
     std::size_t done = 0, reused = 0;
+    std::map<std::string, std::string> hashes;  // file -> content hash, for command.txt
     // When the kept runs were made (their run.json files' times), for the RESULTS text.
     std::optional<std::time_t> kept_from, kept_to;
     std::vector<std::string> failed;  // logs of the runs that failed
@@ -553,13 +593,10 @@ int run(int argc, char** argv) {
                               << std::flush;
                     const std::string json = (dir / "run.json").string();
                     RunFigures f = reuse ? readRun(json) : RunFigures{};
+                    const std::string made_from =
+                        provenance(cmd, runInputs(bin, q.slam_config, in.path), hashes);
                     if (f.ok) {  // a whole run made earlier: kept if it is this one
-                        std::vector<fs::path> deps = {q.slam_config};
-                        for (const char* made_from : {"render.txt", "rgb.txt"})
-                            if (fs::exists(fs::path(in.path) / made_from))
-                                deps.push_back(fs::path(in.path) / made_from);
-                        if (fs::is_regular_file(in.path)) deps.push_back(in.path);
-                        if (const std::string why = staleRun(dir, cmd, deps); !why.empty()) {
+                        if (const std::string why = staleRun(dir, made_from); !why.empty()) {
                             std::cout << "  not kept: its run.json was " << why << "\n";
                             f = RunFigures{};
                         }
@@ -569,7 +606,7 @@ int run(int argc, char** argv) {
                     if (!have && !core::stopSignal()) {
                         // A run killed before it wrote its own must not leave an older one.
                         fs::remove(json);
-                        std::ofstream(dir / "command.txt") << cmd << "\n";
+                        core::writeFileWhole((dir / "command.txt").string(), made_from);
                         rc = core::runCommand(cmd);
                     }
                     if (const int sig = stopAfter(rc))
@@ -608,8 +645,6 @@ int run(int argc, char** argv) {
                             << fmt(f.fps_mean, 2) << "," << fmt(f.lost, 0) << "\n";
                 }
 
-    std::ofstream(fs::path(b.out_dir) / "runs.csv") << all_csv.str();
-
     // 3. Medians over the runs (renders x repeats); the median-ATE run's plot is kept.
     const auto med = [&](const std::vector<RunFigures>& v, double RunFigures::*field) {
         std::vector<double> x;
@@ -619,9 +654,8 @@ int run(int argc, char** argv) {
     };
     std::ostringstream t1, t2, t3, t4, t5;
     std::map<std::string, std::vector<std::string>> plots;  // sequence -> modes with a plot
-    std::ofstream c1(fs::path(b.out_dir) / "table1_rpe.csv"),
-        c2(fs::path(b.out_dir) / "table2_ate.csv"), c3(fs::path(b.out_dir) / "table3_fps.csv"),
-        c4(fs::path(b.out_dir) / "filter_truth.csv");
+    // The CSV files, written with tables.md at the end, each whole or not at all.
+    std::ostringstream c1, c2, c3, c4, targets_csv;
     t1 << "| sequence | mode | trans RMSE (m) | trans mean (m) | trans median (m) | rot RMSE (deg) "
           "| rot mean (deg) | rot median (deg) |\n|---|---|---|---|---|---|---|---|\n";
     t2 << "| sequence | mode | ATE RMSE (m) | ATE mean (m) | ATE median (m) | lost frames | runs "
@@ -764,7 +798,7 @@ int run(int argc, char** argv) {
     if (!b.targets.empty()) {
         std::vector<bench::SequenceInputs> inputs;
         for (const auto& q : b.sequences) inputs.push_back({q.name, q.seeds});
-        std::ofstream csv(fs::path(b.out_dir) / "targets.csv");
+        auto& csv = targets_csv;
         csv << "target,sequence,mode,figure,op,value,measured,measured_on,met,inputs_met,"
                "inputs,paired_geomean,paired_lo95,paired_hi95\n";
         targets_md << "**Targets** (bench.ini `[targets]`, checked on the medians of the tables "
@@ -885,10 +919,16 @@ int run(int argc, char** argv) {
        << "`; tables as CSV and the "
           "trajectory plots (`<sequence>_<mode>_trajectory.png`, median-ATE run) in `"
        << b.out_dir << "/`.\n";
-    {
-        std::ofstream f(fs::path(b.out_dir) / "tables.md");
-        f << md.str();
-    }
+    const fs::path out(b.out_dir);
+    for (const auto& [name, text] :
+         std::vector<std::pair<std::string, std::string>>{{"runs.csv", all_csv.str()},
+                                                          {"table1_rpe.csv", c1.str()},
+                                                          {"table2_ate.csv", c2.str()},
+                                                          {"table3_fps.csv", c3.str()},
+                                                          {"filter_truth.csv", c4.str()},
+                                                          {"tables.md", md.str()}})
+        core::writeFileWhole((out / name).string(), text);
+    if (!b.targets.empty()) core::writeFileWhole((out / "targets.csv").string(), targets_csv.str());
     std::cout << md.str();
     if (!failed.empty()) {
         // The tables count them as failed runs; a results file keeps its last whole bench.
@@ -899,6 +939,10 @@ int run(int argc, char** argv) {
         return 1;
     }
     if (!results.empty()) core::replaceResultsSection(results, "bench", md.str());
+    if (const int sig = core::stopSignal())  // the runs were all done by then
+        std::cerr << "devslam-bench: " << core::signalName(sig)
+                  << " came after the last run; the bench is whole"
+                  << (results.empty() ? std::string() : " and " + results + " was written") << "\n";
     return 0;
 }
 

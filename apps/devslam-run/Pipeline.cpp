@@ -6,6 +6,7 @@
 #include <devslam/core/Interrupt.h>
 #include <devslam/core/Pose.h>
 #include <devslam/core/Progress.h>
+#include <devslam/core/Results.h>
 #include <devslam/core/Stats.h>
 #include <devslam/eval/Report.h>
 #include <devslam/io/TrajectoryIO.h>
@@ -286,9 +287,14 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
     if (!rc.out_dir.empty()) {
         namespace fs = std::filesystem;
         fs::create_directories(rc.out_dir);
-        // run.json comes last and says the outputs are whole: an earlier run's goes first,
-        // so that a run killed while writing leaves none beside its new files.
-        fs::remove(fs::path(rc.out_dir) / "run.json");
+        // An earlier run's outputs go first: a run that writes fewer (no ATE plot without
+        // ground truth, no mask errors without person truth) or is killed while writing
+        // leaves none of them beside its own. run.json comes last and says they are whole.
+        for (const char* f :
+             {"run.json", "run.json.part", "trajectory.txt", "keyframes.txt", "lost_frames.txt",
+              "loops.txt", "map.ply", "map.3Dscene", "map_grid.png", "map_grid.gridmap",
+              "trajectory.png", "mask_errors.csv"})
+            fs::remove(fs::path(rc.out_dir) / f);
         auto out = [&](const std::string& name) {
             std::string p = (fs::path(rc.out_dir) / name).string();
             rep.outputs.push_back(p);
@@ -361,13 +367,7 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
             }
         }
         rep.peak_rss_mb = peakRssMb();
-        const std::string json = out("run.json");
-        {
-            std::ofstream js(json + ".part");
-            js << toJson(rep);
-            if (!js.flush()) throw std::runtime_error("cannot write '" + json + ".part'");
-        }
-        fs::rename(json + ".part", json);  // whole or not there
+        core::writeFileWhole(out("run.json"), toJson(rep));
     }
     rep.peak_rss_mb = peakRssMb();
     return rep;

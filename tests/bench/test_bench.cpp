@@ -268,10 +268,13 @@ TEST(DevslamBench, CtrlCStopsTheBenchAndReuseRunsResumes) {
     const fs::path tmp = devslam::test::scratchPath("devslam_bench_ctrl_c");
     fs::remove_all(tmp);
     fs::create_directories(tmp);
+    // A copy of the config (with the filter config it names), changed at the end.
+    fs::copy_file(root + "/config_ini/slam_tum_fr1.ini", tmp / "slam.ini");
+    fs::copy_file(root + "/config_ini/dynamic_filter.ini", tmp / "dynamic_filter.ini");
     std::ofstream(tmp / "bench.ini")
         << "[bench]\nrepeats = 4\nmodes = none\n"
-        << "[sequence_fr1]\npath = " << root << "/data/tum/fr1_xyz_first37\nslam_config = " << root
-        << "/config_ini/slam_tum_fr1.ini\n";
+        << "[sequence_fr1]\npath = " << root
+        << "/data/tum/fr1_xyz_first37\nslam_config = " << (tmp / "slam.ini").string() << "\n";
     std::ofstream(tmp / "RESULTS.md") << "# Results\n";
     const std::string args = "--config " + (tmp / "bench.ini").string() + " --max-frames 3 --out " +
                              (tmp / "out").string() + " --results " + (tmp / "RESULTS.md").string();
@@ -315,6 +318,20 @@ TEST(DevslamBench, CtrlCStopsTheBenchAndReuseRunsResumes) {
         readFile(tmp / "out/runs/fr1/none" / ("r" + std::to_string(last - 1)) / "run.json");
     EXPECT_NE(js.find("\"interrupted\": \"\""), std::string::npos) << js.substr(0, 300);
     EXPECT_NE(js.find("\"frames\": 2,"), std::string::npos) << js.substr(0, 300);
+
+    // Finished, then the config changes, keeping its old time (as `cp -p` or `tar x` do): the
+    // runs made from the old content are not kept.
+    ASSERT_EQ(devslam::test::runApp("devslam-bench", other).rc, 0);
+    const auto when = fs::last_write_time(tmp / "slam.ini");
+    std::ofstream(tmp / "slam.ini", std::ios::app) << "# changed\n";
+    fs::last_write_time(tmp / "slam.ini", when);
+    const auto changed = devslam::test::runApp("devslam-bench", other);
+    EXPECT_EQ(changed.rc, 0) << changed.out;
+    EXPECT_NE(changed.out.find("not kept: its run.json was made from another " +
+                               (tmp / "slam.ini").string() + " (its content changed since)"),
+              std::string::npos)
+        << changed.out;
+    EXPECT_EQ(readFile(tmp / "RESULTS.md").find("runs were kept"), std::string::npos);
     fs::remove_all(tmp);
 }
 

@@ -391,6 +391,30 @@ TEST(Results, SectionsAreReplacedInPlaceAndBrokenMarkersRefused) {
     std::filesystem::remove(path);
 }
 
+// A file is replaced whole or not at all; its hash tells a change of content.
+TEST(Results, FilesAreWrittenWholeAndHashedByContent) {
+    const auto dir = devslam::test::scratchPath("results_whole");
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    const std::string f = (dir / "a.txt").string();
+    devslam::core::writeFileWhole(f, "one\n");
+    devslam::core::writeFileWhole(f, "two\n");
+    std::ifstream in(f);
+    std::string line;
+    std::getline(in, line);
+    EXPECT_EQ(line, "two");
+    EXPECT_FALSE(std::filesystem::exists(f + ".part"));
+    EXPECT_THROW(devslam::core::writeFileWhole((dir / "no/such/b.txt").string(), "x"),
+                 std::runtime_error);
+    const std::string h = devslam::core::fileHash(f);
+    EXPECT_EQ(h.size(), 16u);
+    EXPECT_EQ(devslam::core::fileHash(f), h);
+    devslam::core::writeFileWhole(f, "twO\n");
+    EXPECT_NE(devslam::core::fileHash(f), h);
+    EXPECT_EQ(devslam::core::fileHash((dir / "missing").string()), "");
+    std::filesystem::remove_all(dir);
+}
+
 TEST(Results, MeasuredOnLineNamesTheHostAndItsSimdLevel) {
     const std::string line = measuredOnLine();
     EXPECT_NE(line.find(" UTC, "), std::string::npos) << line;
@@ -509,6 +533,11 @@ TEST(Interrupt, FirstSignalIsRecordedAndChildStatusesAreRead) {
     EXPECT_EQ(devslam::core::stopSignal(), 0);
     ASSERT_EQ(std::raise(SIGTERM), 0);
     EXPECT_EQ(devslam::core::stopSignal(), SIGTERM);  // still running
+    struct sigaction now {};
+    ASSERT_EQ(sigaction(SIGINT, nullptr, &now), 0);
+    EXPECT_EQ(now.sa_handler, SIG_IGN);  // the first signal reset only what was installed
+    ASSERT_EQ(sigaction(SIGTERM, nullptr, &now), 0);
+    EXPECT_EQ(now.sa_handler, SIG_DFL);  // a second SIGTERM would end the program
     devslam::core::clearStopSignal();
     EXPECT_EQ(devslam::core::signalName(SIGINT), "SIGINT");
     EXPECT_EQ(devslam::core::signalName(SIGTERM), "SIGTERM");

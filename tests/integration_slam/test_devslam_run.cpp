@@ -36,8 +36,13 @@ std::size_t lines(const fs::path& p) {
 TEST(DevslamRun, WritesEveryOutputAndPrintsTheSummary) {
     const fs::path out = devslam::test::scratchPath("devslam_run_smoke");
     fs::remove_all(out);
+    // An earlier run's output that this run does not write (no person truth, no mask
+    // errors) must not stay beside its outputs.
+    fs::create_directories(out);
+    std::ofstream(out / "mask_errors.csv") << "from an earlier run\n";
     const auto r = run("--mode none --quiet --out " + out.string());
     ASSERT_EQ(r.rc, 0) << r.out;
+    EXPECT_FALSE(fs::exists(out / "mask_errors.csv"));
     for (const char* key : {"frames     : 32", "lost frames: 0", "ATE        : RMSE", "RPE (1 f)",
                             "median", "tracking", "backend", "finalize   : "})
         EXPECT_NE(r.out.find(key), std::string::npos) << key << "\n" << r.out;

@@ -1,5 +1,6 @@
 #include <devslam/core/Interrupt.h>
 
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 #include <cerrno>
@@ -15,14 +16,22 @@ volatile std::sig_atomic_t g_signal = 0;
 const char* g_program = "";
 std::size_t g_program_len = 0;
 constexpr int kStopSignals[] = {SIGINT, SIGTERM};
+bool g_installed[2] = {false, false};  // per kStopSignals: the handler was installed
+
+/// Sets the signals the handler was installed for back to the default action (a signal
+/// ignored at start stays ignored). Async-signal-safe.
+void resetInstalled() {
+    struct sigaction dfl {};
+    dfl.sa_handler = SIG_DFL;
+    sigemptyset(&dfl.sa_mask);
+    for (int k = 0; k < 2; ++k)
+        if (g_installed[k]) sigaction(kStopSignals[k], &dfl, nullptr);
+}
 
 extern "C" void onStopSignal(int sig) {
     // Only async-signal-safe calls here (sigaction, write), nothing that allocates or locks.
     // The next signal of either kind takes the default action: the program ends at once.
-    struct sigaction dfl {};
-    dfl.sa_handler = SIG_DFL;
-    sigemptyset(&dfl.sa_mask);
-    for (const int s : kStopSignals) sigaction(s, &dfl, nullptr);
+    resetInstalled();
     if (g_signal == 0) g_signal = sig;
     constexpr char msg[] =
         ": stopping after the current step, keeping what is done (again to quit at once)\n";
@@ -42,12 +51,12 @@ void installStopHandler(const char* program) {
     for (const int s : kStopSignals) sigaddset(&sa.sa_mask, s);
     // SA_RESTART: reads and writes in progress go on instead of failing with EINTR.
     sa.sa_flags = SA_RESTART;
-    for (const int sig : kStopSignals) {
+    for (int k = 0; k < 2; ++k) {
         // A signal ignored at start stays ignored: a shell starts background jobs with SIGINT
         // ignored, so that Ctrl-C at the terminal is not theirs.
         struct sigaction old {};
-        if (sigaction(sig, nullptr, &old) == 0 && old.sa_handler == SIG_IGN) continue;
-        sigaction(sig, &sa, nullptr);
+        if (sigaction(kStopSignals[k], nullptr, &old) == 0 && old.sa_handler == SIG_IGN) continue;
+        g_installed[k] = sigaction(kStopSignals[k], &sa, nullptr) == 0;
     }
 }
 
@@ -98,14 +107,29 @@ int stopSignalOf(int status) {
 
 int runCommand(const std::string& cmd) {
     const std::string line = "exec " + cmd;
+    // SIGINT and SIGTERM are blocked across the fork: one that comes in between must not run
+    // this program's handler in the child (and be used up there); the parent gets it when
+    // it unblocks them, the child (which starts with none pending) from the terminal.
+    sigset_t stop, old;
+    sigemptyset(&stop);
+    for (const int s : kStopSignals) sigaddset(&stop, s);
+    sigprocmask(SIG_BLOCK, &stop, &old);
+    const pid_t parent = getpid();
     const pid_t pid = fork();
-    if (pid < 0) return -1;
     if (pid == 0) {
-        // The child starts with the dispositions the program started with: exec resets
-        // handlers to the default, and a signal ignored at start is still ignored.
+        // Only async-signal-safe calls in the child of a threaded program until exec. It gets
+        // the dispositions the program started with (the default, or ignored); and should
+        // the program die without waiting for it (a second Ctrl-C), it dies too instead of
+        // running on unseen beside a resumed command.
+        resetInstalled();
+        prctl(PR_SET_PDEATHSIG, SIGKILL);
+        if (getppid() != parent) _exit(127);  // the program died before prctl
+        sigprocmask(SIG_SETMASK, &old, nullptr);
         execl("/bin/sh", "sh", "-c", line.c_str(), static_cast<char*>(nullptr));
         _exit(127);
     }
+    sigprocmask(SIG_SETMASK, &old, nullptr);
+    if (pid < 0) return -1;
     int status = 0;
     while (waitpid(pid, &status, 0) < 0)
         if (errno != EINTR) return -1;

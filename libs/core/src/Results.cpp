@@ -2,8 +2,11 @@
 
 #include <opencv2/core/utility.hpp>
 
+#include <array>
 #include <cerrno>
 #include <chrono>
+#include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <ctime>
 #include <filesystem>
@@ -68,12 +71,40 @@ void checkResultsSection(const std::string& path, const std::string& name) {
 
 void replaceResultsSection(const std::string& path, const std::string& name,
                            const std::string& markdown) {
-    const std::string text = withSection(path, name, markdown);
-    std::ofstream out(path, std::ios::trunc);
-    out << text;
-    if (!out)
-        throw std::runtime_error("cannot write results file '" + path +
-                                 "': " + std::strerror(errno));
+    writeFileWhole(path, withSection(path, name, markdown));
+}
+
+void writeFileWhole(const std::string& path, const std::string& text) {
+    const std::string part = path + ".part";
+    {
+        std::ofstream out(part, std::ios::trunc | std::ios::binary);
+        out << text;
+        out.flush();
+        if (!out) throw std::runtime_error("cannot write '" + part + "': " + std::strerror(errno));
+    }
+    std::error_code ec;
+    std::filesystem::rename(part, path, ec);
+    if (ec) {
+        std::filesystem::remove(part);
+        throw std::runtime_error("cannot write '" + path + "': " + ec.message());
+    }
+}
+
+std::string fileHash(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) return "";
+    std::uint64_t h = 1469598103934665603ull;  // FNV-1a offset basis
+    std::array<char, 1 << 16> buf{};
+    while (in.read(buf.data(), buf.size()) || in.gcount() > 0) {
+        for (std::streamsize i = 0; i < in.gcount(); ++i) {
+            h ^= static_cast<unsigned char>(buf[static_cast<std::size_t>(i)]);
+            h *= 1099511628211ull;  // FNV prime
+        }
+        if (!in) break;
+    }
+    char hex[17];
+    std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h));
+    return hex;
 }
 
 std::string utcMinute(std::time_t t) {

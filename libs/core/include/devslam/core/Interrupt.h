@@ -36,7 +36,9 @@ void installStopHandler(const char* program);
 /// program, not a shell that would die at once and orphan it), and waits for it; returns its
 /// waitpid status, -1 when it could not start. Unlike std::system, the caller keeps its own
 /// SIGINT handling meanwhile: a Ctrl-C reaches both, and a SIGINT sent to the caller alone
-/// is its own to handle. `cmd` is one simple command, redirections allowed.
+/// is its own to handle. The child starts with the signal dispositions the caller started
+/// with, and is killed if the caller dies first (a second Ctrl-C), so that no run goes on
+/// unseen. `cmd` is one simple command, redirections allowed.
 [[nodiscard]] int runCommand(const std::string& cmd);
 /// For tests: forget a recorded signal (the handlers are left as they are).
 void clearStopSignal();

@@ -16,8 +16,19 @@ namespace devslam::core {
 /// Throws std::runtime_error, writing nothing, if the file has only one of the section's
 /// markers or its END before its BEGIN, or if the file cannot be written; std::invalid_argument if
 /// `name` is empty or contains characters other than [a-z0-9_-].
+/// The file is replaced whole (writeFileWhole): a command killed while writing leaves it as
+/// it was.
 void replaceResultsSection(const std::string& path, const std::string& name,
                            const std::string& markdown);
+
+/// Writes `text` to `path` whole or not at all: into `path`.part, then renamed over `path`,
+/// so that a program killed on the way leaves the old file (and at most the .part beside it).
+/// Throws std::runtime_error naming the file when it cannot be written.
+void writeFileWhole(const std::string& path, const std::string& text);
+
+/// FNV-1a (64 bit) of a file's bytes as 16 hex digits, "" when it cannot be read: tells
+/// whether a file's content changed (not a cryptographic hash).
+[[nodiscard]] std::string fileHash(const std::string& path);
 
 /// What replaceResultsSection would throw for `path` and `name`, found before a command's
 /// work (a bad name, broken markers, a folder, a missing parent folder); writes nothing.
