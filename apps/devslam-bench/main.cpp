@@ -603,15 +603,17 @@ int run(int argc, char** argv) {
                     }
                     const bool have = f.ok;
                     int rc = 0;
-                    if (!have && !core::stopSignal()) {
+                    const bool start = !have && !core::stopSignal();
+                    if (start) {
                         // A run killed before it wrote its own must not leave an older one.
                         fs::remove(json);
                         core::writeFileWhole((dir / "command.txt").string(), made_from);
                         rc = core::runCommand(cmd);
                     }
                     if (const int sig = stopAfter(rc))
-                        throw Interrupted(sig, "interrupted (" + core::signalName(sig) +
-                                                   ") during run " + std::to_string(done) + " of " +
+                        throw Interrupted(sig, "interrupted (" + core::signalName(sig) + ") " +
+                                                   (start ? "during" : "before") + " run " +
+                                                   std::to_string(done) + " of " +
                                                    std::to_string(total) +
                                                    "; the runs that finished are kept");
                     reused += have;
