@@ -55,8 +55,9 @@ const std::string kRoot = DEVSLAM_SOURCE_DIR;
 const char* kUsage =
     "usage: devslam-bench [--config INI] [--repeats N] [--max-frames N] [--out DIR]\n"
     "                     [--results FILE] [--bin DIR] [--reuse-runs] [--render-jobs N]\n"
-    "--reuse-runs: keep the run.json of runs already in the output folder (resume a bench);\n"
-    "              a run that stopped at a frame it could not read is run again\n"
+    "--reuse-runs: keep the runs already in the output folder that this command would make\n"
+    "              (resume a bench): a whole run.json, and a command.txt with this command\n"
+    "              line and the same content of program, configs and input lists\n"
     "--render-jobs N: renders made at once (default: [bench] render_jobs, else the CPU's\n"
     "              threads); the SLAM runs, whose FPS is measured, always run one at a time\n"
     "defaults: --config " DEVSLAM_SOURCE_DIR
@@ -399,17 +400,32 @@ std::vector<std::string> runInputs(const std::string& bin, const std::string& sl
 /// now ("" = it can): its command.txt names another command, or a file that has changed.
 std::string staleRun(const fs::path& dir, const std::string& made_from) {
     std::ifstream in(dir / "command.txt");
+    if (!in) return "made without a command.txt (by an older devslam-bench)";
     std::stringstream ss;
     ss << in.rdbuf();
     const std::string had = ss.str();
     if (had == made_from) return "";
-    std::istringstream a(had), b(made_from);
-    std::string la, lb;
-    for (int line = 0; std::getline(b, lb); ++line)
-        if (!std::getline(a, la) || la != lb)
-            return line == 0 ? "made by another command (command.txt)"
-                             : "made from another " + lb.substr(lb.find(' ') + 1) +
-                                   " (its content changed since)";
+    // Line 1: the command; then "HASH PATH" lines, compared by path (one file more or less
+    // shifts the lines).
+    const auto parse = [](const std::string& text, std::string& cmd) {
+        std::map<std::string, std::string> files;
+        std::istringstream lines(text);
+        std::getline(lines, cmd);
+        for (std::string l; std::getline(lines, l);)
+            if (const auto sp = l.find(' '); sp != std::string::npos)
+                files[l.substr(sp + 1)] = l.substr(0, sp);
+        return files;
+    };
+    std::string had_cmd, now_cmd;
+    const auto had_files = parse(had, had_cmd), now_files = parse(made_from, now_cmd);
+    if (had_cmd != now_cmd) return "made by another command (command.txt)";
+    for (const auto& [path, hash] : now_files) {
+        const auto it = had_files.find(path);
+        if (it == had_files.end()) return "made without " + path;
+        if (it->second != hash) return "made from another " + path + " (its content changed since)";
+    }
+    for (const auto& [path, hash] : had_files)
+        if (!now_files.count(path)) return "made with " + path + ", which it would not read now";
     return "made from other files (command.txt)";
 }
 

@@ -94,6 +94,11 @@ int convert(int argc, char** argv) {
         }
         refuseOverwritingInput(pos[0], pos[1]);
         auto reader = devslam::io::openRgbd(pos[0], ro);
+        if (const int sig = devslam::core::stopSignal()) {  // before the output is opened
+            std::cerr << "devslam-convert: interrupted (" << devslam::core::signalName(sig)
+                      << ") before the first frame; nothing written\n";
+            return 1;
+        }
         std::cerr << "reading " << reader->describe() << "\n";
         const std::size_t total = std::min(reader->size().value_or(0), max_frames);
         devslam::core::ProgressBar bar("converting", total);

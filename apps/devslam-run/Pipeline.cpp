@@ -307,12 +307,13 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
         io::writeTumTrajectory(out("keyframes.txt"), rep.keyframe_trajectory,
                                "DEV-SLAM keyframe trajectory, mode " + rc.mode);
         {
-            std::ofstream lf(out("lost_frames.txt"));
+            std::ostringstream lf;  // each file written whole, or an error
             lf << "# index timestamp (frames without a tracked pose)\n";
             for (std::size_t i : rep.lost) lf << i << " " << num(rep.trajectory[i].t, 6) << "\n";
+            core::writeFileWhole(out("lost_frames.txt"), lf.str());
         }
         {
-            std::ofstream lp(out("loops.txt"));
+            std::ostringstream lp;
             lp << "# loops closed: t_old t_new inliers, measured T_old_new (tx ty tz qx qy qz qw), "
                   "its error against the ground truth [m] [deg] (- without truth)\n";
             for (const auto& l : rep.loop_reports) {
@@ -324,6 +325,7 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
                    << num(q.w(), 7) << " " << (l.error_m ? num(*l.error_m) : "-") << " "
                    << (l.error_deg ? num(*l.error_deg, 3) : "-") << "\n";
             }
+            core::writeFileWhole(out("loops.txt"), lp.str());
         }
         slam::writePly(out("map.ply"), slam.map());
         std::optional<core::Trajectory> gt_in_est;
@@ -349,7 +351,7 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
             eval::plotAte(out("trajectory.png"), *rep.ate,
                           fs::path(rc.input).filename().string() + ", mode " + rc.mode);
         if (rep.mask_score) {
-            std::ofstream mf(out("mask_errors.csv"));
+            std::ostringstream mf;
             mf << "# person instances the masks got wrong (renderer truth): walkers not masked, "
                   "static people masked. filter_box: state of the filter box covering most of "
                   "the person (none: no box covers "
@@ -365,6 +367,7 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
                    << num(e.masked_fraction, 3) << "," << e.filter_box << "," << num(e.box_cover, 2)
                    << "\n";
             }
+            core::writeFileWhole(out("mask_errors.csv"), mf.str());
         }
         rep.peak_rss_mb = peakRssMb();
         core::writeFileWhole(out("run.json"), toJson(rep));

@@ -20,6 +20,7 @@ namespace devslam::test {
 struct CommandResult {
     int rc = -1;      ///< exit status; -1 when it could not run or did not exit
     std::string out;  ///< stdout and stderr
+    bool signalled = false;  ///< signalAppWhen: the signal was sent (it had not ended before)
 };
 
 /// `<DEVSLAM_BIN_DIR>/<app> <args>` through the shell (quote arguments with spaces).
@@ -69,7 +70,7 @@ inline CommandResult signalAppWhen(const std::string& app, const std::string& ar
            !(ended = waitpid(pid, &st, WNOHANG) == pid))
         std::this_thread::sleep_for(std::chrono::milliseconds(50));
     if (!ended) {
-        kill(group ? -pid : pid, sig);
+        r.signalled = kill(group ? -pid : pid, sig) == 0;
         ended = waitpid(pid, &st, 0) == pid;
     }
     if (ended) r.rc = WIFEXITED(st) ? WEXITSTATUS(st) : 128 + WTERMSIG(st);

@@ -406,6 +406,13 @@ TEST(Results, FilesAreWrittenWholeAndHashedByContent) {
     EXPECT_FALSE(std::filesystem::exists(f + ".part"));
     EXPECT_THROW(devslam::core::writeFileWhole((dir / "no/such/b.txt").string(), "x"),
                  std::runtime_error);
+    // A write that fails leaves the old file as it was (here the .part cannot be made).
+    std::filesystem::create_directories(f + ".part");
+    EXPECT_THROW(devslam::core::writeFileWhole(f, "three\n"), std::runtime_error);
+    std::filesystem::remove_all(f + ".part");
+    std::ifstream again(f);
+    std::getline(again, line);
+    EXPECT_EQ(line, "two");
     const std::string h = devslam::core::fileHash(f);
     EXPECT_EQ(h.size(), 16u);
     EXPECT_EQ(devslam::core::fileHash(f), h);
@@ -566,8 +573,9 @@ TEST(Interrupt, FirstSignalIsRecordedAndChildStatusesAreRead) {
 TEST(Interrupt, ExitBySignalEndsByTheSignal) {
     EXPECT_EXIT(
         {
-            std::cout << "flushed";
+            std::setvbuf(stderr, nullptr, _IOFBF, 4096);  // held until flushed
+            std::fprintf(stderr, "flushed");
             devslam::core::exitBySignal(SIGINT);
         },
-        testing::KilledBySignal(SIGINT), "");
+        testing::KilledBySignal(SIGINT), "flushed");
 }

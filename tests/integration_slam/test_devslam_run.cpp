@@ -209,8 +209,6 @@ TEST(DevslamRun, TruncatedRawlogRunsOnItsIntactPartWhenAsked) {
     fs::remove_all(dir);
 }
 
-// A frame whose image is there but does not decode is found only when it is read: the run
-// stops there, keeps (writes) the frames before it, names the file and exits with 1.
 // Ctrl-C stops a run after the frame it is on: it writes its results for the frames done, as
 // at the end of its input, says so, and exits 130 (128 + SIGINT).
 TEST(DevslamRun, CtrlCStopsTheRunAndKeepsTheFramesDone) {
@@ -223,6 +221,7 @@ TEST(DevslamRun, CtrlCStopsTheRunAndKeepsTheFramesDone) {
         "--input " + std::string(DEVSLAM_SOURCE_DIR) +
             "/data/tum/fr1_xyz_first37 --replay 1000 --mode none --out " + (dir / "run").string(),
         " fps", SIGINT, (dir / "log.txt").string());
+    ASSERT_TRUE(r.signalled) << "it ended before the signal:\n" << r.out;
     EXPECT_EQ(r.rc, 130) << r.out;
     const auto at = r.out.find("devslam-run: interrupted (SIGINT) after ");
     ASSERT_NE(at, std::string::npos) << r.out;
@@ -246,6 +245,8 @@ TEST(DevslamRun, CtrlCStopsTheRunAndKeepsTheFramesDone) {
     fs::remove_all(dir);
 }
 
+// A frame whose image is there but does not decode is found only when it is read: the run
+// stops there, keeps (writes) the frames before it, names the file and exits with 1.
 TEST(DevslamRun, AnUndecodableFrameMidRunKeepsTheFramesBeforeIt) {
     const fs::path dir = devslam::test::scratchPath("devslam_run_undecodable");
     fs::remove_all(dir);

@@ -1,8 +1,10 @@
 #include <devslam/core/Interrupt.h>
 
+#include <pthread.h>
 #include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include <atomic>
 #include <cerrno>
 #include <csignal>
 #include <cstdio>
@@ -12,7 +14,10 @@
 
 namespace devslam::core {
 namespace {
-volatile std::sig_atomic_t g_signal = 0;
+// Read by other threads (the bench's render workers): an atomic, lock-free and so usable in
+// a signal handler.
+std::atomic<int> g_signal{0};
+static_assert(std::atomic<int>::is_always_lock_free);
 const char* g_program = "";
 std::size_t g_program_len = 0;
 constexpr int kStopSignals[] = {SIGINT, SIGTERM};
@@ -32,7 +37,8 @@ extern "C" void onStopSignal(int sig) {
     // Only async-signal-safe calls here (sigaction, write), nothing that allocates or locks.
     // The next signal of either kind takes the default action: the program ends at once.
     resetInstalled();
-    if (g_signal == 0) g_signal = sig;
+    int none = 0;
+    g_signal.compare_exchange_strong(none, sig);
     constexpr char msg[] =
         ": stopping after the current step, keeping what is done (again to quit at once)\n";
     ssize_t ignored = ::write(STDERR_FILENO, "\n", 1);
@@ -56,6 +62,7 @@ void installStopHandler(const char* program) {
         // ignored, so that Ctrl-C at the terminal is not theirs.
         struct sigaction old {};
         if (sigaction(kStopSignals[k], nullptr, &old) == 0 && old.sa_handler == SIG_IGN) continue;
+        g_installed[k] = true;  // before the handler can run
         g_installed[k] = sigaction(kStopSignals[k], &sa, nullptr) == 0;
     }
 }
@@ -87,7 +94,7 @@ void exitBySignal(int sig) {
     sigset_t set;
     sigemptyset(&set);
     sigaddset(&set, sig);
-    sigprocmask(SIG_UNBLOCK, &set, nullptr);
+    pthread_sigmask(SIG_UNBLOCK, &set, nullptr);
     std::raise(sig);
     std::_Exit(128 + sig);  // not reached for SIGINT and SIGTERM
 }
@@ -113,7 +120,7 @@ int runCommand(const std::string& cmd) {
     sigset_t stop, old;
     sigemptyset(&stop);
     for (const int s : kStopSignals) sigaddset(&stop, s);
-    sigprocmask(SIG_BLOCK, &stop, &old);
+    pthread_sigmask(SIG_BLOCK, &stop, &old);
     const pid_t parent = getpid();
     const pid_t pid = fork();
     if (pid == 0) {
@@ -124,11 +131,11 @@ int runCommand(const std::string& cmd) {
         resetInstalled();
         prctl(PR_SET_PDEATHSIG, SIGKILL);
         if (getppid() != parent) _exit(127);  // the program died before prctl
-        sigprocmask(SIG_SETMASK, &old, nullptr);
+        pthread_sigmask(SIG_SETMASK, &old, nullptr);
         execl("/bin/sh", "sh", "-c", line.c_str(), static_cast<char*>(nullptr));
         _exit(127);
     }
-    sigprocmask(SIG_SETMASK, &old, nullptr);
+    pthread_sigmask(SIG_SETMASK, &old, nullptr);
     if (pid < 0) return -1;
     int status = 0;
     while (waitpid(pid, &status, 0) < 0)

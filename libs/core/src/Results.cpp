@@ -76,17 +76,24 @@ void replaceResultsSection(const std::string& path, const std::string& name,
 
 void writeFileWhole(const std::string& path, const std::string& text) {
     const std::string part = path + ".part";
+    std::error_code ec;
     {
+        errno = 0;
         std::ofstream out(part, std::ios::trunc | std::ios::binary);
         out << text;
         out.flush();
-        if (!out) throw std::runtime_error("cannot write '" + part + "': " + std::strerror(errno));
+        if (!out) {
+            const std::string why = errno ? std::strerror(errno) : "write failed";
+            out.close();
+            std::filesystem::remove(part, ec);
+            throw std::runtime_error("cannot write '" + part + "': " + why);
+        }
     }
-    std::error_code ec;
     std::filesystem::rename(part, path, ec);
     if (ec) {
-        std::filesystem::remove(part);
-        throw std::runtime_error("cannot write '" + path + "': " + ec.message());
+        const std::string why = ec.message();
+        std::filesystem::remove(part, ec);
+        throw std::runtime_error("cannot write '" + path + "': " + why);
     }
 }
 

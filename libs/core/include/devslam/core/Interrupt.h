@@ -37,8 +37,8 @@ void installStopHandler(const char* program);
 /// waitpid status, -1 when it could not start. Unlike std::system, the caller keeps its own
 /// SIGINT handling meanwhile: a Ctrl-C reaches both, and a SIGINT sent to the caller alone
 /// is its own to handle. The child starts with the signal dispositions the caller started
-/// with, and is killed if the caller dies first (a second Ctrl-C), so that no run goes on
-/// unseen. `cmd` is one simple command, redirections allowed.
+/// with, and is killed if the calling thread dies first (a second Ctrl-C ends the program),
+/// so that no run goes on unseen. `cmd` is one simple command, redirections allowed.
 [[nodiscard]] int runCommand(const std::string& cmd);
 /// For tests: forget a recorded signal (the handlers are left as they are).
 void clearStopSignal();
