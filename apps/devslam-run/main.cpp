@@ -236,7 +236,7 @@ int runOnce(const Args& a) {
                   << " frames" << kept << "\n";
         return 1;
     }
-    if (core::stopSignal())  // it came during the last frame
+    if (core::stopSignal())  // it came after the last frame was read (finalize, outputs)
         std::cerr << "devslam-run: " << core::signalName(core::stopSignal())
                   << " came after the last frame; the run is whole\n";
     return 0;
@@ -248,17 +248,12 @@ std::string fmt(double v, int p) {
     return b;
 }
 
-/// A run of `--bench` stopped early (Ctrl-C): the bench writes nothing.
-struct BenchInterrupted : std::runtime_error {
-    using std::runtime_error::runtime_error;
-};
-
-/// `rep` when it covers the whole input; a bench over part of it would mislead.
-run::RunReport requireWhole(run::RunReport rep) {
+/// Throws unless `rep` covers the whole input: a bench over part of it would mislead (a frame
+/// that did not read, a Ctrl-C), so the bench writes nothing.
+void requireWhole(const run::RunReport& rep) {
     if (!rep.read_error.empty()) throw std::runtime_error(rep.read_error);
     if (!rep.interrupted.empty())
-        throw BenchInterrupted("interrupted (" + rep.interrupted + "); the bench wrote nothing");
-    return rep;
+        throw std::runtime_error("interrupted (" + rep.interrupted + "); the bench wrote nothing");
 }
 
 int runBench(const Args& a) {
@@ -343,7 +338,8 @@ int runBench(const Args& a) {
         auto l = loadConfig(a, sets);
         auto reader = io::openRgbd(a.input, l.reader);
         const auto rc = runConfig(a, l, "none");
-        const auto rep = requireWhole(run::runSequence(*reader, rc, *l.cfg, *l.filter_cfg));
+        const auto rep = run::runSequence(*reader, rc, *l.cfg, *l.filter_cfg);
+        requireWhole(rep);
         abl << "| " << name << " | " << (rep.ate ? fmt(rep.ate->trans.rmse, 4) : "-") << " | "
             << rep.keyframes << " | " << fmt(rep.median_fps, 1) << " |\n";
         std::cerr << "ablation " << name << ": ATE "
@@ -359,7 +355,8 @@ int runBench(const Args& a) {
         auto rc = runConfig(a, l, "dynamic");
         rc.max_frames = 0;       // every replayed frame
         rc.score_masks = false;  // replayed: timestamps are not the truth's
-        const auto rep = requireWhole(run::runSequence(reader, rc, *l.cfg, *l.filter_cfg));
+        const auto rep = run::runSequence(reader, rc, *l.cfg, *l.filter_cfg);
+        requireWhole(rep);
         mem << "\nLong run (memory): the input replayed forward/backward " << kPasses
             << " times (`devslam-run --replay " << kPasses << " --mode dynamic`): " << rep.frames
             << " frames, " << rep.keyframes << " keyframes, " << rep.landmarks << " landmarks, "

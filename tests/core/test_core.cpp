@@ -549,15 +549,14 @@ TEST(Interrupt, FirstSignalIsRecordedAndChildStatusesAreRead) {
     EXPECT_EQ(devslam::core::signalName(SIGINT), "SIGINT");
     EXPECT_EQ(devslam::core::signalName(SIGTERM), "SIGTERM");
     std::signal(SIGINT, SIG_DFL);  // the children below inherit it
-    using devslam::core::endedByStopSignal;
-    EXPECT_TRUE(endedByStopSignal(std::system("kill -INT $$")));
-    EXPECT_TRUE(endedByStopSignal(std::system("kill -TERM $$")));
-    EXPECT_TRUE(endedByStopSignal(std::system("exit 130")));
-    EXPECT_TRUE(endedByStopSignal(std::system("exit 143")));
-    EXPECT_FALSE(endedByStopSignal(std::system("exit 0")));
-    EXPECT_FALSE(endedByStopSignal(std::system("exit 1")));
-    EXPECT_FALSE(endedByStopSignal(std::system("kill -KILL $$")));
-    EXPECT_EQ(devslam::core::stopSignalOf(std::system("exit 130")), SIGINT);
+    using devslam::core::stopSignalOf;
+    EXPECT_EQ(stopSignalOf(std::system("kill -INT $$")), SIGINT);
+    EXPECT_EQ(stopSignalOf(std::system("kill -TERM $$")), SIGTERM);
+    EXPECT_EQ(stopSignalOf(std::system("exit 130")), SIGINT);
+    EXPECT_EQ(stopSignalOf(std::system("exit 143")), SIGTERM);
+    EXPECT_EQ(stopSignalOf(std::system("exit 0")), 0);
+    EXPECT_EQ(stopSignalOf(std::system("exit 1")), 0);
+    EXPECT_EQ(stopSignalOf(std::system("kill -KILL $$")), 0);
     // runCommand: the shell execs the program, so the program is the caller's child, which
     // a signal to the child reaches (std::system's shell would die of SIGTERM at once and
     // leave the program running); the program's status comes back.

@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <iostream>
+#include <iterator>
 
 namespace devslam::core {
 namespace {
@@ -21,7 +22,7 @@ static_assert(std::atomic<int>::is_always_lock_free);
 const char* g_program = "";
 std::size_t g_program_len = 0;
 constexpr int kStopSignals[] = {SIGINT, SIGTERM};
-bool g_installed[2] = {false, false};  // per kStopSignals: the handler was installed
+bool g_installed[std::size(kStopSignals)] = {};  // per kStopSignals: the handler was installed
 
 /// Sets the signals the handler was installed for back to the default action (a signal
 /// ignored at start stays ignored). Async-signal-safe.
@@ -29,7 +30,7 @@ void resetInstalled() {
     struct sigaction dfl {};
     dfl.sa_handler = SIG_DFL;
     sigemptyset(&dfl.sa_mask);
-    for (int k = 0; k < 2; ++k)
+    for (std::size_t k = 0; k < std::size(kStopSignals); ++k)
         if (g_installed[k]) sigaction(kStopSignals[k], &dfl, nullptr);
 }
 
@@ -57,7 +58,7 @@ void installStopHandler(const char* program) {
     for (const int s : kStopSignals) sigaddset(&sa.sa_mask, s);
     // SA_RESTART: reads and writes in progress go on instead of failing with EINTR.
     sa.sa_flags = SA_RESTART;
-    for (int k = 0; k < 2; ++k) {
+    for (std::size_t k = 0; k < std::size(kStopSignals); ++k) {
         // A signal ignored at start stays ignored: a shell starts background jobs with SIGINT
         // ignored, so that Ctrl-C at the terminal is not theirs.
         struct sigaction old {};
@@ -97,10 +98,6 @@ void exitBySignal(int sig) {
     pthread_sigmask(SIG_UNBLOCK, &set, nullptr);
     std::raise(sig);
     std::_Exit(128 + sig);  // not reached for SIGINT and SIGTERM
-}
-
-bool endedByStopSignal(int status) {
-    return stopSignalOf(status) != 0;
 }
 
 int stopSignalOf(int status) {

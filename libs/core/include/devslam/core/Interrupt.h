@@ -27,10 +27,8 @@ void installStopHandler(const char* program);
 /// Flushes stdout and stderr and ends the program by `sig` with its default action (the
 /// shell then reports 128 + sig: 130 for Ctrl-C). Call it after every file is closed.
 [[noreturn]] void exitBySignal(int sig);
-/// Whether a child's exit status (waitpid's, std::system's) says it was stopped by SIGINT or
-/// SIGTERM: killed by it, or exited with 128 + it.
-[[nodiscard]] bool endedByStopSignal(int status);
-/// The signal a status of endedByStopSignal names (0 when none).
+/// The signal that stopped a child, from its exit status (waitpid's, std::system's): SIGINT
+/// or SIGTERM when it was killed by it or exited with 128 + it, else 0.
 [[nodiscard]] int stopSignalOf(int status);
 /// Runs one command line through /bin/sh, which execs it (so a signal sent to it reaches the
 /// program, not a shell that would die at once and orphan it), and waits for it; returns its
