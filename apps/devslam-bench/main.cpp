@@ -342,8 +342,10 @@ std::string lastLines(const std::string& path, std::size_t n) {
     return out;
 }
 
-/// How a child process ended, from std::system's status: "exit N" or "killed by signal N".
+/// How a child process ended, from core::runCommand's status: "exit N", "killed by signal
+/// N", or that it never started (-1: no process could be made or waited for).
 std::string endedBy(int status) {
+    if (status == -1) return "could not be started: no process could be made or waited for";
     return WIFSIGNALED(status) ? "killed by signal " + std::to_string(WTERMSIG(status))
                                : "exit " + std::to_string(WEXITSTATUS(status));
 }

@@ -19,6 +19,7 @@
 #include <limits>
 #include <map>
 #include <optional>
+#include <regex>
 #include <sstream>
 #include <string>
 #include <tuple>
@@ -307,8 +308,9 @@ TEST(DevslamBench, CtrlCStopsTheBenchAndReuseRunsResumes) {
 
     // A SIGINT sent to the bench alone lets the run finish, then stops the bench. The runs of
     // another command (here another frame count) are not kept: they run again.
-    const std::string other = args.substr(0, args.find(" --max-frames 3")) + " --max-frames 2" +
-                              args.substr(args.find(" --max-frames 3") + 15) + " --reuse-runs";
+    const std::string other =
+        std::regex_replace(args, std::regex(" --max-frames 3"), " --max-frames 2") +
+        " --reuse-runs";
     const auto alone = devslam::test::signalAppWhen("devslam-bench", other, "[2/8]", SIGINT,
                                                     (tmp / "log2.txt").string(), false);
     ASSERT_TRUE(alone.signalled) << "the bench ended before the signal:\n" << alone.out;
@@ -318,10 +320,12 @@ TEST(DevslamBench, CtrlCStopsTheBenchAndReuseRunsResumes) {
         << alone.out;
     // The run it was in finished whole (or, had the signal come before the bench started run
     // 2, the first); either way with this command's 2 frames.
-    const auto stop = alone.out.find("devslam-bench: interrupted (SIGINT) ");
-    ASSERT_NE(stop, std::string::npos) << alone.out;
-    const bool during = alone.out.compare(stop + 36, 11, "during run ") == 0;
-    const int last = std::stoi(alone.out.substr(stop + 47)) - (during ? 1 : 2);
+    std::smatch stop;
+    ASSERT_TRUE(std::regex_search(
+        alone.out, stop,
+        std::regex(R"(devslam-bench: interrupted \(SIGINT\) (during|before) run (\d+) of 8)")))
+        << alone.out;
+    const int last = std::stoi(stop[2].str()) - (stop[1] == "during" ? 1 : 2);
     const std::string js =
         readFile(tmp / "out/runs/fr1/none" / ("r" + std::to_string(last)) / "run.json");
     EXPECT_NE(js.find("\"interrupted\": \"\""), std::string::npos) << js.substr(0, 300);

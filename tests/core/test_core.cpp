@@ -419,6 +419,23 @@ TEST(Results, FilesAreWrittenWholeAndHashedByContent) {
     devslam::core::writeFileWhole(f, "twO\n");
     EXPECT_NE(devslam::core::fileHash(f), h);
     EXPECT_EQ(devslam::core::fileHash((dir / "missing").string()), "");
+    // The file keeps its permissions, and a link to it stays a link.
+    namespace fs = std::filesystem;
+    fs::permissions(f, fs::perms::owner_read | fs::perms::owner_write);
+    const fs::path link = dir / "link.txt";
+    fs::create_symlink("a.txt", link);
+    devslam::core::writeFileWhole(link.string(), "four\n");
+    EXPECT_TRUE(fs::is_symlink(link));
+    std::ifstream through(f);
+    std::getline(through, line);
+    EXPECT_EQ(line, "four");
+    EXPECT_EQ(fs::status(f).permissions() & fs::perms::all,
+              fs::perms::owner_read | fs::perms::owner_write);
+    EXPECT_FALSE(fs::exists(dir / "a.txt.part"));
+    EXPECT_FALSE(fs::exists(dir / "link.txt.part"));
+    fs::create_symlink("nowhere.txt", dir / "dangling.txt");
+    EXPECT_THROW(devslam::core::writeFileWhole((dir / "dangling.txt").string(), "x"),
+                 std::runtime_error);
     std::filesystem::remove_all(dir);
 }
 

@@ -5,6 +5,8 @@
 #include <devslam/eval/Report.h>
 #include <devslam/io/TrajectoryIO.h>
 
+#include <mrpt/core/bits_math.h>
+
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -187,6 +189,50 @@ TEST(Rpe, ReproducesEvaluateRpeQuirks) {
     // Half a frame would pair every pose with itself (error 0): whole frames only, as there.
     o.delta = 0.5;
     EXPECT_THROW((void)eval::computeRpe(line, rotated, o), std::invalid_argument);
+}
+
+// evaluate_rpe.py's error is A B^-1 (A, B: the estimate's and the ground truth's relative
+// motions), not the TUM paper's B^-1 A: with a rotation error its translation differs.
+// Ground truth: 1 m steps along x. Estimate: the same positions, turned 10 deg more about z
+// at each pose. Pair (0,1): A = T(1 0 0) Rz(10), B = T(1 0 0): |e_x - Rz(10) e_x| =
+// 2 sin(5 deg); pair (1,2): A = Rz(-10) T(1 0 0) Rz(20): |Rz(-10) e_x - Rz(10) e_x| =
+// 2 sin(10 deg); (2,3) ends at the last pose (dropped). B^-1 A would give 0 and 2 sin(5 deg).
+TEST(Rpe, TranslationIsTheScriptsNotThePapers) {
+    core::Trajectory gt, est;
+    for (int i = 0; i < 4; ++i) {
+        gt.push_back({double(i), CPose3D(i, 0, 0, 0, 0, 0)});
+        est.push_back({double(i), CPose3D(i, 0, 0, mrpt::DEG2RAD(10.0 * i), 0, 0)});
+    }
+    eval::RpeOptions o;
+    o.delta = 1;
+    o.delta_in_frames = true;
+    const auto r = eval::computeRpe(gt, est, o);
+    ASSERT_EQ(r.n_pairs, 2u);
+    EXPECT_NEAR(r.trans.min, 2 * std::sin(mrpt::DEG2RAD(5.0)), 1e-12);
+    EXPECT_NEAR(r.trans.max, 2 * std::sin(mrpt::DEG2RAD(10.0)), 1e-12);
+    EXPECT_NEAR(r.rot.min, 10.0, 1e-9);
+    EXPECT_NEAR(r.rot.max, 10.0, 1e-9);
+    // The script's definition, transcribed with 4x4 matrices: ominus(a, b) = a^-1 b.
+    const auto M = [](const CPose3D& p) { return core::toIsometry(p).matrix(); };
+    const auto ominus = [](const Eigen::Matrix4d& a, const Eigen::Matrix4d& b) {
+        return Eigen::Matrix4d(a.inverse() * b);
+    };
+    for (int i = 0; i < 2; ++i) {
+        const Eigen::Matrix4d e = ominus(ominus(M(est[i + 1].pose), M(est[i].pose)),
+                                         ominus(M(gt[i + 1].pose), M(gt[i].pose)));
+        const double t = e.block<3, 1>(0, 3).norm();
+        EXPECT_NEAR(t, i == 0 ? r.trans.min : r.trans.max, 1e-12);
+    }
+    // One pair is too few, as there: the script raises.
+    core::Trajectory gt3(gt.begin(), gt.begin() + 3), est3(est.begin(), est.begin() + 3);
+    try {
+        (void)eval::computeRpe(gt3, est3, o);
+        ADD_FAILURE() << "one pair gave figures";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("RPE: one pose pair 1 frames apart"),
+                  std::string::npos)
+            << e.what();
+    }
 }
 
 // The real fr1_xyz ground truth (100 Hz motion capture), subsampled and perturbed by known

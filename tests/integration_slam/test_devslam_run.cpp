@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <regex>
 #include <sstream>
 #include <string>
 
@@ -223,9 +224,11 @@ TEST(DevslamRun, CtrlCStopsTheRunAndKeepsTheFramesDone) {
         " fps", SIGINT, (dir / "log.txt").string());
     ASSERT_TRUE(r.signalled) << "it ended before the signal:\n" << r.out;
     EXPECT_EQ(r.rc, 130) << r.out;
-    const auto at = r.out.find("devslam-run: interrupted (SIGINT) after ");
-    ASSERT_NE(at, std::string::npos) << r.out;
-    const std::size_t frames = std::stoul(r.out.substr(at + 40));
+    std::smatch at;
+    ASSERT_TRUE(std::regex_search(
+        r.out, at, std::regex(R"(devslam-run: interrupted \(SIGINT\) after (\d+) )")))
+        << r.out;
+    const std::size_t frames = std::stoul(at[1].str());
     EXPECT_GT(frames, 0u);
     EXPECT_LT(frames, 37000u);
     EXPECT_NE(r.out.find(" frames; " + (dir / "run").string() + " holds their results"),

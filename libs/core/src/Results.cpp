@@ -74,9 +74,20 @@ void replaceResultsSection(const std::string& path, const std::string& name,
     writeFileWhole(path, withSection(path, name, markdown));
 }
 
-void writeFileWhole(const std::string& path, const std::string& text) {
-    const std::string part = path + ".part";
+void writeFileWhole(const std::string& link, const std::string& text) {
+    namespace fs = std::filesystem;
     std::error_code ec;
+    // The rename would replace a symbolic link (say, a RESULTS.md linked from elsewhere) by a
+    // plain file: the file it points to is written instead, beside itself.
+    std::string path = link;
+    if (fs::is_symlink(link, ec)) {
+        const fs::path target = fs::canonical(link, ec);
+        if (ec)
+            throw std::runtime_error("cannot write '" + link + "': its link leads nowhere (" +
+                                     ec.message() + ")");
+        path = target.string();
+    }
+    const std::string part = path + ".part";
     {
         errno = 0;
         std::ofstream out(part, std::ios::trunc | std::ios::binary);
@@ -89,6 +100,9 @@ void writeFileWhole(const std::string& path, const std::string& text) {
             throw std::runtime_error("cannot write '" + part + "': " + why);
         }
     }
+    // The file keeps its permissions (the .part got the default ones).
+    if (const fs::file_status st = fs::status(path, ec); !ec && fs::exists(st))
+        fs::permissions(part, st.permissions(), ec);
     std::filesystem::rename(part, path, ec);
     if (ec) {
         const std::string why = ec.message();

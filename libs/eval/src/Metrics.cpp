@@ -123,16 +123,22 @@ RpeResult computeRpe(const core::Trajectory& gt, const core::Trajectory& est,
         if (std::abs(sg[g0] - (se[i] + opts.offset)) > gt_max_dt ||
             std::abs(sg[g1] - (se[j] + opts.offset)) > gt_max_dt)
             continue;
-        const mrpt::poses::CPose3D rel_est = est[j].pose - est[i].pose;  // P_i^-1 P_j
-        const mrpt::poses::CPose3D rel_gt = gt[g1].pose - gt[g0].pose;   // Q_i^-1 Q_j
-        const mrpt::poses::CPose3D err = rel_gt - rel_est;               // (P rel)^-1 (Q rel)
+        const mrpt::poses::CPose3D rel_est = est[j].pose - est[i].pose;  // A = P_i^-1 P_j
+        mrpt::poses::CPose3D inv_rel_gt = gt[g1].pose - gt[g0].pose;     // B = Q_i^-1 Q_j
+        inv_rel_gt.inverse();
+        // evaluate_rpe.py's ominus(ominus(P_j, P_i), ominus(Q_j, Q_i)) = A B^-1. Its
+        // translation, t_A - R_A R_B^T t_B, is not that of A^-1 B (|t_B - t_A|) when the
+        // rotations differ: a rotation error adds to the translational figure there.
+        const mrpt::poses::CPose3D err = rel_est + inv_rel_gt;
         trans.push_back(err.norm());
         rot.push_back(core::rotationAngle(err) * 180.0 / M_PI);
     }
-    if (trans.empty())
-        throw std::invalid_argument("RPE: no pose pair " + std::to_string(opts.delta) +
-                                    (opts.delta_in_frames ? " frames" : " s") +
-                                    " apart has ground truth (sequence too short?)");
+    // evaluate_rpe.py gives no figures for fewer than two pairs either.
+    if (trans.size() < 2)
+        throw std::invalid_argument(
+            "RPE: " + std::string(trans.empty() ? "no pose pair" : "one pose pair") + " " +
+            (std::ostringstream() << opts.delta).str() + (opts.delta_in_frames ? " frames" : " s") +
+            " apart has ground truth, two are needed (sequence too short?)");
     RpeResult r;
     r.trans = core::summarize(trans);
     r.rot = core::summarize(rot);

@@ -58,11 +58,13 @@ struct RpeResult {
     std::size_t n_pairs = 0;
 };
 
-/// E_i = (Q_i^-1 Q_j)^-1 (P_i^-1 P_j), j = the estimate index closest to "i + delta" (the
-/// paper's (2)-(3); evaluate_rpe.py --fixed_delta, which also skips j = last index): the
-/// translational norm and rotation angle of E_i. Q (ground truth) is the gt pose closest
-/// to each estimate stamp, and a pair is skipped when that is more than twice the median gt
-/// interval away, as evaluate_rpe.py does. Throws std::invalid_argument when no pair exists.
+/// E_i = (P_i^-1 P_j) (Q_i^-1 Q_j)^-1, j = the estimate index closest to "i + delta"
+/// (evaluate_rpe.py --fixed_delta, which also skips j = last index): the translational norm
+/// and rotation angle of E_i. The TUM paper's (Q_i^-1 Q_j)^-1 (P_i^-1 P_j) has the same angle
+/// but another translation; the script's is the one published (docs/eval.md). Q (ground
+/// truth) is the gt pose closest to each estimate stamp, and a pair is skipped when that is
+/// more than twice the median gt interval away, as evaluate_rpe.py does. Throws
+/// std::invalid_argument when fewer than two pairs exist (evaluate_rpe.py raises too).
 [[nodiscard]] RpeResult computeRpe(const core::Trajectory& gt, const core::Trajectory& est,
                                    const RpeOptions& opts = {});
 
