@@ -118,6 +118,36 @@ TEST(ShiTomasi, RegionWithMaskMatchesGoodFeaturesToTrackOnTheRegion) {
     EXPECT_GE(same, got.size() * 9 / 10) << got.size() << " corners, " << same << " shared";
 }
 
+TEST(ShiTomasi, TakenCornersAreNotChosenAgain) {
+    // The filter's per-box selection after its image-wide one (same map): the region's own
+    // corners, max_corners of them where it has that many, none within min_distance of a
+    // corner taken before, whether inside the region or just outside it.
+    const cv::Mat work = workImage();
+    const auto map = dynamic::ShiTomasiMap::compute(work);
+    const cv::Rect roi(100, 60, 90, 120);
+    const auto all =
+        dynamic::selectShiTomasi(map, cv::Rect(0, 0, work.cols, work.rows), 200, 0.01, 5);
+    const auto plain = dynamic::selectShiTomasi(map, roi, 40, 0.01, 2.5);
+    std::size_t shared = 0;
+    for (const auto& p : plain) shared += std::count(all.begin(), all.end(), p) > 0;
+    ASSERT_GT(shared, 3u) << "the region's strongest corners are the image's too";
+    const auto own = dynamic::selectShiTomasi(map, roi, 40, 0.01, 2.5, cv::Mat(), all);
+    EXPECT_EQ(own.size(), 40u);
+    for (const auto& p : own) {
+        EXPECT_TRUE(roi.contains(cv::Point(cvRound(p.x), cvRound(p.y))));
+        for (const auto& q : all) EXPECT_GE(cv::norm(p - q), 2.5) << p << " near " << q;
+    }
+    for (std::size_t i = 0; i < own.size(); ++i)
+        for (std::size_t j = i + 1; j < own.size(); ++j) EXPECT_GE(cv::norm(own[i] - own[j]), 2.5);
+    // Without a spacing, only the taken pixels themselves are left out.
+    const auto dense = dynamic::selectShiTomasi(map, roi, 0, 0.01, 0, cv::Mat(), all);
+    const auto dense_plain = dynamic::selectShiTomasi(map, roi, 0, 0.01, 0);
+    std::size_t in_roi = 0;
+    for (const auto& q : all) in_roi += std::count(dense_plain.begin(), dense_plain.end(), q) > 0;
+    EXPECT_EQ(dense.size() + in_roi, dense_plain.size());
+    for (const auto& p : dense) EXPECT_EQ(std::count(all.begin(), all.end(), p), 0);
+}
+
 TEST(ShiTomasi, BadArgumentsAreRejected) {
     const auto map = dynamic::ShiTomasiMap::compute(workImage());
     EXPECT_THROW((void)dynamic::selectShiTomasi(map, cv::Rect(300, 0, 40, 40), 10, 0.01, 5),

@@ -206,6 +206,10 @@ void DynamicObjectFilter::Options::loadFromConfig(const mrpt::config::CConfigFil
     mask_unknown_first_frame =
         core::readBool(c, s, "mask_unknown_first_frame", mask_unknown_first_frame);
     mask_border_snap = core::readInt(c, s, "mask_border_snap", mask_border_snap);
+    validate(s);
+}
+
+void DynamicObjectFilter::Options::validate(const std::string& s) const {
     core::requireValue(mask_border_snap >= 0, s, "mask_border_snap", "must be >= 0");
     core::requireValue(detect_every >= 1, s, "detect_every", "must be >= 1");
     core::requireValue(flow_scale > 0.1 && flow_scale <= 1.0, s, "flow_scale",
@@ -414,6 +418,7 @@ DynamicObjectFilter::DynamicObjectFilter(const Options& opts,
     if (!detector_ && opts_.mode != MaskMode::None)
         throw std::invalid_argument("dynamic filter: mode '" + toString(opts_.mode) +
                                     "' needs a detector");
+    opts_.validate();  // options set in code get the INI's checks (detect_every 0 divides by 0)
 }
 
 DynamicObjectFilter::~DynamicObjectFilter() = default;
@@ -432,6 +437,9 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
     out.mask = cv::Mat::zeros(frame.bgr.size(), CV_8UC1);
     if (opts_.mode == MaskMode::None) return out;
 
+    // A frame of another size has no previous frame to flow from, and the tracks' boxes
+    // are in the old size's pixels: it starts afresh, as a first frame.
+    if (!impl_->prev_depth.empty() && impl_->prev_depth.size() != frame.bgr.size()) reset();
     Impl& im = *impl_;
     const auto t_filter0 = Clock::now();
     double detect_ms = 0;
@@ -538,8 +546,12 @@ PointFlow DynamicObjectFilter::Impl::trackCorners(const Options& o, const cv::Re
                 cv::inRange(prev_depth(full), zp - h, zp + h, band);
                 cv::resize(band, fg, roi.size(), 0, 0, cv::INTER_NEAREST);
             }
+            // A box's strongest corners are often the image's too (one eigenvalue map), and
+            // overlapping boxes share theirs: the box gets corners of its own, apart from those
+            // chosen before, or one pixel's flow would count twice towards its evidence
+            // (min_points, threshold2_count), as it did until session 32.
             const auto pts = selectShiTomasi(corner_map, roi, o.max_corners_per_box,
-                                             o.corner_quality, o.corner_min_distance * 0.5, fg);
+                                             o.corner_quality, o.corner_min_distance * 0.5, fg, p0);
             p0.insert(p0.end(), pts.begin(), pts.end());
         }
     }
@@ -647,7 +659,8 @@ void DynamicObjectFilter::Impl::measureBoxes(const cv::Mat& depth, const Options
     tracks.erase(std::remove_if(tracks.begin(), tracks.end(),
                                 [](const Track& t) { return t.tb.box.area() < 16.f; }),
                  tracks.end());
-    const bool need_depth = o.fg_depth_band > 0 || o.mask_silhouette || o.depth_frames > 0;
+    const bool need_depth = o.fg_depth_band > 0 || o.mask_silhouette || o.depth_frames > 0 ||
+                            (o.slow_frames > 0 && o.slow_speed > 0);
     for (auto& t : tracks)
         t.depth = need_depth ? personDepth(depth, t.tb.box, o.max_depth) : std::nullopt;
 }
@@ -701,8 +714,10 @@ Eigen::Isometry3d DynamicObjectFilter::Impl::egoMotion(
     const bool ok = cv::solvePnPRansac(bg_obj, bg_img, K_cv, cv::noArray(), rvec, tvec, true,
                                        100, static_cast<float>(o.ransac_reprojection), 0.99,
                                        inliers, cv::SOLVEPNP_ITERATIVE);
+    // At least a quarter of the background points: walkers the detector missed, and the
+    // clutter around the boxes, can be many of them.
     if (ok && static_cast<int>(inliers.size()) >= o.min_background_points &&
-        inliers.size() * 2 >= bg_obj.size() / 2) {
+        inliers.size() * 4 >= bg_obj.size()) {
         cv::Mat R_new;
         cv::Rodrigues(rvec, R_new);
         Eigen::Matrix3d R;

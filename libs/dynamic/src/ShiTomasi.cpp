@@ -3,6 +3,8 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <cmath>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <tuple>
@@ -52,7 +54,8 @@ void ShiTomasiMap::update(const cv::Mat& gray) {
 
 std::vector<cv::Point2f> selectShiTomasi(const ShiTomasiMap& map, const cv::Rect& roi,
                                          int max_corners, double quality, double min_distance,
-                                         const cv::Mat& mask) {
+                                         const cv::Mat& mask,
+                                         const std::vector<cv::Point2f>& taken) {
     if (map.empty()) throw std::invalid_argument("Shi-Tomasi selection: empty map");
     const cv::Rect whole(0, 0, map.eig.cols, map.eig.rows);
     if (roi.width < 0 || roi.height < 0 || (!roi.empty() && (roi & whole) != roi))
@@ -93,8 +96,11 @@ std::vector<cv::Point2f> selectShiTomasi(const ShiTomasiMap& map, const cv::Rect
     };
     const cv::Point2f offset(static_cast<float>(roi.x), static_cast<float>(roi.y));
     if (min_distance < 1) {
+        std::set<std::pair<int, int>> used;  // the taken corners' pixels in the region
+        for (const auto& q : taken) used.insert({cvRound(q.y) - roi.y, cvRound(q.x) - roi.x});
         for (const auto& c : cand) {
             if (full()) break;
+            if (used.count({c.y, c.x})) continue;
             corners.emplace_back(cv::Point2f(static_cast<float>(c.x), static_cast<float>(c.y)) +
                                  offset);
         }
@@ -105,6 +111,21 @@ std::vector<cv::Point2f> selectShiTomasi(const ShiTomasiMap& map, const cv::Rect
     const int gw = (roi.width + cell - 1) / cell, gh = (roi.height + cell - 1) / cell;
     std::vector<std::vector<cv::Point2f>> grid(static_cast<std::size_t>(gw) * gh);
     const auto d2 = static_cast<float>(min_distance * min_distance);
+    // The taken corners within min_distance of the region hold their place: one just outside
+    // goes into the nearest border cell, whose 3x3 neighbourhood holds every candidate closer
+    // to it than min_distance.
+    for (const auto& q : taken) {
+        const cv::Point2f r = q - offset;
+        const auto md = static_cast<float>(min_distance);
+        if (r.x <= -md || r.y <= -md || r.x >= static_cast<float>(roi.width) + md ||
+            r.y >= static_cast<float>(roi.height) + md)
+            continue;
+        const int cx =
+            std::clamp(static_cast<int>(std::floor(r.x / static_cast<float>(cell))), 0, gw - 1);
+        const int cy =
+            std::clamp(static_cast<int>(std::floor(r.y / static_cast<float>(cell))), 0, gh - 1);
+        grid[static_cast<std::size_t>(cy) * gw + cx].push_back(r);
+    }
     for (const auto& c : cand) {
         const int cx = c.x / cell, cy = c.y / cell;
         bool good = true;

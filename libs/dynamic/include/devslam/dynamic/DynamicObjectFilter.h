@@ -228,6 +228,9 @@ class DynamicObjectFilter {
         /// Reads `[section]`; unknown keys throw std::invalid_argument naming them.
         void loadFromConfig(const mrpt::config::CConfigFileBase& cfg,
                             const std::string& section = "dynamic_filter");
+        /// Throws std::invalid_argument "[section] key: must be ..." for the first value out
+        /// of range (loadFromConfig and the filter's constructor call it).
+        void validate(const std::string& section = "dynamic_filter") const;
         void saveToConfig(mrpt::config::CConfigFileBase& cfg,
                           const std::string& section = "dynamic_filter") const;
     };
