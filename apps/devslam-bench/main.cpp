@@ -705,10 +705,22 @@ int run(int argc, char** argv) {
                << fmt(med(v, &R::rpe_t_mean), 6) << "," << fmt(med(v, &R::rpe_t_median), 6) << ","
                << fmt(med(v, &R::rpe_r_rmse), 4) << "," << fmt(med(v, &R::rpe_r_mean), 4) << ","
                << fmt(med(v, &R::rpe_r_median), 4) << "\n";
+            // A run that finished may lack a figure (no ground truth, too short for the RPE):
+            // the medians are over the runs that have it, and the table says how many.
+            const auto having = [&](double R::*field) {
+                int n = 0;
+                for (const auto& f : v) n += f.ok && !std::isnan(f.*field);
+                return n;
+            };
+            std::string runs_ok = std::to_string(ok) + "/" + std::to_string(v.size());
+            if (const int n = having(&R::ate_rmse); n < ok)
+                runs_ok += "; ATE from " + std::to_string(n);
+            if (const int n = having(&R::rpe_t_rmse); n < ok)
+                runs_ok += "; RPE from " + std::to_string(n);
             // 5 decimals: sitting_xyz's modes differ by tenths of a millimetre.
             t2 << "| " << q.name << " | " << m << " | " << fmt(med(v, &R::ate_rmse), 5) << " | "
                << fmt(med(v, &R::ate_mean), 5) << " | " << fmt(med(v, &R::ate_median), 5) << " | "
-               << fmt(med(v, &R::lost), 0) << " | " << ok << "/" << v.size() << " |\n";
+               << fmt(med(v, &R::lost), 0) << " | " << runs_ok << " |\n";
             c2 << q.name << "," << m << "," << fmt(med(v, &R::ate_rmse), 6) << ","
                << fmt(med(v, &R::ate_mean), 6) << "," << fmt(med(v, &R::ate_median), 6) << ","
                << fmt(med(v, &R::lost), 0) << "," << ok << "\n";
@@ -912,6 +924,9 @@ int run(int argc, char** argv) {
        << targets_md.str() << "**Table 1: RPE**\n\n"
        << t1.str() << "\n**Table 2: ATE**\n\n"
        << t2.str()
+       << "\n*runs ok*: the runs that finished, of those made. Tables 1 and 2 give medians over "
+          "the runs that have the figure; *runs ok* says so where fewer do (\"RPE from 3\": a "
+          "run too short for pairs 1 s apart, or without ground truth).\n"
        << (t5.str().empty()
                ? std::string()
                : "\n**ATE RMSE (m) per render** (median over the render's runs; Table 2 gives "

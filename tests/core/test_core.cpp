@@ -433,9 +433,13 @@ TEST(Results, FilesAreWrittenWholeAndHashedByContent) {
               fs::perms::owner_read | fs::perms::owner_write);
     EXPECT_FALSE(fs::exists(dir / "a.txt.part"));
     EXPECT_FALSE(fs::exists(dir / "link.txt.part"));
-    fs::create_symlink("nowhere.txt", dir / "dangling.txt");
-    EXPECT_THROW(devslam::core::writeFileWhole((dir / "dangling.txt").string(), "x"),
-                 std::runtime_error);
+    // A link to a file not made yet makes it, as a shell's `>` would.
+    fs::create_symlink("later.txt", dir / "dangling.txt");
+    devslam::core::writeFileWhole((dir / "dangling.txt").string(), "five\n");
+    EXPECT_TRUE(fs::is_symlink(dir / "dangling.txt"));
+    std::ifstream later(dir / "later.txt");
+    std::getline(later, line);
+    EXPECT_EQ(line, "five");
     std::filesystem::remove_all(dir);
 }
 

@@ -148,7 +148,7 @@ TEST(RelativePose, ErrorOfAMeasuredConstraintAgainstTheTruth) {
 }
 
 TEST(Rpe, ConstantDriftGivesExpectedError) {
-    // World-frame drift d per frame: E_i has translation -(j-i) R_j^T d, norm (j-i)|d|,
+    // World-frame drift d per frame: E_i has translation (j-i) R_i^T d, norm (j-i)|d|,
     // and no rotation, whatever the ground truth's orientation.
     const auto gt = helix(300, 30);
     auto est = gt;

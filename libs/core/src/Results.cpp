@@ -78,15 +78,17 @@ void writeFileWhole(const std::string& link, const std::string& text) {
     namespace fs = std::filesystem;
     std::error_code ec;
     // The rename would replace a symbolic link (say, a RESULTS.md linked from elsewhere) by a
-    // plain file: the file it points to is written instead, beside itself.
-    std::string path = link;
-    if (fs::is_symlink(link, ec)) {
-        const fs::path target = fs::canonical(link, ec);
-        if (ec)
-            throw std::runtime_error("cannot write '" + link + "': its link leads nowhere (" +
-                                     ec.message() + ")");
-        path = target.string();
+    // plain file: the file it points to is written instead, beside itself (and made, as a
+    // shell's `>` would, when the link's target does not exist yet).
+    fs::path target = link;
+    for (int hops = 0; fs::is_symlink(target, ec); ++hops) {
+        const fs::path next = fs::read_symlink(target, ec);
+        if (ec || hops == 40)
+            throw std::runtime_error("cannot write '" + link + "': " +
+                                     (ec ? ec.message() : "too many levels of symbolic links"));
+        target = next.is_absolute() ? next : target.parent_path() / next;
     }
+    const std::string path = target.string();
     const std::string part = path + ".part";
     {
         errno = 0;

@@ -115,7 +115,10 @@ std::vector<cv::Point2f> selectShiTomasi(const ShiTomasiMap& map, const cv::Rect
     // goes into the nearest border cell, whose 3x3 neighbourhood holds every candidate closer
     // to it than min_distance.
     for (const auto& q : taken) {
-        const cv::Point2f r = q - offset;
+        // Whole pixels, as the candidates: then one in a cell two cells away from another is
+        // at least cell + 1 > min_distance from it (a fractional one could be closer).
+        const cv::Point2f r(static_cast<float>(cvRound(q.x) - roi.x),
+                            static_cast<float>(cvRound(q.y) - roi.y));
         const auto md = static_cast<float>(min_distance);
         if (r.x <= -md || r.y <= -md || r.x >= static_cast<float>(roi.width) + md ||
             r.y >= static_cast<float>(roi.height) + md)

@@ -24,7 +24,7 @@ void replaceResultsSection(const std::string& path, const std::string& name,
 /// Writes `text` to `path` whole or not at all: into `path`.part, then renamed over `path`,
 /// so that a program killed on the way leaves the old file (and at most the .part beside it).
 /// The file keeps its permissions; a symbolic link stays one (the file it leads to is
-/// replaced). Throws std::runtime_error naming the file when it cannot be written.
+/// replaced, or made). Throws std::runtime_error naming the file when it cannot be written.
 void writeFileWhole(const std::string& path, const std::string& text);
 
 /// FNV-1a (64 bit) of a file's bytes as 16 hex digits, "" when it cannot be read: tells

@@ -44,9 +44,10 @@ struct ShiTomasiMap {
 /// Corners in `roi` of the map (coordinates of the whole image). mask: empty, or CV_8U of
 /// roi's size (non-zero = allowed), like goodFeaturesToTrack's mask. max_corners <= 0: no
 /// limit. The outermost row and column of the roi are skipped, as goodFeaturesToTrack does.
-/// taken: corners chosen before (whole-image coordinates, say the image-wide selection's):
-/// none is returned again, and the new ones keep min_distance from them as from each other,
-/// so that max_corners new corners are found where the region has them.
+/// taken: corners chosen before (whole-image coordinates, say the image-wide selection's,
+/// rounded to whole pixels): none is returned again, and the new ones keep min_distance from
+/// them as from each other, so that max_corners new corners are found where the region has
+/// them.
 [[nodiscard]] std::vector<cv::Point2f> selectShiTomasi(const ShiTomasiMap& map, const cv::Rect& roi,
                                                        int max_corners, double quality,
                                                        double min_distance,
