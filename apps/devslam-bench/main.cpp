@@ -666,10 +666,15 @@ int run(int argc, char** argv) {
                 }
 
     // 3. Medians over the runs (renders x repeats); the median-ATE run's plot is kept.
-    const auto med = [&](const std::vector<RunFigures>& v, double RunFigures::*field) {
+    // A figure of the runs that finished and have it (no ground truth, too short for the RPE).
+    const auto having = [](const std::vector<RunFigures>& v, double RunFigures::*field) {
         std::vector<double> x;
         for (const auto& f : v)
             if (f.ok && !std::isnan(f.*field)) x.push_back(f.*field);
+        return x;
+    };
+    const auto med = [&](const std::vector<RunFigures>& v, double RunFigures::*field) {
+        const auto x = having(v, field);
         return x.empty() ? std::numeric_limits<double>::quiet_NaN() : core::median(x);
     };
     std::ostringstream t1, t2, t3, t4, t5;
@@ -705,17 +710,11 @@ int run(int argc, char** argv) {
                << fmt(med(v, &R::rpe_t_mean), 6) << "," << fmt(med(v, &R::rpe_t_median), 6) << ","
                << fmt(med(v, &R::rpe_r_rmse), 4) << "," << fmt(med(v, &R::rpe_r_mean), 4) << ","
                << fmt(med(v, &R::rpe_r_median), 4) << "\n";
-            // A run that finished may lack a figure (no ground truth, too short for the RPE):
-            // the medians are over the runs that have it, and the table says how many.
-            const auto having = [&](double R::*field) {
-                int n = 0;
-                for (const auto& f : v) n += f.ok && !std::isnan(f.*field);
-                return n;
-            };
+            // The medians are over the runs that have the figure: the table says how many.
             std::string runs_ok = std::to_string(ok) + "/" + std::to_string(v.size());
-            if (const int n = having(&R::ate_rmse); n < ok)
+            if (const auto n = having(v, &R::ate_rmse).size(); n < std::size_t(ok))
                 runs_ok += "; ATE from " + std::to_string(n);
-            if (const int n = having(&R::rpe_t_rmse); n < ok)
+            if (const auto n = having(v, &R::rpe_t_rmse).size(); n < std::size_t(ok))
                 runs_ok += "; RPE from " + std::to_string(n);
             // 5 decimals: sitting_xyz's modes differ by tenths of a millimetre.
             t2 << "| " << q.name << " | " << m << " | " << fmt(med(v, &R::ate_rmse), 5) << " | "

@@ -3,7 +3,6 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
-#include <cmath>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -117,17 +116,14 @@ std::vector<cv::Point2f> selectShiTomasi(const ShiTomasiMap& map, const cv::Rect
     for (const auto& q : taken) {
         // Whole pixels, as the candidates: then one in a cell two cells away from another is
         // at least cell + 1 > min_distance from it (a fractional one could be closer).
-        const cv::Point2f r(static_cast<float>(cvRound(q.x) - roi.x),
-                            static_cast<float>(cvRound(q.y) - roi.y));
-        const auto md = static_cast<float>(min_distance);
-        if (r.x <= -md || r.y <= -md || r.x >= static_cast<float>(roi.width) + md ||
-            r.y >= static_cast<float>(roi.height) + md)
+        const int x = cvRound(q.x) - roi.x, y = cvRound(q.y) - roi.y;
+        if (x <= -min_distance || y <= -min_distance || x >= roi.width + min_distance ||
+            y >= roi.height + min_distance)
             continue;
-        const int cx =
-            std::clamp(static_cast<int>(std::floor(r.x / static_cast<float>(cell))), 0, gw - 1);
-        const int cy =
-            std::clamp(static_cast<int>(std::floor(r.y / static_cast<float>(cell))), 0, gh - 1);
-        grid[static_cast<std::size_t>(cy) * gw + cx].push_back(r);
+        // (x / cell rounds a negative x towards 0: the clamp puts it in the border cell anyway)
+        const int cx = std::clamp(x / cell, 0, gw - 1), cy = std::clamp(y / cell, 0, gh - 1);
+        grid[static_cast<std::size_t>(cy) * gw + cx].push_back(
+            cv::Point2f(static_cast<float>(x), static_cast<float>(y)));
     }
     for (const auto& c : cand) {
         const int cx = c.x / cell, cy = c.y / cell;
