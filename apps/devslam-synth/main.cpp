@@ -1,9 +1,13 @@
 // devslam-synth: renders a synthetic dynamic RGB-D sequence with exact ground truth.
 //
-//   devslam-synth walking_xyz                      # sim_worlds/synth/walking_xyz.ini ->
-//   out/synth/walking_xyz devslam-synth path/to/scenario.ini -o DIR [--rawlog FILE] [--frames N]
-//   [--no-labels] devslam-synth --list                           # the shipped scenarios
-//   devslam-synth --cut-texture IMAGE X,Y,W,H OUT.png   # person photo -> RGBA texture (GrabCut)
+//   devslam-synth walking_xyz          # sim_worlds/synth/walking_xyz.ini -> out/synth/walking_xyz
+//   devslam-synth path/to/scenario.ini -o DIR [--rawlog FILE] [--frames N] [--no-labels]
+//   devslam-synth --list               # the shipped scenarios
+//   devslam-synth --cut-texture IMAGE X,Y,W,H OUT.png   # person photo -> RGBA texture
+//
+// Ctrl-C stops the render after the current frame: the frames so far are written as a TUM
+// folder, without render.txt (so --if-changed renders it again).
+#include <devslam/core/Interrupt.h>
 #include <devslam/core/Parse.h>
 #include <devslam/core/Progress.h>
 #include <devslam/render/PersonTexture.h>
@@ -37,7 +41,9 @@ const char* kUsage =
     "SCENARIO: a name from sim_worlds/synth/ (e.g. walking_xyz) or an INI file.\n"
     "Writes a TUM folder (rgb/ depth/ rgb.txt depth.txt groundtruth.txt) plus persons.txt,\n"
     "labels/, camera.ini and preview.png, and render.txt last (what the render is made of:\n"
-    "scenario and room text, seed, frames); default DIR: out/synth/<name>.\n";
+    "scenario and room text, seed, frames); default DIR: out/synth/<name>.\n"
+    "Ctrl-C stops after the current frame: DIR then holds the frames rendered so far as a\n"
+    "TUM folder with their ground truth, and no render.txt.\n";
 
 const std::string kSynthDir = std::string(DEVSLAM_SOURCE_DIR) + "/sim_worlds/synth";
 
@@ -169,9 +175,17 @@ int run(int argc, char** argv) {
             throw std::runtime_error("cannot write '" + prev + "'");
     }
     core::ProgressBar bar("render " + sc.name, n);
+    o.stop = [] { return core::stopSignal() != 0; };
     const auto sum =
         render::writeSequence(sc, o, [&](std::size_t done, std::size_t) { bar.update(done); });
     bar.finish();
+    if (sum.stopped) {
+        std::cerr << "devslam-synth: interrupted (" << core::signalName(core::stopSignal())
+                  << ") after " << sum.n_frames << " of " << n << " frames: " << out_dir
+                  << " holds them as a TUM folder with their ground truth; render.txt was not "
+                     "written, so it is not a current render (--if-changed renders it again)\n";
+        return 1;
+    }
 
     std::cout << "scenario " << sc.name << " -> " << out_dir << "\n"
               << "  frames " << sum.n_frames << " (" << sc.rate_hz << " Hz), intrinsics fx "
@@ -187,10 +201,14 @@ int run(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
+    core::installStopHandler("devslam-synth");
+    int rc = 1;
     try {
-        return run(argc, argv);
+        rc = run(argc, argv);
     } catch (const std::exception& e) {
         std::cerr << "devslam-synth: " << e.what() << "\n";
-        return 1;
     }
+    // After Ctrl-C, with every file closed: end by the signal, so that a script stops too.
+    if (const int sig = core::stopSignal()) core::exitBySignal(sig);
+    return rc;
 }

@@ -444,6 +444,41 @@ TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
     fs::remove_all(tmp);
 }
 
+// Ctrl-C stops devslam-synth after the current frame: the frames so far are a TUM folder with
+// their ground truth, and without render.txt the folder is not taken for a finished render.
+// (The signal comes with the first progress line, about 4.5 s in; 300 frames take 30 s.)
+TEST(DevslamSynth, CtrlCKeepsTheFramesRenderedSoFar) {
+    const fs::path tmp = devslam::test::scratchPath("devslam_synth_ctrl_c");
+    fs::remove_all(tmp);
+    fs::create_directories(tmp);
+    const auto r = devslam::test::signalAppWhen(
+        "devslam-synth", "walking_xyz --frames 300 --no-labels -o '" + (tmp / "seq").string() + "'",
+        "render walking_xyz [", SIGINT, (tmp / "log.txt").string());
+    ASSERT_TRUE(r.signalled) << "the render ended before the signal:\n" << r.out;
+    EXPECT_EQ(r.rc, 130) << r.out;
+    std::smatch m;
+    ASSERT_TRUE(std::regex_search(
+        r.out, m,
+        std::regex(
+            R"(devslam-synth: interrupted \(SIGINT\) after (\d+) of 300 frames: .* holds them)")))
+        << r.out;
+    const std::size_t frames = std::stoul(m[1].str());
+    EXPECT_GE(frames, 1u);
+    EXPECT_LT(frames, 300u);
+    const auto lines = [&](const char* name) {
+        std::istringstream in(readFile(tmp / "seq" / name));
+        std::size_t n = 0;
+        for (std::string l; std::getline(in, l);) n += !l.empty() && l[0] != '#';
+        return n;
+    };
+    EXPECT_EQ(lines("rgb.txt"), frames);
+    EXPECT_EQ(lines("depth.txt"), frames);
+    EXPECT_EQ(lines("groundtruth.txt"), frames);
+    EXPECT_TRUE(fs::exists(tmp / "seq/camera.ini"));
+    EXPECT_FALSE(fs::exists(tmp / "seq/render.txt"));
+    fs::remove_all(tmp);
+}
+
 // devslam-synth --seed: the same scene and camera path with other noise (how a setting is
 // compared on several renders, docs/dynamic.md); a bad value is refused.
 TEST(DevslamSynth, SeedOptionGivesAnotherRenderOfTheSameScene) {

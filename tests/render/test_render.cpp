@@ -371,6 +371,42 @@ TEST(RenderSequence, RenderTxtTellsWhetherAFolderHoldsThisRender) {
     EXPECT_FALSE(fs::exists(o.out_dir + "/labels"));
 }
 
+// Ctrl-C (WriteOptions::stop) ends a render at a frame: the frames before it are a whole TUM
+// folder with their ground truth, rawlog and person truth, but not a current render.
+TEST(RenderSequence, StopEndsTheRenderWithTheFramesBeforeItWritten) {
+    TempDir tmp;
+    const Scenario sc = smallShort();
+    WriteOptions o;
+    o.out_dir = tmp.str("seq");
+    o.rawlog_path = tmp.str("seq.rawlog");
+    o.max_frames = 5;
+    int asked = 0;
+    o.stop = [&] { return ++asked == 3; };  // asked before frames 0, 1, 2: stops before 2
+    const auto sum = writeSequence(sc, o);
+    EXPECT_TRUE(sum.stopped);
+    EXPECT_EQ(sum.n_frames, 2u);
+    EXPECT_EQ(asked, 3);
+    EXPECT_FALSE(fs::exists(o.out_dir + "/render.txt"));
+    EXPECT_FALSE(isRenderCurrent(sc, o));
+    auto tum = io::openRgbd(o.out_dir, {});
+    EXPECT_EQ(tum->size(), std::optional<std::size_t>(2));
+    EXPECT_EQ(io::readTumTrajectory(o.out_dir + "/groundtruth.txt").size(), 2u);
+    EXPECT_EQ(io::RawlogReader(o.rawlog_path).size(), std::optional<std::size_t>(2));
+    EXPECT_TRUE(fs::exists(o.out_dir + "/camera.ini"));
+    std::size_t person_rows = 0;
+    std::istringstream persons(readFile(o.out_dir + "/persons.txt"));
+    for (std::string line; std::getline(persons, line);)
+        person_rows += !line.empty() && line[0] != '#';
+    EXPECT_EQ(person_rows, 2 * sc.people.size());
+
+    // Not stopped: the whole render, and render.txt.
+    o.stop = [] { return false; };
+    const auto whole = writeSequence(sc, o);
+    EXPECT_FALSE(whole.stopped);
+    EXPECT_EQ(whole.n_frames, 5u);
+    EXPECT_TRUE(isRenderCurrent(sc, o));
+}
+
 // A seated person who moves a hand: the labelled pixels follow the hand (they differ between
 // the swing's two extremes only near the hand, and lie on the photo's plane), the person stays
 // static in the truth, and a person whose gesture_deg is 0 renders exactly as one without.

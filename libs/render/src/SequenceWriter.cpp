@@ -110,7 +110,12 @@ WriteSummary writeSequence(const Scenario& sc, const WriteOptions& o,
     core::Trajectory gt;
     WriteSummary sum;
     std::vector<double> ms;
-    for (std::size_t i = 0; i < n; ++i) {
+    std::size_t i = 0;
+    for (; i < n; ++i) {
+        if (o.stop && o.stop()) {
+            sum.stopped = true;
+            break;
+        }
         const auto t0 = std::chrono::steady_clock::now();
         const RenderedFrame rf = renderer.render(i);
         ms.push_back(
@@ -155,13 +160,13 @@ WriteSummary writeSequence(const Scenario& sc, const WriteOptions& o,
        << text;
     if (!cf) throw std::runtime_error("cannot write '" + cam_path + "'");
 
+    sum.n_frames = i;
+    sum.render_ms_median = core::median(ms);
+    if (sum.stopped) return sum;  // not this render's frame count: no render.txt
     const std::string sig_path = signaturePath(o).string();
     std::ofstream sf(sig_path, std::ios::binary);
     sf << signature;
     if (!sf) throw std::runtime_error("cannot write '" + sig_path + "'");
-
-    sum.n_frames = n;
-    sum.render_ms_median = core::median(ms);
     return sum;
 }
 

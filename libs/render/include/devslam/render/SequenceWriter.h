@@ -20,6 +20,10 @@ struct WriteOptions {
     std::string rawlog_path;     ///< empty = no rawlog
     bool write_labels = true;    ///< labels/<timestamp>.png (person id per pixel)
     std::size_t max_frames = 0;  ///< 0 = all frames of the scenario
+    /// Asked before each frame; true ends the render there (Ctrl-C): the frames rendered so
+    /// far are written as a whole TUM folder (lists, ground truth, camera.ini), but without
+    /// render.txt, so the folder is not a current render (isRenderCurrent).
+    std::function<bool()> stop;
 };
 
 struct WriteSummary {
@@ -28,6 +32,7 @@ struct WriteSummary {
     std::size_t frames_with_static_person =
         0;                          ///< frames where a sitting/standing person is visible
     double render_ms_median = 0.0;  ///< GL render + read-back per frame [ms]
+    bool stopped = false;           ///< WriteOptions::stop ended it before the last frame
 };
 
 /// Renders and writes every frame; `progress(done, total)` is called after each frame.
