@@ -2,8 +2,10 @@
 // people, office, obstacle near goal), the same worlds for every holonomic method, tables
 // per category written to the `nav` section of docs/RESULTS.md, plus PNGs. Also times one
 // VFH+ step and A* on a 400x400 grid. --quick: a smoke test (2 worlds per category, no
-// RESULTS.md unless --results is given).
+// RESULTS.md unless --results is given). Ctrl-C stops after the current episode and prints the
+// tables of the episodes done, leaving RESULTS.md and the pictures as they were.
 #include <devslam/core/Config.h>
+#include <devslam/core/Interrupt.h>
 #include <devslam/core/Parse.h>
 #include <devslam/core/Progress.h>
 #include <devslam/core/Results.h>
@@ -176,6 +178,7 @@ void writeChart(const std::string& path, const std::vector<devslam::sim::Categor
 }  // namespace
 
 int main(int argc, char** argv) {
+    devslam::core::installStopHandler("devslam-nav-bench");
     Args a;
     bool results_given = false, per_category_given = false, png_dir_given = false;
     try {
@@ -263,53 +266,56 @@ int main(int argc, char** argv) {
         size_t done = 0;
         const auto t_start = Clock::now();
         double sim_seconds = 0;
-        for (size_t c = 0; c < cats.size(); c++) {
-            for (int i = 0; i < a.per_category; i++) {
-                auto planner_opts = nav_opts.planner;
-                const auto world = devslam::sim::randomWorld(cats[c], a.seed + i, planner_opts);
-                for (const auto& m : a.methods) {
-                    devslam::sim::EpisodeOptions eo;
-                    eo.holonomic_method = m;
-                    const auto r = devslam::sim::runEpisode(world, *ini, nav_opts, eo);
-                    sim_seconds += r.time;
-                    auto& t = tally[{static_cast<int>(c), m}];
-                    t.n++;
-                    const double ot = r.astar_length / world.robot.max_v;  // optimal time
-                    double score = 0;
-                    switch (r.outcome) {
-                        case devslam::sim::Outcome::Success:
-                            t.success++;
-                            t.success_time.push_back(r.time);
-                            if (r.astar_length > 0)
-                                t.ratio.push_back(r.path_length / r.astar_length);
-                            score = ot / std::clamp(r.time, ot, 8.0 * ot);
-                            break;
-                        case devslam::sim::Outcome::Collision:
-                            t.collision++;
-                            break;
-                        default:
-                            t.timeout++;
-                            break;
+        // Returns the signal that stopped it (Ctrl-C, before an episode), else 0.
+        const auto runEpisodes = [&]() -> int {
+            for (size_t c = 0; c < cats.size(); c++) {
+                for (int i = 0; i < a.per_category; i++) {
+                    if (const int sig = devslam::core::stopSignal()) return sig;
+                    auto planner_opts = nav_opts.planner;
+                    const auto world = devslam::sim::randomWorld(cats[c], a.seed + i, planner_opts);
+                    for (const auto& m : a.methods) {
+                        if (const int sig = devslam::core::stopSignal()) return sig;
+                        devslam::sim::EpisodeOptions eo;
+                        eo.holonomic_method = m;
+                        const auto r = devslam::sim::runEpisode(world, *ini, nav_opts, eo);
+                        sim_seconds += r.time;
+                        auto& t = tally[{static_cast<int>(c), m}];
+                        t.n++;
+                        const double ot = r.astar_length / world.robot.max_v;  // optimal time
+                        double score = 0;
+                        switch (r.outcome) {
+                            case devslam::sim::Outcome::Success:
+                                t.success++;
+                                t.success_time.push_back(r.time);
+                                if (r.astar_length > 0)
+                                    t.ratio.push_back(r.path_length / r.astar_length);
+                                score = ot / std::clamp(r.time, ot, 8.0 * ot);
+                                break;
+                            case devslam::sim::Outcome::Collision:
+                                t.collision++;
+                                break;
+                            default:
+                                t.timeout++;
+                                break;
+                        }
+                        t.static_collision += r.static_collisions > 0 ? 1 : 0;
+                        t.person_collision += r.person_collisions > 0 ? 1 : 0;
+                        t.score.push_back(score);
+                        if (!world.pedestrians.empty())
+                            t.people_clearance.push_back(r.min_clearance_people);
+                        for (double s : r.step_seconds) step_ms[m].push_back(1e3 * s);
+                        if (i == 0 && m == a.methods.front())  // pictured after the results
+                            pictures.push_back({world, r, m});
+                        bar.update(++done, std::string(devslam::sim::toString(cats[c])) + " " +
+                                               shortName(m));
                     }
-                    t.static_collision += r.static_collisions > 0 ? 1 : 0;
-                    t.person_collision += r.person_collisions > 0 ? 1 : 0;
-                    t.score.push_back(score);
-                    if (!world.pedestrians.empty())
-                        t.people_clearance.push_back(r.min_clearance_people);
-                    for (double s : r.step_seconds) step_ms[m].push_back(1e3 * s);
-                    if (i == 0 && m == a.methods.front())  // pictured after the results
-                        pictures.push_back({world, r, m});
-                    bar.update(++done,
-                               std::string(devslam::sim::toString(cats[c])) + " " + shortName(m));
                 }
             }
-        }
+            return 0;
+        };
+        const int stopped = runEpisodes();
         bar.finish();
         const double wall = std::chrono::duration<double>(Clock::now() - t_start).count();
-
-        double astar_len = 0;
-        const double vfh_ms = timeVfhStep();
-        const double astar_ms = timeAStar400(&astar_len);
 
         std::ostringstream md;
         md << "## Navigation benchmark (`devslam-nav-bench`)\n\n"
@@ -329,7 +335,12 @@ int main(int argc, char** argv) {
               "that keep its clearance). Score (BARN-style) = success x OT / clip(T, OT, 8 OT) "
               "with OT = A* "
               "length / max speed, averaged over all runs.\n\n";
+        if (stopped)
+            md << "**Interrupted (" << devslam::core::signalName(stopped) << ") after " << done
+               << " of " << total << " episodes: the tables below cover those only.**\n\n";
         for (size_t c = 0; c < cats.size(); c++) {
+            // Stopped: a category not reached (its first world's first method did not run).
+            if (tally[{static_cast<int>(c), a.methods.front()}].n == 0) continue;
             const bool people = devslam::sim::hasPeople(cats[c]);
             md << "### " << devslam::sim::toString(cats[c])
                << (people ? " (moving people)" : " (static)") << "\n\n"
@@ -341,6 +352,7 @@ int main(int argc, char** argv) {
                << "\n|---|---|---|---|---|---|---|" << (people ? "---|---|" : "") << "\n";
             for (const auto& m : a.methods) {
                 const auto& t = tally[{static_cast<int>(c), m}];
+                if (t.n == 0) continue;  // stopped before this method's first run here
                 const auto st = devslam::core::summarize(t.success_time);
                 const auto rt = devslam::core::summarize(t.ratio);
                 const auto sc = devslam::core::summarize(t.score);
@@ -361,9 +373,23 @@ int main(int argc, char** argv) {
                     md << " - | - |";
                 md << "\n";
             }
-            md << "\n![" << devslam::sim::toString(cats[c]) << "](images/nav_bench_"
-               << devslam::sim::toString(cats[c]) << ".png)\n\n";
+            md << "\n";
+            if (!stopped)  // the pictures are made only by a whole run
+                md << "![" << devslam::sim::toString(cats[c]) << "](images/nav_bench_"
+                   << devslam::sim::toString(cats[c]) << ".png)\n\n";
         }
+        if (stopped) {
+            std::cout << md.str();
+            std::cerr << "devslam-nav-bench: interrupted (" << devslam::core::signalName(stopped)
+                      << ") after " << done << " of " << total
+                      << " episodes; the tables above cover those; "
+                      << (a.results.empty() ? std::string() : a.results + " and ")
+                      << "the pictures were left as they were\n";
+            devslam::core::exitBySignal(stopped);
+        }
+        double astar_len = 0;
+        const double vfh_ms = timeVfhStep();
+        const double astar_ms = timeAStar400(&astar_len);
         md << "![success rates](images/nav_bench_success.png)\n\n"
            << "### Timing (thread CPU time, so shared-machine load does not inflate it)\n\n| "
               "measure | median |\n|---|---|\n"
@@ -392,6 +418,8 @@ int main(int argc, char** argv) {
                 pictures[c].world.name + " / " + pictures[c].method);
         writeChart(a.png_dir + "/nav_bench_success.png", cats, a.methods, tally);
         std::cerr << "devslam-nav-bench: pictures in " << a.png_dir << "\n";
+        // Ctrl-C during the timings: all was written; end by the signal, as a script expects.
+        if (const int sig = devslam::core::stopSignal()) devslam::core::exitBySignal(sig);
         return 0;
     } catch (const std::exception& e) {
         std::cerr << "devslam-nav-bench: " << e.what() << "\n";

@@ -23,9 +23,12 @@
 #include <mrpt/system/filesystem.h>
 
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <regex>
+#include <sstream>
 
 namespace {
 const std::string kSrc = DEVSLAM_SOURCE_DIR;
@@ -202,5 +205,47 @@ TEST(IntegrationNav, AppsSmokeTest) {
     EXPECT_NE(r.out.find("section 'nav' needs"), std::string::npos) << r.out;
     EXPECT_EQ(r.out.find("nav-bench ["), std::string::npos) << "ran before refusing: " << r.out;
     EXPECT_FALSE(mrpt::system::directoryExists(out + "/refused"));
+    mrpt::system::deleteFilesInDirectory(out, true);
+}
+
+// Ctrl-C stops devslam-nav-bench after the current episode: the tables of the episodes done
+// go to stdout, saying how many; RESULTS.md and the pictures are left as they were. (The
+// signal comes with the first progress line, about 4.5 s in; 200 episodes take a minute.)
+TEST(IntegrationNav, NavBenchCtrlCPrintsTheEpisodesDone) {
+    const std::string out = mrpt::system::getTempFileName() + "_navbench_ctrl_c";
+    mrpt::system::createDirectory(out);
+    std::ofstream(out + "/RESULTS.md") << "# R\n";
+    const auto r =
+        devslam::test::signalAppWhen("devslam-nav-bench",
+                                     "--per-category 50 --methods CHolonomicVFHPlus --results " +
+                                         out + "/RESULTS.md --png-dir " + out + "/png",
+                                     "nav-bench [", SIGINT, out + "/log.txt");
+    ASSERT_TRUE(r.signalled) << "the bench ended before the signal:\n" << r.out;
+    EXPECT_EQ(r.rc, 130) << r.out;
+    std::smatch m;
+    ASSERT_TRUE(std::regex_search(
+        r.out, m,
+        std::regex(R"(\*\*Interrupted \(SIGINT\) after (\d+) of 200 episodes: the tables below)")))
+        << r.out;
+    const int done = std::stoi(m[1].str());
+    EXPECT_GE(done, 1);
+    EXPECT_LT(done, 200);
+    // The rows count the episodes done, no more and no fewer: "| VFHPlus | 100.0% (k/n) |".
+    int rows_n = 0;
+    const std::regex row(R"(\| VFHPlus \| [0-9.]+% \((\d+)/(\d+)\) \|)");
+    for (auto it = std::sregex_iterator(r.out.begin(), r.out.end(), row);
+         it != std::sregex_iterator(); ++it)
+        rows_n += std::stoi((*it)[2].str());
+    EXPECT_EQ(rows_n, done) << r.out;
+    EXPECT_NE(r.out.find("devslam-nav-bench: interrupted (SIGINT) after " + std::to_string(done) +
+                         " of 200 episodes; the tables above cover those; " + out +
+                         "/RESULTS.md and the pictures were left as they were"),
+              std::string::npos)
+        << r.out;
+    std::ifstream in(out + "/RESULTS.md");
+    std::stringstream results;
+    results << in.rdbuf();
+    EXPECT_EQ(results.str(), "# R\n");
+    EXPECT_FALSE(mrpt::system::directoryExists(out + "/png"));
     mrpt::system::deleteFilesInDirectory(out, true);
 }
