@@ -99,8 +99,9 @@ void usage() {
     std::cerr
         << "usage: devslam-nav WORLD.ini|random:CATEGORY:SEED [options]\n"
            "  --config FILE   navigation INI (default config_ini/nav_reactive.ini)\n"
-           "  --method NAME   holonomic method: CHolonomicVFHPlus (default), CHolonomicND,\n"
-           "                  CHolonomicVFF, CHolonomicFullEval\n"
+           "  --method NAME   holonomic method: CHolonomicVFHPlus, CHolonomicND,\n"
+           "                  CHolonomicVFF, CHolonomicFullEval (default: the INI's\n"
+           "                  [navigator] holonomic_method)\n"
            "  --png FILE      picture of the run (default out/devslam-nav/nav_<world>.png)\n"
            "  --navlog DIR    also write MRPT's navlog into DIR\n"
            "  --verbose       MRPT navigator messages (DEBUG level)\n"
@@ -115,7 +116,7 @@ void usage() {
 int main(int argc, char** argv) {
     std::string world_path, png, navlog, map, from = "0,0", to;
     std::string config = std::string(DEVSLAM_SOURCE_DIR) + "/config_ini/nav_reactive.ini";
-    std::string method = "CHolonomicVFHPlus";
+    std::string method;  // empty: the INI's [navigator] holonomic_method
     bool verbose = false;
     for (int i = 1; i < argc; i++) {
         const std::string a = argv[i];
@@ -168,7 +169,7 @@ int main(int argc, char** argv) {
         if (!png.empty() && !devslam::core::endsWithNoCase(png, ".png"))
             throw std::invalid_argument("--png '" + png + "': the picture's name must end in .png");
         if (!map.empty()) return planOnSlamMap(map, from, to, config, png);
-        devslam::nav::requireHolonomicMethod(method, "--method");
+        if (!method.empty()) devslam::nav::requireHolonomicMethod(method, "--method");
         const auto world = loadOrGenerate(world_path);
         const auto ini = devslam::core::loadIni(config);
         auto nav_opts = devslam::nav::NavigatorOptions::fromConfig(*ini, config);
@@ -187,15 +188,15 @@ int main(int argc, char** argv) {
             "world=%s method=%s result=%s time=%.2f s path=%.2f m astar=%.2f m "
             "min_clearance_static=%.3f m min_clearance_people=%.3f m collisions_static=%d "
             "collisions_people=%d replans=%d png=%s%s%s\n",
-            world.name.c_str(), method.c_str(), devslam::sim::toString(r.outcome), r.time,
-            r.path_length, r.astar_length, r.min_clearance_static,
+            world.name.c_str(), r.holonomic_method.c_str(), devslam::sim::toString(r.outcome),
+            r.time, r.path_length, r.astar_length, r.min_clearance_static,
             world.pedestrians.empty() ? -1.0 : r.min_clearance_people, r.static_collisions,
             r.person_collisions, r.replans, png.c_str(),
             navlog.empty() ? "" : " navlog=", navlog.c_str());
         if (!r.reason.empty()) std::printf("reason: %s\n", r.reason.c_str());
         std::fflush(stdout);
         writePicture(png, [&] {
-            devslam::sim::writeEpisodePng(world, r, png, world.name + " / " + method);
+            devslam::sim::writeEpisodePng(world, r, png, world.name + " / " + r.holonomic_method);
         });
         return r.outcome == devslam::sim::Outcome::Success ? 0 : 1;
     } catch (const std::exception& e) {

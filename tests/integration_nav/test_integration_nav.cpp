@@ -11,6 +11,7 @@
 
 #include "Command.h"
 
+#include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/core/Clock.h>
 #include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/kinematics/CVehicleSimul_DiffDriven.h>
@@ -123,6 +124,29 @@ TEST(IntegrationNav, AStarPlusVfhInBulletWorld) {
     EXPECT_GT(r.min_clearance_static, 0.0);
     EXPECT_LT(r.time, 40.0);
     EXPECT_GT(r.path_length, 6.5);  // straight-line distance is 7.0 m (minus the tolerance)
+}
+
+// The INI's [navigator] holonomic_method is the method used unless the episode names another
+// (devslam-nav --method, the bench); until session 33 the episode's default always won.
+TEST(IntegrationNav, TheIniChoosesTheHolonomicMethod) {
+    auto world = devslam::sim::loadWorld(kSrc + "/sim_worlds/obstacle_near_goal.ini");
+    world.timeout = 0.3;  // [s] the method is made at the start; no need to drive
+    const auto ini = devslam::core::loadIni(kIni);
+    EXPECT_EQ(devslam::sim::runEpisode(world, *ini,
+                                       devslam::nav::NavigatorOptions::fromConfig(*ini, kIni), {})
+                  .holonomic_method,
+              "CHolonomicVFHPlus");
+    std::ifstream in(kIni);
+    std::stringstream text;
+    text << in.rdbuf();
+    mrpt::config::CConfigFileMemory nd(text.str());
+    nd.write("navigator", "holonomic_method", "CHolonomicND");
+    const auto opts = devslam::nav::NavigatorOptions::fromConfig(nd, "nd.ini");
+    EXPECT_EQ(devslam::sim::runEpisode(world, nd, opts, {}).holonomic_method, "CHolonomicND");
+    devslam::sim::EpisodeOptions eo;
+    eo.holonomic_method = "CHolonomicFullEval";
+    EXPECT_EQ(devslam::sim::runEpisode(world, *ini, opts, eo).holonomic_method,
+              "CHolonomicFullEval");
 }
 
 TEST(IntegrationNav, AppsSmokeTest) {

@@ -42,6 +42,13 @@ class ReactiveNav : public mrpt::nav::CReactiveNavigationSystem {
                               : std::min(d, v->lastOutput().target_density);
         return d;
     }
+    /// As the INI names it: "mrpt::nav::CHolonomicND" -> "CHolonomicND".
+    std::string holonomicClass() const {
+        if (m_holonomicMethod.empty() || !m_holonomicMethod.front()) return {};
+        const std::string name = m_holonomicMethod.front()->GetRuntimeClass()->className;
+        const auto colon = name.rfind("::");
+        return colon == std::string::npos ? name : name.substr(colon + 2);
+    }
 };
 
 void copyConfig(const mrpt::config::CConfigFileBase& from, mrpt::config::CConfigFileMemory& to) {
@@ -170,6 +177,10 @@ Navigator::Navigator(mrpt::nav::CRobot2NavInterface& robot,
 }
 
 Navigator::~Navigator() = default;
+
+std::string Navigator::holonomicMethod() const {
+    return static_cast<const ReactiveNav&>(*nav_).holonomicClass();
+}
 
 mrpt::nav::CReactiveNavigationSystem& Navigator::reactive() {
     return *nav_;

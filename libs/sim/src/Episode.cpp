@@ -54,7 +54,7 @@ EpisodeResult runEpisode(const WorldSpec& world, const mrpt::config::CConfigFile
     EpisodeResult res;
     nav_opts.robot_radius = world.robot.radius;
     nav_opts.planner.robot_radius = world.robot.radius;
-    nav_opts.holonomic_method = opts.holonomic_method;
+    if (!opts.holonomic_method.empty()) nav_opts.holonomic_method = opts.holonomic_method;
     nav_opts.log_file = opts.log_file;
     nav_opts.log_directory = opts.log_directory;
 
@@ -63,6 +63,7 @@ EpisodeResult runEpisode(const WorldSpec& world, const mrpt::config::CConfigFile
     const auto grid = rasterize(world);
     const auto statics = staticObstacles(world);
     nav::Navigator navigator(robot, nav_ini, nav_opts);
+    res.holonomic_method = navigator.holonomicMethod();
     if (!navigator.start(grid, world.robot.start, world.goal, world.goal_tolerance)) {
         res.outcome = Outcome::NoPath;
         res.reason = navigator.lastError();

@@ -80,6 +80,8 @@ class Navigator {
     [[nodiscard]] double lastStepSeconds() const { return last_step_s_; }
     [[nodiscard]] std::string lastError() const { return last_error_; }
     [[nodiscard]] double refDistance() const { return ref_distance_; }
+    /// The class of the holonomic method MRPT's navigator made (e.g. "CHolonomicVFHPlus").
+    [[nodiscard]] std::string holonomicMethod() const;
     [[nodiscard]] mrpt::nav::CReactiveNavigationSystem& reactive();
 
   private:

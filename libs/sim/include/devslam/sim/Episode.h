@@ -20,8 +20,9 @@
 namespace devslam::sim {
 
 struct EpisodeOptions {
-    std::string holonomic_method = "CHolonomicVFHPlus";  ///< MRPT class name
-    bool log_file = false;                               ///< write an MRPT navlog
+    /// MRPT class name; empty: the navigator options' own ([navigator] holonomic_method)
+    std::string holonomic_method;
+    bool log_file = false;  ///< write an MRPT navlog
     std::string log_directory = "reactivenav.logs";
     double record_period = 0.1;  ///< [s] trajectory / tracks sampling
 };
@@ -42,6 +43,7 @@ struct EpisodeResult {
     int static_collisions = 0;          ///< contact events with walls/boxes
     int person_collisions = 0;          ///< contact events with people
     int replans = 0;
+    std::string holonomic_method;      ///< the class MRPT's navigator made
     std::vector<double> step_seconds;  ///< wall time of each navigationStep()
     std::vector<mrpt::math::TPose2D> trajectory;
     std::vector<std::vector<mrpt::math::TPoint2D>> pedestrian_tracks;
