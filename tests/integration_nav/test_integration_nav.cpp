@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "Command.h"
+#include "Scratch.h"
 
 #include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/core/Clock.h>
@@ -151,7 +152,7 @@ TEST(IntegrationNav, TheIniChoosesTheHolonomicMethod) {
 
 TEST(IntegrationNav, AppsSmokeTest) {
     const std::string bin = DEVSLAM_BIN_DIR;
-    const std::string out = mrpt::system::getTempFileName() + "_navsmoke";
+    const std::string out = devslam::test::scratchPath("devslam_navsmoke").string();
     ASSERT_TRUE(mrpt::system::createDirectory(out));
     const std::string png = out + "/fig6.png";
     const std::string cmd = bin + "/devslam-nav " + kSrc + "/sim_worlds/paper_fig6.ini --png " +
@@ -236,7 +237,7 @@ TEST(IntegrationNav, AppsSmokeTest) {
 // go to stdout, saying how many; RESULTS.md and the pictures are left as they were. (The
 // signal comes with the first progress line, about 4.5 s in; 200 episodes take a minute.)
 TEST(IntegrationNav, NavBenchCtrlCPrintsTheEpisodesDone) {
-    const std::string out = mrpt::system::getTempFileName() + "_navbench_ctrl_c";
+    const std::string out = devslam::test::scratchPath("devslam_navbench_ctrl_c").string();
     mrpt::system::createDirectory(out);
     std::ofstream(out + "/RESULTS.md") << "# R\n";
     const auto r =

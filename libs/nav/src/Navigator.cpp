@@ -12,6 +12,7 @@
 #include <chrono>
 #include <cmath>
 #include <ctime>
+#include <filesystem>
 #include <functional>
 #include <sstream>
 
@@ -166,9 +167,10 @@ Navigator::Navigator(mrpt::nav::CRobot2NavInterface& robot,
         std::ostringstream os;
         for (const auto& k : keys) os << k << "=" << cfg.read_string(sec_rns, k, "") << ";";
         os << cfg.read_string(sec_ptg, "ref_distance", "");
-        cache = mrpt::system::getTempFileName();
-        cache = mrpt::system::extractFileDirectory(cache) + "/devslam_ptg_cache_" +
-                std::to_string(std::hash<std::string>{}(os.str()));
+        // (Not mrpt::system::getTempFileName(): it creates a file, left behind by every run.)
+        cache = (std::filesystem::temp_directory_path() /
+                 ("devslam_ptg_cache_" + std::to_string(std::hash<std::string>{}(os.str()))))
+                    .string();
     }
     mrpt::system::createDirectory(cache);
     nav_->params_abstract_ptg_navigator.ptg_cache_files_directory = cache;
