@@ -6,9 +6,11 @@
 #include <devslam/sim/World.h>
 
 #include <gtest/gtest.h>
+
 #include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/kinematics/CVehicleVelCmd_DiffDriven.h>
 #include <mrpt/maps/CSimplePointsMap.h>
+#include <regex>
 
 #include <cmath>
 
@@ -107,8 +109,30 @@ TEST(World, BadEntriesNameTheKey) {
                       "start_x=1\nstart_y=1\n[goal]\nx=4\ny=4\n"),
               "w.ini [world] timeout: timeout 1e+07 s at time_step 0.01 s makes 1e+09 physics "
               "steps (at most 1e6)");
-    EXPECT_NE(errorOf(head + "[laser]\nrays = 2000000000\n").find("2 <= rays <= 100000"),
-              std::string::npos);
+    EXPECT_EQ(errorOf(head + "[laser]\nrays = 2000000000\n"),
+              "w.ini [laser] rays: must be in [2, 100000]");
+    // The key that is wrong is the one named (they were max_v, x_min, start_x for all).
+    EXPECT_EQ(errorOf(head + "[robot]\nmax_ang_acc_deg = 0\n"),
+              "w.ini [robot] max_ang_acc_deg: speed and acceleration limits must be > 0");
+    EXPECT_EQ(errorOf("[world]\nx_min=0\nx_max=5\ny_min=5\ny_max=0\n[robot]\nstart_x=1\n"
+                      "start_y=1\n[goal]\nx=4\ny=4\n"),
+              "w.ini [world] y_max: must be > y_min");
+    EXPECT_EQ(errorOf("[world]\nx_min=0\nx_max=5\ny_min=0\ny_max=5\n[robot]\nstart_x=1\n"
+                      "start_y=7\n[goal]\nx=4\ny=4\n"),
+              "w.ini [robot] start_y: start is outside the world bounds");
+    EXPECT_EQ(errorOf(head + "[laser]\nfov_deg = 400\n"),
+              "w.ini [laser] fov_deg: must be in (0, 360]");
+    // A goal the exact distance allows (0.298 m from the box, robot radius 0.25 m) but the
+    // planner's grid does not (clearance between cell centres): refused in the file's terms.
+    const std::string near =
+        "[world]\nx_min=0\nx_max=8\ny_min=0\ny_max=4\n[robot]\nstart_x=1\nstart_y=2\n"
+        "[goal]\nx=4.701\ny=2\n[obstacles]\nb = box 5.499 2 1 1\n";
+    EXPECT_EQ(errorOf(near),
+              "w.ini [goal] x: the goal is 0.298 m from obstacle 'b', but on the planner's 0.05 m "
+              "grid (grid_resolution) it has 0.225 m of clearance, less than the robot radius "
+              "0.25 m: move it at least 0.025 m further off, or use a finer grid");
+    EXPECT_EQ(errorOf(std::regex_replace(near, std::regex("x=4.701"), "x=4.6")), "")
+        << "0.399 m from the box";
     // People: none may start on the robot or in an obstacle, or walk through one (they are
     // kinematic); brushing past an edge is allowed.
     const std::string box = "[obstacles]\nb1 = box 3 2 1 1\n";

@@ -147,8 +147,8 @@ std::optional<GridPath> GridPlanner::plan(const mrpt::math::TPoint2D& start,
             std::ostringstream os;
             os << "global planner: " << name << " " << fmtPoint(p) << " is " << toString(st);
             if (st != EndpointStatus::OutsideMap)
-                os << " (clearance " << clearance(p) << " m, robot radius " << opts_.robot_radius
-                   << " m)";
+                os << " (clearance " << clearance(p) << " m on its " << grid_.getResolution()
+                   << " m grid, robot radius " << opts_.robot_radius << " m)";
             else
                 os << " [" << grid_.getXMin() << ", " << grid_.getXMax() << "] x ["
                    << grid_.getYMin() << ", " << grid_.getYMax() << "]";

@@ -1,5 +1,6 @@
 #include <devslam/core/Config.h>
 #include <devslam/core/Parse.h>
+#include <devslam/nav/GridPlanner.h>
 #include <devslam/sim/World.h>
 
 #include <mrpt/config/CConfigFileBase.h>
@@ -10,6 +11,7 @@
 #include <cstdint>
 #include <sstream>
 #include <stdexcept>
+#include <tuple>
 
 namespace devslam::sim {
 
@@ -184,8 +186,8 @@ WorldSpec parseWorld(const mrpt::config::CConfigFileBase& c, const std::string& 
 
 void validateWorld(const WorldSpec& w) {
     const auto& src = w.source;
-    if (!(w.x_max > w.x_min) || !(w.y_max > w.y_min))
-        fail(src, "world", "x_min", "bounds must satisfy x_min < x_max and y_min < y_max");
+    if (!(w.x_max > w.x_min)) fail(src, "world", "x_max", "must be > x_min");
+    if (!(w.y_max > w.y_min)) fail(src, "world", "y_max", "must be > y_min");
     if (w.grid_resolution <= 0 || w.grid_resolution > 0.5)
         fail(src, "world", "grid_resolution", "must be in (0, 0.5] m");
     // The occupancy grid holds every cell of the bounds; MRPT counts them in 32 bits.
@@ -210,20 +212,31 @@ void validateWorld(const WorldSpec& w) {
         fail(src, "world", "timeout", m.str());
     }
     if (w.robot.radius <= 0) fail(src, "robot", "radius", "must be > 0 m");
-    if (w.robot.max_v <= 0 || w.robot.max_w <= 0 || w.robot.max_acc <= 0 ||
-        w.robot.max_ang_acc <= 0)
-        fail(src, "robot", "max_v", "speed and acceleration limits must be > 0");
-    if (w.laser.range <= 0 || w.laser.rays < 2 || w.laser.rays > 100000 || w.laser.rate <= 0 ||
-        w.laser.noise_std < 0 || w.laser.fov <= 0 || w.laser.fov > 2 * M_PI + 1e-9)
-        fail(src, "laser", "",
-             "range > 0, 2 <= rays <= 100000, rate_hz > 0, noise_std >= 0, 0 < fov_deg <= 360");
+    for (const auto& [key, v] : {std::pair{"max_v", w.robot.max_v},
+                                 {"max_w_deg", w.robot.max_w},
+                                 {"max_acc", w.robot.max_acc},
+                                 {"max_ang_acc_deg", w.robot.max_ang_acc}})
+        if (!(v > 0)) fail(src, "robot", key, "speed and acceleration limits must be > 0");
+    if (!(w.laser.range > 0)) fail(src, "laser", "range", "must be > 0 m");
+    if (w.laser.rays < 2 || w.laser.rays > 100000)
+        fail(src, "laser", "rays", "must be in [2, 100000]");
+    if (!(w.laser.rate > 0)) fail(src, "laser", "rate_hz", "must be > 0");
+    if (!(w.laser.noise_std >= 0)) fail(src, "laser", "noise_std", "must be >= 0 m");
+    if (!(w.laser.fov > 0) || w.laser.fov > 2 * M_PI + 1e-9)
+        fail(src, "laser", "fov_deg", "must be in (0, 360]");
     if (w.goal_tolerance <= 0) fail(src, "goal", "tolerance", "must be > 0 m");
     auto inside = [&](const mrpt::math::TPoint2D& p) {
         return p.x > w.x_min && p.x < w.x_max && p.y > w.y_min && p.y < w.y_max;
     };
+    // The coordinate that is out names the key (x first when both are).
+    const auto outKey = [&](const mrpt::math::TPoint2D& p, const char* kx, const char* ky) {
+        return p.x > w.x_min && p.x < w.x_max ? ky : kx;
+    };
     if (!inside({w.robot.start.x, w.robot.start.y}))
-        fail(src, "robot", "start_x", "start is outside the world bounds");
-    if (!inside(w.goal)) fail(src, "goal", "x", "goal is outside the world bounds");
+        fail(src, "robot", outKey({w.robot.start.x, w.robot.start.y}, "start_x", "start_y"),
+             "start is outside the world bounds");
+    if (!inside(w.goal))
+        fail(src, "goal", outKey(w.goal, "x", "y"), "goal is outside the world bounds");
     const auto statics = staticObstacles(w);
     for (const auto& o : statics) {
         const double dg = distanceToObstacle(o, w.goal);
@@ -236,6 +249,34 @@ void validateWorld(const WorldSpec& w) {
         if (distanceToObstacle(o, {w.robot.start.x, w.robot.start.y}) < w.robot.radius)
             fail(src, "robot", "start_x",
                  "the robot starts inside or touching obstacle '" + o.name + "'");
+    }
+    // The planner sees the world on its grid, where clearance is measured between cell centres
+    // and obstacles grow to whole cells: up to about 1.7 cells less than the exact distance.
+    // A goal or start the exact test passes can still be one the planner refuses; say so here,
+    // in the world file's terms, rather than as a planning error when the run starts.
+    if (!statics.empty()) {
+        nav::GridPlannerOptions po;
+        po.robot_radius = w.robot.radius;
+        nav::GridPlanner planner(po);
+        planner.setMap(rasterize(w));
+        for (const auto& [what, section, key, p] :
+             {std::tuple{"goal", "goal", "x", w.goal},
+              std::tuple{"start", "robot", "start_x",
+                         mrpt::math::TPoint2D{w.robot.start.x, w.robot.start.y}}}) {
+            const double c = planner.clearance(p);
+            if (c >= w.robot.radius) continue;
+            const Obstacle* nearest = &statics.front();
+            for (const auto& o : statics)
+                if (distanceToObstacle(o, p) < distanceToObstacle(*nearest, p)) nearest = &o;
+            std::ostringstream m;
+            m << "the " << what << " is " << distanceToObstacle(*nearest, p) << " m from obstacle '"
+              << nearest->name << "', but on the planner's " << w.grid_resolution
+              << " m grid (grid_resolution) it has " << c
+              << " m of clearance, less than the robot radius " << w.robot.radius
+              << " m: move it at least " << w.robot.radius - c
+              << " m further off, or use a finer grid";
+            fail(src, section, key, m.str());
+        }
     }
     const auto at = [](const mrpt::math::TPoint2D& q) {
         std::ostringstream m;
