@@ -164,6 +164,66 @@ TEST(Replan, PathBlockedLooksAheadOnly) {
     EXPECT_FALSE(pathBlocked(path, {4.5, 0}, {{1.0, 0.0}}, 0.3, 2.0));  // behind the robot
 }
 
+// A person sensed beside the goal (or the robot) is stamped on the replanning map, and the
+// goal and start stay plannable: a disc whose cells reached within the robot radius of the
+// goal's cell (clearance between cell centres) made the replan fail and fall back to the
+// static map, without any of the sensed obstacles (0.55-0.57 m from the goal: 57 % of points).
+TEST(Replan, SensedDiscsLeaveStartAndGoalPlannable) {
+    const auto map = emptyGrid(6, 6, 0.05);
+    GridPlannerOptions po;
+    po.robot_radius = 0.25;
+    GridPlanner planner(po);
+    ReplanOptions ro;  // discs of 0.30 m within 3 m
+    const TPoint2D robot{1.51, 3.02}, goal{3.52, 3.02};
+    int stamped = 0;
+    for (int k = 0; k < 36; ++k) {
+        const double a = k * 10.0 * M_PI / 180.0;
+        // (Points within the robot radius + the disc of the goal, 0.55 m, are not stamped.)
+        for (const double d : {0.56, 0.57, 0.58, 0.62, 0.66, 0.70}) {
+            const TPoint2D near_goal{goal.x + d * std::cos(a), goal.y + d * std::sin(a)};
+            const TPoint2D near_robot{robot.x + d * std::cos(a), robot.y + d * std::sin(a)};
+            const auto m =
+                stampSensedObstacles(map, robot, goal, {near_goal, near_robot}, 0.25, ro);
+            planner.setMap(m);
+            ASSERT_EQ(planner.checkEndpoint(goal), EndpointStatus::Ok) << d << " m at " << k * 10;
+            ASSERT_EQ(planner.checkEndpoint(robot), EndpointStatus::Ok) << d << " m at " << k * 10;
+            ASSERT_TRUE(planner.plan(robot, goal).has_value());
+            // The sensed point itself is on the map (not dropped), where it is in reach.
+            stamped += m.getCell(m.x2idx(near_goal.x), m.y2idx(near_goal.y)) < 0.5f;
+        }
+    }
+    EXPECT_EQ(stamped, 36 * 6);
+    // Nothing is stamped on the robot itself or beyond sensed_range.
+    const auto m = stampSensedObstacles(map, robot, goal, {{1.6, 3.02}, {5.9, 0.5}}, 0.25, ro);
+    EXPECT_GT(m.getCell(m.x2idx(1.6), m.y2idx(3.02)), 0.5f);
+    EXPECT_GT(m.getCell(m.x2idx(5.9), m.y2idx(0.5)), 0.5f);
+}
+
+// The laser sees the walls the route keeps clear of: those points are not obstacles to replan
+// for (a route 0.25-0.35 m from a wall was "blocked" by it and planned again, unchanged, every
+// min_interval). People and unmapped objects are.
+TEST(Replan, OnlyPointsTheMapDoesNotHoldCount) {
+    auto map = emptyGrid(6, 6, 0.05);
+    fillRect(map, 0, 2.0, 6, 2.1);  // a wall along y = 2.0-2.1
+    GridPlannerOptions po;
+    po.robot_radius = 0.25;
+    GridPlanner planner(po);
+    planner.setMap(map);
+    const std::vector<TPoint2D> sensed{{1.0, 1.99},
+                                       {2.0, 1.97},
+                                       {3.0, 2.11},   // the wall's faces
+                                       {4.0, 1.70}};  // a person 0.3 m from it
+    const auto left = unmappedPoints(planner, sensed);
+    ASSERT_EQ(left.size(), 1u);
+    EXPECT_DOUBLE_EQ(left[0].x, 4.0);
+    // A route 0.3 m from the wall is blocked by the person only.
+    const std::vector<TPoint2D> route{{0.5, 1.7}, {5.5, 1.7}};
+    EXPECT_TRUE(pathBlocked(route, {0.5, 1.7}, sensed, 0.30, 6.0)) << "all points";
+    EXPECT_FALSE(
+        pathBlocked(route, {0.5, 1.7}, unmappedPoints(planner, {sensed[0], sensed[1]}), 0.30, 6.0));
+    EXPECT_TRUE(pathBlocked(route, {0.5, 1.7}, left, 0.30, 6.0));
+}
+
 TEST(NavConfig, EveryNavIniLoads) {
     const std::string path = std::string(DEVSLAM_SOURCE_DIR) + "/config_ini/nav_reactive.ini";
     const auto cfg = devslam::core::loadIni(path);

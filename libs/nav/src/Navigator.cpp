@@ -223,22 +223,8 @@ void Navigator::sendWaypoints() {
 bool Navigator::replan(const mrpt::math::TPose2D& pose,
                        const std::vector<mrpt::math::TPoint2D>& sensed) {
     // static map + sensed obstacles (people, unmapped objects) stamped as discs
-    mrpt::maps::COccupancyGridMap2D m = static_map_;
-    const double keep_out = opts_.planner.robot_radius + opts_.replan.obstacle_inflation + 0.05;
-    const double r = opts_.replan.obstacle_inflation;
-    const double res = m.getResolution();
-    for (const auto& o : sensed) {
-        const double d = std::hypot(o.x - pose.x, o.y - pose.y);
-        if (d > opts_.replan.sensed_range || d < keep_out) continue;
-        if (std::hypot(o.x - goal_.x, o.y - goal_.y) < opts_.planner.robot_radius + r) continue;
-        for (double dy = -r; dy <= r; dy += res)
-            for (double dx = -r; dx <= r; dx += res)
-                if (dx * dx + dy * dy <= r * r) {
-                    const int cx = m.x2idx(o.x + dx), cy = m.y2idx(o.y + dy);
-                    if (cx >= 0 && cy >= 0 && cx < int(m.getSizeX()) && cy < int(m.getSizeY()))
-                        m.setCell(cx, cy, 0.0f);
-                }
-    }
+    mrpt::maps::COccupancyGridMap2D m = stampSensedObstacles(
+        static_map_, {pose.x, pose.y}, goal_, sensed, opts_.planner.robot_radius, opts_.replan);
     std::optional<GridPath> p;
     for (const auto* mp : {&m, &static_map_}) {
         planner_.setMap(*mp);
@@ -292,6 +278,9 @@ NavState Navigator::step(double t) {
             sensed.emplace_back(gx, gy);
         }
     }
+    // Only what the static map does not hold (people, objects missing from it): the walls the
+    // route already keeps clear of made the blocked-path check replan the same route again.
+    sensed = unmappedPoints(planner_, sensed);
     if (st == mrpt::nav::CAbstractNavigator::NAV_ERROR ||
         st == mrpt::nav::CAbstractNavigator::IDLE) {
         // MRPT gave up ("not approaching target") or ended short of the goal: replan

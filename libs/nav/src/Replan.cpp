@@ -104,4 +104,50 @@ bool pathBlocked(const std::vector<mrpt::math::TPoint2D>& path, const mrpt::math
     return false;
 }
 
+std::vector<mrpt::math::TPoint2D> unmappedPoints(const GridPlanner& static_map,
+                                                 const std::vector<mrpt::math::TPoint2D>& sensed) {
+    // A wall's surface lies in its own (grown) cells or the next: clearance up to half a cell.
+    const double mapped_within = static_map.map().getResolution();
+    std::vector<mrpt::math::TPoint2D> out;
+    for (const auto& p : sensed)
+        if (static_map.clearance(p) > mapped_within) out.push_back(p);
+    return out;
+}
+
+mrpt::maps::COccupancyGridMap2D stampSensedObstacles(
+    const mrpt::maps::COccupancyGridMap2D& static_map, const mrpt::math::TPoint2D& robot,
+    const mrpt::math::TPoint2D& goal, const std::vector<mrpt::math::TPoint2D>& sensed,
+    double robot_radius, const ReplanOptions& o) {
+    mrpt::maps::COccupancyGridMap2D m = static_map;
+    const double r = o.obstacle_inflation;
+    const double keep_out = robot_radius + r + 0.05;
+    const double res = m.getResolution();
+    const int W = static_cast<int>(m.getSizeX()), H = static_cast<int>(m.getSizeY());
+    const auto inGrid = [&](int cx, int cy) { return cx >= 0 && cy >= 0 && cx < W && cy < H; };
+    for (const auto& p : sensed) {
+        const double d = std::hypot(p.x - robot.x, p.y - robot.y);
+        if (d > o.sensed_range || d < keep_out) continue;
+        if (std::hypot(p.x - goal.x, p.y - goal.y) < robot_radius + r) continue;
+        for (double dy = -r; dy <= r; dy += res)
+            for (double dx = -r; dx <= r; dx += res)
+                if (dx * dx + dy * dy <= r * r) {
+                    const int cx = m.x2idx(p.x + dx), cy = m.y2idx(p.y + dy);
+                    if (inGrid(cx, cy)) m.setCell(cx, cy, 0.0f);
+                }
+    }
+    // The planner's clearance at a point is measured from its cell's centre (up to res/sqrt 2
+    // away) to the nearest occupied cell's centre, less half a cell: with no stamped cell
+    // centre within robot_radius + 1.5 res of the point, it is above robot_radius.
+    const double keep = robot_radius + 1.5 * res;
+    for (const auto& e : {robot, goal}) {
+        const int c0x = m.x2idx(e.x - keep), c1x = m.x2idx(e.x + keep);
+        const int c0y = m.y2idx(e.y - keep), c1y = m.y2idx(e.y + keep);
+        for (int cy = c0y; cy <= c1y; ++cy)
+            for (int cx = c0x; cx <= c1x; ++cx)
+                if (inGrid(cx, cy) && std::hypot(m.idx2x(cx) - e.x, m.idx2y(cy) - e.y) <= keep)
+                    m.setCell(cx, cy, static_map.getCell(cx, cy));
+    }
+    return m;
+}
+
 }  // namespace devslam::nav

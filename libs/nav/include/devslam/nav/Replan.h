@@ -8,7 +8,10 @@
 /// Usage:
 ///   ReplanTrigger trigger(opts);
 ///   if (auto r = trigger.update({t, blocked, density}); r != ReplanReason::None) replan();
+#include <devslam/nav/GridPlanner.h>
+
 #include <mrpt/config/CConfigFileBase.h>
+#include <mrpt/maps/COccupancyGridMap2D.h>
 #include <mrpt/math/TPoint2D.h>
 
 #include <string>
@@ -60,5 +63,23 @@ class ReplanTrigger {
                                const mrpt::math::TPoint2D& robot,
                                const std::vector<mrpt::math::TPoint2D>& obstacles, double radius,
                                double lookahead);
+
+/// The points of `sensed` (world frame) that the static map does not explain: farther than
+/// one cell from its obstacles. The laser sees the walls the plan already keeps clear of; only
+/// people and objects missing from the map block a path or belong on a replanning map.
+/// `static_map` holds the static map (GridPlanner::setMap).
+[[nodiscard]] std::vector<mrpt::math::TPoint2D> unmappedPoints(
+    const GridPlanner& static_map, const std::vector<mrpt::math::TPoint2D>& sensed);
+
+/// The map to replan on: `static_map` with a disc of `o.obstacle_inflation` stamped around
+/// each point of `sensed` within `o.sensed_range` of `robot` (none closer than the robot's
+/// own radius plus the disc plus 5 cm, nor on the goal). The cells around `robot` and `goal`
+/// keep their static values, so that a disc never takes the planner's clearance there below
+/// `robot_radius`: the plan then starts and ends where the robot and goal are, instead of
+/// failing and falling back to the static map without the sensed obstacles.
+[[nodiscard]] mrpt::maps::COccupancyGridMap2D stampSensedObstacles(
+    const mrpt::maps::COccupancyGridMap2D& static_map, const mrpt::math::TPoint2D& robot,
+    const mrpt::math::TPoint2D& goal, const std::vector<mrpt::math::TPoint2D>& sensed,
+    double robot_radius, const ReplanOptions& o);
 
 }  // namespace devslam::nav
