@@ -453,6 +453,22 @@ TEST(Rawlog, ReadsMrptsOwnOpenNiObservation) {
     EXPECT_LT(hi, 2.6);
     EXPECT_GT(cv::countNonZero(f->depth > 0), 200000);  // of 273225 valid depth pixels
     EXPECT_FALSE(r.next().has_value());
+
+    // Written as a TUM folder, its depth is in TUM's 5000 units per metre: read back, it is
+    // the same (it was written in millimetres and read as 0.2 mm units, 5x too near).
+    TempDir d;
+    {
+        io::TumWriter w(d.str("tum"), "test");
+        w.write(*f);
+        w.close();
+    }
+    auto back = io::openRgbd(d.str("tum"), {});
+    const auto g = back->next();
+    ASSERT_TRUE(g.has_value());
+    EXPECT_EQ(g->depth_scale, 5000.0);
+    // (Its depth is reprojected into the colour camera: not whole millimetres, so within the
+    // rounding to TUM's 0.2 mm units.)
+    EXPECT_LE(cv::norm(g->depth, f->depth, cv::NORM_INF), 0.5 / 5000 + 1e-7);
 }
 
 TEST(Rawlog, RejectsFramesThatCannotBeWritten) {

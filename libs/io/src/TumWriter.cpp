@@ -45,12 +45,17 @@ TumWriter::~TumWriter() = default;
 void TumWriter::write(const core::Frame& f) {
     if (!rgb_list_) throw std::logic_error("TumWriter::write after close: " + folder_);
     core::validateFrame(f, "frame " + std::to_string(f.index));
+    // TUM's depth PNGs hold 5000 units per metre, whatever the source's units (an OpenNI
+    // rawlog's millimetres become 5 units each, exactly); a reader of the folder, ours or the
+    // TUM tools, knows no other scale.
+    constexpr double kTumScale = 5000.0;
     double max_depth = 0;
     cv::minMaxLoc(f.depth, nullptr, &max_depth);
-    if (max_depth * f.depth_scale > 65535.5)
+    if (max_depth * kTumScale > 65535.5)
         throw std::runtime_error("frame " + std::to_string(f.index) + ": depth " +
-                                 std::to_string(max_depth) + " m does not fit 16 bits at scale " +
-                                 std::to_string(f.depth_scale));
+                                 std::to_string(max_depth) +
+                                 " m does not fit a TUM depth PNG (16 bits at 5000 per metre: "
+                                 "at most 13.1 m)");
     if (count_ == 0) {
         // Intrinsics travel with the folder (TumReader reads camera.ini before guessing).
         mrpt::config::CConfigFileMemory cam;
@@ -68,7 +73,9 @@ void TumWriter::write(const core::Frame& f) {
     const std::string depth = std::string("depth/") + depth_stamp + ".png";
     if (!cv::imwrite(folder_ + "/" + rgb, f.bgr))
         throw std::runtime_error("cannot write '" + folder_ + "/" + rgb + "'");
-    if (!cv::imwrite(folder_ + "/" + depth, f.rawDepth16()))
+    cv::Mat raw;
+    f.depth.convertTo(raw, CV_16U, kTumScale);  // rounds to nearest, as Frame::rawDepth16
+    if (!cv::imwrite(folder_ + "/" + depth, raw))
         throw std::runtime_error("cannot write '" + folder_ + "/" + depth + "'");
     std::fprintf(rgb_list_.get(), "%s %s\n", stamp, rgb.c_str());
     std::fprintf(depth_list_.get(), "%s %s\n", depth_stamp, depth.c_str());
