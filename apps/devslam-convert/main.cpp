@@ -120,6 +120,7 @@ int convert(int argc, char** argv) {
                         break;
                     }
                     undecodable.push_back(e.what());
+                    if ((interrupted = devslam::core::stopSignal())) break;
                     continue;
                 }
                 if (!f) break;

@@ -261,9 +261,17 @@ std::optional<core::Frame> RawlogReader::next() {
     try {
         o = stream_->next(opts_.sensor_label, skipped, sf, ob);
     } catch (const std::exception& e) {
-        throw changed(e.what());
+        o = nullptr;
+        skipped = 0;
+        const auto error = changed(e.what());
+        n_read_ = n_frames_;  // a stream that broke cannot go on: the next call ends
+        throw error;
     }
-    if (!o) throw changed("ended");
+    if (!o) {
+        const auto error = changed("ended");
+        n_read_ = n_frames_;
+        throw error;
+    }
     // Counted before decoding: after a bad observation the next call names the one after it.
     const std::size_t index = n_read_++;
     const std::string what = path_ + " observation " + std::to_string(index);
