@@ -66,7 +66,7 @@ class ReplanTrigger {
 
 /// The points of `sensed` (world frame) that the static map does not explain: farther than
 /// one cell from its obstacles. The laser sees the walls the plan already keeps clear of; only
-/// people and objects missing from the map block a path or belong on a replanning map.
+/// people and objects missing from the map block a path (pathBlocked).
 /// `static_map` holds the static map (GridPlanner::setMap).
 [[nodiscard]] std::vector<mrpt::math::TPoint2D> unmappedPoints(
     const GridPlanner& static_map, const std::vector<mrpt::math::TPoint2D>& sensed);
