@@ -238,6 +238,14 @@ TEST(TrajectoryIO, RoundTripAndErrors) {
     writeText(d.str("bad.txt"), "# only comments\n");
     expectError([&] { (void)io::readTumTrajectory(d.str("bad.txt")); }, "no poses");
     expectError([&] { (void)io::readTumTrajectory(d.str("missing.txt")); }, "cannot open");
+    // A full disk: two poses fit the write buffer, which goes out (and fails) at the close;
+    // that was not checked, and the lost file passed for written.
+    if (fs::exists("/dev/full"))
+        expectError(
+            [&] {
+                io::writeTumTrajectory("/dev/full", {gt[0], gt[1]});
+            },
+            "error writing '/dev/full'");
 }
 
 // ---------------------------------------------------------------- rawlogs

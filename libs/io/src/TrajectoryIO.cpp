@@ -50,7 +50,10 @@ void writeTumTrajectory(const std::string& path, const core::Trajectory& traj,
         std::fprintf(f.get(), "%.6f %.9f %.9f %.9f %.9f %.9f %.9f %.9f\n", sp.t, q.x(), q.y(),
                      q.z(), q.quat().x(), q.quat().y(), q.quat().z(), q.quat().r());
     }
-    if (std::ferror(f.get())) throw std::runtime_error("error writing '" + path + "'");
+    // The last buffer goes out at fclose: a full disk is found there, not by ferror before.
+    const bool failed = std::ferror(f.get()) != 0;
+    if (std::fclose(f.release()) != 0 || failed)
+        throw std::runtime_error("error writing '" + path + "'");
 }
 
 }  // namespace devslam::io

@@ -60,10 +60,13 @@ void TumWriter::write(const core::Frame& f) {
         // Intrinsics travel with the folder (TumReader reads camera.ini before guessing).
         mrpt::config::CConfigFileMemory cam;
         f.K.saveToConfig(cam, "camera");
-        std::ofstream(folder_ + "/camera.ini")
-            << "# Camera intrinsics of this sequence (pinhole, depth registered to colour).\n"
-            << "# fx fy cx cy [px], width height [px], dist = k1 k2 p1 p2 k3 (OpenCV order)\n"
-            << cam.getContent();
+        const std::string cam_path = folder_ + "/camera.ini";
+        std::ofstream cf(cam_path);
+        cf << "# Camera intrinsics of this sequence (pinhole, depth registered to colour).\n"
+           << "# fx fy cx cy [px], width height [px], dist = k1 k2 p1 p2 k3 (OpenCV order)\n"
+           << cam.getContent();
+        cf.close();  // flushed here: a full disk is found now
+        if (!cf) throw std::runtime_error("cannot write '" + cam_path + "'");
     }
     char stamp[32], depth_stamp[32];
     std::snprintf(stamp, sizeof stamp, "%.6f", f.timestamp);
@@ -88,9 +91,10 @@ void TumWriter::writeGroundTruth(const core::Trajectory& gt) {
 
 void TumWriter::close() {
     for (auto* f : {&rgb_list_, &depth_list_}) {
-        if (*f && std::fflush(f->get()) != 0)
+        if (!*f) continue;
+        const bool failed = std::ferror(f->get()) != 0;
+        if (std::fclose(f->release()) != 0 || failed)
             throw std::runtime_error("error writing the lists of '" + folder_ + "'");
-        f->reset();
     }
 }
 

@@ -158,6 +158,7 @@ WriteSummary writeSequence(const Scenario& sc, const WriteOptions& o,
     cf << "# exact pinhole intrinsics of this synthetic sequence (no distortion), scenario "
        << sc.name << "\n"
        << text;
+    cf.close();  // flushed here: a full disk is found now, before render.txt says "whole"
     if (!cf) throw std::runtime_error("cannot write '" + cam_path + "'");
 
     sum.n_frames = i;
@@ -166,6 +167,7 @@ WriteSummary writeSequence(const Scenario& sc, const WriteOptions& o,
     const std::string sig_path = signaturePath(o).string();
     std::ofstream sf(sig_path, std::ios::binary);
     sf << signature;
+    sf.close();
     if (!sf) throw std::runtime_error("cannot write '" + sig_path + "'");
     return sum;
 }
