@@ -752,7 +752,22 @@ TEST(Scenario, ShippedFilesLoadAndTyposAreReported) {
         },
         "[scenario] texture_filter: must be linear or nearest, got 'cubic'");
     expectMessage([&] { (void)loadScenario(withEdit(text, "kind    = walking", "kind = flying")); },
-                  "unknown person kind 'flying'");
+                  tmp.str("s.ini") + " [person_1] kind: unknown person kind 'flying'");
+    (void)withEdit(text, "n_frames", "n_frames");  // s.ini (= base) as it was
+    // Each range error names its own key (they named the first key of a pair).
+    expectMessage([&] { (void)loadScenario(base, {"depth_noise.sigma_b=-1"}); },
+                  tmp.str("s.ini") + " [depth_noise] sigma_b: must be >= 0");
+    expectMessage([&] { (void)loadScenario(base, {"trajectory.elevation_period=0"}); },
+                  tmp.str("s.ini") + " [trajectory] elevation_period: must be > 0 [s]");
+    // A duration shorter than half a frame is no sequence at all (it wrote empty lists).
+    expectMessage(
+        [&] {
+            (void)loadScenario(base, {"scenario.n_frames=0", "scenario.duration=0.01"});
+        },
+        "[scenario] n_frames: must be >= 1");
+    expectMessage(
+        [&] { (void)loadScenario(withEdit(text, "n_frames        = 60", "duration = 0.01")); },
+        tmp.str("s.ini") + " [scenario] duration: gives no frame at rate_hz");
     expectMessage(
         [&] {
             (void)loadScenario(

@@ -124,8 +124,8 @@ void TrajectoryOptions::loadFromConfig(const mrpt::config::CConfigFileBase& cfg,
         core::requireValue(period[i] > 0, s, "period", "must be > 0 [s]");
         core::requireValue(rot_period[i] > 0, s, "rot_period", "must be > 0 [s]");
     }
-    core::requireValue(azimuth_period > 0 && elevation_period > 0, s, "azimuth_period",
-                       "periods must be > 0 [s]");
+    core::requireValue(azimuth_period > 0, s, "azimuth_period", "must be > 0 [s]");
+    core::requireValue(elevation_period > 0, s, "elevation_period", "must be > 0 [s]");
     core::requireValue((look_at - position).norm() > 1e-3, s, "look_at",
                        "must differ from position");
     // lookAtPose levels the camera's roll on the horizontal: a vertical view has none.

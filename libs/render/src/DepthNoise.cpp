@@ -25,9 +25,10 @@ void DepthNoiseOptions::loadFromConfig(const mrpt::config::CConfigFileBase& cfg,
     edge_jump = core::readDouble(cfg, s, "edge_jump", edge_jump);
     edge_dilate = core::readInt(cfg, s, "edge_dilate", edge_dilate);
     dropout = core::readDouble(cfg, s, "dropout", dropout);
-    core::requireValue(min_range >= 0 && max_range > min_range, s, "max_range",
-                       "need 0 <= min_range < max_range [m]");
-    core::requireValue(sigma_a >= 0 && sigma_b >= 0, s, "sigma_a", "must be >= 0");
+    core::requireValue(min_range >= 0, s, "min_range", "must be >= 0 [m]");
+    core::requireValue(max_range > min_range, s, "max_range", "must be > min_range [m]");
+    core::requireValue(sigma_a >= 0, s, "sigma_a", "must be >= 0");
+    core::requireValue(sigma_b >= 0, s, "sigma_b", "must be >= 0");
     core::requireValue(baseline > 0, s, "baseline", "must be > 0 [m]");
     core::requireValue(disparity_step >= 0, s, "disparity_step", "must be >= 0 [px]");
     core::requireValue(edge_jump > 0, s, "edge_jump", "must be > 0");

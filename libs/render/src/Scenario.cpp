@@ -109,8 +109,8 @@ void readRoom(const std::string& path, RoomSpec& room) {
     room.panel_width = core::readDouble(*cfg, s, "panel_width", room.panel_width);
     room.panel_height = core::readDouble(*cfg, s, "panel_height", room.panel_height);
     core::requireValue(room.size.minCoeff() > 0.5, "room", "size", "each side > 0.5 [m]");
-    core::requireValue(room.panel_width > 0.05 && room.panel_height > 0.05, "room",
-                       "panel_width", "panels must be > 0.05 m");
+    core::requireValue(room.panel_width > 0.05, "room", "panel_width", "must be > 0.05 [m]");
+    core::requireValue(room.panel_height > 0.05, "room", "panel_height", "must be > 0.05 [m]");
     {  // Every panel holds a photo crop of its own: a 10 km room ran out of memory.
         const auto n = [](double len, double panel) { return std::ceil(len / panel); };
         const double X = room.size.x(), Y = room.size.y(), Z = room.size.z();
@@ -163,7 +163,13 @@ PersonSpec loadPerson(const mrpt::config::CConfigFileBase& cfg, const std::strin
     PersonSpec p;
     p.name = s;
     const std::string where = path + " [" + s + "]";
-    p.kind = parsePersonKind(requiredText(cfg, s, "kind"));
+    try {
+        p.kind = parsePersonKind(requiredText(cfg, s, "kind"));
+    } catch (const std::invalid_argument& e) {
+        const std::string m = e.what();
+        if (m.rfind('[', 0) == 0) throw;  // requiredText's own: "[section] key: missing"
+        throw std::invalid_argument("[" + s + "] kind: " + m);  // the file is added to "[..."
+    }
     const auto tex =
         resolveImages(requiredText(cfg, s, "texture"), dirOf(path), where + " texture");
     if (tex.size() != 1) throw std::invalid_argument(where + " texture: need exactly one file");
@@ -242,6 +248,8 @@ Scenario readScenario(const std::string& path, const std::vector<std::string>& o
         throw std::invalid_argument(
             path + " [scenario]: give exactly one of 'duration' [s] or 'n_frames'");
     sc.n_frames = n > 0 ? std::size_t(n) : std::size_t(std::lround(duration * sc.rate_hz));
+    core::requireValue(sc.n_frames > 0, s, "duration",
+                       "gives no frame at rate_hz (at least one: duration >= 0.5 / rate_hz)");
     sc.t0 = core::readDouble(*cfg, s, "t0", sc.t0);
     sc.seed = core::readUint64(*cfg, s, "seed", sc.seed);
     sc.rgb_noise_sigma = core::readDouble(*cfg, s, "rgb_noise_sigma", sc.rgb_noise_sigma);
