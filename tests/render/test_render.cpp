@@ -759,6 +759,13 @@ TEST(Scenario, ShippedFilesLoadAndTyposAreReported) {
                   tmp.str("s.ini") + " [depth_noise] sigma_b: must be >= 0");
     expectMessage([&] { (void)loadScenario(base, {"trajectory.elevation_period=0"}); },
                   tmp.str("s.ini") + " [trajectory] elevation_period: must be > 0 [s]");
+    // A halfsphere orbit over the top would turn the view over between two frames.
+    expectMessage(
+        [&] {
+            (void)loadScenario(
+                base, {"trajectory.type=halfsphere", "trajectory.elevation_amplitude_deg=120"});
+        },
+        tmp.str("s.ini") + " [trajectory] elevation_amplitude_deg: the orbit reaches");
     // A duration shorter than half a frame is no sequence at all (it wrote empty lists).
     expectMessage(
         [&] {

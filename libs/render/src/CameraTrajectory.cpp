@@ -9,6 +9,7 @@
 #include <Eigen/Geometry>
 
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 
 namespace devslam::render {
@@ -134,6 +135,17 @@ void TrajectoryOptions::loadFromConfig(const mrpt::config::CConfigFileBase& cfg,
         "look_at",
         "straight above or below position: the view needs a "
         "horizontal part to level the camera");
+    if (type == TrajectoryType::Halfsphere) {
+        // Over the top of the sphere the levelled view turns upside down between two frames.
+        const Eigen::Vector3d d0 = position - look_at;
+        const double el0 = std::asin(d0.z() / d0.norm()) / kDeg;
+        const double reach = std::abs(el0) + std::abs(elevation_amplitude_deg);
+        std::ostringstream m;
+        m << "the orbit reaches " << reach << " deg of elevation (the mean view's " << el0
+          << " deg and this amplitude); it must stay below 89 deg, where the view would turn "
+             "over";
+        core::requireValue(reach < 89.0, s, "elevation_amplitude_deg", m.str());
+    }
 }
 
 mrpt::poses::CPose3D lookAtPose(const Eigen::Vector3d& eye, const Eigen::Vector3d& target) {
