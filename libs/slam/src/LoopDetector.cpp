@@ -71,7 +71,7 @@ bool loopsAgree(const Map& map, const LoopConstraint& a, const LoopConstraint& b
 
 std::optional<LoopConstraint> detectLoop(const Map& map, KeyframeId current,
                                          const core::CameraIntrinsics& K, const LoopOptions& opts,
-                                         const PoseRefineOptions& refine, unsigned long long seed) {
+                                         const PoseRefineOptions& refine) {
     if (!opts.enabled) return std::nullopt;
     const Keyframe& cur = map.keyframe(current);
     std::vector<std::pair<double, KeyframeId>> cands;
@@ -110,7 +110,6 @@ std::optional<LoopConstraint> detectLoop(const Map& map, KeyframeId current,
         PnpRansacOptions pnp;
         pnp.iterations = 300;
         pnp.min_inliers = opts.min_inliers;
-        pnp.seed = seed;
         const auto sol = solvePnpRansac(obs, K, pnp);
         if (!sol) continue;
         const auto ref = refinePose(obs, sol->T_wc, K, refine);

@@ -45,7 +45,6 @@ std::optional<PnpResult> solvePnpRansac(const std::vector<PoseObservation>& obs,
         use_guess = true;
     }
     std::vector<int> inliers;
-    cv::theRNG().state = opts.seed;
     const bool ok = cv::solvePnPRansac(obj, img, Kc, cv::noArray(), rvec, tvec, use_guess,
                                        opts.iterations, static_cast<float>(opts.reprojection_px),
                                        opts.confidence, inliers, cv::SOLVEPNP_EPNP);

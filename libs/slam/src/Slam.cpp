@@ -77,9 +77,8 @@ SlamOptions SlamOptions::fromConfig(const mrpt::config::CConfigFileBase& cfg) {
     o.mapping.loadFromConfig(cfg, "mapping");
     o.local_ba.loadFromConfig(cfg, "local_ba");
     o.loop.loadFromConfig(cfg, "loop_closure");
-    core::requireKnownKeys(cfg, "pose_graph", {"max_iterations", "seed"});
+    core::requireKnownKeys(cfg, "pose_graph", {"max_iterations"});
     o.pose_graph.max_iterations = core::readInt(cfg, "pose_graph", "max_iterations", 100);
-    o.seed = static_cast<unsigned long long>(core::readUint64(cfg, "pose_graph", "seed", o.seed));
     core::requireValue(o.pose_graph.max_iterations > 0, "pose_graph", "max_iterations",
                        "must be > 0");
     // The level sigmas of tracking and BA follow the ORB pyramid.
@@ -97,7 +96,6 @@ void SlamOptions::saveToConfig(mrpt::config::CConfigFileBase& cfg) const {
     local_ba.saveToConfig(cfg, "local_ba");
     loop.saveToConfig(cfg, "loop_closure");
     cfg.write("pose_graph", "max_iterations", pose_graph.max_iterations);
-    cfg.write("pose_graph", "seed", static_cast<uint64_t>(seed));
 }
 
 Slam::Slam(const SlamOptions& opts) : opts_(opts), orb_(opts.orb), tracker_(opts.tracker) {}
@@ -139,7 +137,7 @@ TrackResult Slam::track(const core::Frame& frame, const FrameFeatures& features,
         return res;
     }
     const TrackInput in{&features, frame.timestamp, prior};
-    res = tracker_.track(in, map_, frame.K, opts_.seed + frame.index);
+    res = tracker_.track(in, map_, frame.K);
     rec.valid = res.pose_valid;
     const auto last = map_.lastKeyframes(1);
     if (!last.empty()) {
@@ -292,8 +290,7 @@ BackendResult Slam::backendStep(const MappingResult& mapping, const core::Camera
     if (!mapping.keyframe_inserted || !opts_.loop.enabled) return out;
     if (!loops_.empty() && mapping.keyframe - loops_.back().new_kf < opts_.loop.cooldown_keyframes)
         return out;
-    out.loop = detectLoop(map_, mapping.keyframe, K, opts_.loop, opts_.tracker.refine,
-                          opts_.seed + static_cast<unsigned long long>(mapping.keyframe));
+    out.loop = detectLoop(map_, mapping.keyframe, K, opts_.loop, opts_.tracker.refine);
     const int confirm = opts_.loop.confirm_keyframes;
     if (pending_loop_ && mapping.keyframe - pending_loop_->new_kf > confirm) pending_loop_.reset();
     if (!out.loop) return out;

@@ -152,7 +152,6 @@ std::optional<PoseRefineResult> Tracker::trackWithMap(const FrameFeatures& f, Ma
                                                       const core::CameraIntrinsics& K,
                                                       const Eigen::Isometry3d& pred,
                                                       const std::vector<LandmarkId>& local,
-                                                      unsigned long long seed,
                                                       TrackResult& res) const {
     const KeypointGrid grid(f.keypoints, cv::Size(K.width, K.height));
     auto matches = matchByProjection(map, local, f, grid, pred, K, opts_.projection);
@@ -166,9 +165,7 @@ std::optional<PoseRefineResult> Tracker::trackWithMap(const FrameFeatures& f, Ma
         return std::nullopt;
     }
     auto obs = observationsOf(map, f, matches, opts_.scale_factor);
-    auto pnp_opts = opts_.pnp;
-    pnp_opts.seed = seed;
-    const auto pnp = solvePnpRansac(obs, K, pnp_opts, pred);
+    const auto pnp = solvePnpRansac(obs, K, opts_.pnp, pred);
     Eigen::Isometry3d T0 = pred;
     if (pnp) T0 = pnp->T_wc;
     auto refined = refinePose(obs, T0, K, opts_.refine);
@@ -211,7 +208,6 @@ bool Tracker::relocPlausible(const Eigen::Isometry3d& T_wc, double timestamp) co
 
 std::optional<Eigen::Isometry3d> Tracker::relocalize(const FrameFeatures& f, const Map& map,
                                                      const core::CameraIntrinsics& K,
-                                                     unsigned long long seed,
                                                      double timestamp) const {
     // Candidates: the newest keyframes and the ones nearest to the last pose.
     std::vector<std::pair<double, KeyframeId>> by_dist;
@@ -247,7 +243,6 @@ std::optional<Eigen::Isometry3d> Tracker::relocalize(const FrameFeatures& f, con
                            1.0 / (s * s)});
         }
         auto pnp_opts = opts_.pnp;
-        pnp_opts.seed = seed;
         pnp_opts.iterations = std::max(pnp_opts.iterations, 300);
         pnp_opts.min_inliers = opts_.reloc_min_inliers;
         const auto pnp = solvePnpRansac(obs, K, pnp_opts);
@@ -262,8 +257,7 @@ std::optional<Eigen::Isometry3d> Tracker::relocalize(const FrameFeatures& f, con
     return best;
 }
 
-TrackResult Tracker::track(const TrackInput& in, Map& map, const core::CameraIntrinsics& K,
-                           unsigned long long seed) {
+TrackResult Tracker::track(const TrackInput& in, Map& map, const core::CameraIntrinsics& K) {
     TrackResult res;
     const FrameFeatures& f = *in.features;
     res.landmark_of_kp.assign(f.size(), kNoId);
@@ -279,13 +273,13 @@ TrackResult Tracker::track(const TrackInput& in, Map& map, const core::CameraInt
 
     std::optional<PoseRefineResult> ok;
     const bool was_lost = state_ == TrackingState::Lost;
-    if (!was_lost && f.size() > 0) ok = trackWithMap(f, map, K, pred, local, seed, res);
+    if (!was_lost && f.size() > 0) ok = trackWithMap(f, map, K, pred, local, res);
     if (!ok && f.size() > 0) {
         // Relocalize against keyframes, then track the local map from that pose.
         TrackResult reloc_res;
-        if (const auto T = relocalize(f, map, K, seed, in.timestamp)) {
+        if (const auto T = relocalize(f, map, K, in.timestamp)) {
             auto near = map.landmarksOf(map.lastKeyframes(opts_.local_keyframes));
-            ok = trackWithMap(f, map, K, *T, near, seed + 1, reloc_res);
+            ok = trackWithMap(f, map, K, *T, near, reloc_res);
             // The local map may pull the pose away again (its newest keyframes can be the
             // bad poses that lost the track): the bound holds for the final pose too.
             if (ok && !relocPlausible(ok->T_wc, in.timestamp)) ok.reset();

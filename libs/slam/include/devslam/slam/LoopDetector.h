@@ -65,7 +65,6 @@ struct LoopConstraint {
 [[nodiscard]] std::optional<LoopConstraint> detectLoop(const Map& map, KeyframeId current,
                                                        const core::CameraIntrinsics& K,
                                                        const LoopOptions& opts,
-                                                       const PoseRefineOptions& refine = {},
-                                                       unsigned long long seed = 777);
+                                                       const PoseRefineOptions& refine = {});
 
 }  // namespace devslam::slam

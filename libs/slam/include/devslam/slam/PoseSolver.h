@@ -25,7 +25,6 @@ struct PnpRansacOptions {
     double reprojection_px = 4.0;     ///< [px] inlier threshold
     double confidence = 0.99;         ///< RANSAC confidence
     int min_inliers = 12;             ///< fewer: no pose
-    unsigned long long seed = 12345;  ///< cv::theRNG() state before the call (determinism)
 };
 
 struct PnpResult {
@@ -33,7 +32,10 @@ struct PnpResult {
     std::vector<int> inliers;  ///< indices into the observations
 };
 
-/// RANSAC PnP (EPnP hypotheses). `guess_T_wc` (optional) seeds the final iterative fit.
+/// RANSAC PnP (EPnP hypotheses and EPnP on the inliers). Deterministic without a seed:
+/// OpenCV's RANSAC draws its samples from a generator of its own with a fixed seed (it does
+/// not read cv::theRNG()). `guess_T_wc` (optional) is passed as OpenCV's extrinsic guess,
+/// which EPnP does not use: the caller's refinement (refinePose) starts from the result.
 /// std::nullopt with fewer than max(6, min_inliers) observations or inliers.
 [[nodiscard]] std::optional<PnpResult> solvePnpRansac(
     const std::vector<PoseObservation>& obs, const core::CameraIntrinsics& K,

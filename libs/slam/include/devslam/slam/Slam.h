@@ -11,7 +11,7 @@
 ///   devslam::slam::Slam slam(devslam::slam::SlamOptions::fromConfig(*cfg));
 ///   while (auto f = reader->next()) { auto r = slam.process(*f, mask); }
 ///   auto traj = slam.trajectory();           // every frame, lost ones flagged
-/// Not thread-safe; deterministic (RANSAC seeded from the frame index).
+/// Not thread-safe; deterministic (OpenCV's RANSAC draws from a fixed-seed generator).
 #include <devslam/core/Frame.h>
 #include <devslam/core/Trajectory.h>
 #include <devslam/slam/KeyframeSelector.h>
@@ -74,7 +74,6 @@ struct SlamOptions {
     LocalBaOptions local_ba;
     LoopOptions loop;
     PoseGraphOptions pose_graph;
-    unsigned long long seed = 12345;  ///< base RANSAC seed (per frame: seed + frame index)
 
     /// Sections [orb] [tracker] [keyframes] [mapping] [local_ba] [loop_closure]
     /// [pose_graph] (all optional; unknown keys throw naming section and key).

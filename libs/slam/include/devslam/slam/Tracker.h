@@ -9,7 +9,7 @@
 /// Usage:
 ///   Tracker tracker(opts);
 ///   tracker.initialize(T_wc0, t0);                       // after the first keyframe
-///   auto r = tracker.track({&features, t, prior}, map, K, seed);
+///   auto r = tracker.track({&features, t, prior}, map, K);
 /// Not thread-safe.
 #include <devslam/core/Camera.h>
 #include <devslam/slam/Map.h>
@@ -86,9 +86,8 @@ class Tracker {
     /// Starts tracking at a pose (the first keyframe's).
     void initialize(const Eigen::Isometry3d& T_wc, double timestamp);
     /// Tracks one frame against `map`; updates the landmarks' visible/found counters.
-    /// `seed` makes RANSAC deterministic.
-    [[nodiscard]] TrackResult track(const TrackInput& in, Map& map, const core::CameraIntrinsics& K,
-                                    unsigned long long seed);
+    [[nodiscard]] TrackResult track(const TrackInput& in, Map& map,
+                                    const core::CameraIntrinsics& K);
     /// Constant-velocity prediction of the next camera in the last one (p_prev = T * p_cur)
     /// for a frame at `timestamp`; nullopt when unknown (not initialized, lost, big gap).
     [[nodiscard]] std::optional<Eigen::Isometry3d> predictPrevCur(double timestamp) const;
@@ -110,11 +109,11 @@ class Tracker {
                                                  const core::CameraIntrinsics& K,
                                                  const Eigen::Isometry3d& pred,
                                                  const std::vector<LandmarkId>& local,
-                                                 unsigned long long seed, TrackResult& res) const;
+                                                 TrackResult& res) const;
     /// `timestamp`: of the frame, for the jump bound.
     std::optional<Eigen::Isometry3d> relocalize(const FrameFeatures& f, const Map& map,
                                                 const core::CameraIntrinsics& K,
-                                                unsigned long long seed, double timestamp) const;
+                                                double timestamp) const;
 
     TrackerOptions opts_;
     TrackingState state_ = TrackingState::NotInitialized;
