@@ -582,6 +582,25 @@ TEST(Config, EveryShippedSlamIniLoadsAndUnknownKeysAreRejected) {
     }
     mrpt::config::CConfigFileMemory neg("[orb]\nn_features = -5\n");
     EXPECT_THROW((void)SlamOptions::fromConfig(neg), std::invalid_argument);
+    // Values that broke a run part-way (a vector resized to -1, an OpenCV assertion, every
+    // landmark culled or every frame lost) are refused at the start, naming their own key.
+    for (const auto& [text, message] : std::vector<std::pair<std::string, std::string>>{
+             {"[loop_closure]\nmax_candidates = -1\n", "[loop_closure] max_candidates: must be"},
+             {"[tracker]\npnp_confidence = 1\n", "[tracker] pnp_confidence: must be in (0, 1)"},
+             {"[mapping]\ncull_keyframe_age = 0\n", "[mapping] cull_keyframe_age: must be >= 1"},
+             {"[tracker]\nrefine_rounds = 0\n", "[tracker] refine_rounds: must be >= 1"},
+             {"[tracker]\nmax_depth = 0\n", "[tracker] max_depth: must be > 0"},
+             {"[tracker]\nfine_radius = 0\n", "[tracker] fine_radius: must be > 0"},
+             {"[loop_closure]\nsigma_r_deg = 0\n", "[loop_closure] sigma_r_deg: must be > 0"},
+             {"[local_ba]\nchi2_mono = -1\n", "[local_ba] chi2_mono: must be > 0"}}) {
+        mrpt::config::CConfigFileMemory c(text);
+        try {
+            (void)SlamOptions::fromConfig(c);
+            ADD_FAILURE() << "accepted: " << text;
+        } catch (const std::invalid_argument& e) {
+            EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
+        }
+    }
 }
 
 TEST(Config, SaveLoadRoundTrip) {

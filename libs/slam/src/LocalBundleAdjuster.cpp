@@ -30,6 +30,8 @@ void LocalBaOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, cons
     core::requireValue(window >= 1 && window <= 30, s, "window", "must be in [1, 30]");
     core::requireValue(iterations >= 0, s, "iterations", "must be >= 0");
     core::requireValue(bf > 0, s, "bf", "must be > 0");
+    core::requireValue(chi2_mono > 0, s, "chi2_mono", "must be > 0");
+    core::requireValue(chi2_stereo > 0, s, "chi2_stereo", "must be > 0");
     max_keyframe_shift = core::readDouble(c, s, "max_keyframe_shift", max_keyframe_shift);
     core::requireValue(max_keyframe_shift >= 0, s, "max_keyframe_shift", "must be >= 0 (0 = off)");
 }

@@ -31,13 +31,20 @@ void LoopOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, const s
     sigma_t = core::readDouble(c, s, "sigma_t", sigma_t);
     sigma_r_deg = core::readDouble(c, s, "sigma_r_deg", sigma_r_deg);
     core::requireValue(min_keyframe_gap >= 1, s, "min_keyframe_gap", "must be >= 1");
+    core::requireValue(cooldown_keyframes >= 0, s, "cooldown_keyframes", "must be >= 0");
+    core::requireValue(max_candidates >= 1, s, "max_candidates", "must be >= 1");
+    core::requireValue(max_hamming > 0 && max_hamming <= 256, s, "max_hamming",
+                       "must be in (0, 256]");
+    core::requireValue(ratio > 0 && ratio <= 1, s, "ratio", "must be in (0, 1]");
     core::requireValue(max_distance > 0, s, "max_distance", "must be > 0");
     core::requireValue(min_inliers >= 6, s, "min_inliers", "must be >= 6");
-    core::requireValue(max_correction > 0 && max_correction_deg > 0, s,
-                       "max_correction/max_correction_deg", "must be > 0");
+    core::requireValue(max_correction > 0, s, "max_correction", "must be > 0 [m]");
+    core::requireValue(max_correction_deg > 0, s, "max_correction_deg", "must be > 0");
     core::requireValue(confirm_keyframes >= 0, s, "confirm_keyframes", "must be >= 0");
-    core::requireValue(confirm_t > 0 && confirm_deg > 0, s, "confirm_t/confirm_deg", "must be > 0");
-    core::requireValue(sigma_t > 0 && sigma_r_deg > 0, s, "sigma_t/sigma_r_deg", "must be > 0");
+    core::requireValue(confirm_t > 0, s, "confirm_t", "must be > 0 [m]");
+    core::requireValue(confirm_deg > 0, s, "confirm_deg", "must be > 0");
+    core::requireValue(sigma_t > 0, s, "sigma_t", "must be > 0 [m]");
+    core::requireValue(sigma_r_deg > 0, s, "sigma_r_deg", "must be > 0");
 }
 
 void LoopOptions::saveToConfig(mrpt::config::CConfigFileBase& c, const std::string& s) const {

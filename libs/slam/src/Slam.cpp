@@ -27,8 +27,11 @@ void MappingOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, cons
     core::requireValue(min_init_points >= 10, s, "min_init_points", "must be >= 10");
     core::requireValue(cull_min_found_ratio >= 0 && cull_min_found_ratio < 1, s,
                        "cull_min_found_ratio", "must be in [0, 1)");
-    core::requireValue(odometry_sigma_t > 0 && odometry_sigma_r_deg > 0, s,
-                       "odometry_sigma_t/odometry_sigma_r_deg", "must be > 0");
+    core::requireValue(cull_min_visible >= 0, s, "cull_min_visible", "must be >= 0");
+    core::requireValue(cull_keyframe_age >= 1, s, "cull_keyframe_age",
+                       "must be >= 1 (0 culled every new landmark at once)");
+    core::requireValue(odometry_sigma_t > 0, s, "odometry_sigma_t", "must be > 0 [m]");
+    core::requireValue(odometry_sigma_r_deg > 0, s, "odometry_sigma_r_deg", "must be > 0");
 }
 
 void MappingOptions::saveToConfig(mrpt::config::CConfigFileBase& c, const std::string& s) const {

@@ -59,20 +59,34 @@ void TrackerOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, cons
     reloc_max_speed = core::readDouble(c, s, "reloc_max_speed", reloc_max_speed);
     reloc_max_jump_deg = core::readDouble(c, s, "reloc_max_jump_deg", reloc_max_jump_deg);
     reloc_max_rate_deg = core::readDouble(c, s, "reloc_max_rate_deg", reloc_max_rate_deg);
-    core::requireValue(projection.radius > 0 && fine_radius > 0, s, "search_radius/fine_radius",
-                       "must be > 0");
+    core::requireValue(projection.radius > 0, s, "search_radius", "must be > 0 [px]");
+    core::requireValue(fine_radius > 0, s, "fine_radius", "must be > 0 [px]");
+    core::requireValue(wide_radius_factor >= 1, s, "wide_radius_factor", "must be >= 1");
     core::requireValue(projection.max_hamming > 0 && projection.max_hamming <= 256, s,
                        "max_hamming", "must be in (0, 256]");
     core::requireValue(projection.ratio > 0 && projection.ratio <= 1, s, "match_ratio",
                        "must be in (0, 1]");
+    core::requireValue(projection.max_depth > 0, s, "max_depth", "must be > 0 [m]");
     core::requireValue(pnp.iterations > 0, s, "pnp_iterations", "must be > 0");
     core::requireValue(pnp.reprojection_px > 0, s, "pnp_reprojection_px", "must be > 0");
+    core::requireValue(pnp.confidence > 0 && pnp.confidence < 1, s, "pnp_confidence",
+                       "must be in (0, 1)");
     core::requireValue(refine.bf > 0, s, "bf", "must be > 0");
+    core::requireValue(refine.rounds >= 1, s, "refine_rounds", "must be >= 1");
+    core::requireValue(refine.iterations >= 1, s, "refine_iterations", "must be >= 1");
+    core::requireValue(min_matches >= 6, s, "min_matches", "must be >= 6");
     core::requireValue(min_inliers >= 6, s, "min_inliers", "must be >= 6");
     core::requireValue(local_keyframes >= 1, s, "local_keyframes", "must be >= 1");
+    core::requireValue(max_motion_dt > 0, s, "max_motion_dt", "must be > 0 [s]");
     core::requireValue(reloc_keyframes >= 1, s, "reloc_keyframes", "must be >= 1");
-    core::requireValue(reloc_max_jump >= 0 && reloc_max_jump_deg >= 0 && reloc_max_rate_deg >= 0,
-                       s, "reloc_max_jump/reloc_max_jump_deg/reloc_max_rate_deg", "must be >= 0");
+    core::requireValue(reloc_min_inliers >= 6, s, "reloc_min_inliers", "must be >= 6");
+    core::requireValue(reloc_max_hamming > 0 && reloc_max_hamming <= 256, s, "reloc_max_hamming",
+                       "must be in (0, 256]");
+    core::requireValue(reloc_ratio > 0 && reloc_ratio <= 1, s, "reloc_ratio", "must be in (0, 1]");
+    core::requireValue(reloc_max_jump >= 0, s, "reloc_max_jump", "must be >= 0 [m]");
+    core::requireValue(reloc_max_speed >= 0, s, "reloc_max_speed", "must be >= 0 [m/s]");
+    core::requireValue(reloc_max_jump_deg >= 0, s, "reloc_max_jump_deg", "must be >= 0");
+    core::requireValue(reloc_max_rate_deg >= 0, s, "reloc_max_rate_deg", "must be >= 0");
 }
 
 void TrackerOptions::saveToConfig(mrpt::config::CConfigFileBase& c, const std::string& s) const {
