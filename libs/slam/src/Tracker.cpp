@@ -162,11 +162,12 @@ std::vector<PoseObservation> observationsOf(const Map& map, const FrameFeatures&
 }
 }  // namespace
 
-std::optional<PoseRefineResult> Tracker::trackWithMap(const FrameFeatures& f, Map& map,
+std::optional<PoseRefineResult> Tracker::trackWithMap(const FrameFeatures& f, const Map& map,
                                                       const core::CameraIntrinsics& K,
                                                       const Eigen::Isometry3d& pred,
                                                       const std::vector<LandmarkId>& local,
-                                                      TrackResult& res) const {
+                                                      TrackResult& res,
+                                                      std::vector<LandmarkId>& in_view) const {
     const KeypointGrid grid(f.keypoints, cv::Size(K.width, K.height));
     auto matches = matchByProjection(map, local, f, grid, pred, K, opts_.projection);
     if (static_cast<int>(matches.size()) < opts_.min_matches) {
@@ -190,7 +191,7 @@ std::optional<PoseRefineResult> Tracker::trackWithMap(const FrameFeatures& f, Ma
     // Second pass: every local landmark again around the refined pose, tighter window.
     auto fine = opts_.projection;
     fine.radius = opts_.fine_radius;
-    std::vector<LandmarkId> in_view;
+    in_view.clear();
     matches =
         matchByProjection(map, local, f, grid, refined.T_wc, K, fine, &res.n_in_view, &in_view);
     obs = observationsOf(map, f, matches, opts_.scale_factor);
@@ -202,12 +203,8 @@ std::optional<PoseRefineResult> Tracker::trackWithMap(const FrameFeatures& f, Ma
     }
     res.n_matches = static_cast<int>(matches.size());
     res.landmark_of_kp.assign(f.size(), kNoId);
-    for (LandmarkId id : in_view) ++map.landmark(id)->n_visible;
-    for (std::size_t i = 0; i < matches.size(); ++i) {
-        if (!refined2.inlier[i]) continue;
-        res.landmark_of_kp[matches[i].kp] = matches[i].landmark;
-        ++map.landmark(matches[i].landmark)->n_found;
-    }
+    for (std::size_t i = 0; i < matches.size(); ++i)
+        if (refined2.inlier[i]) res.landmark_of_kp[matches[i].kp] = matches[i].landmark;
     return refined2;
 }
 
@@ -287,13 +284,15 @@ TrackResult Tracker::track(const TrackInput& in, Map& map, const core::CameraInt
 
     std::optional<PoseRefineResult> ok;
     const bool was_lost = state_ == TrackingState::Lost;
-    if (!was_lost && f.size() > 0) ok = trackWithMap(f, map, K, pred, local, res);
+    std::vector<LandmarkId> in_view;
+    if (!was_lost && f.size() > 0) ok = trackWithMap(f, map, K, pred, local, res, in_view);
     if (!ok && f.size() > 0) {
         // Relocalize against keyframes, then track the local map from that pose.
         TrackResult reloc_res;
         if (const auto T = relocalize(f, map, K, in.timestamp)) {
             auto near = map.landmarksOf(map.lastKeyframes(opts_.local_keyframes));
-            ok = trackWithMap(f, map, K, *T, near, reloc_res);
+            std::vector<LandmarkId> reloc_in_view;
+            ok = trackWithMap(f, map, K, *T, near, reloc_res, reloc_in_view);
             // The local map may pull the pose away again (its newest keyframes can be the
             // bad poses that lost the track): the bound holds for the final pose too.
             if (ok && !relocPlausible(ok->T_wc, in.timestamp)) ok.reset();
@@ -301,6 +300,7 @@ TrackResult Tracker::track(const TrackInput& in, Map& map, const core::CameraInt
                 const std::string why = res.reason;
                 res = reloc_res;
                 res.reason = was_lost ? "" : "relocalized after: " + why;
+                in_view = std::move(reloc_in_view);
             }
         }
         if (!ok && res.reason.empty()) res.reason = "relocalization failed";
@@ -316,6 +316,11 @@ TrackResult Tracker::track(const TrackInput& in, Map& map, const core::CameraInt
         // Keep last_T_wc_: the next frame predicts from the last good pose.
         return res;
     }
+    // The culling counters, for the pose kept only: a relocalization the jump bound refused
+    // (a false match on repeated texture, say) counts no landmark as seen or found.
+    for (LandmarkId id : in_view) ++map.landmark(id)->n_visible;
+    for (LandmarkId id : res.landmark_of_kp)
+        if (id != kNoId) ++map.landmark(id)->n_found;
     const double dt = in.timestamp - last_t_;
     velocity_ = last_T_wc_.inverse() * ok->T_wc;
     velocity_dt_ = dt;

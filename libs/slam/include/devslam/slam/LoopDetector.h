@@ -1,7 +1,8 @@
 #pragma once
 /// Loop detection: descriptor matching of a new keyframe against older keyframes near
 /// its current pose estimate, geometric verification by PnP-RANSAC + refinement on the
-/// old keyframe's landmarks. Pure function.
+/// old keyframe's own keypoints with depth (not its landmarks: the measured relative pose
+/// depends on the two images only). Pure function.
 ///
 /// Usage:
 ///   if (auto loop = devslam::slam::detectLoop(map, kf_id, K, opts)) edges.push_back(...);

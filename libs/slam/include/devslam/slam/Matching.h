@@ -26,7 +26,7 @@ class KeypointGrid {
 };
 
 struct ProjectionMatchOptions {
-    double radius = 12.0;     ///< [px] search radius around the projection (octave 0)
+    double radius = 12.0;     ///< [px] search radius around the projection (every octave)
     int max_hamming = 60;     ///< best distance must be <= this (0..256)
     double ratio = 0.85;      ///< best < ratio * second best (same frame), else ambiguous
     double max_depth = 10.0;  ///< [m] landmarks farther in front of the camera are not searched
@@ -47,8 +47,9 @@ struct Match {
     const ProjectionMatchOptions& opts, int* n_in_view = nullptr,
     std::vector<LandmarkId>* in_view = nullptr);
 
-/// Brute-force matching of query rows against train rows with the ratio test and a
-/// mutual check (each train row used once). Returns (query, train) index pairs.
+/// Brute-force matching of query rows against train rows with the ratio test, one to one
+/// (each train row kept for its best query row; not a mutual best check). Returns (query,
+/// train) index pairs.
 [[nodiscard]] std::vector<std::pair<int, int>> matchBruteForce(const cv::Mat& query,
                                                                const cv::Mat& train,
                                                                int max_hamming, double ratio);

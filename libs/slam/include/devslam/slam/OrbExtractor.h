@@ -40,7 +40,8 @@ class OrbExtractor {
         /// (the paper's wording; n_masked counts them).
         bool detect_outside_mask = false;
         /// A keypoint whose 5x5 depth neighbourhood spreads more than this fraction of its
-        /// depth (or has holes) sits on an occlusion edge - often a corner formed by a
+        /// depth (holes are left out: Kinect shadows are evidence neither way) sits on an
+        /// occlusion edge - often a corner formed by a
         /// person's silhouette against the background, which moves with the person while
         /// its depth is the wall's. Its depth is discarded, so it never becomes a landmark.
         /// 0 = off.

@@ -105,11 +105,14 @@ class Tracker {
     [[nodiscard]] bool relocPlausible(const Eigen::Isometry3d& T_wc, double timestamp) const;
 
   private:
-    std::optional<PoseRefineResult> trackWithMap(const FrameFeatures& f, Map& map,
+    /// `in_view`: the local landmarks that projected into the image in the fine pass (their
+    /// visible counters are the caller's to update, once the pose is kept).
+    std::optional<PoseRefineResult> trackWithMap(const FrameFeatures& f, const Map& map,
                                                  const core::CameraIntrinsics& K,
                                                  const Eigen::Isometry3d& pred,
                                                  const std::vector<LandmarkId>& local,
-                                                 TrackResult& res) const;
+                                                 TrackResult& res,
+                                                 std::vector<LandmarkId>& in_view) const;
     /// `timestamp`: of the frame, for the jump bound.
     std::optional<Eigen::Isometry3d> relocalize(const FrameFeatures& f, const Map& map,
                                                 const core::CameraIntrinsics& K,
