@@ -266,6 +266,10 @@ TEST(NavConfig, MrptSectionsAreReadStrictly) {
         return navError(c);
     };
     EXPECT_EQ(errorOf("navigator", "nav_period", "0.1"), "");  // the shipped file passes
+    // [replan] values that silently turned a trigger off (a negative margin) are refused.
+    EXPECT_EQ(errorOf("replan", "blocked_margin", "-0.5"),
+              "x.ini [replan] blocked_margin: must be >= 0 m");
+    EXPECT_EQ(errorOf("replan", "sensed_range", "0"), "x.ini [replan] sensed_range: must be > 0 m");
     EXPECT_EQ(errorOf("CAbstractPTGBasedReactive", "robotMax_V_mps", "fast"),
               "x.ini [CAbstractPTGBasedReactive] robotMax_V_mps: expected a number, got 'fast'");
     EXPECT_EQ(errorOf("CAbstractNavigator", "alarm_seems_not_approaching_target_timeout", "15s"),

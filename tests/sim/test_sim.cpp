@@ -111,6 +111,9 @@ TEST(World, BadEntriesNameTheKey) {
               "steps (at most 1e6)");
     EXPECT_EQ(errorOf(head + "[laser]\nrays = 2000000000\n"),
               "w.ini [laser] rays: must be in [2, 100000]");
+    EXPECT_EQ(errorOf(head + "[laser]\nrays = 100000\nrate_hz = 100\n"),
+              "w.ini [laser] rays: 100000 rays at 100 Hz over the 60 s timeout are 6e+08 ray "
+              "casts (at most 1e8)");
     // The key that is wrong is the one named (they were max_v, x_min, start_x for all).
     EXPECT_EQ(errorOf(head + "[robot]\nmax_ang_acc_deg = 0\n"),
               "w.ini [robot] max_ang_acc_deg: speed and acceleration limits must be > 0");

@@ -21,10 +21,13 @@ void ReplanOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, c
     blocked_margin = core::readDouble(c, s, "blocked_margin", blocked_margin);
     obstacle_inflation = core::readDouble(c, s, "obstacle_inflation", obstacle_inflation);
     sensed_range = core::readDouble(c, s, "sensed_range", sensed_range);
+    core::requireValue(density_threshold >= 0, s, "density_threshold", "must be >= 0");
     core::requireValue(density_time >= 0, s, "density_time", "must be >= 0 s");
     core::requireValue(min_interval >= 0, s, "min_interval", "must be >= 0 s");
     core::requireValue(blocked_lookahead > 0, s, "blocked_lookahead", "must be > 0 m");
+    core::requireValue(blocked_margin >= 0, s, "blocked_margin", "must be >= 0 m");
     core::requireValue(obstacle_inflation >= 0, s, "obstacle_inflation", "must be >= 0 m");
+    core::requireValue(sensed_range > 0, s, "sensed_range", "must be > 0 m");
 }
 
 void ReplanOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const {

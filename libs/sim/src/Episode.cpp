@@ -142,8 +142,9 @@ EpisodeResult runEpisode(const WorldSpec& world, const mrpt::config::CConfigFile
 
 void writeEpisodePng(const WorldSpec& w, const EpisodeResult& r, const std::string& path,
                      const std::string& title) {
-    const double ppm =
-        std::clamp(1000.0 / std::max(w.x_max - w.x_min, w.y_max - w.y_min), 20.0, 100.0);
+    // 20-100 px per metre, and at most 4000 px across (a 5 km world made a 30 GB picture).
+    const double longest = std::max(w.x_max - w.x_min, w.y_max - w.y_min);
+    const double ppm = std::min(std::clamp(1000.0 / longest, 20.0, 100.0), 4000.0 / longest);
     const int W = static_cast<int>(std::ceil((w.x_max - w.x_min) * ppm));
     const int H = static_cast<int>(std::ceil((w.y_max - w.y_min) * ppm)) + nav::kTitleBandHeight;
     cv::Mat img(H, W, CV_8UC3, cv::Scalar(255, 255, 255));

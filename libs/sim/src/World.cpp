@@ -224,6 +224,14 @@ void validateWorld(const WorldSpec& w) {
     if (!(w.laser.noise_std >= 0)) fail(src, "laser", "noise_std", "must be >= 0 m");
     if (!(w.laser.fov > 0) || w.laser.fov > 2 * M_PI + 1e-9)
         fail(src, "laser", "fov_deg", "must be in (0, 360]");
+    // Each ray is a Bullet ray cast (about 1 us): 1e8 of them are a minute and a half.
+    constexpr double kMaxRays = 1e8;
+    if (const double casts = double(w.laser.rays) * w.laser.rate * w.timeout; casts > kMaxRays) {
+        std::ostringstream m;
+        m << w.laser.rays << " rays at " << w.laser.rate << " Hz over the " << w.timeout
+          << " s timeout are " << casts << " ray casts (at most 1e8)";
+        fail(src, "laser", "rays", m.str());
+    }
     if (w.goal_tolerance <= 0) fail(src, "goal", "tolerance", "must be > 0 m");
     auto inside = [&](const mrpt::math::TPoint2D& p) {
         return p.x > w.x_min && p.x < w.x_max && p.y > w.y_min && p.y < w.y_max;
