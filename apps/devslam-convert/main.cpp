@@ -8,6 +8,8 @@
 #include <devslam/io/RgbdReader.h>
 #include <devslam/io/TumWriter.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <iostream>
 #include <optional>
@@ -109,6 +111,8 @@ int convert(int argc, char** argv) {
         std::string stopped;
         std::vector<std::string> undecodable;
         int interrupted = 0;  // the signal that stopped the conversion
+        double depth_gap = 0;  // [s] the largest colour-depth stamp difference written
+        bool to_rawlog = false;
         const auto convertAll = [&](auto& out) {
             while (n < max_frames) {
                 std::optional<devslam::core::Frame> f;
@@ -127,6 +131,8 @@ int convert(int argc, char** argv) {
                 // Ctrl-C (core/Interrupt.h) ends the conversion before this frame, the output
                 // closed whole; one after the last frame leaves it whole.
                 if ((interrupted = devslam::core::stopSignal())) break;
+                if (f->depth_timestamp)
+                    depth_gap = std::max(depth_gap, std::abs(*f->depth_timestamp - f->timestamp));
                 out.write(*f);
                 bar.update(++n);
             }
@@ -135,6 +141,7 @@ int convert(int argc, char** argv) {
             devslam::io::RawlogWriter out(pos[1], wo);
             convertAll(out);
             out.close();
+            to_rawlog = true;
         } else {
             devslam::io::TumWriter out(pos[1], "converted by devslam-convert from " + pos[0]);
             convertAll(out);
@@ -143,6 +150,14 @@ int convert(int argc, char** argv) {
         }
         bar.finish();
         std::cout << "wrote " << n << " frames to " << pos[1] << "\n";
+        if (to_rawlog) {  // a rawlog observation has one stamp, and a rawlog no ground truth
+            if (depth_gap > 0)
+                std::cout << "not kept: the depth images' own stamps (up to "
+                          << std::lround(1e3 * depth_gap)
+                          << " ms from the colour image's; a rawlog keeps one per frame)\n";
+            if (reader->groundTruth())
+                std::cout << "not kept: groundtruth.txt (a rawlog holds no ground truth)\n";
+        }
         if (const std::string lost = reader->damage(); !lost.empty())
             std::cout << "left out (damaged input): " << lost << "\n";
         if (!undecodable.empty())

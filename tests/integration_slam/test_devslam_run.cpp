@@ -163,6 +163,25 @@ TEST(DevslamRun, BadInputIsReported) {
 
 // A rawlog cut short (a recording that crashed): refused with how much is intact, and run
 // on that part with --allow-damaged, which says what was left out.
+// TUM -> rawlog keeps the images bit-exact, but a rawlog has one stamp per frame and no ground
+// truth: devslam-convert says what it did not keep.
+TEST(DevslamConvert, SaysWhatARawlogDoesNotKeep) {
+    const fs::path dir = devslam::test::scratchPath("devslam_convert_notes");
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    const auto r = devslam::test::runApp(
+        "devslam-convert", std::string(DEVSLAM_SOURCE_DIR) + "/data/tum/fr1_xyz_first37 " +
+                               (dir / "x.rawlog").string() + " --max-frames 3");
+    EXPECT_EQ(r.rc, 0) << r.out;
+    EXPECT_TRUE(std::regex_search(
+        r.out, std::regex(R"(not kept: the depth images' own stamps \(up to \d+ ms from)")))
+        << r.out;
+    EXPECT_NE(r.out.find("not kept: groundtruth.txt (a rawlog holds no ground truth)"),
+              std::string::npos)
+        << r.out;
+    fs::remove_all(dir);
+}
+
 TEST(DevslamRun, TruncatedRawlogRunsOnItsIntactPartWhenAsked) {
     const fs::path dir = devslam::test::scratchPath("devslam_run_truncated");
     fs::remove_all(dir);
