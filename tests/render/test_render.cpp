@@ -759,6 +759,12 @@ TEST(Scenario, ShippedFilesLoadAndTyposAreReported) {
                   tmp.str("s.ini") + " [depth_noise] sigma_b: must be >= 0");
     expectMessage([&] { (void)loadScenario(base, {"trajectory.elevation_period=0"}); },
                   tmp.str("s.ini") + " [trajectory] elevation_period: must be > 0 [s]");
+    // A key given with no value is refused, not read as the built-in default (look_at = took
+    // [4 2.5 1.0] over the file's value, name = wrote into out/synth/ itself).
+    expectMessage([&] { (void)loadScenario(base, {"trajectory.look_at="}); },
+                  tmp.str("s.ini") + " [trajectory] look_at: expected 3 numbers, got 0");
+    expectMessage([&] { (void)loadScenario(base, {"scenario.name="}); },
+                  tmp.str("s.ini") + " [scenario] name: must be a non-empty name");
     // A halfsphere orbit over the top would turn the view over between two frames.
     expectMessage(
         [&] {

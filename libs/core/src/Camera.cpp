@@ -76,9 +76,8 @@ CameraIntrinsics CameraIntrinsics::fromConfig(const mrpt::config::CConfigFileBas
     K.width = core::readInt(c, s, "width", K.width);
     K.height = core::readInt(c, s, "height", K.height);
     // Not MRPT's read_vector: its std::stod says only "stod" for "0 x 0" and reads "0.1x" as 0.1.
-    const std::string dist_text = c.read_string(s, "dist", "");
-    if (!dist_text.empty()) {
-        const auto d = parseNumberList(dist_text, "[" + s + "] dist");
+    if (const auto dist_text = readTextIfPresent(c, s, "dist")) {
+        const auto d = parseNumberList(*dist_text, "[" + s + "] dist");
         requireValue(d.size() == 5, s, "dist", "must have 5 values k1 k2 p1 p2 k3");
         std::copy(d.begin(), d.end(), K.dist.begin());
     }

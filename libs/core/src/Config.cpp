@@ -309,6 +309,13 @@ std::uint64_t readUint64(const mrpt::config::CConfigFileBase& cfg, const std::st
     return static_cast<std::uint64_t>(parseInteger(t, field(section, key), 0));
 }
 
+std::optional<std::string> readTextIfPresent(const mrpt::config::CConfigFileBase& cfg,
+                                             const std::string& section, const std::string& key) {
+    std::string t;
+    if (!readText(cfg, section, key, false, t)) return std::nullopt;
+    return t;
+}
+
 double readDouble(const mrpt::config::CConfigFileBase& cfg, const std::string& section,
                   const std::string& key, double def, bool required) {
     std::string t;

@@ -23,9 +23,9 @@ double sine(double amp, double period, double t, double phase = 0.0) {
 
 Eigen::Vector3d readVec3(const mrpt::config::CConfigFileBase& cfg, const std::string& s,
                          const std::string& key, const Eigen::Vector3d& def) {
-    const std::string txt = cfg.read_string(s, key, "");
-    if (txt.empty()) return def;
-    const auto v = core::parseNumberList(txt, "[" + s + "] " + key, 3);
+    const auto txt = core::readTextIfPresent(cfg, s, key);
+    if (!txt) return def;
+    const auto v = core::parseNumberList(*txt, "[" + s + "] " + key, 3);
     return {v[0], v[1], v[2]};
 }
 

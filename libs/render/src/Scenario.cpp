@@ -62,12 +62,12 @@ std::vector<std::string> resolveImages(const std::string& list, const std::strin
 Eigen::Vector3d vec3(const mrpt::config::CConfigFileBase& cfg, const std::string& s,
                      const std::string& key, const std::string& src, bool required,
                      const Eigen::Vector3d& def = Eigen::Vector3d::Zero()) {
-    const std::string txt = cfg.read_string(s, key, "");
-    if (txt.empty()) {
+    const auto txt = core::readTextIfPresent(cfg, s, key);
+    if (!txt) {
         if (required) throw std::invalid_argument(src + " [" + s + "]: missing key '" + key + "'");
         return def;
     }
-    const auto v = core::parseNumberList(txt, src + " [" + s + "] " + key, 3);
+    const auto v = core::parseNumberList(*txt, src + " [" + s + "] " + key, 3);
     return {v[0], v[1], v[2]};
 }
 
@@ -236,6 +236,8 @@ Scenario readScenario(const std::string& path, const std::vector<std::string>& o
                             "room_set"},
                            path);
     sc.name = cfg->read_string(s, "name", fs::path(path).stem().string());
+    core::requireValue(!sc.name.empty() && sc.name.find('/') == std::string::npos, s, "name",
+                       "must be a non-empty name without '/' (it names the output folder)");
     sc.rate_hz = core::readDouble(*cfg, s, "rate_hz", sc.rate_hz);
     core::requireValue(sc.rate_hz > 0 && sc.rate_hz <= 1000, "scenario", "rate_hz",
                        "must be in (0, 1000] [Hz]");

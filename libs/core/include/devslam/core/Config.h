@@ -12,6 +12,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -100,6 +101,11 @@ void applyOverrides(mrpt::config::CConfigFileMemory& cfg, const std::vector<std:
 [[nodiscard]] std::uint64_t readUint64(const mrpt::config::CConfigFileBase& cfg,
                                        const std::string& section, const std::string& key,
                                        std::uint64_t def, bool required = false);
+/// The text of `key`, or std::nullopt when the key is absent. A key given with no value
+/// ("look_at =") is its empty text, for the caller's parser to refuse: not the default.
+[[nodiscard]] std::optional<std::string> readTextIfPresent(const mrpt::config::CConfigFileBase& cfg,
+                                                           const std::string& section,
+                                                           const std::string& key);
 [[nodiscard]] double readDouble(const mrpt::config::CConfigFileBase& cfg,
                                 const std::string& section, const std::string& key, double def,
                                 bool required = false);
