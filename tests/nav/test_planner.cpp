@@ -45,6 +45,19 @@ TEST(GridPlanner, StraightLineInFreeSpace) {
     EXPECT_NEAR(path->length, 7.0, 1e-9);
 }
 
+// Start and goal in one cell: the path runs from the start to the goal (it was the goal
+// twice, length 0, the start lost).
+TEST(GridPlanner, StartAndGoalInOneCell) {
+    GridPlanner p(plain());
+    p.setMap(emptyGrid(10, 10));
+    const auto path = p.plan({1.01, 1.01}, {1.03, 1.05});
+    ASSERT_TRUE(path);
+    ASSERT_EQ(path->points.size(), 2u);
+    EXPECT_DOUBLE_EQ(path->points.front().x, 1.01);
+    EXPECT_DOUBLE_EQ(path->points.back().y, 1.05);
+    EXPECT_NEAR(path->length, std::hypot(0.02, 0.04), 1e-12);
+}
+
 TEST(GridPlanner, OctileDiagonal) {
     GridPlanner p(plain());
     p.setMap(emptyGrid(10, 10));

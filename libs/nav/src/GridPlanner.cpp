@@ -209,10 +209,10 @@ std::optional<GridPath> GridPlanner::plan(const mrpt::math::TPoint2D& start,
     for (int c = t_idx; c != -1; c = parent[c])
         out.points.emplace_back(grid_.idx2x(c % w_), grid_.idx2y(c / w_));
     std::reverse(out.points.begin(), out.points.end());
-    // exact endpoints instead of cell centres
+    // exact endpoints instead of cell centres (start and goal in one cell: both of them)
+    if (out.points.size() == 1) out.points.push_back(goal);
     out.points.front() = start;
     out.points.back() = goal;
-    if (out.points.size() == 1) out.points.push_back(goal);
     out.cost = g[t_idx];
     out.length = polylineLength(out.points);
     return out;
