@@ -118,6 +118,9 @@ int convert(int argc, char** argv) {
                 std::optional<devslam::core::Frame> f;
                 try {
                     f = reader->next();
+                } catch (const devslam::io::InputBroken& e) {
+                    stopped = e.what();  // nothing after it can be read, --allow-damaged or not
+                    break;
                 } catch (const std::exception& e) {
                     if (!ro.allow_damaged) {
                         stopped = e.what();

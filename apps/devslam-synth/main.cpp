@@ -179,6 +179,11 @@ int run(int argc, char** argv) {
     const auto sum =
         render::writeSequence(sc, o, [&](std::size_t done, std::size_t) { bar.update(done); });
     bar.finish();
+    if (sum.stopped && sum.n_frames == 0) {
+        std::cerr << "devslam-synth: interrupted (" << core::signalName(core::stopSignal())
+                  << ") before the first frame: " << out_dir << " was left as it was\n";
+        return 1;
+    }
     if (sum.stopped) {
         std::cerr << "devslam-synth: interrupted (" << core::signalName(core::stopSignal())
                   << ") after " << sum.n_frames << " of " << n << " frames: " << out_dir

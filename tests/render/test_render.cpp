@@ -381,11 +381,11 @@ TEST(RenderSequence, StopEndsTheRenderWithTheFramesBeforeItWritten) {
     o.rawlog_path = tmp.str("seq.rawlog");
     o.max_frames = 5;
     int asked = 0;
-    o.stop = [&] { return ++asked == 3; };  // asked before frames 0, 1, 2: stops before 2
+    o.stop = [&] { return ++asked == 4; };  // asked first, then before frames 0, 1, 2
     const auto sum = writeSequence(sc, o);
     EXPECT_TRUE(sum.stopped);
     EXPECT_EQ(sum.n_frames, 2u);
-    EXPECT_EQ(asked, 3);
+    EXPECT_EQ(asked, 4);
     EXPECT_FALSE(fs::exists(o.out_dir + "/render.txt"));
     EXPECT_FALSE(isRenderCurrent(sc, o));
     auto tum = io::openRgbd(o.out_dir, {});
@@ -405,6 +405,15 @@ TEST(RenderSequence, StopEndsTheRenderWithTheFramesBeforeItWritten) {
     EXPECT_FALSE(whole.stopped);
     EXPECT_EQ(whole.n_frames, 5u);
     EXPECT_TRUE(isRenderCurrent(sc, o));
+    // Stopped before the first frame: that whole render is left as it was.
+    const std::string list = readFile(o.out_dir + "/rgb.txt");
+    o.stop = [] { return true; };
+    const auto none = writeSequence(sc, o);
+    EXPECT_TRUE(none.stopped);
+    EXPECT_EQ(none.n_frames, 0u);
+    o.stop = nullptr;
+    EXPECT_TRUE(isRenderCurrent(sc, o));
+    EXPECT_EQ(readFile(o.out_dir + "/rgb.txt"), list);
 }
 
 // A seated person who moves a hand: the labelled pixels follow the hand (they differ between

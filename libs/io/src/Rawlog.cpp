@@ -253,9 +253,9 @@ std::optional<core::Frame> RawlogReader::next() {
     // The scan at open counted n_frames_ intact observations: a file that ends or breaks
     // before them was changed since (cut, or written over while it was read).
     const auto changed = [&](const std::string& what) {
-        return std::runtime_error(path_ + ": " + what + " after " + std::to_string(n_read_) +
-                                  " of the " + std::to_string(n_frames_) +
-                                  " RGB-D observations it held when opened (changed since?)");
+        return InputBroken(path_ + ": " + what + " after " + std::to_string(n_read_) + " of the " +
+                           std::to_string(n_frames_) +
+                           " RGB-D observations it held when opened (changed since?)");
     };
     CObservation3DRangeScan::Ptr o;
     try {

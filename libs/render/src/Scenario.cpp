@@ -236,8 +236,11 @@ Scenario readScenario(const std::string& path, const std::vector<std::string>& o
                             "room_set"},
                            path);
     sc.name = cfg->read_string(s, "name", fs::path(path).stem().string());
-    core::requireValue(!sc.name.empty() && sc.name.find('/') == std::string::npos, s, "name",
-                       "must be a non-empty name without '/' (it names the output folder)");
+    core::requireValue(!sc.name.empty() && sc.name.find('/') == std::string::npos &&
+                           sc.name != "." && sc.name != "..",
+                       s, "name",
+                       "must be a non-empty name without '/', not '.' or '..' (it names the "
+                       "output folder)");
     sc.rate_hz = core::readDouble(*cfg, s, "rate_hz", sc.rate_hz);
     core::requireValue(sc.rate_hz > 0 && sc.rate_hz <= 1000, "scenario", "rate_hz",
                        "must be in (0, 1000] [Hz]");

@@ -88,6 +88,12 @@ WriteSummary writeSequence(const Scenario& sc, const WriteOptions& o,
                            const std::function<void(std::size_t, std::size_t)>& progress) {
     if (o.out_dir.empty()) throw std::invalid_argument("writeSequence: empty output folder");
     const std::string signature = renderSignature(sc, o);
+    // Stopped before it began: the folder (perhaps a whole earlier render) is left as it was.
+    if (o.stop && o.stop()) {
+        WriteSummary none;
+        none.stopped = true;
+        return none;
+    }
     // Until the last frame is written the folder is not a current render.
     std::error_code ec;
     fs::remove(signaturePath(o), ec);

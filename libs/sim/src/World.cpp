@@ -226,9 +226,11 @@ void validateWorld(const WorldSpec& w) {
         fail(src, "laser", "fov_deg", "must be in (0, 360]");
     // Each ray is a Bullet ray cast (about 1 us): 1e8 of them are a minute and a half.
     constexpr double kMaxRays = 1e8;
-    if (const double casts = double(w.laser.rays) * w.laser.rate * w.timeout; casts > kMaxRays) {
+    // The simulator scans at most once per physics step.
+    const double scans_per_s = std::min(w.laser.rate, 1.0 / w.time_step);
+    if (const double casts = double(w.laser.rays) * scans_per_s * w.timeout; casts > kMaxRays) {
         std::ostringstream m;
-        m << w.laser.rays << " rays at " << w.laser.rate << " Hz over the " << w.timeout
+        m << w.laser.rays << " rays at " << scans_per_s << " Hz over the " << w.timeout
           << " s timeout are " << casts << " ray casts (at most 1e8)";
         fail(src, "laser", "rays", m.str());
     }

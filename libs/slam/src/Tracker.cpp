@@ -77,7 +77,8 @@ void TrackerOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, cons
     core::requireValue(min_matches >= 6, s, "min_matches", "must be >= 6");
     core::requireValue(min_inliers >= 6, s, "min_inliers", "must be >= 6");
     core::requireValue(local_keyframes >= 1, s, "local_keyframes", "must be >= 1");
-    core::requireValue(max_motion_dt > 0, s, "max_motion_dt", "must be > 0 [s]");
+    core::requireValue(max_motion_dt >= 0, s, "max_motion_dt",
+                       "must be >= 0 [s] (0: no motion model)");
     core::requireValue(reloc_keyframes >= 1, s, "reloc_keyframes", "must be >= 1");
     core::requireValue(reloc_min_inliers >= 6, s, "reloc_min_inliers", "must be >= 6");
     core::requireValue(reloc_max_hamming > 0 && reloc_max_hamming <= 256, s, "reloc_max_hamming",

@@ -55,6 +55,14 @@ class DamagedInput : public std::runtime_error {
     std::size_t intact_;
 };
 
+/// Thrown by next() when no frame after this point can be read (a rawlog cut or written over
+/// after it was opened): unlike a damaged frame it cannot be passed, and the next call ends
+/// the input. Frames lost this way are not "left out" frames.
+class InputBroken : public std::runtime_error {
+  public:
+    using std::runtime_error::runtime_error;
+};
+
 class RgbdReader {
   public:
     virtual ~RgbdReader() = default;

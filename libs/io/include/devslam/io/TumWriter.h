@@ -1,7 +1,8 @@
 #pragma once
-/// Writes frames as a TUM RGB-D folder: rgb/<t>.png, depth/<t>.png (16-bit in the frame's
-/// own depth units, so a TUM source round-trips bit-exactly), rgb.txt, depth.txt, and
-/// optionally groundtruth.txt.
+/// Writes frames as a TUM RGB-D folder: rgb/<t>.png, depth/<t>.png (16-bit at TUM's 5000
+/// units per metre whatever the source's, so a TUM source round-trips bit-exactly and an
+/// OpenNI one's millimetres become 5 units each), rgb.txt, depth.txt, and optionally
+/// groundtruth.txt.
 ///
 /// Usage:
 ///   devslam::io::TumWriter out("out/seq");
@@ -24,7 +25,7 @@ class TumWriter {
     TumWriter(const TumWriter&) = delete;
     TumWriter& operator=(const TumWriter&) = delete;
 
-    /// Depth is written as round(depth * f.depth_scale); throws if a value exceeds 16 bits.
+    /// Depth is written as round(depth * 5000); throws for depth beyond 13.1 m (16 bits).
     void write(const core::Frame& f);
     void writeGroundTruth(const core::Trajectory& gt);
     void close();

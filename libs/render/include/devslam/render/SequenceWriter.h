@@ -22,7 +22,8 @@ struct WriteOptions {
     std::size_t max_frames = 0;  ///< 0 = all frames of the scenario
     /// Asked before each frame; true ends the render there (Ctrl-C): the frames rendered so
     /// far are written as a whole TUM folder (lists, ground truth, camera.ini), but without
-    /// render.txt, so the folder is not a current render (isRenderCurrent).
+    /// render.txt, so the folder is not a current render (isRenderCurrent). True before the
+    /// first frame: nothing is written, the folder is left as it was.
     std::function<bool()> stop;
 };
 
