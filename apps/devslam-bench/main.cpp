@@ -220,6 +220,14 @@ Bench readBench(const std::string& path) {
             if (other.name == q.name)
                 throw std::invalid_argument(where + " name: '" + q.name +
                                             "' is already the name of an earlier sequence");
+        // Nor may their renders share a folder: 'a_seed1' renders where 'a' with seed 1 does.
+        for (const auto& other : b.sequences)
+            for (const auto& mine : inputsOf(q, "out"))
+                for (const auto& theirs : inputsOf(other, "out"))
+                    if (!q.scenario.empty() && !other.scenario.empty() && mine.path == theirs.path)
+                        throw std::invalid_argument(
+                            where + " name: its render " + fs::path(mine.path).filename().string() +
+                            " would share a folder with sequence '" + other.name + "''s");
         b.sequences.push_back(q);
     }
     if (b.sequences.empty()) throw std::invalid_argument(path + ": no [sequence_*] section");
@@ -656,13 +664,17 @@ int run(int argc, char** argv) {
                                   << "  (whole output: " << (dir / "log.txt").string() << ")\n";
                     }
                     runs[{q.name, m}].push_back(f);
+                    // A failed run's figures are n/a, not the zeros of an empty RunFigures.
+                    const auto fig = [&](double x, int prec) {
+                        return f.ok ? fmt(x, prec) : std::string("n/a");
+                    };
                     all_csv << q.name << "," << m << "," << seed << "," << r << ","
-                            << fmt(f.ate_rmse, 6) << "," << fmt(f.ate_mean, 6) << ","
-                            << fmt(f.ate_median, 6) << "," << fmt(f.rpe_t_rmse, 6) << ","
-                            << fmt(f.rpe_t_mean, 6) << "," << fmt(f.rpe_t_median, 6) << ","
-                            << fmt(f.rpe_r_rmse, 4) << "," << fmt(f.rpe_r_mean, 4) << ","
-                            << fmt(f.rpe_r_median, 4) << "," << fmt(f.fps_median, 2) << ","
-                            << fmt(f.fps_mean, 2) << "," << fmt(f.lost, 0) << "\n";
+                            << fig(f.ate_rmse, 6) << "," << fig(f.ate_mean, 6) << ","
+                            << fig(f.ate_median, 6) << "," << fig(f.rpe_t_rmse, 6) << ","
+                            << fig(f.rpe_t_mean, 6) << "," << fig(f.rpe_t_median, 6) << ","
+                            << fig(f.rpe_r_rmse, 4) << "," << fig(f.rpe_r_mean, 4) << ","
+                            << fig(f.rpe_r_median, 4) << "," << fig(f.fps_median, 2) << ","
+                            << fig(f.fps_mean, 2) << "," << fig(f.lost, 0) << "\n";
                 }
 
     // 3. Medians over the runs (renders x repeats); the median-ATE run's plot is kept.
@@ -679,6 +691,7 @@ int run(int argc, char** argv) {
     };
     std::ostringstream t1, t2, t3, t4, t5;
     std::map<std::string, std::vector<std::string>> plots;  // sequence -> modes with a plot
+    std::vector<std::pair<fs::path, fs::path>> results_images;  // copied beside RESULTS.md
     // The CSV files, written with tables.md at the end, each whole or not at all.
     std::ostringstream c1, c2, c3, c4, targets_csv;
     t1 << "| sequence | mode | trans RMSE (m) | trans mean (m) | trans median (m) | rot RMSE (deg) "
@@ -754,11 +767,9 @@ int run(int argc, char** argv) {
                               fs::copy_options::overwrite_existing);
                 // Beside RESULTS.md, for its figures (the diagnostic truth mode's plots stay
                 // in the results folder).
-                if (!results.empty() && m != "truth") {
+                if (!results.empty() && m != "truth") {  // copied with the section, if whole
                     const fs::path img = fs::path(results).parent_path() / "images";
-                    fs::create_directories(img);
-                    fs::copy_file(src, img / ("bench_" + q.name + "_" + m + ".png"),
-                                  fs::copy_options::overwrite_existing);
+                    results_images.emplace_back(src, img / ("bench_" + q.name + "_" + m + ".png"));
                     plots[q.name].push_back(m);
                 }
             }
@@ -962,7 +973,10 @@ int run(int argc, char** argv) {
                                                           {"filter_truth.csv", c4.str()},
                                                           {"tables.md", md.str()}})
         core::writeFileWhole((out / name).string(), text);
-    if (!b.targets.empty()) core::writeFileWhole((out / "targets.csv").string(), targets_csv.str());
+    if (!b.targets.empty())
+        core::writeFileWhole((out / "targets.csv").string(), targets_csv.str());
+    else
+        fs::remove(out / "targets.csv");  // an earlier bench's, for targets no longer asked
     std::cout << md.str();
     if (!failed.empty()) {
         // The tables count them as failed runs; a results file keeps its last whole bench.
@@ -972,7 +986,14 @@ int run(int argc, char** argv) {
                   << "--reuse-runs runs only those again\n";
         return 1;
     }
-    if (!results.empty()) core::replaceResultsSection(results, "bench", md.str());
+    if (!results.empty()) {
+        // The plots it shows with it (a bench with failed runs changed neither).
+        for (const auto& [src, dst] : results_images) {
+            fs::create_directories(dst.parent_path());
+            fs::copy_file(src, dst, fs::copy_options::overwrite_existing);
+        }
+        core::replaceResultsSection(results, "bench", md.str());
+    }
     if (const int sig = core::stopSignal())  // the runs were all done by then
         std::cerr << "devslam-bench: " << core::signalName(sig)
                   << " came after the last run; the bench is whole"

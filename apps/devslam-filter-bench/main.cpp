@@ -301,7 +301,9 @@ int main(int argc, char** argv) {
                     TruthDetector* truth = det.get();
                     dynamic::DynamicObjectFilter filter(fo, std::move(det));
                     for (const auto& s : walking) {
-                        truth->next = {{*s.person_box, 0, "person", 0.9f}};
+                        // (No box once the walker has left the view, on a long --frames.)
+                        truth->next.clear();
+                        if (s.person_box) truth->next = {{*s.person_box, 0, "person", 0.9f}};
                         const double c0 = threadCpuMs();
                         const auto out = filter.step(s.frame, s.T_prev_cur);
                         if (s.frame.index == 0) continue;

@@ -391,6 +391,9 @@ TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
         {real + "name = fr1/xyz\n", "bench.ini [sequence_a] name: 'fr1/xyz' (letters, digits"},
         {real + "[sequence_b]\nname = a\n" + fr1,
          "bench.ini [sequence_b] name: 'a' is already the name of an earlier sequence"},
+        {synth + "seeds = 1\n[sequence_b]\nname = a_seed1\nscenario = short_walking\n",
+         "bench.ini [sequence_b] name: its render a_seed1 would share a folder with sequence "
+         "'a''s"},
         {real + "set = person_1.speed=1\n", "[sequence_a] set: only a synthetic sequence"},
         {synth + "set = person_1.speed=1 speed=2\n",
          "[sequence_a] set item 'speed=2': expected SECTION.KEY=VALUE"},
@@ -418,8 +421,9 @@ TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
     std::ofstream(tmp / "RESULTS.md") << "# Results\n";
     std::ofstream(tmp / "bench.ini")
         << "[bench]\nmodes = none\nrepeats = 1\n[sequence_a]\npath = " << (tmp / "not_tum").string()
-        << "\n";
-    const std::string cmd = "'" + bin + "/devslam-bench' --config '" +
+        << "\n[sequence_b]\n"
+        << fr1;
+    const std::string cmd = "'" + bin + "/devslam-bench' --max-frames 5 --config '" +
                             (tmp / "bench.ini").string() + "' --out '" + (tmp / "out").string() +
                             "' --results '" + (tmp / "RESULTS.md").string() + "' > '" +
                             (tmp / "log.txt").string() + "' 2>&1";
@@ -427,12 +431,18 @@ TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
     const std::string log = readFile(tmp / "log.txt");
     EXPECT_NE(log.find("devslam-run failed (exit 1):\n  devslam-run: "), std::string::npos) << log;
     EXPECT_NE(log.find("folder has no rgb.txt"), std::string::npos) << log;
-    EXPECT_NE(log.find("1 of 1 runs failed (the first: "), std::string::npos) << log;
+    EXPECT_NE(log.find("1 of 2 runs failed (the first: "), std::string::npos) << log;
     EXPECT_NE(log.find("RESULTS.md left as it was; --reuse-runs runs only those again"),
               std::string::npos)
         << log;
     EXPECT_EQ(readFile(tmp / "RESULTS.md"), "# Results\n");
     EXPECT_TRUE(fs::exists(tmp / "out/tables.md"));
+    // Nor its pictures (sequence b's plot was copied beside it before the bench failed).
+    EXPECT_TRUE(fs::exists(tmp / "out/b_none_trajectory.png"));
+    EXPECT_FALSE(fs::exists(tmp / "images")) << "the pictures RESULTS.md shows were changed";
+    // The failed run's figures are n/a in runs.csv, not zeros.
+    const std::string runs = readFile(tmp / "out/runs.csv");
+    EXPECT_NE(runs.find("\na,none,,0,n/a,n/a,n/a,"), std::string::npos) << runs;
     // Results in the output folder the bench makes (docs/bench.md's "quick look").
     std::ofstream(tmp / "bench.ini") << "[bench]\nmodes = none\nrepeats = 1\n[sequence_a]\n" << fr1;
     const std::string fresh =
