@@ -7,9 +7,13 @@
 namespace devslam::core {
 
 cv::Mat Frame::rawDepth16() const {
+    return rawDepth16(depth_scale);
+}
+
+cv::Mat Frame::rawDepth16(double units_per_metre) const {
     cv::Mat raw;
     // convertTo rounds to nearest and saturates, so a depth read from uint16 comes back exact.
-    depth.convertTo(raw, CV_16U, depth_scale);
+    depth.convertTo(raw, CV_16U, units_per_metre);
     return raw;
 }
 

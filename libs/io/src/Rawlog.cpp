@@ -251,27 +251,22 @@ std::optional<core::Frame> RawlogReader::next() {
     std::size_t skipped = 0;
     bool sf = false, ob = false;
     // The scan at open counted n_frames_ intact observations: a file that ends or breaks
-    // before them was changed since (cut, or written over while it was read).
-    const auto changed = [&](const std::string& what) {
-        return InputBroken(path_ + ": " + what + " after " + std::to_string(n_read_) + " of the " +
-                           std::to_string(n_frames_) +
-                           " RGB-D observations it held when opened (changed since?)");
+    // before them was changed since (cut, or written over while it was read). Such a stream
+    // cannot go on: the input ends here, and the next call returns nothing.
+    const auto broken = [&](const std::string& what) {
+        InputBroken error(path_ + ": " + what + " after " + std::to_string(n_read_) + " of the " +
+                          std::to_string(n_frames_) +
+                          " RGB-D observations it held when opened (changed since?)");
+        n_read_ = n_frames_;
+        throw error;
     };
     CObservation3DRangeScan::Ptr o;
     try {
         o = stream_->next(opts_.sensor_label, skipped, sf, ob);
     } catch (const std::exception& e) {
-        o = nullptr;
-        skipped = 0;
-        const auto error = changed(e.what());
-        n_read_ = n_frames_;  // a stream that broke cannot go on: the next call ends
-        throw error;
+        broken(e.what());
     }
-    if (!o) {
-        const auto error = changed("ended");
-        n_read_ = n_frames_;
-        throw error;
-    }
+    if (!o) broken("ended");
     // Counted before decoding: after a bad observation the next call names the one after it.
     const std::size_t index = n_read_++;
     const std::string what = path_ + " observation " + std::to_string(index);

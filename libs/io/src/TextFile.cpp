@@ -43,4 +43,15 @@ std::string lineError(const std::string& path, int line, const std::string& msg)
     return path + " line " + std::to_string(line) + ": " + msg;
 }
 
+WrittenFile openForWriting(const std::string& path) {
+    WrittenFile f(std::fopen(path.c_str(), "w"), &std::fclose);
+    if (!f) throw std::runtime_error("cannot write '" + path + "'");
+    return f;
+}
+
+void closeWritten(WrittenFile& f, const std::string& error) {
+    const bool failed = std::ferror(f.get()) != 0;
+    if (std::fclose(f.release()) != 0 || failed) throw std::runtime_error(error);
+}
+
 }  // namespace devslam::io::detail

@@ -1,8 +1,10 @@
 #pragma once
-// Private helper: iterate over the data lines of a whitespace-separated text file with
-// '#' comments (the TUM list and trajectory formats).
+// Private helpers: iterate over the data lines of a whitespace-separated text file with
+// '#' comments (the TUM list and trajectory formats), and write one whole.
 
+#include <cstdio>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -19,5 +21,15 @@ void forEachDataLine(const std::string& path,
                                  const std::string& what);
 
 [[nodiscard]] std::string lineError(const std::string& path, int line, const std::string& msg);
+
+using WrittenFile = std::unique_ptr<std::FILE, int (*)(std::FILE*)>;
+
+/// fopen(path, "w"); throws std::runtime_error "cannot write '<path>'".
+[[nodiscard]] WrittenFile openForWriting(const std::string& path);
+
+/// Closes `f` (released whatever happens) and throws std::runtime_error(error) if any write
+/// failed: the last buffer goes out at fclose, so a full disk is found there, not by ferror
+/// before.
+void closeWritten(WrittenFile& f, const std::string& error);
 
 }  // namespace devslam::io::detail

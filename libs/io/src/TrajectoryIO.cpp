@@ -41,8 +41,7 @@ core::Trajectory readTumTrajectory(const std::string& path) {
 
 void writeTumTrajectory(const std::string& path, const core::Trajectory& traj,
                         const std::string& header_comment) {
-    std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(path.c_str(), "w"), &std::fclose);
-    if (!f) throw std::runtime_error("cannot write trajectory '" + path + "'");
+    auto f = detail::openForWriting(path);
     if (!header_comment.empty()) std::fprintf(f.get(), "# %s\n", header_comment.c_str());
     std::fprintf(f.get(), "# timestamp tx ty tz qx qy qz qw\n");
     for (const auto& sp : traj) {
@@ -50,10 +49,7 @@ void writeTumTrajectory(const std::string& path, const core::Trajectory& traj,
         std::fprintf(f.get(), "%.6f %.9f %.9f %.9f %.9f %.9f %.9f %.9f\n", sp.t, q.x(), q.y(),
                      q.z(), q.quat().x(), q.quat().y(), q.quat().z(), q.quat().r());
     }
-    // The last buffer goes out at fclose: a full disk is found there, not by ferror before.
-    const bool failed = std::ferror(f.get()) != 0;
-    if (std::fclose(f.release()) != 0 || failed)
-        throw std::runtime_error("error writing '" + path + "'");
+    detail::closeWritten(f, "error writing '" + path + "'");
 }
 
 }  // namespace devslam::io

@@ -1,6 +1,8 @@
 #include <devslam/io/TrajectoryIO.h>
 #include <devslam/io/TumWriter.h>
 
+#include "TextFile.h"
+
 #include <mrpt/config/CConfigFileMemory.h>
 
 #include <opencv2/imgcodecs.hpp>
@@ -16,11 +18,9 @@ namespace fs = std::filesystem;
 namespace devslam::io {
 
 namespace {
-std::unique_ptr<std::FILE, int (*)(std::FILE*)> openList(const std::string& path,
-                                                         const std::string& kind,
-                                                         const std::string& description) {
-    std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(path.c_str(), "w"), &std::fclose);
-    if (!f) throw std::runtime_error("cannot write '" + path + "'");
+detail::WrittenFile openList(const std::string& path, const std::string& kind,
+                             const std::string& description) {
+    auto f = detail::openForWriting(path);
     std::fprintf(f.get(), "# %s images\n# %s\n# timestamp filename\n", kind.c_str(),
                  description.c_str());
     return f;
@@ -76,9 +76,7 @@ void TumWriter::write(const core::Frame& f) {
     const std::string depth = std::string("depth/") + depth_stamp + ".png";
     if (!cv::imwrite(folder_ + "/" + rgb, f.bgr))
         throw std::runtime_error("cannot write '" + folder_ + "/" + rgb + "'");
-    cv::Mat raw;
-    f.depth.convertTo(raw, CV_16U, kTumScale);  // rounds to nearest, as Frame::rawDepth16
-    if (!cv::imwrite(folder_ + "/" + depth, raw))
+    if (!cv::imwrite(folder_ + "/" + depth, f.rawDepth16(kTumScale)))
         throw std::runtime_error("cannot write '" + folder_ + "/" + depth + "'");
     std::fprintf(rgb_list_.get(), "%s %s\n", stamp, rgb.c_str());
     std::fprintf(depth_list_.get(), "%s %s\n", depth_stamp, depth.c_str());
@@ -91,10 +89,7 @@ void TumWriter::writeGroundTruth(const core::Trajectory& gt) {
 
 void TumWriter::close() {
     for (auto* f : {&rgb_list_, &depth_list_}) {
-        if (!*f) continue;
-        const bool failed = std::ferror(f->get()) != 0;
-        if (std::fclose(f->release()) != 0 || failed)
-            throw std::runtime_error("error writing the lists of '" + folder_ + "'");
+        if (*f) detail::closeWritten(*f, "error writing the lists of '" + folder_ + "'");
     }
 }
 

@@ -36,6 +36,8 @@ struct Frame {
     }
     /// The depth as the source's raw 16-bit units (round(depth * depth_scale)).
     [[nodiscard]] cv::Mat rawDepth16() const;
+    /// The depth as 16-bit units at another scale (round(depth * units_per_metre), saturated).
+    [[nodiscard]] cv::Mat rawDepth16(double units_per_metre) const;
 };
 
 /// Checks the invariants above (types, equal sizes, intrinsics size); throws
