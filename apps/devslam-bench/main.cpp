@@ -54,7 +54,11 @@ const std::string kRoot = DEVSLAM_SOURCE_DIR;
 
 const char* kUsage =
     "usage: devslam-bench [--config INI] [--repeats N] [--max-frames N] [--out DIR]\n"
-    "                     [--results FILE] [--bin DIR] [--reuse-runs] [--render-jobs N]\n"
+    "                     [--results FILE|none] [--bin DIR] [--reuse-runs] [--render-jobs N]\n"
+    "--max-frames N: the first N frames of each sequence (0: whole sequences, also over the\n"
+    "              INI's [bench] max_frames)\n"
+    "--results none: write no RESULTS.md section (the tables and plots go to the output\n"
+    "              folder only)\n"
     "--reuse-runs: keep the runs already in the output folder that this command would make\n"
     "              (resume a bench): a whole run.json, and a command.txt with this command\n"
     "              line and the same content of program, configs and input lists\n"
@@ -514,7 +518,7 @@ int run(int argc, char** argv) {
     std::string bin = fs::absolute(argv[0]).parent_path().string();
     int repeats = 0, render_jobs = 0;
     bool reuse = false;
-    std::size_t max_frames = 0;
+    std::optional<std::size_t> max_frames;
     for (int i = 1; i < argc; ++i) {
         const std::string k = argv[i];
         const auto value = [&]() -> std::string {
@@ -529,9 +533,10 @@ int run(int argc, char** argv) {
             max_frames = std::size_t(core::parseInteger(value(), "--max-frames", 0));
         else if (k == "--out")
             out_override = value();
-        else if (k == "--results")
+        else if (k == "--results") {
             results = value();
-        else if (k == "--bin")
+            if (results.empty() || results == "none") results.clear();
+        } else if (k == "--bin")
             bin = value();
         else if (k == "--reuse-runs")
             reuse = true;
@@ -548,7 +553,7 @@ int run(int argc, char** argv) {
         b.repeats = repeats;
         for (auto& q : b.sequences) q.repeats = 0;
     }
-    if (max_frames > 0) b.max_frames = max_frames;
+    if (max_frames) b.max_frames = *max_frames;
     if (!out_override.empty()) b.out_dir = out_override;
     fs::create_directories(b.out_dir);
     // Before hours of work (after the output folder is made: the results may go in it).

@@ -178,6 +178,9 @@ int main(int argc, char** argv) {
         std::ostringstream md;
         md << "## Person detection and dynamic-object filter (`devslam-filter-bench`)\n\n"
            << "Command: `devslam-filter-bench --threads " << threads << " --frames " << n_frames
+           << (filter_ini == kRoot + "/config_ini/dynamic_filter.ini"
+                   ? std::string()
+                   : " --config " + core::shownPath(filter_ini, kRoot))
            << "` (OpenCV threads = " << threads
            << "). Times are per-frame medians of wall time at 640x480. This 2-core VM's speed "
               "drifts by 20 % and more within minutes (docs/detect.md), so a single figure moves "
@@ -478,8 +481,7 @@ int main(int argc, char** argv) {
 
         // 3. detect_every trade-off with the real detector.
         md << "\n**detect_every trade-off** (real detector from `"
-           << "dynamic_filter.ini"
-           << "`, synthetic sequences of " << n_frames
+           << core::shownPath(filter_ini, kRoot) << "`, synthetic sequences of " << n_frames
            << " frames at 640x480 with exact truth, true relative pose as prior; rates over "
               "frames 1..N-1):\n\n"
               "| detect_every | walking person Moving | standing person Static | no person: "

@@ -61,24 +61,18 @@ std::string methodList(const std::vector<std::string>& methods) {
     return s;
 }
 
-/// The config as the results name it: relative to the repository when it lies in it.
-std::string shownConfig(const std::string& config) {
-    const auto rel = std::filesystem::absolute(config).lexically_normal().lexically_relative(
-        std::filesystem::path(DEVSLAM_SOURCE_DIR).lexically_normal());
-    return !rel.empty() && rel.begin()->string() != ".." ? rel.string() : config;
-}
-
 void usage() {
-    std::cerr << "usage: devslam-nav-bench [options]\n"
-                 "  --per-category N  worlds per category (default 50 -> 200 worlds)\n"
-                 "  --quick           smoke test: 2 worlds per category, RESULTS.md untouched,\n"
-                 "                    pictures in out/devslam-nav-bench unless --png-dir\n"
-                 "  --methods a,b     holonomic methods (default all four)\n"
-                 "  --config FILE     navigation INI (default config_ini/nav_reactive.ini)\n"
-                 "  --results FILE    RESULTS.md to update (default docs/RESULTS.md)\n"
-                 "  --png-dir DIR     where PNGs go (default docs/images)\n"
-                 "  --seed S          first world seed (default 1)\n"
-                 "  --person-margin M [m] overrides the INI's [navigator] person_margin\n";
+    std::cerr
+        << "usage: devslam-nav-bench [options]\n"
+           "  --per-category N  worlds per category (default 50 -> 200 worlds)\n"
+           "  --quick           smoke test: 2 worlds per category, RESULTS.md untouched,\n"
+           "                    pictures in out/devslam-nav-bench unless --png-dir\n"
+           "  --methods a,b     holonomic methods (default all four)\n"
+           "  --config FILE     navigation INI (default config_ini/nav_reactive.ini)\n"
+           "  --results FILE    RESULTS.md to update (default docs/RESULTS.md; none: no file)\n"
+           "  --png-dir DIR     where PNGs go (default docs/images)\n"
+           "  --seed S          first world seed (default 1)\n"
+           "  --person-margin M [m] overrides the INI's [navigator] person_margin\n";
 }
 
 struct Tally {
@@ -198,6 +192,7 @@ int main(int argc, char** argv) {
                 a.config = next();
             else if (s == "--results") {
                 a.results = next();
+                if (a.results == "none") a.results.clear();
                 results_given = true;
             } else if (s == "--png-dir") {
                 a.png_dir = next();
@@ -323,10 +318,10 @@ int main(int argc, char** argv) {
            << a.seed
            << (a.person_margin ? " --person-margin " + num(*a.person_margin) : std::string())
            << (a.methods.size() < 4 ? " --methods " + methodList(a.methods) : std::string())
-           << (a.quick ? " --quick" : "") << "` (config `" << shownConfig(a.config)
-           << "`; people get " << num(nav_opts.person_margin)
-           << " m more room than walls, `person_margin`). " << a.per_category
-           << " seeded random worlds "
+           << (a.quick ? " --quick" : "") << "` (config `"
+           << devslam::core::shownPath(a.config, DEVSLAM_SOURCE_DIR) << "`; people get "
+           << num(nav_opts.person_margin) << " m more room than walls, `person_margin`). "
+           << a.per_category << " seeded random worlds "
            << "per category, " << a.per_category * cats.size()
            << " worlds in all, the same worlds for every method; Bullet simulation at 100 Hz, "
               "navigator at 10 Hz, simulated clock. Success: within the goal tolerance before the "

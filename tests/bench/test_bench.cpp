@@ -443,7 +443,7 @@ TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
     // The failed run's figures are n/a in runs.csv, not zeros.
     const std::string runs = readFile(tmp / "out/runs.csv");
     EXPECT_NE(runs.find("\na,none,,0,n/a,n/a,n/a,"), std::string::npos) << runs;
-    // Results in the output folder the bench makes (docs/bench.md's "quick look").
+    // Results in the output folder the bench makes.
     std::ofstream(tmp / "bench.ini") << "[bench]\nmodes = none\nrepeats = 1\n[sequence_a]\n" << fr1;
     const std::string fresh =
         "'" + bin + "/devslam-bench' --config '" + (tmp / "bench.ini").string() +
@@ -451,6 +451,22 @@ TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
         (tmp / "fresh/R.md").string() + "' > '" + (tmp / "log.txt").string() + "' 2>&1";
     EXPECT_EQ(std::system(fresh.c_str()), 0) << readFile(tmp / "log.txt");
     EXPECT_NE(readFile(tmp / "fresh/R.md").find("<!-- BEGIN bench -->"), std::string::npos);
+    // --results none writes no results file (it wrote one named 'none'), and --max-frames 0
+    // runs whole sequences over the INI's max_frames.
+    std::ofstream(tmp / "bench.ini")
+        << "[bench]\nmodes = none\nrepeats = 1\nmax_frames = 2\n[sequence_a]\n"
+        << fr1;
+    const std::string none = "cd '" + tmp.string() + "' && '" + bin +
+                             "/devslam-bench' --config bench.ini --max-frames 0 --out whole "
+                             "--results none > log.txt 2>&1";
+    EXPECT_EQ(std::system(none.c_str()), 0) << readFile(tmp / "log.txt");
+    EXPECT_FALSE(fs::exists(tmp / "none"));
+    EXPECT_TRUE(fs::exists(tmp / "whole/tables.md"));
+    const std::string whole_runs = readFile(tmp / "whole/runs.csv");
+    EXPECT_NE(whole_runs.find("\na,none,,0,"), std::string::npos) << whole_runs;
+    EXPECT_NE(readFile(tmp / "whole/runs/a/none/r0/log.txt").find("frames     : 32 "),
+              std::string::npos)
+        << readFile(tmp / "whole/runs/a/none/r0/log.txt");
     fs::remove_all(tmp);
 }
 

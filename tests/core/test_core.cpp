@@ -11,11 +11,14 @@
 
 #include <gtest/gtest.h>
 
+#include <opencv2/core/utility.hpp>
+
 #include "Scratch.h"
 
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <thread>
 
 #include <sys/wait.h>
 #include <cmath>
@@ -446,11 +449,25 @@ TEST(Results, FilesAreWrittenWholeAndHashedByContent) {
 TEST(Results, MeasuredOnLineNamesTheHostAndItsSimdLevel) {
     const std::string line = measuredOnLine();
     EXPECT_NE(line.find(" UTC, "), std::string::npos) << line;
-    EXPECT_NE(line.find(" hardware threads, "), std::string::npos) << line;
-    const bool simd = line.find("OpenCV SIMD AVX2") != std::string::npos ||
-                      line.find("OpenCV SIMD AVX-512") != std::string::npos ||
-                      line.find("OpenCV SIMD SSE/AVX") != std::string::npos;
-    EXPECT_TRUE(simd) << line;
+    EXPECT_NE(line.find(", " + std::to_string(std::thread::hardware_concurrency()) +
+                        " hardware threads, "),
+              std::string::npos)
+        << line;
+    // The level of this host: AVX-512 needs the SKX set (F, CD, BW, DQ, VL), not F alone.
+    const bool avx512 =
+        cv::checkHardwareSupport(CV_CPU_AVX_512F) && cv::checkHardwareSupport(CV_CPU_AVX_512BW) &&
+        cv::checkHardwareSupport(CV_CPU_AVX_512DQ) && cv::checkHardwareSupport(CV_CPU_AVX_512VL);
+    const std::string simd = avx512                                  ? "AVX-512"
+                             : cv::checkHardwareSupport(CV_CPU_AVX2) ? "AVX2"
+                                                                     : "SSE/AVX";
+    EXPECT_EQ(line.substr(line.rfind(", ") + 2), "OpenCV SIMD " + simd) << line;
+}
+
+TEST(Results, ShownPathIsRelativeToTheRepositoryOnlyInsideIt) {
+    EXPECT_EQ(shownPath("/repo/config_ini/a.ini", "/repo"), "config_ini/a.ini");
+    EXPECT_EQ(shownPath("/repo/x/../config_ini/a.ini", "/repo/"), "config_ini/a.ini");
+    EXPECT_EQ(shownPath("/other/a.ini", "/repo"), "/other/a.ini");
+    EXPECT_EQ(shownPath("/repository2/a.ini", "/repo"), "/repository2/a.ini");
 }
 
 TEST(Association, NearestPairsNeverReused) {

@@ -162,4 +162,11 @@ std::string measuredOnLine() {
            " hardware threads, " + cpu + ", OpenCV SIMD " + simd;
 }
 
+std::string shownPath(const std::string& path, const std::string& root) {
+    namespace fs = std::filesystem;
+    const auto rel = fs::absolute(path).lexically_normal().lexically_relative(
+        fs::absolute(root).lexically_normal());
+    return !rel.empty() && rel.begin()->string() != ".." ? rel.string() : path;
+}
+
 }  // namespace devslam::core

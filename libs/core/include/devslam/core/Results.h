@@ -35,6 +35,10 @@ void writeFileWhole(const std::string& path, const std::string& text);
 /// work (a bad name, broken markers, a folder, a missing parent folder); writes nothing.
 void checkResultsSection(const std::string& path, const std::string& name);
 
+/// A file as results name it: relative to `root` (the repository) when it lies in it, else
+/// as given.
+[[nodiscard]] std::string shownPath(const std::string& path, const std::string& root);
+
 /// The current UTC date-time and host facts ("2026-11-21 06:00 UTC, 2 hardware threads,
 /// AMD EPYC (family 25 model 1), OpenCV SIMD AVX2") for a "measured on" line under each
 /// table. The SIMD level matters: OpenCV picks its kernels by it at run time, and the same
