@@ -63,7 +63,8 @@ const char* kUsage =
     "              (resume a bench): a whole run.json, and a command.txt with this command\n"
     "              line and the same content of program, configs and input lists\n"
     "--render-jobs N: renders made at once (default: [bench] render_jobs, else the CPU's\n"
-    "              threads); the SLAM runs, whose FPS is measured, always run one at a time\n"
+    "              threads, at most 8); the SLAM runs, whose FPS is measured, always run one\n"
+    "              at a time\n"
     "defaults: --config " DEVSLAM_SOURCE_DIR
     "/config_ini/bench.ini, repeats and out from the INI,\n"
     "          --results " DEVSLAM_SOURCE_DIR
@@ -910,7 +911,8 @@ int run(int argc, char** argv) {
     std::ostringstream md;
     md << "## Dynamic-SLAM benchmark: the paper's Tables 1-3 (`devslam-bench`)\n\n"
        << "Measured " << core::measuredOnLine() << " by `devslam-bench --config "
-       << fs::path(config).filename().string()
+       << core::shownPath(config, kRoot)
+       << (out_override.empty() ? std::string() : " --out " + quote(out_override))
        << (repeats ? " --repeats " + std::to_string(b.repeats) : std::string())
        << (max_frames ? " --max-frames " + std::to_string(b.max_frames) : std::string())
        << (reuse ? " --reuse-runs" : "") << "`: " << runsLine.str()

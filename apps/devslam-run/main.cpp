@@ -257,11 +257,26 @@ void requireWhole(const run::RunReport& rep) {
 }
 
 int runBench(const Args& a) {
+    // The command that makes the section again, run from the repository: every option that
+    // is not its default (the paths relative to the repository when they lie in it).
+    const Args defaults;
+    const std::string root = DEVSLAM_SOURCE_DIR;
+    const auto path_option = [&](const char* option, const std::string& p, const std::string& d) {
+        return fs::path(p).lexically_normal() == fs::path(d).lexically_normal()
+                   ? std::string()
+                   : std::string(" ") + option + " " + core::shownPath(p, root);
+    };
+    const bool rendered = fs::is_regular_file(fs::path(a.input) / "render.txt");
     std::ostringstream md;
-    md << "## SLAM (`devslam-run --bench " << a.bench
-       << (a.section != "slam" ? " --section " + a.section : std::string()) << "`)\n\n"
-       << "Sequence `" << fs::path(a.input).filename().string() << "`, config `"
-       << fs::path(a.config).filename().string() << "`, " << a.bench
+    md << "## SLAM (`devslam-run --bench " << a.bench << (a.modes_only ? " --modes-only" : "")
+       << (a.section != "slam" ? " --section " + a.section : std::string())
+       << path_option("--config", a.config, defaults.config)
+       << path_option("--input", a.input, defaults.input) << "`)\n\n"
+       << "Sequence `" << fs::path(a.input).filename().string() << "`"
+       << (rendered ? " (rendered by devslam-synth; its render.txt says how, docs/slam.md gives "
+                      "the command)"
+                    : "")
+       << ", config `" << fs::path(a.config).filename().string() << "`, " << a.bench
        << " runs per mode, medians over runs. FPS = whole pipeline per frame (detector, filter, "
           "features, tracking, mapping, back end; image decoding excluded). ATE over every frame "
           "(lost frames included), TUM-exact (devslam::eval).\n\n"

@@ -122,6 +122,11 @@ TEST(DevslamBench, TwoFrameSmokeRunOfTheWholeCommand) {
     EXPECT_NE(results.find("Table 1: RPE"), std::string::npos);
     EXPECT_NE(results.find("Table 2: ATE"), std::string::npos);
     EXPECT_NE(results.find("Table 3: speed"), std::string::npos);
+    // The command that made the section, as it can be run again (the whole config path).
+    EXPECT_NE(results.find("by `devslam-bench --config " + (tmp / "bench.ini").string() +
+                           " --out '" + (tmp / "out").string() + "' --max-frames 2`"),
+              std::string::npos)
+        << results;
     // Sequences in the order bench.ini gives them (MRPT alone would sort them).
     EXPECT_NE(results.find("short 2 renders (seed 5 6) x 1 run, sit 1 render (seed 7) x 1 run, fr1 "
                            "1 run per mode"),

@@ -6,9 +6,10 @@
 
 #include <gtest/gtest.h>
 
-#include "Scratch.h"
 #include <mrpt/config/CConfigFileMemory.h>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include "Scratch.h"
 
 #include <filesystem>
 #include <fstream>
@@ -257,6 +258,30 @@ TEST(DetectHog, ResizeOrMinScoreOutOfRangeIsRejected) {
             EXPECT_EQ(std::string(e.what()), message);
         }
     }
+}
+
+// An image smaller than the 64x128 window, as given or after `resize`, holds no person the
+// SVM can find: none is found (OpenCV's detectMultiScale read out of bounds on it).
+TEST(DetectHog, ImageSmallerThanTheWindowHasNoPerson) {
+    const cv::Mat person = readImage("data/images/person.jpg");
+    for (const auto& [size, resize] : {std::pair{cv::Size(200, 100), 1.0},
+                                       {cv::Size(32, 24), 1.0},
+                                       {cv::Size(32, 24), 0.5},
+                                       {cv::Size(1, 1), 0.1},
+                                       {cv::Size(640, 480), 0.2},
+                                       {cv::Size(63, 300), 1.0}}) {
+        detect::HogDetector::Options o;
+        o.resize = resize;
+        detect::HogDetector hog(o);
+        cv::Mat img;
+        cv::resize(person, img, size);
+        EXPECT_TRUE(hog.detect(img).empty()) << size << " at resize " << resize;
+    }
+    // The smallest image it scans: the window itself.
+    detect::HogDetector hog({});
+    cv::Mat img;
+    cv::resize(person, img, cv::Size(64, 128));
+    EXPECT_NO_THROW((void)hog.detect(img));
 }
 
 TEST(Detect, WrongImageTypeThrows) {

@@ -358,3 +358,26 @@ TEST(DevslamRun, FilterInASecondThreadKeepsTheSequentialAccuracy) {
     EXPECT_LT(ate(par.out), 0.01);
     EXPECT_NEAR(ate(par.out), ate(seq.out), 0.001);
 }
+
+// --bench's section names the command that makes it again: the options that are not their
+// defaults, a path outside the repository as given, the default config left out.
+TEST(DevslamRun, BenchSectionNamesTheCommandThatMakesIt) {
+    const fs::path tmp = devslam::test::scratchPath("devslam_run_bench_section");
+    fs::remove_all(tmp);
+    fs::create_directories(tmp);
+    const std::string root = DEVSLAM_SOURCE_DIR;
+    fs::create_directory_symlink(root + "/data/tum/fr1_xyz_first37", tmp / "fr1");
+    std::ofstream(tmp / "R.md") << "# R\n";
+    const auto r =
+        run("--bench 1 --modes-only --config " + root + "/config_ini/slam_tum_fr1.ini --input " +
+            (tmp / "fr1").string() + " --results " + (tmp / "R.md").string());
+    ASSERT_EQ(r.rc, 0) << r.out;
+    std::ifstream in(tmp / "R.md");
+    const std::string md((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_NE(md.find("## SLAM (`devslam-run --bench 1 --modes-only --input " +
+                      (tmp / "fr1").string() + "`)\n\nSequence `fr1`, config `slam_tum_fr1.ini`"),
+              std::string::npos)
+        << md;
+    EXPECT_NE(md.find("| dynamic | "), std::string::npos) << md;
+    fs::remove_all(tmp);
+}

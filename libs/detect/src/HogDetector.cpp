@@ -55,8 +55,13 @@ std::string HogDetector::name() const {
 std::vector<Detection> HogDetector::detect(const cv::Mat& bgr) {
     if (bgr.empty() || bgr.type() != CV_8UC3)
         throw std::invalid_argument("hog: detect() needs a non-empty CV_8UC3 image");
+    // An image smaller than the SVM's window holds no person it can find, and OpenCV's
+    // detectMultiScale does not check: it scans a negative window count and reads out of
+    // bounds (a segfault on a 200x100 image, or at resize 0.2 on 640x480).
+    const cv::Size scaled(cvRound(bgr.cols * opts_.resize), cvRound(bgr.rows * opts_.resize));
+    if (scaled.width < hog_.winSize.width || scaled.height < hog_.winSize.height) return {};
     cv::Mat img = bgr;
-    if (opts_.resize != 1.0) cv::resize(bgr, img, cv::Size(), opts_.resize, opts_.resize);
+    if (opts_.resize != 1.0) cv::resize(bgr, img, scaled);
     std::vector<cv::Rect> rects;
     std::vector<double> weights;
     hog_.detectMultiScale(img, rects, weights, opts_.hit_threshold,
