@@ -200,6 +200,44 @@ TEST(DetectYolo, BadOptionsAreRejected) {
     }
 }
 
+// OpenCV zeroes the class scores at or under a [yolo] layer's `thresh` (0.2 where the cfg
+// sets none, as in the shipped cfgs): a conf_threshold under it is refused, naming the floor;
+// a cfg that lowers it takes one.
+TEST(DetectYolo, ConfThresholdUnderTheModelsFloorIsRefused) {
+    const std::string xl = kRoot + "/models/yolo-fastest-1.1/yolo-fastest-1.1-xl.cfg";
+    EXPECT_FLOAT_EQ(detect::darknetScoreFloor(xl), 0.2f);
+    mrpt::config::CConfigFileMemory cfg;
+    cfg.write("detector", "conf_threshold", 0.15);
+    try {
+        (void)detect::makeDetector(cfg);
+        ADD_FAILURE() << "conf_threshold 0.15 was accepted";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_EQ(std::string(e.what()).rfind("[detector] conf_threshold: 0.15 is below the 0.2 "
+                                              "of the [yolo] layers of '",
+                                              0),
+                  0u)
+            << e.what();
+    }
+    // A copy whose layers set thresh (one 0.01, one 0.1): the floor is the larger.
+    const fs::path dir = devslam::test::scratchPath("yolo_floor");
+    fs::create_directories(dir);
+    std::ifstream in(xl);
+    std::ofstream out(dir / "low.cfg");
+    int layer = 0;
+    for (std::string line; std::getline(in, line);) {
+        out << line << "\n";
+        if (line == "[yolo]") out << "thresh = " << (layer++ == 0 ? "0.01" : "0.1") << "\n";
+    }
+    out.close();
+    ASSERT_EQ(layer, 2);
+    EXPECT_FLOAT_EQ(detect::darknetScoreFloor((dir / "low.cfg").string()), 0.1f);
+    cfg.write("detector", "model", (dir / "low.cfg").string());
+    cfg.write("detector", "weights",
+              kRoot + "/models/yolo-fastest-1.1/yolo-fastest-1.1-xl.weights");
+    EXPECT_NO_THROW((void)detect::makeDetector(cfg));
+    fs::remove_all(dir);
+}
+
 TEST(DetectYolo, OptionsRoundTrip) {
     detect::YoloDetector::Options a;
     a.input_width = 416;

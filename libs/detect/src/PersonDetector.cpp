@@ -20,7 +20,7 @@ std::unique_ptr<PersonDetector> makeDetector(const mrpt::config::CConfigFileBase
         o.loadFromConfig(cfg, section);
         try {
             return std::make_unique<YoloDetector>(o);
-        } catch (const YoloDetector::UnknownClass& e) {
+        } catch (const std::invalid_argument& e) {  // an option: UnknownClass, conf_threshold
             throw std::invalid_argument("[" + section + "] " + e.what());
         }
     }

@@ -74,6 +74,36 @@ std::string resolveModelPath(const std::string& path, const std::string& what) {
     throw std::runtime_error(what + ": file not found (tried " + tried + ")");
 }
 
+float darknetScoreFloor(const std::string& cfg_path) {
+    std::ifstream in(cfg_path);
+    if (!in) throw std::runtime_error("cannot open darknet cfg '" + cfg_path + "'");
+    // OpenCV's darknet reader gives each [yolo] layer `thresh` (default 0.2) and sets every
+    // class score at or below it to 0: no box under it ever comes out.
+    constexpr float kOpenCvDefault = 0.2f;
+    float floor = 0.f, layer = 0.f;
+    bool in_yolo = false;
+    for (std::string line; std::getline(in, line);) {
+        line = trim(line.substr(0, line.find_first_of("#;")));
+        if (line.empty()) continue;
+        if (line.front() == '[') {
+            if (in_yolo) floor = std::max(floor, layer);
+            in_yolo = line == "[yolo]";
+            layer = kOpenCvDefault;
+        } else if (in_yolo && line.find('=') != std::string::npos &&
+                   trim(line.substr(0, line.find('='))) == "thresh") {
+            const std::string v = trim(line.substr(line.find('=') + 1));
+            try {
+                layer = std::stof(v);
+            } catch (const std::exception&) {
+                throw std::runtime_error("darknet cfg '" + cfg_path + "': thresh '" + v +
+                                         "' is not a number");
+            }
+        }
+    }
+    if (in_yolo) floor = std::max(floor, layer);
+    return floor;
+}
+
 cv::dnn::Net readDarknetCfg(const std::string& cfg_path) {
     const std::string path = resolveModelPath(cfg_path, "darknet cfg");
     try {
@@ -152,6 +182,16 @@ YoloDetector::YoloDetector(const Options& opts) : opts_(opts) {
                 throw std::runtime_error("yolo weights '" + weights + "' is too small (" +
                                          std::to_string(fs::file_size(weights)) +
                                          " bytes) to be a darknet weights file");
+            // A threshold the network never reaches down to would promise weak boxes (those
+            // that only continue tracks) that never come.
+            if (const float floor = darknetScoreFloor(model); opts_.conf_threshold < floor) {
+                std::ostringstream msg;
+                msg << "conf_threshold: " << opts_.conf_threshold << " is below the " << floor
+                    << " of the [yolo] layers of '" << model
+                    << "' (their thresh, 0.2 when the cfg sets none): OpenCV returns no box "
+                       "scoring at or under it";
+                throw std::invalid_argument(msg.str());
+            }
             net_ = read([&] { return cv::dnn::readNetFromDarknet(model, weights); });
             // cv::dnn reads a truncated weights file without complaint (missing values
             // stay uninitialised): compare the file size with the parameters the cfg needs.

@@ -72,4 +72,9 @@ class YoloDetector final : public PersonDetector {
 /// Throws std::runtime_error naming the file on a parse error.
 [[nodiscard]] cv::dnn::Net readDarknetCfg(const std::string& cfg_path);
 
+/// The lowest score a darknet cfg's network returns: the largest `thresh` of its [yolo]
+/// layers (OpenCV's default 0.2 where one sets none), at or under which OpenCV zeroes every
+/// class score; 0 for a cfg without [yolo] layers.
+[[nodiscard]] float darknetScoreFloor(const std::string& cfg_path);
+
 }  // namespace devslam::detect
