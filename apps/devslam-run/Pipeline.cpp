@@ -149,9 +149,17 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
         FrameLog fl;
         fl.index = n;
         fl.t = cur->timestamp;
-        const MaskStep ms = rc.async_filter
-                                ? pending.get()
-                                : masks->step(*cur, slam.predictPrevCur(cur->timestamp));
+        MaskStep ms;
+        try {
+            ms = rc.async_filter ? pending.get()
+                                 : masks->step(*cur, slam.predictPrevCur(cur->timestamp));
+        } catch (const eval::MissingTruth& e) {
+            // Mode truth: no person truth for this frame, so no mask: stop before it and keep
+            // the frames done, as for a frame that does not read. (Other errors of the mask
+            // step are the program's, and end it.)
+            rep.read_error = e.what();
+            break;
+        }
         // Reading/decoding the next frame is not part of the pipeline time.
         const auto t_read = Clock::now();
         const double cpu_read = processCpuMs();
@@ -177,7 +185,15 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
         if (truth) {  // not part of the pipeline time either
             const auto t_score = Clock::now();
             const double cpu_score = processCpuMs();
-            truth->score(ms.mask, cur->timestamp, rc.min_person_pixels, *rep.mask_score, ms.boxes);
+            try {
+                truth->score(ms.mask, cur->timestamp, rc.min_person_pixels, *rep.mask_score,
+                             ms.boxes);
+            } catch (const eval::MissingTruth& e) {
+                // No person truth for this frame: this frame is the last (its SLAM step runs,
+                // its mask is unscored), and the frames done are kept.
+                rep.read_error = e.what();
+                nxt.reset();
+            }
             fl.read_ms += msSince(t_score);
             fl.read_cpu_ms += processCpuMs() - cpu_score;
         }
@@ -483,9 +499,17 @@ std::string formatSummary(const RunReport& r) {
 
 std::string toJson(const RunReport& r) {
     std::ostringstream o;
+    // A JSON string: '"' and '\' escaped, and every control character (a tab or newline in
+    // a path or an error message made the file invalid JSON).
     auto esc = [](const std::string& s) {
         std::string e;
         for (char c : s) {
+            if (static_cast<unsigned char>(c) < 0x20) {
+                char u[8];
+                std::snprintf(u, sizeof u, "\\u%04x", static_cast<unsigned>(c));
+                e += u;
+                continue;
+            }
             if (c == '"' || c == '\\') e += '\\';
             e += c;
         }

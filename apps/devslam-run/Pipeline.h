@@ -71,8 +71,8 @@ struct LoopReport {
 struct RunReport {
     std::string input, mode, camera, mask_source;
     std::string input_damage;  ///< what of the input was unreadable and left out ("" = none)
-    /// A frame that failed to read during the run ("" = none): the run stopped there and its
-    /// outputs hold the frames before it.
+    /// A frame that failed to read during the run, or whose mask or person truth failed
+    /// ("" = none): the run stopped there and its outputs hold the frames before it.
     std::string read_error;
     /// The signal (core/Interrupt.h) that stopped the run early ("SIGINT"; "" = none): its
     /// outputs hold the frames before it.

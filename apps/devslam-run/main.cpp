@@ -15,6 +15,8 @@
 #include <devslam/core/Results.h>
 #include <devslam/core/Stats.h>
 
+#include <unistd.h>
+
 #include <filesystem>
 #include <iostream>
 #include <sstream>
@@ -100,9 +102,21 @@ Args parse(int argc, char** argv) {
         } else
             throw std::invalid_argument("unknown argument '" + k + "'\n" + kUsage);
     }
-    // Found now, not when the run's results are written.
-    if (!a.out.empty() && std::filesystem::exists(a.out) && !std::filesystem::is_directory(a.out))
-        throw std::invalid_argument("--out '" + a.out + "': a file is there, not a folder");
+    // Found now, not when the run's results are written (after the whole run): a file where
+    // the folder or one above it goes, or a folder it cannot be made in. Nothing is created.
+    if (!a.out.empty()) {
+        namespace fs = std::filesystem;
+        fs::path p = fs::absolute(a.out).lexically_normal();
+        if (fs::exists(p) && !fs::is_directory(p))
+            throw std::invalid_argument("--out '" + a.out + "': a file is there, not a folder");
+        while (!p.empty() && p != p.root_path() && !fs::exists(p)) p = p.parent_path();
+        if (!fs::is_directory(p))
+            throw std::invalid_argument("--out '" + a.out + "': '" + p.string() +
+                                        "' is a file, not a folder");
+        if (::access(p.c_str(), W_OK | X_OK) != 0)
+            throw std::invalid_argument("--out '" + a.out + "': cannot write in '" + p.string() +
+                                        "'");
+    }
     if (a.bench > 0) {
         // Its table says it ran the INI as it is on every frame of the input, in all modes.
         for (const auto& [given, option] : {std::pair{a.max_frames > 0, "--max-frames"},
@@ -154,10 +168,11 @@ Loaded loadConfig(const Args& a, const std::vector<std::string>& extra_sets = {}
     applySets(*l.cfg, a.sets);
     applySets(*l.cfg, extra_sets);
     core::requireKnownSections(*l.cfg, with_filter, "--set");
-    core::requireKnownKeys(*l.cfg, "run",
-                           {"mode", "filter_config", "filter_overrides", "async_filter"}, a.config);
     const bool set = !a.sets.empty() || !extra_sets.empty();
     l.config_source = a.config + (set ? " with --set" : "");
+    core::requireKnownKeys(*l.cfg, "run",
+                           {"mode", "filter_config", "filter_overrides", "async_filter"},
+                           l.config_source);
     l.filter_source = core::filterSource(*l.cfg, a.config);
     if (set)
         l.filter_source +=

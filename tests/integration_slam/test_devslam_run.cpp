@@ -125,6 +125,14 @@ TEST(DevslamRun, BadInputIsReported) {
     EXPECT_NE(r.out.find("--out '" + ini.string() + "': a file is there, not a folder"),
               std::string::npos)
         << r.out;
+    // ... and a file where a folder above it goes (it ran all frames, then failed to write)
+    r = run("--mode none --quiet --out " + ini.string() + "/sub/run");
+    EXPECT_EQ(r.rc, 1);
+    EXPECT_NE(r.out.find("--out '" + ini.string() + "/sub/run': '" + ini.string() +
+                         "' is a file, not a folder"),
+              std::string::npos)
+        << r.out;
+    EXPECT_EQ(r.out.find("ATE"), std::string::npos) << "ran before refusing";
     fs::remove(ini);
     // the diagnostic truth mask needs a rendered folder's person truth
     r = run("--mode truth --quiet --out ''");
@@ -156,6 +164,12 @@ TEST(DevslamRun, BadInputIsReported) {
     r = run("--set dynamic_filter.mask_margn=3 --mode truth --quiet --out ''");
     EXPECT_EQ(r.rc, 1);
     EXPECT_NE(r.out.find("[dynamic_filter]: unknown key 'mask_margn'"), std::string::npos) << r.out;
+    // a mistyped [run] key from --set is not blamed on the file alone
+    r = run("--set run.moed=none --quiet --out ''");
+    EXPECT_EQ(r.rc, 1);
+    EXPECT_NE(r.out.find("slam_tum_fr1.ini with --set [run]: unknown key 'moed'"),
+              std::string::npos)
+        << r.out;
     r = run("--frobnicate");
     EXPECT_EQ(r.rc, 1);
     EXPECT_NE(r.out.find("usage"), std::string::npos);
@@ -380,4 +394,56 @@ TEST(DevslamRun, BenchSectionNamesTheCommandThatMakesIt) {
         << md;
     EXPECT_NE(md.find("| dynamic | "), std::string::npos) << md;
     fs::remove_all(tmp);
+}
+
+// A rendered folder whose person truth lacks a frame: the run stops at that frame and keeps
+// the frames done (it lost the whole run, writing nothing). Scoring the masks (any mode) needs
+// the truth after the frame's SLAM step, so that frame is the last; mode truth needs it for
+// the mask, before the frame. (The folder's name holds a tab, which run.json escapes.)
+TEST(DevslamRun, MissingPersonTruthStopsTheRunAndKeepsTheFramesDone) {
+    const fs::path dir = devslam::test::scratchPath("devslam_run_no_truth");
+    fs::remove_all(dir);
+    const fs::path seq = dir / "se\tq";
+    const std::string synth = std::string(DEVSLAM_BIN_DIR) + "/devslam-synth short_walking -o '" +
+                              seq.string() + "' --frames 8 > /dev/null 2>&1";
+    ASSERT_EQ(std::system(synth.c_str()), 0) << synth;
+    std::ifstream list(seq / "rgb.txt");
+    std::string line, stamp;
+    for (int k = 0; k <= 5 && std::getline(list, line);)
+        if (!line.empty() && line[0] != '#' && k++ == 5) stamp = line.substr(0, line.find(' '));
+    ASSERT_FALSE(stamp.empty());
+    std::ifstream in(seq / "persons.txt");
+    std::string kept;
+    std::size_t dropped = 0;
+    for (std::string l; std::getline(in, l);) {
+        if (l.rfind(stamp + " ", 0) == 0)
+            ++dropped;
+        else
+            kept += l + "\n";
+    }
+    in.close();
+    ASSERT_GT(dropped, 0u);
+    std::ofstream(seq / "persons.txt") << kept;
+
+    for (const auto& [mode, frames] : {std::pair{"none", 6u}, {"truth", 5u}}) {
+        const fs::path out = dir / (std::string("run_") + mode);
+        const auto r = run("--input '" + seq.string() + "' --config " +
+                           DEVSLAM_SOURCE_DIR + "/config_ini/slam_synthetic.ini --mode " + mode +
+                           " --quiet --out " + out.string());
+        EXPECT_EQ(r.rc, 1) << r.out;
+        EXPECT_NE(r.out.find("persons.txt: no entry for frame " + stamp), std::string::npos)
+            << r.out;
+        EXPECT_NE(r.out.find("stopped after " + std::to_string(frames) + " frames; " +
+                             out.string() + " holds their"),
+                  std::string::npos)
+            << r.out;
+        EXPECT_EQ(lines(out / "trajectory.txt"), frames) << mode;
+        std::ifstream js(out / "run.json");
+        const std::string json((std::istreambuf_iterator<char>(js)),
+                               std::istreambuf_iterator<char>());
+        EXPECT_NE(json.find("\"input\": \"" + dir.string() + "/se\\u0009q\""), std::string::npos)
+            << json.substr(0, 300);
+        EXPECT_EQ(json.find('\t'), std::string::npos);
+    }
+    fs::remove_all(dir);
 }

@@ -113,12 +113,12 @@ PersonTruth::FrameTruth PersonTruth::frame(double timestamp, cv::Size expected) 
     std::snprintf(stamp, sizeof stamp, "%.6f", timestamp);
     const auto it = persons_.find(stamp);
     if (it == persons_.end())
-        throw std::runtime_error(folder_ + "/persons.txt: no entry for frame " + stamp);
+        throw MissingTruth(folder_ + "/persons.txt: no entry for frame " + stamp);
     const std::string label_path = folder_ + "/labels/" + stamp + ".png";
     FrameTruth f;
     f.labels = cv::imread(label_path, cv::IMREAD_UNCHANGED);
     if (f.labels.empty() || f.labels.type() != CV_8UC1)
-        throw std::runtime_error("cannot read person labels '" + label_path +
+        throw MissingTruth("cannot read person labels '" + label_path +
                                  "' (expected an 8-bit one-channel PNG)");
     if (!expected.empty() && f.labels.size() != expected)
         throw std::runtime_error(

@@ -7,6 +7,7 @@
 #include <cstddef>
 #include <map>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -66,6 +67,13 @@ struct MaskScore {
     [[nodiscard]] double movingAreaRecall() const;
     /// Fraction of the masked area that lies on walking people.
     [[nodiscard]] double precision() const;
+};
+
+/// A frame whose person truth is missing or unreadable (no persons.txt entry, no label
+/// image): a damaged folder, which a run treats as its end (devslam-run keeps the frames
+/// before it).
+struct MissingTruth : std::runtime_error {
+    using std::runtime_error::runtime_error;
 };
 
 /// The person truth of a rendered folder (persons.txt + labels/<timestamp>.png), to score
