@@ -19,6 +19,7 @@
 #include <fstream>
 #include <limits>
 #include <thread>
+#include <typeinfo>
 
 #include <sys/wait.h>
 #include <cmath>
@@ -84,7 +85,12 @@ TEST(Camera, ConfigRoundTripAndErrors) {
     mrpt::config::CConfigFileMemory typo("[camera]\npreset = freiburg1\nfxx = 3\n");
     EXPECT_THROW((void)CameraIntrinsics::fromConfig(typo, "camera"), std::invalid_argument);
     mrpt::config::CConfigFileMemory missing("[camera]\nfx = 500\nfy = 500\ncx = 320\n");
-    EXPECT_ANY_THROW((void)CameraIntrinsics::fromConfig(missing, "camera"));
+    try {
+        (void)CameraIntrinsics::fromConfig(missing, "camera");
+        ADD_FAILURE() << "no error for a missing cy";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_EQ(std::string(e.what()), "[camera] cy: required key is missing");
+    }
     mrpt::config::CConfigFileMemory bad("[camera]\npreset = fr1\ncx = 900\n");
     EXPECT_THROW((void)CameraIntrinsics::fromConfig(bad, "camera"), std::invalid_argument);
 }
@@ -124,6 +130,24 @@ TEST(Config, FilterIniFollowsRunFilterConfigWithOverrides) {
         EXPECT_NE(std::string(e.what()).find(bad), std::string::npos) << e.what();
         EXPECT_NE(std::string(e.what()).find("'detect_every=3'"), std::string::npos) << e.what();
     }
+    // A mistyped section was written into a section nothing reads, and a key set twice kept
+    // the last: both are refused, naming the item.
+    const auto refusal = [&](const std::string& overrides) {
+        std::ofstream(bad) << "[run]\nfilter_overrides = " << overrides << "\n";
+        try {
+            (void)loadFilterIni(*loadIni(bad), bad);
+        } catch (const std::invalid_argument& e) {
+            return std::string(e.what());
+        }
+        return std::string();
+    };
+    EXPECT_EQ(refusal("dynamic_filtr.detect_every=3"),
+              bad + " [run] filter_overrides item 'dynamic_filtr.detect_every=3': section "
+                    "'dynamic_filtr' is not one of the filter's (detector, dynamic_filter)");
+    EXPECT_EQ(refusal("dynamic_filter.mask_margin=3 dynamic_filter.Mask_Margin=4"),
+              bad + " [run] filter_overrides item 'dynamic_filter.Mask_Margin=4': "
+                    "[dynamic_filter] Mask_Margin is set twice (also "
+                    "'dynamic_filter.mask_margin=3')");
     const std::string missing = dir + "/missing.ini";
     std::ofstream(missing) << "[run]\nfilter_config = nowhere.ini\n";
     try {
@@ -155,7 +179,9 @@ TEST(Parse, NumbersAreReadInFullOrRejected) {
     EXPECT_DOUBLE_EQ(parseNumber("3.000000e+01", "x"), 30.0);  // MRPT's $eval{} output
     EXPECT_EQ(invalidArgument([] { (void)parseNumber("0.5m", "[a] k"); }),
               "[a] k: expected a number, got '0.5m'");
-    for (const char* bad : {"", "  ", "abc", "1,5", "nan", "inf", "1e999", "2 3"})
+    // strtod reads C's hexadecimal ("0x10" = 16): no INI reader takes it for a number.
+    for (const char* bad : {"", "  ", "abc", "1,5", "nan", "inf", "1e999", "2 3", "0x10", "0x1p-5",
+                            "0X1P3"})
         EXPECT_NE(invalidArgument([&] { (void)parseNumber(bad, "x"); }), "") << bad;
 }
 
@@ -194,7 +220,8 @@ TEST(Parse, IntegersAreWholeAndInRange) {
     EXPECT_EQ(invalidArgument(
                   [] { (void)parseInteger("9", "--k", std::numeric_limits<long long>::min(), 8); }),
               "--k: expected an integer <= 8, got '9'");
-    for (const char* bad : {"", "2.5", "1e-3", "abc", "99999999999999999999", "1e30", "0.1e1x"})
+    for (const char* bad :
+         {"", "2.5", "1e-3", "abc", "99999999999999999999", "1e30", "0.1e1x", "0x10", "0x1p4"})
         EXPECT_NE(invalidArgument([&] { (void)parseInteger(bad, "x"); }), "") << bad;
 }
 
@@ -272,6 +299,17 @@ TEST(Config, RepeatedKeysAndSectionsAreRefused) {
     EXPECT_EQ(error("[navigator\nk = 1\n"), path + " line 1: '[navigator' has no ']'");
     EXPECT_EQ(error("[a]\nk = 1\nspeed 3\n"),
               path + " line 3: 'speed 3' is neither a [section] nor a key = value");
+    EXPECT_EQ(error("[orb] junk\nk = 1\n"),
+              path + " line 1: '[orb] junk': text after the section's ']'");
+    EXPECT_EQ(error("[orb] # the features\n[b] // more\n[c] ; and\nk = 1\n"), "");
+    // A comment ending in '\' takes the next line into it: a key there is lost (here MRPT
+    // read the default instead of n = 20); a comment there is not.
+    EXPECT_EQ(error("[orb]\n# see C:\\docs\\\nn = 20\n"),
+              path + " line 2: a comment ends in '\\', so MRPT reads line 3 ('n = 20') as part "
+                     "of it");
+    EXPECT_EQ(error("[orb]\n#   a command \\\n#       --more \\\n\nn = 20\n"), "");
+    // A define whose value holds its own name is used once (the check ran for ever).
+    EXPECT_EQ(error("@define A ${A}\n[a]\n${A} = 4\n"), "");
     // Not repeats: one key in two sections, comments, a value continued on the next lines.
     EXPECT_EQ(error("[a]\nk = 1\n# k = 2\n; k = 3\n// k = 4\n[b]\nk = 5\nf = \\\n"
                     "  var k := 1; \\\n  k = 2\n"),
@@ -347,8 +385,28 @@ TEST(Config, NamingSourcePrefixesFieldOnlyErrors) {
                   namingSource("f.ini", [] { throw std::invalid_argument("room.ini [room]: x"); });
               }),
               "room.ini [room]: x");
-    EXPECT_THROW(namingSource("f.ini", [] { throw std::runtime_error("[a] io"); }),
-                 std::runtime_error);
+    try {  // (an invalid_argument is a logic_error: the exact type is checked)
+        namingSource("f.ini", [] { throw std::logic_error("[a] bug"); });
+        ADD_FAILURE() << "no error";
+    } catch (const std::logic_error& e) {
+        EXPECT_TRUE(typeid(e) == typeid(std::logic_error)) << typeid(e).name();
+        EXPECT_EQ(std::string(e.what()), "[a] bug");
+    }
+    // A file a key names that does not load (a runtime_error) is named with the INI too.
+    try {
+        namingSource("f.ini", [] { throw std::runtime_error("[a] weights: file not found"); });
+        ADD_FAILURE() << "no error";
+    } catch (const std::invalid_argument&) {
+        ADD_FAILURE() << "became an invalid_argument";
+    } catch (const std::runtime_error& e) {
+        EXPECT_EQ(std::string(e.what()), "f.ini [a] weights: file not found");
+    }
+    try {
+        namingSource("f.ini", [] { throw std::runtime_error("disk: io"); });
+        ADD_FAILURE() << "no error";
+    } catch (const std::runtime_error& e) {
+        EXPECT_EQ(std::string(e.what()), "disk: io");
+    }
 }
 
 // A section is replaced in place, others are kept; broken markers stop it before it writes

@@ -107,8 +107,10 @@ TEST(Ate, AssociationWindowIsHonoured) {
     wide.max_dt = 0.03;
     EXPECT_EQ(eval::computeAte(gt, est, wide).trans.count, 100u);
     eval::AteOptions off;
-    off.offset = -0.025;  // undoes the even poses' shift exactly
-    EXPECT_GE(eval::computeAte(gt, est, off).trans.count, 50u);
+    off.offset = -0.025;  // undoes the even poses' shift exactly; the odd ones are 0.01 s off
+    EXPECT_EQ(eval::computeAte(gt, est, off).trans.count, 100u);
+    off.max_dt = 0.005;  // ... now only the even ones (none without the offset)
+    EXPECT_EQ(eval::computeAte(gt, est, off).trans.count, 50u);
     auto far = gt;
     for (auto& p : far) p.t += 1000;
     const auto message = [&](const core::Trajectory& e) {

@@ -95,6 +95,8 @@ TEST(TumReader, ReadsShippedFramesLikeAssociatePy) {
     EXPECT_EQ(f.bgr.size(), cv::Size(640, 480));
     // depth [m] == raw PNG value / 5000
     const cv::Mat raw = cv::imread(f.depth_source, cv::IMREAD_UNCHANGED);
+    ASSERT_EQ(raw.type(), CV_16UC1) << f.depth_source;
+    ASSERT_EQ(raw.size(), f.depth.size());
     for (auto [u, v] : {std::pair{320, 240}, {100, 400}, {600, 50}})
         EXPECT_FLOAT_EQ(f.depth.at<float>(v, u), raw.at<uint16_t>(v, u) / 5000.0f);
     EXPECT_EQ(cv::countNonZero(raw == 0), cv::countNonZero(f.depth == 0.0f));  // 0 = missing
@@ -235,6 +237,10 @@ TEST(TrajectoryIO, RoundTripAndErrors) {
                 "line 2: duplicate timestamp");
     writeText(d.str("bad.txt"), "1 0 0 0 0 0 0 3\n");
     expectError([&] { (void)io::readTumTrajectory(d.str("bad.txt")); }, "line 1: quaternion norm");
+    // The TUM tools' float() reads no hexadecimal (std::stod did: 0x1p-3 was 0.125).
+    writeText(d.str("bad.txt"), "1 0x1p-3 0 0 0 0 0 1\n");
+    expectError([&] { (void)io::readTumTrajectory(d.str("bad.txt")); },
+                "line 1: tx '0x1p-3' is not a number");
     writeText(d.str("bad.txt"), "# only comments\n");
     expectError([&] { (void)io::readTumTrajectory(d.str("bad.txt")); }, "no poses");
     expectError([&] { (void)io::readTumTrajectory(d.str("missing.txt")); }, "cannot open");

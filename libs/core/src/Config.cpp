@@ -17,33 +17,55 @@ namespace {
 /// - a repeated key (names in any letter case; MRPT keeps the last) or section (MRPT merges
 ///   it into the first): a pasted line or section would replace a value the reader of the
 ///   file sees first (a goal, an obstacle, a gain); both lines are named;
-/// - a '[' without ']', and a line that is neither a section nor `key = value` (ignored).
+/// - a '[' without ']', text after a section's ']', and a line that is neither a section
+///   nor `key = value` (ignored);
+/// - a comment ending in '\' followed by a key or section (MRPT joins them: the key is lost).
 /// Comments (#, ;, //), @ directives and continued values ('\' at the end) are skipped.
 void refuseMisreadLines(const std::string& text, const std::string& path) {
     std::map<std::string, int> sections;
     std::map<std::pair<std::string, std::string>, int> keys;
     std::map<std::string, std::string> defines;  // MRPT's "@define NAME VALUE", used as ${NAME}
     const auto expand = [&](std::string s) {
+        // Each use replaced once, the search going on after the value put in: a value that
+        // holds its own name ("@define A ${A}") searched from the start again for ever.
         for (const auto& [name, value] : defines)
             for (auto p = s.find("${" + name + "}"); p != std::string::npos;
-                 p = s.find("${" + name + "}"))
+                 p = s.find("${" + name + "}", p + value.size()))
                 s.replace(p, name.size() + 3, value);
         return s;
     };
     std::istringstream in(text);
     std::string section;
     int n = 0;
-    bool continued = false;  // the line before ended in '\': this one is part of its value
+    bool continued = false;   // the line before ended in '\': this one is part of its value
+    bool in_comment = false;  // ... and it was a comment: this line is read as comment too
+    const auto isComment = [](const std::string& line) {
+        const auto a = line.find_first_not_of(" \t");
+        return a == std::string::npos || line[a] == '#' || line[a] == ';' ||
+               line.compare(a, 2, "//") == 0;
+    };
     for (std::string line; std::getline(in, line);) {
         ++n;
         if (!line.empty() && line.back() == '\r') line.pop_back();
         const bool continuation = continued;
         continued = !line.empty() && line.back() == '\\';  // MRPT joins only there
-        if (continuation) continue;
-        const auto a = line.find_first_not_of(" \t");
-        if (a == std::string::npos || line[a] == '#' || line[a] == ';' ||
-            line.compare(a, 2, "//") == 0)
+        if (continuation) {
+            // A key or section joined to a comment is lost without a word ("# see C:\docs\"
+            // above a key); a comment joined to one (a shell command's '\') is harmless.
+            if (in_comment && !isComment(line))
+                throw std::invalid_argument(
+                    path + " line " + std::to_string(n - 1) +
+                    ": a comment ends in '\\', so MRPT reads line " + std::to_string(n) + " ('" +
+                    trimmed(line) + "') as part of it");
             continue;
+        }
+        in_comment = false;
+        const auto a = line.find_first_not_of(" \t");
+        if (a == std::string::npos) continue;
+        if (isComment(line)) {
+            in_comment = continued;
+            continue;
+        }
         if (line[a] == '@') {  // a directive: only @define matters for names
             std::istringstream d(line.substr(a));
             std::string word, name, value;
@@ -57,6 +79,12 @@ void refuseMisreadLines(const std::string& text, const std::string& path) {
             if (b == std::string::npos)  // MRPT would make a section of it and the next line
                 throw std::invalid_argument(path + " line " + std::to_string(n) + ": '" +
                                             trimmed(line) + "' has no ']'");
+            // After ']' only a comment: MRPT ignores the rest ("[orb] junk" is [orb]).
+            const auto rest = line.find_first_not_of(" \t", b + 1);
+            if (rest != std::string::npos && line[rest] != '#' && line[rest] != ';' &&
+                line.compare(rest, 2, "//") != 0)
+                throw std::invalid_argument(path + " line " + std::to_string(n) + ": '" +
+                                            trimmed(line) + "': text after the section's ']'");
             section = trimmed(expand(line.substr(a + 1, b - a - 1)));  // MRPT trims the name
             const auto [at, fresh] = sections.emplace(lowercase(section), n);
             if (!fresh)
@@ -96,12 +124,19 @@ std::unique_ptr<mrpt::config::CConfigFileMemory> loadIni(const std::string& path
 
 void applyOverrides(mrpt::config::CConfigFileMemory& cfg, const std::vector<std::string>& items,
                     const std::string& what) {
+    // One key set twice keeps the last without a word, as a key repeated in a file would.
+    std::map<std::pair<std::string, std::string>, std::string> given;
     for (const auto& s : items) {
         const auto dot = s.find('.'), eq = s.find('=');
         if (dot == std::string::npos || eq == std::string::npos || dot > eq || dot == 0 ||
             eq == dot + 1)
             throw std::invalid_argument(what + " '" + s + "': expected SECTION.KEY=VALUE");
-        cfg.write(s.substr(0, dot), s.substr(dot + 1, eq - dot - 1), s.substr(eq + 1));
+        const std::string section = s.substr(0, dot), key = s.substr(dot + 1, eq - dot - 1);
+        const auto [at, fresh] = given.emplace(std::pair{lowercase(section), lowercase(key)}, s);
+        if (!fresh)
+            throw std::invalid_argument(what + " '" + s + "': [" + section + "] " + key +
+                                        " is set twice (also '" + at->second + "')");
+        cfg.write(section, key, s.substr(eq + 1));
     }
 }
 
@@ -204,9 +239,19 @@ std::unique_ptr<mrpt::config::CConfigFileMemory> loadFilterIni(
     auto out = loadIni(file);
     // A file of its own holds only the filter's sections (else the SLAM INI's check covers it).
     if (!fc.empty()) requireKnownSections(*out, filterSections(), file);
-    applyOverrides(*out, overrideItems(cfg.read_string("run", "filter_overrides", ""),
-                                       path + " [run] filter_overrides"),
-                   path + " [run] filter_overrides item");
+    const auto items = overrideItems(cfg.read_string("run", "filter_overrides", ""),
+                                     path + " [run] filter_overrides");
+    // An item for another section would add that section and be read by nothing.
+    for (const auto& item : items) {
+        const std::string section = item.substr(0, std::min(item.find('.'), item.find('=')));
+        const auto& known = filterSections();
+        if (std::find(known.begin(), known.end(), lowercase(section)) == known.end() &&
+            item.find('.') < item.find('='))
+            throw std::invalid_argument(path + " [run] filter_overrides item '" + item +
+                                        "': section '" + section +
+                                        "' is not one of the filter's (detector, dynamic_filter)");
+    }
+    applyOverrides(*out, items, path + " [run] filter_overrides item");
     return out;
 }
 

@@ -28,8 +28,16 @@ namespace {
     throw std::invalid_argument(what + ": expected " + expected + ", got '" + text + "'");
 }
 
-/// `t` read in full as one finite number (no trailing characters, no overflow, no nan/inf).
+/// strtod also reads C's hexadecimal numbers ("0x10" is 16, "0x1p-5"), which no reader of
+/// an INI or a TUM file (Python's float()) takes for numbers: refused.
+bool hexadecimal(const std::string& t) {
+    return t.find_first_of("xX") != std::string::npos;
+}
+
+/// `t` read in full as one finite number (no trailing characters, no overflow, no nan/inf,
+/// no hexadecimal).
 bool readFinite(const std::string& t, double& v) {
+    if (hexadecimal(t)) return false;
     char* end = nullptr;
     errno = 0;
     v = std::strtod(t.c_str(), &end);
@@ -54,6 +62,7 @@ long long parseInteger(const std::string& text, const std::string& what, long lo
     errno = 0;
     long long v = std::strtoll(t.c_str(), &end, 10);
     if (end != t.c_str() + t.size() || errno == ERANGE) {
+        if (hexadecimal(t)) fail(what, "an integer", text);
         errno = 0;
         const double d = std::strtod(t.c_str(), &end);
         if (end != t.c_str() + t.size() || errno == ERANGE || !std::isfinite(d) ||
@@ -94,7 +103,7 @@ std::vector<double> parseNumberList(const std::string& text, const std::string& 
             // "nan", "inf" and "1e400" read in full, but are no place, size or time.
             char* end = nullptr;
             std::strtod(tok.c_str(), &end);
-            const bool whole = end == tok.c_str() + tok.size();
+            const bool whole = !hexadecimal(tok) && end == tok.c_str() + tok.size();
             throw std::invalid_argument(what + ": '" + tok + "' is not a " +
                                         (whole ? "finite number" : "number"));
         }

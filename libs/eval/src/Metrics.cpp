@@ -138,7 +138,8 @@ RpeResult computeRpe(const core::Trajectory& gt, const core::Trajectory& est,
         throw std::invalid_argument(
             "RPE: " + std::string(trans.empty() ? "no pose pair" : "one pose pair") + " " +
             (std::ostringstream() << opts.delta).str() + (opts.delta_in_frames ? " frames" : " s") +
-            " apart has ground truth, two are needed (sequence too short?)");
+            " apart that ends before the estimate's last pose (evaluate_rpe.py drops those) and "
+            "has ground truth at both ends; two are needed (sequence too short?)");
     RpeResult r;
     r.trans = core::summarize(trans);
     r.rot = core::summarize(rot);

@@ -30,7 +30,8 @@ double parseNumber(const std::string& token, const std::string& path, int line,
     std::size_t used = 0;
     double v = 0;
     try {
-        v = std::stod(token, &used);
+        // stod also reads hexadecimal ("0x1p-3"), which the TUM tools' float() refuses.
+        if (token.find_first_of("xX") == std::string::npos) v = std::stod(token, &used);
     } catch (const std::exception&) {
         used = 0;
     }

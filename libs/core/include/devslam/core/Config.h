@@ -114,7 +114,9 @@ void applyOverrides(mrpt::config::CConfigFileMemory& cfg, const std::vector<std:
 
 /// Runs `load()` and returns what it returns. A std::invalid_argument whose message names
 /// only the field ("[section] key: ...", as the reads above and requireValue throw) comes
-/// back as "<source> [section] key: ...", so a loader that reads one file can name it.
+/// back as "<source> [section] key: ...", so a loader that reads one file can name it; so
+/// does a std::runtime_error that starts with a section (a file a key names: "[detector]
+/// yolo weights: file not found").
 template <class Load>
 decltype(auto) namingSource(const std::string& source, Load&& load) {
     try {
@@ -123,6 +125,10 @@ decltype(auto) namingSource(const std::string& source, Load&& load) {
         const std::string msg = e.what();
         if (msg.empty() || msg.front() != '[') throw;
         throw std::invalid_argument(source + " " + msg);
+    } catch (const std::runtime_error& e) {
+        const std::string msg = e.what();
+        if (msg.empty() || msg.front() != '[') throw;
+        throw std::runtime_error(source + " " + msg);
     }
 }
 
