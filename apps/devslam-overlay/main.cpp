@@ -217,15 +217,18 @@ int main(int argc, char** argv) {
                 char name[64];
                 std::snprintf(name, sizeof name, "overlay_%05zu.png", k);
                 const std::string file = (fs::path(out_dir) / name).string();
-                bool ok = false;
+                // Drawn outside the write's try: a drawing error is not a write error.
+                const cv::Mat picture = drawOverlay(*f, out);
+                std::string why;
                 try {
-                    ok = cv::imwrite(file, drawOverlay(*f, out));
-                } catch (const cv::Exception&) {
+                    if (!cv::imwrite(file, picture)) why = "imwrite failed";
+                } catch (const cv::Exception& e) {
+                    why = e.what();
                 }
-                if (!ok)
+                if (!why.empty())
                     throw std::runtime_error("cannot write " + file + " (" +
                                              std::to_string(written) +
-                                             " overlays written before it)");
+                                             " overlays written before it): " + why);
                 ++written;
             }
             bar.update(++k);

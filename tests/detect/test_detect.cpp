@@ -88,10 +88,13 @@ TEST(DetectYolo, DeterministicOutput) {
     const cv::Mat img = readImage("data/images/person.jpg");
     const auto a = det->detect(img);
     const auto b = det->detect(img);
+    ASSERT_FALSE(a.empty());
     ASSERT_EQ(a.size(), b.size());
-    for (std::size_t i = 0; i < a.size(); ++i) {
-        EXPECT_NEAR(a[i].box.x, b[i].box.x, 1e-3);
-        EXPECT_NEAR(a[i].score, b[i].score, 1e-5);
+    for (std::size_t i = 0; i < a.size(); ++i) {  // one net, one image: the same bits
+        EXPECT_EQ(a[i].box, b[i].box) << i;
+        EXPECT_EQ(a[i].score, b[i].score) << i;
+        EXPECT_EQ(a[i].class_id, b[i].class_id) << i;
+        EXPECT_EQ(a[i].class_name, b[i].class_name) << i;
     }
 }
 

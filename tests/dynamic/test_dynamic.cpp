@@ -191,6 +191,7 @@ TEST(DynamicFilter, BoxAtTheBorderIsStaticOnlyAfterConfirmFrames) {
         DynamicObjectFilter filter(fo, std::move(det));
         const int confirm = border ? fo.confirm_border_frames : 1;
         for (int k = 0; k < static_cast<int>(seq.size()); ++k) {
+            ASSERT_TRUE(seq[k].person_box.has_value()) << "frame " << k;
             cv::Rect2f box = *seq[k].person_box;
             if (border) {  // the same person's box, reaching the left border
                 box.width += box.x;
@@ -255,6 +256,7 @@ TEST(DynamicFilter, HysteresisReleasesAfterQuietFrames) {
         std::vector<BoxState> states;
         for (int k = 0; k < 24; ++k) {
             const auto& s = k < 12 ? seq[k] : seq2[k];
+            ASSERT_TRUE(s.person_box.has_value()) << "frame " << k;
             script->next = {{*s.person_box, 0, "person", 0.9f}};
             const auto out = filter.step(s.frame, s.T_prev_cur);
             ASSERT_EQ(out.boxes.size(), 1u);
@@ -291,6 +293,7 @@ TEST(DynamicFilter, DetectEveryKCarriesBoxes) {
     DynamicObjectFilter filter(fo, std::move(det));
     int moving = 0, good_iou = 0;
     for (const auto& s : seq) {
+        ASSERT_TRUE(s.person_box.has_value()) << "frame " << s.frame.index;
         script->next = {{*s.person_box, 0, "person", 0.9f}};
         const auto out = filter.step(s.frame, s.T_prev_cur);
         EXPECT_EQ(out.detector_ran, s.frame.index % 3 == 0);
@@ -361,6 +364,53 @@ TEST(DynamicFilter, OptionsSetInCodeAreChecked) {
                   std::string::npos)
             << e.what();
     }
+    // Values that crashed a step (a corner spacing past int's range) or grow its images
+    // without bound are refused, naming the key.
+    for (const auto& [key, set] :
+         std::vector<std::pair<std::string, std::function<void(DynamicObjectFilter::Options&)>>>{
+             {"corner_min_distance", [](auto& o) { o.corner_min_distance = 3e9; }},
+             {"corner_min_distance", [](auto& o) { o.corner_min_distance = -1; }},
+             {"lk_window", [](auto& o) { o.lk_window = 1001; }},
+             {"lk_window", [](auto& o) { o.lk_window = 12; }}}) {
+        auto o = testOptions();
+        set(o);
+        try {
+            DynamicObjectFilter filter(o, std::make_unique<ScriptedDetector>());
+            ADD_FAILURE() << key << " accepted";
+        } catch (const std::invalid_argument& e) {
+            EXPECT_NE(std::string(e.what()).find("[dynamic_filter] " + key + ": must be"),
+                      std::string::npos)
+                << e.what();
+        }
+    }
+}
+
+// A frame smaller than the flow's window (lk_window / flow_scale px: 22 with the shipped
+// INI) is refused naming it; cv::resize asserted on a 1x1 frame. One a little larger runs.
+TEST(DynamicFilter, FrameSmallerThanTheFlowWindowIsRefused) {
+    const core::Frame wall = flatWallFrame();
+    const auto crop = [&](int side, std::size_t index) {
+        core::Frame f = wall;
+        f.bgr = wall.bgr(cv::Rect(300, 200, side, side)).clone();
+        f.depth = wall.depth(cv::Rect(300, 200, side, side)).clone();
+        f.K.width = f.K.height = side;
+        f.index = index;
+        return f;
+    };
+    DynamicObjectFilter filter(testOptions(), std::make_unique<ScriptedDetector>());
+    for (int side : {1, 21}) {
+        try {
+            (void)filter.step(crop(side, 7), std::nullopt);
+            ADD_FAILURE() << side << " px accepted";
+        } catch (const std::invalid_argument& e) {
+            EXPECT_NE(std::string(e.what()).find("frame 7 is " + std::to_string(side) + "x" +
+                                                 std::to_string(side) +
+                                                 " px; the flow needs at least 22x22"),
+                      std::string::npos)
+                << e.what();
+        }
+    }
+    for (std::size_t i = 0; i < 3; ++i) EXPECT_NO_THROW((void)filter.step(crop(40, i), std::nullopt));
 }
 
 TEST(DynamicFilter, EachCornerIsTrackedOnce) {
@@ -394,8 +444,9 @@ TEST(DynamicFilter, EachCornerIsTrackedOnce) {
 
 TEST(DynamicFilter, StageTimesAddUpToTheFilterTime) {
     // stage_ms splits filter_ms (the detector excluded) into the stages devslam-filter-bench
-    // reports: they cover the step without overlap, and a first frame has no corners or
-    // flow to time.
+    // reports: they do not overlap (their sum is within filter_ms), and a first frame has no
+    // corners or flow to time. (How much of the step they cover is a timing, which a loaded
+    // machine can upset: not asserted.)
     dynamic::SyntheticOptions so;
     so.person = dynamic::PersonMotion::Walking;
     so.n_frames = kFrames;
@@ -415,7 +466,6 @@ TEST(DynamicFilter, StageTimesAddUpToTheFilterTime) {
         }
         EXPECT_TRUE(out.detector_ran);
         EXPECT_LE(sum, out.filter_ms + 1e-6) << "frame " << i;  // the detector is not in it
-        EXPECT_GE(sum, 0.5 * out.filter_ms) << "frame " << i;
         if (i == 0) {
             EXPECT_EQ(t.corners, 0.0);
             EXPECT_EQ(t.flow, 0.0);
@@ -437,6 +487,7 @@ TEST(DynamicFilter, ModesAndMask) {
         auto fo = testOptions();
         fo.mode = mode;
         auto det = std::make_unique<ScriptedDetector>();
+        ASSERT_TRUE(seq[0].person_box.has_value());
         det->next = {{*seq[0].person_box, 0, "person", 0.9f}};
         DynamicObjectFilter filter(fo, std::move(det));
         dynamic::FilterOutput out;
@@ -473,6 +524,7 @@ TEST(DynamicFilter, RefinedEgoMotionMatchesTruth) {
     ScriptedDetector* script = det.get();
     DynamicObjectFilter filter(testOptions(), std::move(det));
     for (const auto& s : seq) {
+        ASSERT_TRUE(s.person_box.has_value()) << "frame " << s.frame.index;
         script->next = {{*s.person_box, 0, "person", 0.9f}};
         const auto out = filter.step(s.frame, std::nullopt);
         if (s.frame.index == 0) continue;
@@ -1070,6 +1122,7 @@ TEST(DynamicFilter, TracksNothingShowsLeaveTheMaskButAreRemembered) {
         int hide;
         bool at_border;  // the detections moved left until they touch the image border
     };
+    for (int i = 0; i <= kLast; ++i) ASSERT_TRUE(walking[i].person_box.has_value()) << i;
     for (const Case c : {Case{0, false}, Case{3, false}, Case{3, true}}) {
         const float shift = c.at_border ? -walking[kLast].person_box->x : 0.f;
         auto detection = [&](int i) {

@@ -124,15 +124,25 @@ TEST(DevslamFilterBench, BadConfigStopsItBeforeAnyWork) {
     std::ifstream in2(results);
     EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in2), {}), "# Results\n");
 
+    // The detector is checked before the work in mode none too (the filter makes none there;
+    // it failed after the timing runs, without naming the file).
+    std::ofstream(ini) << "[detector]\nweights = models/missing.weights\n[dynamic_filter]\n"
+                          "mode = none\n";
+    r = runApp("devslam-filter-bench", "--config " + ini + " --results none");
+    EXPECT_EQ(r.rc, 1) << r.out;
+    EXPECT_NE(r.out.find(ini + " [detector] yolo weights: file not found"), std::string::npos)
+        << r.out;
+    // --results none in each: a refusal that broke would run the bench, whose default results
+    // file is the repository's docs/RESULTS.md.
     std::ofstream(ini) << "[run]\nfilter_config = nowhere.ini\n";
-    r = runApp("devslam-filter-bench", "--config " + ini);
+    r = runApp("devslam-filter-bench", "--config " + ini + " --results none");
     EXPECT_EQ(r.rc, 1) << r.out;
     EXPECT_NE(r.out.find("nowhere.ini"), std::string::npos) << r.out;
 
-    r = runApp("devslam-filter-bench", "--frames 1");
+    r = runApp("devslam-filter-bench", "--frames 1 --results none");
     EXPECT_EQ(r.rc, 2) << r.out;
     EXPECT_NE(r.out.find("--frames"), std::string::npos) << r.out;
-    r = runApp("devslam-filter-bench", "--threads");
+    r = runApp("devslam-filter-bench", "--results none --threads");
     EXPECT_EQ(r.rc, 2) << r.out;
     EXPECT_NE(r.out.find("devslam-filter-bench: --threads needs a value"), std::string::npos)
         << r.out;

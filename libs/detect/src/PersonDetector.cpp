@@ -22,6 +22,8 @@ std::unique_ptr<PersonDetector> makeDetector(const mrpt::config::CConfigFileBase
             return std::make_unique<YoloDetector>(o);
         } catch (const std::invalid_argument& e) {  // an option: UnknownClass, conf_threshold
             throw std::invalid_argument("[" + section + "] " + e.what());
+        } catch (const std::runtime_error& e) {  // a file it names: missing, or does not load
+            throw std::runtime_error("[" + section + "] " + e.what());
         }
     }
     if (name == "hog") {

@@ -80,28 +80,23 @@ float darknetScoreFloor(const std::string& cfg_path) {
     // OpenCV's darknet reader gives each [yolo] layer `thresh` (default 0.2) and sets every
     // class score at or below it to 0: no box under it ever comes out.
     constexpr float kOpenCvDefault = 0.2f;
-    float floor = 0.f, layer = 0.f;
+    float highest = 0.f, layer = 0.f;
     bool in_yolo = false;
     for (std::string line; std::getline(in, line);) {
         line = trim(line.substr(0, line.find_first_of("#;")));
         if (line.empty()) continue;
         if (line.front() == '[') {
-            if (in_yolo) floor = std::max(floor, layer);
+            if (in_yolo) highest = std::max(highest, layer);
             in_yolo = line == "[yolo]";
             layer = kOpenCvDefault;
         } else if (in_yolo && line.find('=') != std::string::npos &&
                    trim(line.substr(0, line.find('='))) == "thresh") {
-            const std::string v = trim(line.substr(line.find('=') + 1));
-            try {
-                layer = std::stof(v);
-            } catch (const std::exception&) {
-                throw std::runtime_error("darknet cfg '" + cfg_path + "': thresh '" + v +
-                                         "' is not a number");
-            }
+            layer = static_cast<float>(core::parseNumber(trim(line.substr(line.find('=') + 1)),
+                                                         "darknet cfg '" + cfg_path + "' thresh"));
         }
     }
-    if (in_yolo) floor = std::max(floor, layer);
-    return floor;
+    if (in_yolo) highest = std::max(highest, layer);
+    return highest;
 }
 
 cv::dnn::Net readDarknetCfg(const std::string& cfg_path) {
@@ -184,9 +179,9 @@ YoloDetector::YoloDetector(const Options& opts) : opts_(opts) {
                                          " bytes) to be a darknet weights file");
             // A threshold the network never reaches down to would promise weak boxes (those
             // that only continue tracks) that never come.
-            if (const float floor = darknetScoreFloor(model); opts_.conf_threshold < floor) {
+            if (const float lowest = darknetScoreFloor(model); opts_.conf_threshold < lowest) {
                 std::ostringstream msg;
-                msg << "conf_threshold: " << opts_.conf_threshold << " is below the " << floor
+                msg << "conf_threshold: " << opts_.conf_threshold << " is below the " << lowest
                     << " of the [yolo] layers of '" << model
                     << "' (their thresh, 0.2 when the cfg sets none): OpenCV returns no box "
                        "scoring at or under it";

@@ -218,8 +218,12 @@ void DynamicObjectFilter::Options::validate(const std::string& s) const {
     core::requireValue(max_corners_per_box >= 0, s, "max_corners_per_box", "must be >= 0");
     core::requireValue(corner_quality > 0 && corner_quality < 1, s, "corner_quality",
                        "must be in (0, 1)");
-    core::requireValue(lk_window >= 5 && lk_window % 2 == 1, s, "lk_window",
-                       "must be odd and >= 5");
+    // A huge spacing overflowed the corner grid's cell count (a crash at 3e9); a huge window
+    // grows the pyramids' borders by its size.
+    core::requireValue(corner_min_distance >= 0 && corner_min_distance <= 1000, s,
+                       "corner_min_distance", "must be in [0, 1000] px");
+    core::requireValue(lk_window >= 5 && lk_window <= 255 && lk_window % 2 == 1, s, "lk_window",
+                       "must be odd and in [5, 255]");
     core::requireValue(lk_levels >= 0 && lk_levels <= 6, s, "lk_levels", "must be in [0, 6]");
     core::requireValue(fb_max_error > 0, s, "fb_max_error", "must be > 0");
     core::requireValue(min_background_points >= 6, s, "min_background_points", "must be >= 6");
@@ -433,6 +437,17 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
         frame.bgr.size() != frame.depth.size() || frame.bgr.empty())
         throw std::invalid_argument("dynamic filter: frame " + std::to_string(frame.index) +
                                     " needs CV_8UC3 colour and CV_32FC1 depth of equal size");
+    // The flow runs on the image scaled by flow_scale, with an lk_window-sized window: an
+    // image smaller than that window (a 1x1 frame gave cv::resize an empty size) is refused.
+    const int min_side =
+        static_cast<int>(std::ceil(opts_.lk_window / std::min(opts_.flow_scale, 1.0)));
+    if (opts_.mode != MaskMode::None &&
+        (frame.bgr.cols < min_side || frame.bgr.rows < min_side))
+        throw std::invalid_argument(
+            "dynamic filter: frame " + std::to_string(frame.index) + " is " +
+            std::to_string(frame.bgr.cols) + "x" + std::to_string(frame.bgr.rows) +
+            " px; the flow needs at least " + std::to_string(min_side) + "x" +
+            std::to_string(min_side) + " (lk_window / flow_scale)");
     FilterOutput out;
     out.mask = cv::Mat::zeros(frame.bgr.size(), CV_8UC1);
     if (opts_.mode == MaskMode::None) return out;

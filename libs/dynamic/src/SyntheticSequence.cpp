@@ -55,7 +55,10 @@ std::vector<SyntheticFrame> makeSyntheticSequence(const SyntheticOptions& o,
     std::vector<SyntheticFrame> seq;
     Eigen::Isometry3d T_prev = Eigen::Isometry3d::Identity();
     cv::Mat map_wx(K.height, K.width, CV_32FC1), map_wy(K.height, K.width, CV_32FC1);
-    cv::Mat map_px(K.height, K.width, CV_32FC1), map_py(K.height, K.width, CV_32FC1);
+    // Set only where the person is seen; elsewhere remap reads them too (its result there is
+    // not used), so they hold a defined value rather than uninitialised memory.
+    cv::Mat map_px(K.height, K.width, CV_32FC1, cv::Scalar(-1)),
+        map_py(K.height, K.width, CV_32FC1, cv::Scalar(-1));
     for (int k = 0; k < o.n_frames; ++k) {
         const double t = k * dt;
         Eigen::Isometry3d T_wc = Eigen::Isometry3d::Identity();
