@@ -176,10 +176,9 @@ int main(int argc, char** argv) {
         nav_opts.verbose = verbose;
         devslam::sim::EpisodeOptions eo;
         eo.holonomic_method = method;
-        if (!navlog.empty()) {
-            mrpt::system::createDirectory(navlog);
-            eo.log_file = true;
-            eo.log_directory = navlog;
+        if (!navlog.empty()) {  // over the INI's [navigator] log_file / log_directory
+            nav_opts.log_file = true;
+            nav_opts.log_directory = navlog;
         }
         const auto r = devslam::sim::runEpisode(world, *ini, nav_opts, eo);
         if (png.empty()) png = kDefaultDir + "/nav_" + world.name + ".png";

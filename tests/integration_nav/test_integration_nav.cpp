@@ -83,7 +83,12 @@ TEST(IntegrationNav, AStarPlusVfhOnMrptKinematicSimulator) {
     KinematicRobot robot(sim, grid);
 
     mrpt::Clock::setSimulatedTime(mrpt::Clock::fromDouble(1.7e9));
-    const auto prev_clock = mrpt::Clock::getActiveClock();
+    // MRPT's clock is process-wide: set back however the test ends (a failed ASSERT returns
+    // early, and later tests in this binary would run on the simulated clock).
+    struct ClockGuard {
+        mrpt::Clock::Source prev = mrpt::Clock::getActiveClock();
+        ~ClockGuard() { mrpt::Clock::setActiveClock(prev); }
+    } clock_guard;
     mrpt::Clock::setActiveClock(mrpt::Clock::Simulated);
     const auto ini = devslam::core::loadIni(kIni);
     auto opts = devslam::nav::NavigatorOptions::fromConfig(*ini, kIni);
@@ -107,7 +112,6 @@ TEST(IntegrationNav, AStarPlusVfhOnMrptKinematicSimulator) {
         const double dy = std::max({0.1 - p.y, 0.0, p.y - 5.0});
         min_wall = std::min(min_wall, std::hypot(dx, dy));
     }
-    mrpt::Clock::setActiveClock(prev_clock);
     const auto p = sim.getCurrentGTPose();
     EXPECT_TRUE(reached) << "final pose " << p.x << ", " << p.y;
     EXPECT_LT(std::hypot(p.x - 10.5, p.y - 2.0), 0.35);
@@ -152,8 +156,10 @@ TEST(IntegrationNav, TheIniChoosesTheHolonomicMethod) {
 
 TEST(IntegrationNav, AppsSmokeTest) {
     const std::string bin = DEVSLAM_BIN_DIR;
-    const std::string out = devslam::test::scratchPath("devslam_navsmoke").string();
-    ASSERT_TRUE(mrpt::system::createDirectory(out));
+    // Emptied first (an earlier failed run's files would pass the checks below), removed
+    // however the test ends.
+    const devslam::test::TempDir dir("devslam_");
+    const std::string out = dir.str();
     const std::string png = out + "/fig6.png";
     const std::string cmd = bin + "/devslam-nav " + kSrc + "/sim_worlds/paper_fig6.ini --png " +
                             png + " --navlog " + out + "/navlog > " + out + "/nav.txt 2>&1";
@@ -180,6 +186,35 @@ TEST(IntegrationNav, AppsSmokeTest) {
                     vfh_records++;
         }
         EXPECT_GT(vfh_records, 20);
+    }
+    {
+        // --navlog printed MRPT's DEBUG lines (the log was enabled before the level was set)
+        std::ifstream in(out + "/nav.txt");
+        const std::string text((std::istreambuf_iterator<char>(in)),
+                               std::istreambuf_iterator<char>());
+        EXPECT_EQ(text.find("DEBUG"), std::string::npos) << text;
+    }
+    {
+        // The INI's [navigator] log_file and log_directory work as --navlog does (the
+        // episode's own default overrode them).
+        std::ifstream in(kIni);
+        std::string ini((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        const auto set = [&](const std::string& key, const std::string& value) {
+            const std::regex line("\\n" + key + "( *)=[^\\n]*");
+            ASSERT_TRUE(std::regex_search(ini, line)) << key;
+            ini = std::regex_replace(ini, line, "\n" + key + "$1= " + value);
+        };
+        set("log_file", "true");
+        set("log_directory", out + "/ini_navlog");
+        std::ofstream(out + "/nav.ini") << ini;
+        const auto r = devslam::test::runApp("devslam-nav", kSrc + "/sim_worlds/paper_fig6.ini --png " +
+                                                                out + "/ini.png --config " + out +
+                                                                "/nav.ini");
+        EXPECT_EQ(r.rc, 0) << r.out;
+        mrpt::system::CDirectoryExplorer::TFileInfoList ini_logs;
+        mrpt::system::CDirectoryExplorer::explore(out + "/ini_navlog", FILE_ATTRIB_ARCHIVE,
+                                                  ini_logs);
+        EXPECT_FALSE(ini_logs.empty()) << "no navlog written from the INI's log_file";
     }
     // bad world: clear error, exit code 2
     const std::string bad = bin + "/devslam-nav " + kSrc +
@@ -230,15 +265,14 @@ TEST(IntegrationNav, AppsSmokeTest) {
     EXPECT_NE(r.out.find("section 'nav' needs"), std::string::npos) << r.out;
     EXPECT_EQ(r.out.find("nav-bench ["), std::string::npos) << "ran before refusing: " << r.out;
     EXPECT_FALSE(mrpt::system::directoryExists(out + "/refused"));
-    mrpt::system::deleteFilesInDirectory(out, true);
 }
 
 // Ctrl-C stops devslam-nav-bench after the current episode: the tables of the episodes done
 // go to stdout, saying how many; RESULTS.md and the pictures are left as they were. (The
 // signal comes with the first progress line, about 4.5 s in; 200 episodes take a minute.)
 TEST(IntegrationNav, NavBenchCtrlCPrintsTheEpisodesDone) {
-    const std::string out = devslam::test::scratchPath("devslam_navbench_ctrl_c").string();
-    mrpt::system::createDirectory(out);
+    const devslam::test::TempDir dir("devslam_");
+    const std::string out = dir.str();
     std::ofstream(out + "/RESULTS.md") << "# R\n";
     const auto r =
         devslam::test::signalAppWhen("devslam-nav-bench",
@@ -272,5 +306,4 @@ TEST(IntegrationNav, NavBenchCtrlCPrintsTheEpisodesDone) {
     results << in.rdbuf();
     EXPECT_EQ(results.str(), "# R\n");
     EXPECT_FALSE(mrpt::system::directoryExists(out + "/png"));
-    mrpt::system::deleteFilesInDirectory(out, true);
 }

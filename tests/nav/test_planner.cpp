@@ -237,7 +237,9 @@ TEST(Replan, OnlyPointsTheMapDoesNotHoldCount) {
     EXPECT_TRUE(pathBlocked(route, {0.5, 1.7}, left, 0.30, 6.0));
 }
 
-TEST(NavConfig, EveryNavIniLoads) {
+// config_ini/nav_reactive.ini is the one navigation INI shipped (the world files have their
+// own test): its values are read, not the defaults.
+TEST(NavConfig, TheShippedNavIniLoads) {
     const std::string path = std::string(DEVSLAM_SOURCE_DIR) + "/config_ini/nav_reactive.ini";
     const auto cfg = devslam::core::loadIni(path);
     const auto o = NavigatorOptions::fromConfig(*cfg, path);

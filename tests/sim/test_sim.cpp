@@ -227,7 +227,19 @@ TEST(Simulator, PedestrianWalksScriptAndIsSeenAndTouched) {
     w.pedestrians.push_back(p);
     Simulator sim(w);
     EXPECT_NEAR(sim.scan().ranges[180], 3.75, 0.02);  // ray 180 of 360 points at angle 0
-    for (int i = 0; i < 400; i++) sim.step();         // contact from t = 3.5 s (x = 2.5)
+    // It walks its script at its speed, x = 6 - 1.0 t, before it reaches the robot ...
+    while (sim.time() < 3.0 - 1e-9) {
+        sim.step();
+        const double t = sim.time();
+        if (std::abs(t - 1.0) < 1e-6 || std::abs(t - 2.0) < 1e-6 || std::abs(t - 3.0) < 1e-6) {
+            ASSERT_EQ(sim.pedestrianPositions().size(), 1u);
+            EXPECT_NEAR(sim.pedestrianPositions()[0].x, 6.0 - t, 0.02) << "t = " << t;
+            EXPECT_NEAR(sim.pedestrianPositions()[0].y, 3.0, 0.02) << "t = " << t;
+        }
+    }
+    EXPECT_EQ(sim.collisions().person_events, 0);
+    // ... and touches it (contact from t = 3.5 s, x = 2.5).
+    while (sim.time() < 4.0 - 1e-9) sim.step();
     EXPECT_GE(sim.collisions().person_events, 1);
     EXPECT_EQ(sim.collisions().static_events, 0);
 }
@@ -332,9 +344,39 @@ TEST(SimRobot, PeopleGetARingOfPointsTheMarginOut) {
 TEST(RandomWorlds, SameSeedSameWorldAndAlwaysSolvable) {
     for (auto c : allCategories())
         for (uint32_t s = 1; s <= 3; s++) {
+            const std::string what = std::string(toString(c)) + " seed " + std::to_string(s);
             const auto a = randomWorld(c, s), b = randomWorld(c, s);
-            ASSERT_EQ(a.obstacles.size(), b.obstacles.size());
-            EXPECT_DOUBLE_EQ(a.goal.x, b.goal.x);
-            EXPECT_NO_THROW(validateWorld(a));
+            // The same world, all of it: obstacles, start, goal, people.
+            ASSERT_EQ(a.obstacles.size(), b.obstacles.size()) << what;
+            for (std::size_t i = 0; i < a.obstacles.size(); ++i) {
+                const auto &p = a.obstacles[i], &q = b.obstacles[i];
+                EXPECT_TRUE(p.shape == q.shape && p.kind == q.kind && p.cx == q.cx &&
+                            p.cy == q.cy && p.sx == q.sx && p.sy == q.sy && p.yaw == q.yaw &&
+                            p.radius == q.radius)
+                    << what << " obstacle " << i;
+            }
+            EXPECT_EQ(a.robot.start, b.robot.start) << what;
+            EXPECT_EQ(a.goal, b.goal) << what;
+            ASSERT_EQ(a.pedestrians.size(), b.pedestrians.size()) << what;
+            for (std::size_t i = 0; i < a.pedestrians.size(); ++i)
+                EXPECT_TRUE(a.pedestrians[i].path == b.pedestrians[i].path &&
+                            a.pedestrians[i].speed == b.pedestrians[i].speed &&
+                            a.pedestrians[i].mode == b.pedestrians[i].mode)
+                    << what << " pedestrian " << i;
+            // Another seed, another world.
+            const auto other = randomWorld(c, s + 100);
+            EXPECT_FALSE(other.goal == a.goal && other.robot.start == a.robot.start) << what;
+            // Solvable: planned here, on the world's own grid, for the world's robot.
+            EXPECT_NO_THROW(validateWorld(a)) << what;
+            devslam::nav::GridPlannerOptions po;
+            po.robot_radius = a.robot.radius;
+            devslam::nav::GridPlanner planner(po);
+            planner.setMap(rasterize(a));
+            const auto path = planner.plan({a.robot.start.x, a.robot.start.y}, a.goal);
+            ASSERT_TRUE(path.has_value()) << what << ": no path from start to goal";
+            EXPECT_GE(path->length, std::hypot(a.goal.x - a.robot.start.x,
+                                               a.goal.y - a.robot.start.y) -
+                                        0.1)
+                << what;
         }
 }

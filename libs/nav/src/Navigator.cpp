@@ -29,8 +29,10 @@ double threadCpuSeconds() {
 /// Exposes the per-PTG holonomic objects and silences MRPT's timing table.
 class ReactiveNav : public mrpt::nav::CReactiveNavigationSystem {
   public:
-    ReactiveNav(mrpt::nav::CRobot2NavInterface& r, bool log, const std::string& dir)
-        : CReactiveNavigationSystem(r, false, log, dir) {
+    /// The navlog is enabled later (enableLogFile), after the logging level is set: enabled
+    /// here, MRPT printed DEBUG lines whatever the level.
+    ReactiveNav(mrpt::nav::CRobot2NavInterface& r, const std::string& dir)
+        : CReactiveNavigationSystem(r, false, false, dir) {
         m_timlog_delays.enable(false);
     }
     /// Lowest VFH+ target density over the PTGs (-1 if no VFH+ instance).
@@ -157,8 +159,15 @@ Navigator::Navigator(mrpt::nav::CRobot2NavInterface& robot,
     cfg.write(sec_rns, "RobotModel_shape2D_xs", xs);
     cfg.write(sec_rns, "RobotModel_shape2D_ys", ys);
 
-    nav_ = std::make_unique<ReactiveNav>(robot_, opts_.log_file, opts_.log_directory);
+    nav_ = std::make_unique<ReactiveNav>(robot_, opts_.log_directory);
     nav_->setMinLoggingLevel(opts_.verbose ? mrpt::system::LVL_DEBUG : mrpt::system::LVL_ERROR);
+    if (opts_.log_file) {
+        if (!mrpt::system::directoryExists(opts_.log_directory) &&
+            !mrpt::system::createDirectory(opts_.log_directory))
+            throw std::runtime_error("[navigator] log_directory: cannot create '" +
+                                     opts_.log_directory + "'");
+        nav_->enableLogFile(true);
+    }
     std::string cache = opts_.ptg_cache_directory;
     if (cache.empty()) {
         // PTG collision grids depend on the PTG section and the robot shape only.

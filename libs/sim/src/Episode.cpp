@@ -55,8 +55,6 @@ EpisodeResult runEpisode(const WorldSpec& world, const mrpt::config::CConfigFile
     nav_opts.robot_radius = world.robot.radius;
     nav_opts.planner.robot_radius = world.robot.radius;
     if (!opts.holonomic_method.empty()) nav_opts.holonomic_method = opts.holonomic_method;
-    nav_opts.log_file = opts.log_file;
-    nav_opts.log_directory = opts.log_directory;
 
     Simulator sim(world);
     SimRobot robot(sim, nav_opts.person_margin);

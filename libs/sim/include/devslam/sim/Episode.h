@@ -22,8 +22,6 @@ namespace devslam::sim {
 struct EpisodeOptions {
     /// MRPT class name; empty: the navigator options' own ([navigator] holonomic_method)
     std::string holonomic_method;
-    bool log_file = false;  ///< write an MRPT navlog
-    std::string log_directory = "reactivenav.logs";
     double record_period = 0.1;  ///< [s] trajectory / tracks sampling
 };
 
