@@ -171,6 +171,11 @@ Bench readBench(const std::string& path) {
         Sequence q;
         q.name = cfg->read_string(s, "name", s.substr(9));
         q.scenario = cfg->read_string(s, "scenario", "");
+        // A scenario file (not a name devslam-synth finds in sim_worlds/synth) is found as
+        // `path` is, from the bench INI's folder first: devslam-synth would look in the
+        // working directory.
+        if (q.scenario.find('/') != std::string::npos || core::endsWithNoCase(q.scenario, ".ini"))
+            q.scenario = resolve(q.scenario, base);
         q.path = resolve(cfg->read_string(s, "path", ""), base);
         q.slam_config = resolve(cfg->read_string(s, "slam_config", ""), base);
         if (q.slam_config.empty()) q.slam_config = b.slam_config;
@@ -556,6 +561,12 @@ int run(int argc, char** argv) {
     }
     if (max_frames) b.max_frames = *max_frames;
     if (!out_override.empty()) b.out_dir = out_override;
+    {  // One spelling of the folder ("./out/" is "out"): its runs' command lines, which
+       // --reuse-runs compares, name it.
+        fs::path o = fs::path(b.out_dir).lexically_normal();
+        if (!o.has_filename() && o.has_parent_path()) o = o.parent_path();
+        b.out_dir = o.string();
+    }
     fs::create_directories(b.out_dir);
     // Before hours of work (after the output folder is made: the results may go in it).
     if (!results.empty()) core::checkResultsSection(results, "bench");
@@ -901,7 +912,9 @@ int run(int argc, char** argv) {
     for (const auto& q : b.sequences) {
         if (q.scenario.empty() || (q.sets.empty() && q.name == q.scenario)) continue;
         scenes << (scenes.tellp() > 0 ? "; " : "Sequences: ") << q.name << " is scenario `"
-               << q.scenario << "`";
+               << (fs::path(q.scenario).is_absolute() ? core::shownPath(q.scenario, kRoot)
+                                                      : q.scenario)
+               << "`";
         for (std::size_t k = 0; k < q.sets.size(); ++k)
             scenes << (k ? " " : " with `devslam-synth ") << "--set "
                    << (q.sets[k].find(' ') == std::string::npos ? q.sets[k] : quote(q.sets[k]));
