@@ -437,6 +437,7 @@ TEST(RenderSequence, GesturingHandIsRenderedAndLabelled) {
     SequenceRenderer r(sc);
     const auto a = r.render(1), b = r.render(3);
     ASSERT_EQ(a.persons.size(), 1u);
+    ASSERT_EQ(b.persons.size(), 1u);
     EXPECT_FALSE(a.persons[0].moving);
     ASSERT_GT(a.persons[0].visible_pixels, 500);
     const cv::Mat la = a.labels == 1, lb = b.labels == 1, changed = la ^ lb;

@@ -405,13 +405,21 @@ TEST(Matching, HammingAndBruteForce) {
     cv::Mat a(3, 32, CV_8U, cv::Scalar(0)), b(3, 32, CV_8U, cv::Scalar(0));
     a.row(0).setTo(0xFF);
     b.row(2).setTo(0xFF);  // a0 <-> b2 (distance 0)
-    b.at<uchar>(1, 0) =
-        0x0F;  // a1 (zeros) closest to b0 (0) vs b1 (4): ratio test fails? 0 < 0.8*4
+    b.at<uchar>(1, 0) = 0x0F;  // a1 and a2 (zeros): b0 at 0, b1 at 4 -> b0 (0 <= 0.8 * 4)
     EXPECT_EQ(hamming32(a.ptr<uchar>(0), b.ptr<uchar>(0)), 256);
     EXPECT_EQ(hamming32(a.ptr<uchar>(1), b.ptr<uchar>(1)), 4);
-    const auto m = matchBruteForce(a, b, 50, 0.8);
-    ASSERT_FALSE(m.empty());
-    EXPECT_EQ(m.front(), std::make_pair(0, 2));
+    // One to one: a1 and a2 both want b0, which keeps the first of its best (a1).
+    using M = std::vector<std::pair<int, int>>;
+    EXPECT_EQ(matchBruteForce(a, b, 50, 0.8), (M{{0, 2}, {1, 0}}));
+    // The ratio test: a row 2 bits from both b0 and b1 is ambiguous (2 > 0.8 * 2).
+    cv::Mat c(1, 32, CV_8U, cv::Scalar(0));
+    c.at<uchar>(0, 0) = 0x03;
+    EXPECT_TRUE(matchBruteForce(c, b, 50, 0.8).empty());
+    EXPECT_EQ(matchBruteForce(c, b, 50, 1.0), (M{{0, 0}}));  // a tie passes ratio 1
+    // max_hamming: a row 1 bit from b0 (3 from b1) matches only when 1 is allowed.
+    c.at<uchar>(0, 0) = 0x01;
+    EXPECT_TRUE(matchBruteForce(c, b, 0, 0.8).empty());
+    EXPECT_EQ(matchBruteForce(c, b, 1, 0.8), (M{{0, 0}}));
 }
 
 TEST(Map, ObservationsAndRemovalStayConsistent) {
@@ -494,9 +502,11 @@ TEST(LocalBundleAdjuster, ReducesPoseAndPointErrors) {
             << k;
     EXPECT_TRUE(map.keyframe(0).T_wc.isApprox(sc.gt[0]));
     double worst = 0;
-    for (std::size_t i = 0; i < sc.pts.size(); ++i)
-        worst =
-            std::max(worst, (map.landmark(static_cast<LandmarkId>(i))->p_w - sc.pts[i]).norm());
+    for (std::size_t i = 0; i < sc.pts.size(); ++i) {
+        const auto* lm = map.landmark(static_cast<LandmarkId>(i));
+        ASSERT_NE(lm, nullptr) << "landmark " << i << " removed";
+        worst = std::max(worst, (lm->p_w - sc.pts[i]).norm());
+    }
     EXPECT_LT(worst, 2e-3);
     EXPECT_EQ(res.n_outliers_removed, 0);
     EXPECT_FALSE(res.rejected);
