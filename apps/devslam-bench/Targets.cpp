@@ -43,6 +43,11 @@ std::vector<Target> loadTargets(const mrpt::config::CConfigFileBase& cfg, const 
     };
     for (const auto& key : keys) {
         const std::string where = path + " [targets] " + key;
+        // The key is a cell of targets.csv and of the Markdown table (no quoting there).
+        if (key.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789"
+                                  "_.-") != std::string::npos)
+            throw std::invalid_argument(where + ": a target's name is letters, digits, '_', '.', "
+                                                "'-' only (it is a cell of targets.csv)");
         const std::string line = cfg.read_string("targets", key, "");
         std::istringstream in(line);
         Target t;

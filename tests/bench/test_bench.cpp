@@ -418,6 +418,8 @@ TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
         {real + "[targets]\nx = a dynamic ate/truth <= 1\n", "ratio 'ate/truth'"},
         {real + "[targets]\nx = a dynamic ate =< 1\n", "unknown comparison '=<'"},
         {real + "[targets]\nx = * dynamic ate <= 1x\n", "[targets] x"},
+        {real + "[targets]\nx,y = a dynamic ate <= 1\n",
+         "[targets] x,y: a target's name is letters, digits"},
     };
     for (const auto& [ini, msg] : cases)
         EXPECT_NE(refused(ini).find(msg), std::string::npos)
