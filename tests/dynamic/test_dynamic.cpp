@@ -371,7 +371,9 @@ TEST(DynamicFilter, OptionsSetInCodeAreChecked) {
              {"corner_min_distance", [](auto& o) { o.corner_min_distance = 3e9; }},
              {"corner_min_distance", [](auto& o) { o.corner_min_distance = -1; }},
              {"lk_window", [](auto& o) { o.lk_window = 1001; }},
-             {"lk_window", [](auto& o) { o.lk_window = 12; }}}) {
+             {"lk_window", [](auto& o) { o.lk_window = 12; }},
+             {"static_person_weight", [](auto& o) { o.static_person_weight = 0; }},
+             {"static_person_weight", [](auto& o) { o.static_person_weight = 1.5; }}}) {
         auto o = testOptions();
         set(o);
         try {
@@ -676,6 +678,12 @@ TEST(DynamicConfig, ShippedIniLoadsAndRoundTrips) {
     EXPECT_EQ(b.release_frames, a.release_frames);
     EXPECT_EQ(b.confirm_border_frames, a.confirm_border_frames);
     EXPECT_EQ(b.lk_window, a.lk_window);
+    EXPECT_EQ(b.static_person_weight, a.static_person_weight);
+    mrpt::config::CConfigFileMemory quarter;
+    quarter.write("dynamic_filter", "static_person_weight", 0.25);
+    DynamicObjectFilter::Options c;
+    c.loadFromConfig(quarter);
+    EXPECT_EQ(c.static_person_weight, 0.25);
     auto f = dynamic::makeFilterFromConfig(*cfg, MaskMode::None);
     EXPECT_EQ(f->options().mode, MaskMode::None);
 }

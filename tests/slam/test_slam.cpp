@@ -111,6 +111,55 @@ TEST(PoseSolver, RefineFromPerturbedGuessWithoutRansac) {
     EXPECT_EQ(ref.n_inliers, 200);
 }
 
+// [dynamic_filter] static_person_weight: keypoints in a seated person's box count less.
+TEST(FrameFeatures, WeightInsideABoxScalesTheInformation) {
+    FrameFeatures f;
+    f.keypoints = {cv::KeyPoint(10, 10, 31, -1, 0, 0), cv::KeyPoint(50, 50, 31, -1, 0, 2),
+                   cv::KeyPoint(60, 55, 31, -1, 0, 0)};
+    EXPECT_TRUE(f.weight.empty());
+    EXPECT_DOUBLE_EQ(f.information(1, 1.2), 1.0 / std::pow(1.2, 4));
+    f.weighInside(cv::Rect2f(40, 40, 30, 30), 0.5f);
+    ASSERT_EQ(f.weight.size(), 3u);
+    EXPECT_EQ(f.weight[0], 1.f);
+    EXPECT_DOUBLE_EQ(f.information(0, 1.2), 1.0);
+    EXPECT_DOUBLE_EQ(f.information(1, 1.2), 0.5 / std::pow(1.2, 4));
+    EXPECT_DOUBLE_EQ(f.information(2, 1.2), 0.5);
+    f.weighInside(cv::Rect2f(55, 50, 10, 10), 0.8f);  // in two boxes: the lower weight stays
+    EXPECT_EQ(f.weight[2], 0.5f);
+    f.weighInside(cv::Rect2f(0, 0, 20, 20), 0.25f);
+    EXPECT_EQ(f.weight[0], 0.25f);
+    EXPECT_EQ(f.weight[1], 0.5f);
+}
+
+// A person who moved 2 px since the map saw them pulls the pose; weighed down, less.
+TEST(PoseSolver, LowWeightReducesTheBiasOfAShiftedGroup) {
+    const auto K = fr1NoDist();
+    const Eigen::Isometry3d T_true = makePose(0.1, 0.0, 0.05, 0.02, -0.03, 0.01);
+    auto obs = syntheticObservations(T_true, K, 300, 0.3, 0.0, 7);
+    const cv::Rect2f person(150, 60, 250, 360);
+    FrameFeatures f;
+    int shifted = 0;
+    for (auto& o : obs) {
+        if (person.contains(cv::Point2f(static_cast<float>(o.uv.x()), static_cast<float>(o.uv.y())))) {
+            o.uv.x() += 2.0;
+            ++shifted;
+        }
+        f.keypoints.emplace_back(static_cast<float>(o.uv.x()), static_cast<float>(o.uv.y()), 31.f);
+    }
+    ASSERT_GT(shifted, 50);
+    const auto error = [&](float w) {
+        FrameFeatures g = f;
+        g.weighInside(person, w);
+        auto weighed = obs;
+        for (std::size_t i = 0; i < weighed.size(); ++i) weighed[i].inv_sigma2 = g.information(i, 1.2);
+        const auto ref = refinePose(weighed, T_true, K, {});
+        return (ref.T_wc.translation() - T_true.translation()).norm();
+    };
+    const double e1 = error(1.f), e01 = error(0.1f);
+    EXPECT_GT(e1, 0.001) << "the shifted group should bias the pose";
+    EXPECT_LT(e01, 0.5 * e1) << e01 << " m with weight 0.1, " << e1 << " m with 1";
+}
+
 TEST(PoseSolver, TooFewPointsGiveNoPose) {
     const auto K = fr1NoDist();
     const auto obs = syntheticObservations(Eigen::Isometry3d::Identity(), K, 5, 0.0, 0.0, 1);

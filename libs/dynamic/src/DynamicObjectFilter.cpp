@@ -68,7 +68,8 @@ const std::vector<std::string> kKeys{"mode",
                                      "depth_frames",
                                      "depth_rate_threshold",
                                      "depth_noise_z2",
-                                     "new_track_score"};
+                                     "new_track_score",
+                                     "static_person_weight"};
 
 cv::Rect2f shrink(const cv::Rect2f& b, double f) {
     const auto dx = static_cast<float>(f * b.width), dy = static_cast<float>(f * b.height);
@@ -187,6 +188,8 @@ void DynamicObjectFilter::Options::loadFromConfig(const mrpt::config::CConfigFil
     mask_silhouette = core::readBool(c, s, "mask_silhouette", mask_silhouette);
     silhouette_depth_band = core::readDouble(c, s, "silhouette_depth_band", silhouette_depth_band);
     silhouette_grow = core::readDouble(c, s, "silhouette_grow", silhouette_grow);
+    static_person_weight =
+        core::readDouble(c, s, "static_person_weight", static_person_weight);
     slow_frames = core::readInt(c, s, "slow_frames", slow_frames);
     slow_threshold = core::readDouble(c, s, "slow_threshold", slow_threshold);
     slow_speed = core::readDouble(c, s, "slow_speed", slow_speed);
@@ -241,6 +244,8 @@ void DynamicObjectFilter::Options::validate(const std::string& s) const {
                        "must be >= 0 (0 = fg_depth_band's)");
     core::requireValue(silhouette_grow >= 0 && silhouette_grow <= 1, s, "silhouette_grow",
                        "must be in [0, 1] (0 = the box only)");
+    core::requireValue(static_person_weight > 0 && static_person_weight <= 1, s,
+                       "static_person_weight", "must be in (0, 1] (1 = like any keypoint)");
     core::requireValue(slow_frames >= 0, s, "slow_frames", "must be >= 0 (0 = off)");
     core::requireValue(slow_threshold > 0, s, "slow_threshold", "must be > 0");
     core::requireValue(slow_speed >= 0, s, "slow_speed", "must be >= 0 (0 = off)");
@@ -285,6 +290,7 @@ void DynamicObjectFilter::Options::saveToConfig(mrpt::config::CConfigFileBase& c
     c.write(s, "mask_silhouette", mask_silhouette);
     c.write(s, "silhouette_depth_band", silhouette_depth_band);
     c.write(s, "silhouette_grow", silhouette_grow);
+    c.write(s, "static_person_weight", static_person_weight);
     c.write(s, "slow_frames", slow_frames);
     c.write(s, "slow_threshold", slow_threshold);
     c.write(s, "slow_speed", slow_speed);

@@ -93,12 +93,11 @@ LocalBaResult localBundleAdjust(Map& map, KeyframeId newest, const core::CameraI
             }
             const Keyframe& k = map.keyframe(kf);
             const auto& key = k.features.keypoints[kp];
-            const double s = std::pow(opts.scale_factor, key.octave);
             obs.push_back({it->second,
                            static_cast<int>(li),
                            {key.pt.x, key.pt.y},
                            static_cast<double>(k.features.depth[kp]),
-                           1.0 / (s * s),
+                           k.features.information(kp, opts.scale_factor),
                            kf,
                            kp});
         }

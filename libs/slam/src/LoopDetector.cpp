@@ -108,11 +108,10 @@ std::optional<LoopConstraint> detectLoop(const Map& map, KeyframeId current,
         std::vector<PoseObservation> obs;
         for (const auto& [q, t] : pairs) {
             const auto& kp = cur.features.keypoints[q];
-            const double s = std::pow(opts.scale_factor, kp.octave);
             obs.push_back({old.features.points_c[rows[t]],
                            {kp.pt.x, kp.pt.y},
                            cur.features.depth[q],
-                           1.0 / (s * s)});
+                           cur.features.information(q, opts.scale_factor)});
         }
         PnpRansacOptions pnp;
         pnp.iterations = 300;

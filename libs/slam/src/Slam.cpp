@@ -154,11 +154,10 @@ TrackResult Slam::track(const core::Frame& frame, const FrameFeatures& features,
             const LandmarkId lm = res.landmark_of_kp[i];
             if (lm == kNoId) continue;
             const auto& kp = features.keypoints[i];
-            const double sc = std::pow(opts_.orb.scale_factor, kp.octave);
             rec.obs.emplace_back(lm, PoseObservation{Eigen::Vector3d::Zero(),
                                                      {kp.pt.x, kp.pt.y},
                                                      features.depth[i],
-                                                     1.0 / (sc * sc)});
+                                                     features.information(i, opts_.orb.scale_factor)});
         }
     }
     records_.push_back(std::move(rec));

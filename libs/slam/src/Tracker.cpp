@@ -155,9 +155,10 @@ std::vector<PoseObservation> observationsOf(const Map& map, const FrameFeatures&
     obs.reserve(matches.size());
     for (const auto& m : matches) {
         const auto& kp = f.keypoints[m.kp];
-        const double s = std::pow(scale_factor, kp.octave);
-        obs.push_back(
-            {map.landmark(m.landmark)->p_w, {kp.pt.x, kp.pt.y}, f.depth[m.kp], 1.0 / (s * s)});
+        obs.push_back({map.landmark(m.landmark)->p_w,
+                       {kp.pt.x, kp.pt.y},
+                       f.depth[m.kp],
+                       f.information(m.kp, scale_factor)});
     }
     return obs;
 }
@@ -248,11 +249,10 @@ std::optional<Eigen::Isometry3d> Tracker::relocalize(const FrameFeatures& f, con
         std::vector<PoseObservation> obs;
         for (const auto& [q, t] : pairs) {
             const auto& kp = f.keypoints[q];
-            const double s = std::pow(opts_.scale_factor, kp.octave);
             obs.push_back({map.landmark(kf.landmark_of_kp[rows[t]])->p_w,
                            {kp.pt.x, kp.pt.y},
                            f.depth[q],
-                           1.0 / (s * s)});
+                           f.information(q, opts_.scale_factor)});
         }
         auto pnp_opts = opts_.pnp;
         pnp_opts.iterations = std::max(pnp_opts.iterations, 300);

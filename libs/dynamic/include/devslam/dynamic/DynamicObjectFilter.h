@@ -224,6 +224,13 @@ class DynamicObjectFilter {
         /// person's depth band (or without depth) connected to the silhouette inside the
         /// box. A detector's box often stops short of the head or a hand; 0 = the box only.
         double silhouette_grow = 0.0;
+        /// In (0, 1]: the SLAM's weight for keypoints inside boxes judged Static (devslam-run
+        /// multiplies their 1/sigma^2 in tracking, relocalisation, loop checks and local
+        /// bundle adjustment by it). The filter does not use it. A seated person who sways or
+        /// gestures is not masked, yet their corners move a little; a weight below 1 keeps
+        /// them as structure while the background counts more. 1 = like any other keypoint
+        /// (docs/dynamic.md, "Weighing seated people down", measures 0.25 and 0.5).
+        double static_person_weight = 1.0;
 
         /// Reads `[section]`; unknown keys throw std::invalid_argument naming them.
         void loadFromConfig(const mrpt::config::CConfigFileBase& cfg,

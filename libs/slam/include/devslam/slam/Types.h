@@ -6,6 +6,8 @@
 #include <opencv2/core/mat.hpp>
 #include <opencv2/core/types.hpp>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -24,7 +26,23 @@ struct FrameFeatures {
     std::vector<cv::Vec3b> colors;          ///< BGR at the keypoint
     int n_masked = 0;            ///< keypoints dropped because they fell in the dynamic mask
     double masked_fraction = 0;  ///< fraction of the image covered by the dynamic mask
+    /// Per keypoint, multiplies its 1/sigma^2 in tracking and bundle adjustment; empty: all
+    /// 1 (devslam-run gives keypoints on people the filter judged static a lower weight when
+    /// [dynamic_filter] static_person_weight < 1).
+    std::vector<float> weight;
     [[nodiscard]] std::size_t size() const { return keypoints.size(); }
+    /// Lowers the weight of the keypoints inside `box` [px] to `w` (a keypoint in two boxes
+    /// keeps the lower weight); the first call sets every other weight to 1.
+    void weighInside(const cv::Rect2f& box, float w) {
+        if (weight.empty()) weight.assign(keypoints.size(), 1.f);
+        for (std::size_t i = 0; i < keypoints.size(); ++i)
+            if (box.contains(keypoints[i].pt)) weight[i] = std::min(weight[i], w);
+    }
+    /// 1/sigma^2 of keypoint i: its pyramid level's (scale_factor^octave px) times its weight.
+    [[nodiscard]] double information(std::size_t i, double scale_factor) const {
+        const double s = std::pow(scale_factor, keypoints[i].octave);
+        return (weight.empty() ? 1.0 : static_cast<double>(weight[i])) / (s * s);
+    }
 };
 
 /// A keyframe: a frame kept in the map, with the landmark each keypoint observes.
