@@ -60,6 +60,7 @@ class FilterMask final : public MaskSource {
             s.boxes.push_back({b.box, dynamic::toString(b.state)});
         }
         s.T_prev_cur_refined = out.T_prev_cur_refined;
+        s.static_people = std::move(out.static_people);
         s.static_weight = filter_->options().static_person_weight;
         return s;
     }

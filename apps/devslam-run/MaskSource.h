@@ -23,7 +23,9 @@ struct MaskStep {
     int n_boxes = 0, n_moving = 0;
     std::vector<eval::FilterBox> boxes;  ///< tracked boxes and their states
     std::optional<Eigen::Isometry3d> T_prev_cur_refined;
-    /// the SLAM's weight for keypoints in boxes whose state is "static"
+    /// empty or CV_8UC1, 255 = a person judged static (FilterOutput::static_people)
+    cv::Mat static_people;
+    /// the SLAM's weight for keypoints where static_people is set
     /// ([dynamic_filter] static_person_weight; 1 = like any keypoint)
     double static_weight = 1.0;
 };

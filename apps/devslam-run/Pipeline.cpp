@@ -203,9 +203,8 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
         fl.n_moving = ms.n_moving;
         auto t0 = Clock::now();
         auto feats = slam.extract(*cur, ms.mask);
-        if (ms.static_weight < 1.0)
-            for (const auto& b : ms.boxes)
-                if (b.state == "static") feats.weighInside(b.box, static_cast<float>(ms.static_weight));
+        if (!ms.static_people.empty())
+            feats.weighWhere(ms.static_people, static_cast<float>(ms.static_weight));
         fl.ms.features = msSince(t0);
         fl.n_features = static_cast<int>(feats.size());
         fl.n_masked = feats.n_masked;

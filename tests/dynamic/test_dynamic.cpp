@@ -213,6 +213,69 @@ TEST(DynamicFilter, BoxAtTheBorderIsStaticOnlyAfterConfirmFrames) {
     }
 }
 
+// static_person_weight: the filter marks a person judged Static for the SLAM: their own
+// pixels (the silhouette), not the wall their box also holds; in mode Dynamic only.
+TEST(DynamicFilter, StaticPeopleRegionIsTheStaticPersonsSilhouette) {
+    dynamic::SyntheticOptions so;
+    so.person = dynamic::PersonMotion::Static;
+    so.person_x0 = 0.3;
+    so.n_frames = 6;
+    const auto& seq = sequence(so);
+    struct Case {
+        MaskMode mode;
+        double weight;
+        bool silhouette;
+    };
+    for (const Case c : {Case{MaskMode::Dynamic, 0.5, true}, Case{MaskMode::Dynamic, 0.5, false},
+                         Case{MaskMode::Dynamic, 1.0, true},
+                         Case{MaskMode::AllPersons, 0.5, true}}) {
+        auto fo = testOptions();
+        fo.mode = c.mode;
+        fo.static_person_weight = c.weight;
+        fo.mask_silhouette = c.silhouette;
+        fo.silhouette_depth_band = 0.1;
+        fo.silhouette_grow = 0;
+        auto det = std::make_unique<ScriptedDetector>();
+        ScriptedDetector* script = det.get();
+        DynamicObjectFilter filter(fo, std::move(det));
+        const std::string what = dynamic::toString(c.mode) + " weight " +
+                                 std::to_string(c.weight) + " silhouette " +
+                                 std::to_string(c.silhouette);
+        int statics = 0;
+        for (std::size_t k = 0; k < seq.size(); ++k) {
+            ASSERT_TRUE(seq[k].person_box.has_value()) << "frame " << k;
+            const cv::Rect person = cv::Rect(*seq[k].person_box) & cv::Rect(0, 0, 640, 480);
+            // The detector's box holds 30 px of wall on each side of the billboard.
+            const cv::Rect2f box(person.x - 30.f, person.y, person.width + 60.f, person.height);
+            script->next = {{box, 0, "person", 0.9f}};
+            const auto out = filter.step(seq[k].frame, seq[k].T_prev_cur);
+            ASSERT_EQ(out.boxes.size(), 1u) << what;
+            const bool is_static = out.boxes[0].state == BoxState::Static;
+            statics += is_static ? 1 : 0;
+            if (c.mode != MaskMode::Dynamic || c.weight >= 1.0) {
+                EXPECT_TRUE(out.static_people.empty()) << what << ", frame " << k;
+                continue;
+            }
+            ASSERT_EQ(out.static_people.size(), seq[k].frame.bgr.size()) << what;
+            ASSERT_EQ(out.static_people.type(), CV_8UC1) << what;
+            if (!is_static) {
+                EXPECT_EQ(cv::countNonZero(out.static_people), 0) << what << ", frame " << k;
+                continue;
+            }
+            const cv::Rect inner(person.x + 3, person.y + 3, person.width - 6, person.height - 6);
+            const cv::Rect wall(person.x - 25, person.y + 3, 20, person.height - 6);
+            EXPECT_EQ(cv::countNonZero(out.static_people(inner)), inner.area())
+                << what << ", frame " << k;
+            EXPECT_EQ(cv::countNonZero(out.static_people(wall)), c.silhouette ? 0 : wall.area())
+                << what << ", frame " << k << ": the wall inside the box";
+            EXPECT_EQ(cv::countNonZero(out.static_people), cv::countNonZero(out.static_people(
+                                                               cv::Rect(box) & cv::Rect(0, 0, 640, 480))))
+                << what << ": nothing outside the box (silhouette_grow 0)";
+        }
+        EXPECT_GE(statics, static_cast<int>(seq.size()) - 1) << what;
+    }
+}
+
 TEST(DynamicFilter, PureCameraMotionFlagsNothing) {
     // No person; two boxes on the wall (false detections) must never be flagged, with or
     // without ego-motion prior. Raw displacement (no compensation) flags them: that is the

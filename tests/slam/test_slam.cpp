@@ -111,24 +111,33 @@ TEST(PoseSolver, RefineFromPerturbedGuessWithoutRansac) {
     EXPECT_EQ(ref.n_inliers, 200);
 }
 
-// [dynamic_filter] static_person_weight: keypoints in a seated person's box count less.
-TEST(FrameFeatures, WeightInsideABoxScalesTheInformation) {
+// [dynamic_filter] static_person_weight: keypoints on a seated person count less.
+TEST(FrameFeatures, WeightWhereARegionIsSetScalesTheInformation) {
     FrameFeatures f;
     f.keypoints = {cv::KeyPoint(10, 10, 31, -1, 0, 0), cv::KeyPoint(50, 50, 31, -1, 0, 2),
-                   cv::KeyPoint(60, 55, 31, -1, 0, 0)};
+                   cv::KeyPoint(60, 55, 31, -1, 0, 0), cv::KeyPoint(99.5f, 79.5f, 31, -1, 0, 0)};
     EXPECT_TRUE(f.weight.empty());
     EXPECT_DOUBLE_EQ(f.information(1, 1.2), 1.0 / std::pow(1.2, 4));
-    f.weighInside(cv::Rect2f(40, 40, 30, 30), 0.5f);
-    ASSERT_EQ(f.weight.size(), 3u);
+    const auto region = [](const cv::Rect& r) {
+        cv::Mat m = cv::Mat::zeros(80, 100, CV_8UC1);
+        m(r).setTo(255);
+        return m;
+    };
+    f.weighWhere(region({40, 40, 30, 30}), 0.5f);
+    ASSERT_EQ(f.weight.size(), 4u);
     EXPECT_EQ(f.weight[0], 1.f);
     EXPECT_DOUBLE_EQ(f.information(0, 1.2), 1.0);
     EXPECT_DOUBLE_EQ(f.information(1, 1.2), 0.5 / std::pow(1.2, 4));
     EXPECT_DOUBLE_EQ(f.information(2, 1.2), 0.5);
-    f.weighInside(cv::Rect2f(55, 50, 10, 10), 0.8f);  // in two boxes: the lower weight stays
+    EXPECT_EQ(f.weight[3], 1.f);
+    f.weighWhere(region({55, 50, 10, 10}), 0.8f);  // weighed twice: the lower weight stays
     EXPECT_EQ(f.weight[2], 0.5f);
-    f.weighInside(cv::Rect2f(0, 0, 20, 20), 0.25f);
+    f.weighWhere(region({0, 0, 20, 20}), 0.25f);
     EXPECT_EQ(f.weight[0], 0.25f);
     EXPECT_EQ(f.weight[1], 0.5f);
+    f.weighWhere(region({99, 79, 1, 1}), 0.1f);  // the last pixel: no overrun
+    EXPECT_EQ(f.weight[3], 0.1f);
+    EXPECT_THROW(f.weighWhere(cv::Mat::zeros(80, 100, CV_32FC1), 0.5f), std::invalid_argument);
 }
 
 // A person who moved 2 px since the map saw them pulls the pose; weighed down, less.
@@ -149,7 +158,9 @@ TEST(PoseSolver, LowWeightReducesTheBiasOfAShiftedGroup) {
     ASSERT_GT(shifted, 50);
     const auto error = [&](float w) {
         FrameFeatures g = f;
-        g.weighInside(person, w);
+        cv::Mat where = cv::Mat::zeros(480, 640, CV_8UC1);
+        where(cv::Rect(person)).setTo(255);
+        g.weighWhere(where, w);
         auto weighed = obs;
         for (std::size_t i = 0; i < weighed.size(); ++i) weighed[i].inv_sigma2 = g.information(i, 1.2);
         const auto ref = refinePose(weighed, T_true, K, {});

@@ -57,6 +57,10 @@ struct TrackedBox {
 /// Result of one step.
 struct FilterOutput {
     cv::Mat mask;  ///< CV_8UC1, frame size, 255 = masked (drop keypoints here), 0 = keep
+    /// CV_8UC1, frame size, 255 = a person judged Static (their silhouette as the mask would
+    /// draw it, without the margin; the whole box without mask_silhouette or depth), for
+    /// the SLAM's static_person_weight. Empty unless mode Dynamic and that weight < 1.
+    cv::Mat static_people;
     std::vector<TrackedBox> boxes;
     bool detector_ran = false;
     double detect_ms = 0, filter_ms = 0;  ///< [ms] wall time of this step's stages
@@ -224,8 +228,8 @@ class DynamicObjectFilter {
         /// person's depth band (or without depth) connected to the silhouette inside the
         /// box. A detector's box often stops short of the head or a hand; 0 = the box only.
         double silhouette_grow = 0.0;
-        /// In (0, 1]: the SLAM's weight for keypoints inside boxes judged Static (devslam-run
-        /// multiplies their 1/sigma^2 in tracking, relocalisation, loop checks and local
+        /// In (0, 1]: the SLAM's weight for keypoints on people judged Static
+        /// (FilterOutput::static_people; mode Dynamic only; devslam-run multiplies their 1/sigma^2 in tracking, relocalisation, loop checks and local
         /// bundle adjustment by it). The filter does not use it. A seated person who sways or
         /// gestures is not masked, yet their corners move a little; a weight below 1 keeps
         /// them as structure while the background counts more. 1 = like any other keypoint

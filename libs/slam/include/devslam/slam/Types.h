@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <stdexcept>
 #include <vector>
 
 namespace devslam::slam {
@@ -31,12 +32,21 @@ struct FrameFeatures {
     /// [dynamic_filter] static_person_weight < 1).
     std::vector<float> weight;
     [[nodiscard]] std::size_t size() const { return keypoints.size(); }
-    /// Lowers the weight of the keypoints inside `box` [px] to `w` (a keypoint in two boxes
-    /// keeps the lower weight); the first call sets every other weight to 1.
-    void weighInside(const cv::Rect2f& box, float w) {
+    /// Lowers the weight of the keypoints where `where` (CV_8UC1, the frame's size) is set
+    /// to `w` (a lower weight already there is kept); the first call sets every other
+    /// weight to 1. Throws std::invalid_argument for another type; a keypoint outside
+    /// `where` keeps its weight.
+    void weighWhere(const cv::Mat& where, float w) {
+        if (where.type() != CV_8UC1)
+            throw std::invalid_argument("FrameFeatures::weighWhere: the region must be CV_8UC1");
         if (weight.empty()) weight.assign(keypoints.size(), 1.f);
-        for (std::size_t i = 0; i < keypoints.size(); ++i)
-            if (box.contains(keypoints[i].pt)) weight[i] = std::min(weight[i], w);
+        for (std::size_t i = 0; i < keypoints.size(); ++i) {
+            const int x = static_cast<int>(keypoints[i].pt.x);
+            const int y = static_cast<int>(keypoints[i].pt.y);
+            if (x >= 0 && y >= 0 && x < where.cols && y < where.rows &&
+                where.at<unsigned char>(y, x) != 0)
+                weight[i] = std::min(weight[i], w);
+        }
     }
     /// 1/sigma^2 of keypoint i: its pyramid level's (scale_factor^octave px) times its weight.
     [[nodiscard]] double information(std::size_t i, double scale_factor) const {
