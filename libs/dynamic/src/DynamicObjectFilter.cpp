@@ -991,21 +991,14 @@ void DynamicObjectFilter::Impl::drawMask(const core::Frame& frame, bool have_pre
         out.boxes.push_back(t.tb);
         const bool masked = o.mode == MaskMode::AllPersons || t.tb.state == BoxState::Moving ||
                             (mask_unknown && t.tb.state == BoxState::Unknown);
-        const bool weighed = weigh_static && t.tb.state == BoxState::Static;
-        if (!masked && !weighed) continue;
-        const cv::Rect inner = cv::Rect(t.tb.box) & cv::Rect({}, size);
-        if (weighed) {
-            // The person's own pixels, without the margin: the wall behind a seated
-            // person's shoulder is as good as any wall.
-            if (!o.mask_silhouette || !t.depth) {
-                out.static_people(inner).setTo(255);
-            } else if (!inner.empty()) {
-                cv::Rect outer;
-                const cv::Mat sil = silhouette(frame, t, inner, o, outer);
-                out.static_people(outer) |= sil;
-            }
+        if (!masked && weigh_static && t.tb.state == BoxState::Static) {
+            // The whole box, not the silhouette (with or without the margin): on sitting_xyz
+            // the silhouette's weights were worse (docs/dynamic.md, "Weighing seated people
+            // down"); a gesturing hand leaves the person's depth band, not the box.
+            out.static_people(cv::Rect(t.tb.box) & cv::Rect({}, size)).setTo(255);
             continue;
         }
+        if (!masked) continue;
         const auto m = static_cast<float>(o.mask_margin);
         const auto snap = static_cast<float>(o.mask_border_snap);
         const auto W = static_cast<float>(size.width), H = static_cast<float>(size.height);
@@ -1020,6 +1013,7 @@ void DynamicObjectFilter::Impl::drawMask(const core::Frame& frame, bool have_pre
             out.mask(r).setTo(255);
             continue;
         }
+        const cv::Rect inner = cv::Rect(t.tb.box) & cv::Rect({}, size);
         if (inner.empty()) continue;
         cv::Rect outer;
         const cv::Mat sil = silhouette(frame, t, inner, o, outer);

@@ -57,9 +57,8 @@ struct TrackedBox {
 /// Result of one step.
 struct FilterOutput {
     cv::Mat mask;  ///< CV_8UC1, frame size, 255 = masked (drop keypoints here), 0 = keep
-    /// CV_8UC1, frame size, 255 = a person judged Static (their silhouette as the mask would
-    /// draw it, without the margin; the whole box without mask_silhouette or depth), for
-    /// the SLAM's static_person_weight. Empty unless mode Dynamic and that weight < 1.
+    /// CV_8UC1, frame size, 255 = inside the box of a person judged Static, for the SLAM's
+    /// static_person_weight. Empty unless mode Dynamic and that weight < 1.
     cv::Mat static_people;
     std::vector<TrackedBox> boxes;
     bool detector_ran = false;
