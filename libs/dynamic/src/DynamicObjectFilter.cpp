@@ -418,11 +418,6 @@ struct DynamicObjectFilter::Impl {
     /// 7. The boxes to report and the mask (out.boxes, out.mask).
     void drawMask(const core::Frame& frame, bool have_prev, const Options& o,
                   FilterOutput& out) const;
-    /// A track's silhouette (CV_8UC1, 255 = the person) in `outer`, the part of the image
-    /// it is sought in: `inner` (the box, clipped to the image) grown by silhouette_grow.
-    /// Needs t.depth.
-    static cv::Mat silhouette(const core::Frame& frame, const Track& t, const cv::Rect& inner,
-                              const Options& o, cv::Rect& outer);
     /// This step's images become the previous ones.
     void endStep(const core::Frame& frame);
 };
@@ -991,14 +986,14 @@ void DynamicObjectFilter::Impl::drawMask(const core::Frame& frame, bool have_pre
         out.boxes.push_back(t.tb);
         const bool masked = o.mode == MaskMode::AllPersons || t.tb.state == BoxState::Moving ||
                             (mask_unknown && t.tb.state == BoxState::Unknown);
-        if (!masked && weigh_static && t.tb.state == BoxState::Static) {
+        if (!masked) {
             // The whole box, not the silhouette (with or without the margin): on sitting_xyz
             // the silhouette's weights were worse (docs/dynamic.md, "Weighing seated people
             // down"); a gesturing hand leaves the person's depth band, not the box.
-            out.static_people(cv::Rect(t.tb.box) & cv::Rect({}, size)).setTo(255);
+            if (weigh_static && t.tb.state == BoxState::Static)
+                out.static_people(cv::Rect(t.tb.box) & cv::Rect({}, size)).setTo(255);
             continue;
         }
-        if (!masked) continue;
         const auto m = static_cast<float>(o.mask_margin);
         const auto snap = static_cast<float>(o.mask_border_snap);
         const auto W = static_cast<float>(size.width), H = static_cast<float>(size.height);
@@ -1013,10 +1008,28 @@ void DynamicObjectFilter::Impl::drawMask(const core::Frame& frame, bool have_pre
             out.mask(r).setTo(255);
             continue;
         }
+        // Silhouette: the box's pixels in the person's depth band or without depth (the
+        // holes along a person's outline), dilated by the margin.
+        const float zp = *t.depth;
+        const double band = o.silhouette_depth_band > 0 ? o.silhouette_depth_band
+                            : o.fg_depth_band > 0       ? o.fg_depth_band
+                                                        : 0.5;
+        const float h = depthBand(band, zp);
         const cv::Rect inner = cv::Rect(t.tb.box) & cv::Rect({}, size);
         if (inner.empty()) continue;
-        cv::Rect outer;
-        const cv::Mat sil = silhouette(frame, t, inner, o, outer);
+        // The band is sought in the box grown by silhouette_grow; outside the box only the
+        // parts connected to the silhouette inside it are kept (a head above the box, not
+        // a desk at the person's depth beside it).
+        const int gx = static_cast<int>(std::lround(o.silhouette_grow * t.tb.box.width));
+        const int gy = static_cast<int>(std::lround(o.silhouette_grow * t.tb.box.height));
+        const cv::Rect outer =
+            cv::Rect(inner.x - gx, inner.y - gy, inner.width + 2 * gx, inner.height + 2 * gy) &
+            cv::Rect({}, size);
+        cv::Mat sil, holes;
+        cv::inRange(frame.depth(outer), zp - h, zp + h, sil);
+        cv::compare(frame.depth(outer), 0.f, holes, cv::CMP_LE);
+        sil |= holes;
+        if (outer != inner) keepConnectedTo(sil, inner - outer.tl());
         const cv::Rect region = r | outer;
         cv::Mat big = cv::Mat::zeros(region.size(), CV_8UC1);
         sil.copyTo(big(outer - region.tl()));
@@ -1026,31 +1039,6 @@ void DynamicObjectFilter::Impl::drawMask(const core::Frame& frame, bool have_pre
                            cv::MORPH_RECT, cv::Size(2 * o.mask_margin + 1, 2 * o.mask_margin + 1)));
         out.mask(region) |= big;
     }
-}
-
-cv::Mat DynamicObjectFilter::Impl::silhouette(const core::Frame& frame, const Track& t,
-                                              const cv::Rect& inner, const Options& o,
-                                              cv::Rect& outer) {
-    // The box's pixels in the person's depth band or without depth (the holes along a
-    // person's outline). The band is sought in the box grown by silhouette_grow; outside
-    // the box only the parts connected to the silhouette inside it are kept (a head above
-    // the box, not a desk at the person's depth beside it).
-    const cv::Size size = frame.bgr.size();
-    const float zp = *t.depth;
-    const double band = o.silhouette_depth_band > 0 ? o.silhouette_depth_band
-                        : o.fg_depth_band > 0       ? o.fg_depth_band
-                                                    : 0.5;
-    const float h = depthBand(band, zp);
-    const int gx = static_cast<int>(std::lround(o.silhouette_grow * t.tb.box.width));
-    const int gy = static_cast<int>(std::lround(o.silhouette_grow * t.tb.box.height));
-    outer = cv::Rect(inner.x - gx, inner.y - gy, inner.width + 2 * gx, inner.height + 2 * gy) &
-            cv::Rect({}, size);
-    cv::Mat sil, holes;
-    cv::inRange(frame.depth(outer), zp - h, zp + h, sil);
-    cv::compare(frame.depth(outer), 0.f, holes, cv::CMP_LE);
-    sil |= holes;
-    if (outer != inner) keepConnectedTo(sil, inner - outer.tl());
-    return sil;
 }
 
 void DynamicObjectFilter::Impl::endStep(const core::Frame& frame) {

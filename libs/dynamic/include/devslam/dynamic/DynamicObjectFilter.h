@@ -227,9 +227,10 @@ class DynamicObjectFilter {
         /// person's depth band (or without depth) connected to the silhouette inside the
         /// box. A detector's box often stops short of the head or a hand; 0 = the box only.
         double silhouette_grow = 0.0;
-        /// In (0, 1]: the SLAM's weight for keypoints on people judged Static
-        /// (FilterOutput::static_people; mode Dynamic only; devslam-run multiplies their 1/sigma^2 in tracking, relocalisation, loop checks and local
-        /// bundle adjustment by it). The filter does not use it. A seated person who sways or
+        /// In (0, 1]: the SLAM's weight for keypoints inside the boxes of people judged
+        /// Static (FilterOutput::static_people, mode Dynamic only; devslam-run multiplies
+        /// their 1/sigma^2 in tracking, relocalisation, loop checks and local bundle
+        /// adjustment by it). The filter does not use it. A seated person who sways or
         /// gestures is not masked, yet their corners move a little; a weight below 1 keeps
         /// them as structure while the background counts more. 1 = like any other keypoint
         /// (docs/dynamic.md, "Weighing seated people down", measures 0.25 and 0.5).
