@@ -15,6 +15,7 @@
 
 #include "Scratch.h"
 
+#include <atomic>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -449,6 +450,41 @@ TEST(Results, SectionsAreReplacedInPlaceAndBrokenMarkersRefused) {
     EXPECT_THROW(checkResultsSection(std::filesystem::path(path).parent_path().string(), "b"),
                  std::runtime_error);
     EXPECT_EQ(read(), broken);
+    std::filesystem::remove(path);
+}
+
+// Two commands regenerating their sections at once (say devslam-bench and devslam-nav-bench,
+// each at its end) both read the file, change their section and write it back: without a
+// lock one's section is lost, or both write the same .part. Here four writers, each with its
+// own section, 25 times over: every section holds its writer's last text.
+TEST(Results, WritersAtOnceLoseNoSection) {
+    const std::string path = devslam::test::scratchPath("devslam_results_race").string() + ".md";
+    std::filesystem::remove(path);
+    constexpr int kWriters = 4, kRounds = 25;
+    std::vector<std::thread> writers;
+    std::atomic<int> failed{0};
+    for (int w = 0; w < kWriters; ++w)
+        writers.emplace_back([&path, &failed, w] {
+            for (int r = 0; r < kRounds; ++r) try {
+                    replaceResultsSection(
+                        path, "s" + std::to_string(w),
+                        "writer " + std::to_string(w) + " round " + std::to_string(r));
+                } catch (const std::exception&) {  // e.g. another writer renamed the .part
+                    ++failed;
+                }
+        });
+    for (auto& t : writers) t.join();
+    EXPECT_EQ(failed.load(), 0);
+    std::ifstream in(path);
+    const std::string text(std::istreambuf_iterator<char>(in), {});
+    for (int w = 0; w < kWriters; ++w) {
+        const std::string s = std::to_string(w);
+        EXPECT_NE(text.find("<!-- BEGIN s" + s + " -->\nwriter " + s + " round " +
+                            std::to_string(kRounds - 1) + "\n<!-- END s" + s + " -->"),
+                  std::string::npos)
+            << text;
+    }
+    EXPECT_FALSE(std::filesystem::exists(path + ".part"));
     std::filesystem::remove(path);
 }
 

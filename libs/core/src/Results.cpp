@@ -15,6 +15,10 @@
 #include <stdexcept>
 #include <thread>
 
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
 namespace devslam::core {
 
 namespace {
@@ -69,8 +73,38 @@ void checkResultsSection(const std::string& path, const std::string& name) {
                                  "'");
 }
 
+namespace {
+/// Holds flock(LOCK_EX) on the folder of the results file (links followed) for a read, change
+/// and write of one section: two commands regenerating theirs at once would otherwise both
+/// read the old file and the second write would drop the first's section (and both would
+/// write the same .part). A folder, not a lock file beside RESULTS.md: nothing is left in the
+/// tree. Advisory: only writers that take it wait; a folder that cannot be opened is not
+/// locked (the write then names the problem).
+class FolderLock {
+public:
+    explicit FolderLock(const std::string& file) {
+        std::error_code ec;
+        auto abs = std::filesystem::weakly_canonical(std::filesystem::absolute(file, ec), ec);
+        if (ec) return;
+        fd_ = ::open(abs.parent_path().c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+        if (fd_ < 0) return;
+        while (::flock(fd_, LOCK_EX) != 0 && errno == EINTR) {
+        }
+    }
+    ~FolderLock() {
+        if (fd_ >= 0) ::close(fd_);  // releases the lock
+    }
+    FolderLock(const FolderLock&) = delete;
+    FolderLock& operator=(const FolderLock&) = delete;
+
+private:
+    int fd_ = -1;
+};
+}  // namespace
+
 void replaceResultsSection(const std::string& path, const std::string& name,
                            const std::string& markdown) {
+    const FolderLock lock(path);
     writeFileWhole(path, withSection(path, name, markdown));
 }
 

@@ -17,7 +17,8 @@ namespace devslam::core {
 /// markers or its END before its BEGIN, or if the file cannot be written; std::invalid_argument if
 /// `name` is empty or contains characters other than [a-z0-9_-].
 /// The file is replaced whole (writeFileWhole): a command killed while writing leaves it as
-/// it was.
+/// it was. Commands writing at once take turns (an exclusive flock on the file's folder held
+/// from the read to the rename), so no section is lost.
 void replaceResultsSection(const std::string& path, const std::string& name,
                            const std::string& markdown);
 
