@@ -62,6 +62,7 @@ class FilterMask final : public MaskSource {
         s.T_prev_cur_refined = out.T_prev_cur_refined;
         s.static_people = std::move(out.static_people);
         s.static_weight = filter_->options().static_person_weight;
+        s.static_gate_exponent = filter_->options().static_person_gate;
         return s;
     }
     void reset() override { filter_->reset(); }

@@ -28,6 +28,9 @@ struct MaskStep {
     /// the SLAM's weight for keypoints where static_people is set
     /// ([dynamic_filter] static_person_weight; 1 = like any keypoint)
     double static_weight = 1.0;
+    /// what that weight does to their chi2 tests (slam::FrameFeatures::gate_exponent;
+    /// [dynamic_filter] static_person_gate)
+    double static_gate_exponent = 1.0;
 };
 
 class MaskSource {

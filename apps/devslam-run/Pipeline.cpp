@@ -203,8 +203,10 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
         fl.n_moving = ms.n_moving;
         auto t0 = Clock::now();
         auto feats = slam.extract(*cur, ms.mask);
-        if (!ms.static_people.empty())
+        if (!ms.static_people.empty()) {
             feats.weighWhere(ms.static_people, static_cast<float>(ms.static_weight));
+            feats.gate_exponent = ms.static_gate_exponent;
+        }
         fl.ms.features = msSince(t0);
         fl.n_features = static_cast<int>(feats.size());
         fl.n_masked = feats.n_masked;

@@ -432,7 +432,8 @@ TEST(DynamicFilter, OptionsSetInCodeAreChecked) {
              {"lk_window", [](auto& o) { o.lk_window = 1001; }},
              {"lk_window", [](auto& o) { o.lk_window = 12; }},
              {"static_person_weight", [](auto& o) { o.static_person_weight = 0; }},
-             {"static_person_weight", [](auto& o) { o.static_person_weight = 1.5; }}}) {
+             {"static_person_weight", [](auto& o) { o.static_person_weight = 1.5; }},
+             {"static_person_gate", [](auto& o) { o.static_person_gate = 0.5; }}}) {
         auto o = testOptions();
         set(o);
         try {
@@ -743,6 +744,28 @@ TEST(DynamicConfig, ShippedIniLoadsAndRoundTrips) {
     DynamicObjectFilter::Options c;
     c.loadFromConfig(quarter);
     EXPECT_EQ(c.static_person_weight, 0.25);
+    EXPECT_EQ(c.static_person_gate, 1.0);  // wider, the default
+    for (const auto& [name, p] : std::vector<std::pair<std::string, double>>{
+             {"narrower", -1.0}, {"same", 0.0}, {"wider", 1.0}}) {
+        quarter.write("dynamic_filter", "static_person_gate", name);
+        DynamicObjectFilter::Options g;
+        g.loadFromConfig(quarter);
+        EXPECT_EQ(g.static_person_gate, p) << name;
+        mrpt::config::CConfigFileMemory back;
+        g.saveToConfig(back);
+        DynamicObjectFilter::Options h;
+        h.loadFromConfig(back);
+        EXPECT_EQ(h.static_person_gate, p) << name;
+    }
+    quarter.write("dynamic_filter", "static_person_gate", "tighter");
+    try {
+        DynamicObjectFilter::Options g;
+        g.loadFromConfig(quarter);
+        ADD_FAILURE() << "tighter accepted";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("static_person_gate"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("'tighter'"), std::string::npos) << e.what();
+    }
     auto f = dynamic::makeFilterFromConfig(*cfg, MaskMode::None);
     EXPECT_EQ(f->options().mode, MaskMode::None);
 }

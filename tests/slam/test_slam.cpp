@@ -126,9 +126,20 @@ TEST(FrameFeatures, WeightWhereARegionIsSetScalesTheInformation) {
     f.weighWhere(region({40, 40, 30, 30}), 0.5f);
     ASSERT_EQ(f.weight.size(), 4u);
     EXPECT_EQ(f.weight[0], 1.f);
+    // gate_exponent 1 (the default): the weight is in the information, the tests' too
     EXPECT_DOUBLE_EQ(f.information(0, 1.2), 1.0);
     EXPECT_DOUBLE_EQ(f.information(1, 1.2), 0.5 / std::pow(1.2, 4));
     EXPECT_DOUBLE_EQ(f.information(2, 1.2), 0.5);
+    EXPECT_DOUBLE_EQ(f.weightOf(2), 1.0);
+    // The optimisations always see w / sigma^2 = information x weightOf; the tests w^p / sigma^2.
+    for (const double p : {1.0, 0.0, -1.0}) {
+        f.gate_exponent = p;
+        EXPECT_DOUBLE_EQ(f.information(1, 1.2), std::pow(0.5, p) / std::pow(1.2, 4)) << p;
+        EXPECT_DOUBLE_EQ(f.information(1, 1.2) * f.weightOf(1), 0.5 / std::pow(1.2, 4)) << p;
+        EXPECT_DOUBLE_EQ(f.information(0, 1.2), 1.0) << p;  // weight 1: as any keypoint
+        EXPECT_DOUBLE_EQ(f.weightOf(0), 1.0) << p;
+    }
+    f.gate_exponent = 1.0;
     EXPECT_EQ(f.weight[3], 1.f);
     f.weighWhere(region({55, 50, 10, 10}), 0.8f);  // weighed twice: the lower weight stays
     EXPECT_EQ(f.weight[2], 0.5f);
@@ -162,13 +173,49 @@ TEST(PoseSolver, LowWeightReducesTheBiasOfAShiftedGroup) {
         where(cv::Rect(person)).setTo(255);
         g.weighWhere(where, w);
         auto weighed = obs;
-        for (std::size_t i = 0; i < weighed.size(); ++i) weighed[i].inv_sigma2 = g.information(i, 1.2);
+        for (std::size_t i = 0; i < weighed.size(); ++i) {
+            weighed[i].inv_sigma2 = g.information(i, 1.2);
+            weighed[i].weight = g.weightOf(i);
+        }
         const auto ref = refinePose(weighed, T_true, K, {});
         return (ref.T_wc.translation() - T_true.translation()).norm();
     };
     const double e1 = error(1.f), e01 = error(0.1f);
     EXPECT_GT(e1, 0.001) << "the shifted group should bias the pose";
     EXPECT_LT(e01, 0.5 * e1) << e01 << " m with weight 0.1, " << e1 << " m with 1";
+}
+
+// static_person_gate: a point with depth 2.4 px off in u (u and u_r: chi2 11.5 at sigma 1,
+// the gate 7.815) at weight 0.5 is let in when the weight widens its gate (p = 1: 5.8), is
+// an outlier as any keypoint (p = 0: 11.5) or as a suspect (p = -1: 23); exact points at
+// weight 0.5 stay inliers whatever p.
+TEST(PoseSolver, GateExponentDecidesWhatAWeightDoesToTheOutlierTest) {
+    const auto K = fr1NoDist();
+    const Eigen::Isometry3d T_true = makePose(0.1, 0.0, 0.05, 0.02, -0.03, 0.01);
+    const auto exact = syntheticObservations(T_true, K, 100, 0.0, 0.0, 11);
+    for (const double p : {1.0, 0.0, -1.0}) {
+        FrameFeatures f;
+        auto obs = exact;
+        for (std::size_t i = 0; i < 20; ++i) {
+            if (i < 10) obs[i].uv.x() += 2.4;
+            f.keypoints.emplace_back(static_cast<float>(obs[i].uv.x()),
+                                     static_cast<float>(obs[i].uv.y()), 31.f);
+        }
+        cv::Mat where = cv::Mat::zeros(480, 640, CV_8UC1);
+        for (const auto& kp : f.keypoints)  // the pixel weighWhere reads: truncated
+            where.at<unsigned char>(static_cast<int>(kp.pt.y), static_cast<int>(kp.pt.x)) = 255;
+        f.weighWhere(where, 0.5f);
+        f.gate_exponent = p;
+        for (std::size_t i = 0; i < 20; ++i) {
+            obs[i].inv_sigma2 = f.information(i, 1.2);
+            obs[i].weight = f.weightOf(i);
+        }
+        for (std::size_t i = 0; i < 20; ++i) ASSERT_EQ(f.weight[i], 0.5f) << i;
+        const auto ref = refinePose(obs, T_true, K, {});
+        for (std::size_t i = 0; i < 10; ++i) EXPECT_EQ(ref.inlier[i], p > 0 ? 1 : 0) << p << " " << i;
+        for (std::size_t i = 10; i < obs.size(); ++i) EXPECT_EQ(ref.inlier[i], 1) << p << " " << i;
+        if (p <= 0) EXPECT_LT((ref.T_wc.translation() - T_true.translation()).norm(), 1e-4) << p;
+    }
 }
 
 TEST(PoseSolver, TooFewPointsGiveNoPose) {

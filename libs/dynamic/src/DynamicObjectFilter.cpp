@@ -69,7 +69,8 @@ const std::vector<std::string> kKeys{"mode",
                                      "depth_rate_threshold",
                                      "depth_noise_z2",
                                      "new_track_score",
-                                     "static_person_weight"};
+                                     "static_person_weight",
+                                     "static_person_gate"};
 
 cv::Rect2f shrink(const cv::Rect2f& b, double f) {
     const auto dx = static_cast<float>(f * b.width), dy = static_cast<float>(f * b.height);
@@ -190,6 +191,13 @@ void DynamicObjectFilter::Options::loadFromConfig(const mrpt::config::CConfigFil
     silhouette_grow = core::readDouble(c, s, "silhouette_grow", silhouette_grow);
     static_person_weight =
         core::readDouble(c, s, "static_person_weight", static_person_weight);
+    if (c.keyExists(s, "static_person_gate")) {
+        const std::string g = c.read_string(s, "static_person_gate", "");
+        core::requireValue(g == "wider" || g == "same" || g == "narrower", s,
+                           "static_person_gate",
+                           "must be wider, same or narrower (got '" + g + "')");
+        static_person_gate = g == "wider" ? 1.0 : g == "same" ? 0.0 : -1.0;
+    }
     slow_frames = core::readInt(c, s, "slow_frames", slow_frames);
     slow_threshold = core::readDouble(c, s, "slow_threshold", slow_threshold);
     slow_speed = core::readDouble(c, s, "slow_speed", slow_speed);
@@ -246,6 +254,9 @@ void DynamicObjectFilter::Options::validate(const std::string& s) const {
                        "must be in [0, 1] (0 = the box only)");
     core::requireValue(static_person_weight > 0 && static_person_weight <= 1, s,
                        "static_person_weight", "must be in (0, 1] (1 = like any keypoint)");
+    core::requireValue(static_person_gate == 1.0 || static_person_gate == 0.0 ||
+                           static_person_gate == -1.0,
+                       s, "static_person_gate", "must be 1, 0 or -1 (wider, same, narrower)");
     core::requireValue(slow_frames >= 0, s, "slow_frames", "must be >= 0 (0 = off)");
     core::requireValue(slow_threshold > 0, s, "slow_threshold", "must be > 0");
     core::requireValue(slow_speed >= 0, s, "slow_speed", "must be >= 0 (0 = off)");
@@ -291,6 +302,10 @@ void DynamicObjectFilter::Options::saveToConfig(mrpt::config::CConfigFileBase& c
     c.write(s, "silhouette_depth_band", silhouette_depth_band);
     c.write(s, "silhouette_grow", silhouette_grow);
     c.write(s, "static_person_weight", static_person_weight);
+    c.write(s, "static_person_gate",
+            std::string(static_person_gate > 0.5    ? "wider"
+                        : static_person_gate < -0.5 ? "narrower"
+                                                    : "same"));
     c.write(s, "slow_frames", slow_frames);
     c.write(s, "slow_threshold", slow_threshold);
     c.write(s, "slow_speed", slow_speed);

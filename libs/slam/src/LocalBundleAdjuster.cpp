@@ -53,7 +53,8 @@ struct Obs {
     int landmark;  ///< index into lms
     Eigen::Vector2d uv;
     double depth;
-    double inv_sigma2;
+    double inv_sigma2;  ///< the chi2 test's and the Huber kernel's 1/sigma^2
+    double weight;      ///< multiplies inv_sigma2 in the normal equations (PoseObservation)
     KeyframeId kf;
     int kp;
 };
@@ -98,6 +99,7 @@ LocalBaResult localBundleAdjust(Map& map, KeyframeId newest, const core::CameraI
                            {key.pt.x, key.pt.y},
                            static_cast<double>(k.features.depth[kp]),
                            k.features.information(kp, opts.scale_factor),
+                           k.features.weightOf(kp),
                            kf,
                            kp});
         }
@@ -142,7 +144,9 @@ LocalBaResult localBundleAdjust(Map& map, KeyframeId newest, const core::CameraI
             if (!c)
                 cost += 100.0;
             else
-                cost += c->e2 <= c->d2 ? c->e2 : 2 * std::sqrt(c->e2 * c->d2) - c->d2;
+                // weight x Huber(e2): its gradient is what the normal equations below use
+                cost += o.weight *
+                        (c->e2 <= c->d2 ? c->e2 : 2 * std::sqrt(c->e2 * c->d2) - c->d2);
         }
         return cost;
     };
@@ -190,7 +194,8 @@ LocalBaResult localBundleAdjust(Map& map, KeyframeId newest, const core::CameraI
                     continue;
                 const double e2 = r.squaredNorm() * o.inv_sigma2;
                 const double d2 = rows == 3 ? opts.chi2_stereo : opts.chi2_mono;
-                const double w = o.inv_sigma2 * (e2 <= d2 ? 1.0 : std::sqrt(d2 / e2));
+                const double w =
+                    o.inv_sigma2 * o.weight * (e2 <= d2 ? 1.0 : std::sqrt(d2 / e2));
                 const auto Jpr = Jp;
                 const auto Jlr = Jl;
                 Hll[o.landmark] += w * Jlr.transpose() * Jlr;

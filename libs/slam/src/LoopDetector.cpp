@@ -111,7 +111,8 @@ std::optional<LoopConstraint> detectLoop(const Map& map, KeyframeId current,
             obs.push_back({old.features.points_c[rows[t]],
                            {kp.pt.x, kp.pt.y},
                            cur.features.depth[q],
-                           cur.features.information(q, opts.scale_factor)});
+                           cur.features.information(q, opts.scale_factor),
+                           cur.features.weightOf(q)});
         }
         PnpRansacOptions pnp;
         pnp.iterations = 300;

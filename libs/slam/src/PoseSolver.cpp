@@ -117,7 +117,7 @@ PoseRefineResult refinePose(const std::vector<PoseObservation>& obs,
                     continue;
                 const double e2 = r.squaredNorm() * o.inv_sigma2;
                 const double delta2 = rows == 3 ? opts.chi2_stereo : opts.chi2_mono;
-                double w = o.inv_sigma2;
+                double w = o.inv_sigma2 * o.weight;
                 if (robust && e2 > delta2) w *= std::sqrt(delta2 / e2);  // Huber
                 H += w * Jp.transpose() * Jp;
                 g += w * Jp.transpose() * r;

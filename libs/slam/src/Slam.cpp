@@ -157,7 +157,8 @@ TrackResult Slam::track(const core::Frame& frame, const FrameFeatures& features,
             rec.obs.emplace_back(lm, PoseObservation{Eigen::Vector3d::Zero(),
                                                      {kp.pt.x, kp.pt.y},
                                                      features.depth[i],
-                                                     features.information(i, opts_.orb.scale_factor)});
+                                                     features.information(i, opts_.orb.scale_factor),
+                                                     features.weightOf(i)});
         }
     }
     records_.push_back(std::move(rec));

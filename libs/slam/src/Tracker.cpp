@@ -158,7 +158,8 @@ std::vector<PoseObservation> observationsOf(const Map& map, const FrameFeatures&
         obs.push_back({map.landmark(m.landmark)->p_w,
                        {kp.pt.x, kp.pt.y},
                        f.depth[m.kp],
-                       f.information(m.kp, scale_factor)});
+                       f.information(m.kp, scale_factor),
+                       f.weightOf(m.kp)});
     }
     return obs;
 }
@@ -252,7 +253,8 @@ std::optional<Eigen::Isometry3d> Tracker::relocalize(const FrameFeatures& f, con
             obs.push_back({map.landmark(kf.landmark_of_kp[rows[t]])->p_w,
                            {kp.pt.x, kp.pt.y},
                            f.depth[q],
-                           f.information(q, opts_.scale_factor)});
+                           f.information(q, opts_.scale_factor),
+                           f.weightOf(q)});
         }
         auto pnp_opts = opts_.pnp;
         pnp_opts.iterations = std::max(pnp_opts.iterations, 300);

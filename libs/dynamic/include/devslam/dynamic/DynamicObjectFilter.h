@@ -235,6 +235,12 @@ class DynamicObjectFilter {
         /// them as structure while the background counts more. 1 = like any other keypoint
         /// (docs/dynamic.md, "Weighing seated people down", measures 0.25 and 0.5).
         double static_person_weight = 1.0;
+        /// What static_person_weight w does to those keypoints' outlier tests in the SLAM
+        /// (slam::FrameFeatures::gate_exponent): 1 (INI `wider`) widens their chi2 gate by
+        /// 1/sqrt(w), as for a noisier measurement; 0 (`same`) keeps it; -1 (`narrower`)
+        /// narrows it by sqrt(w): a sitter's corner that drifted with the sway is dropped
+        /// sooner (docs/dynamic.md, "The weight in the chi2 tests"). Only -1, 0 and 1.
+        double static_person_gate = 1.0;
 
         /// Reads `[section]`; unknown keys throw std::invalid_argument naming them.
         void loadFromConfig(const mrpt::config::CConfigFileBase& cfg,

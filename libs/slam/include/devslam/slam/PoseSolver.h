@@ -17,7 +17,11 @@ struct PoseObservation {
     Eigen::Vector3d p_w;    ///< [m]
     Eigen::Vector2d uv;     ///< [px] measured keypoint
     double depth = 0.0;     ///< [m] measured depth at the keypoint, 0 = none
-    double inv_sigma2 = 1;  ///< 1/sigma^2 of the keypoint's pyramid level
+    double inv_sigma2 = 1;  ///< 1/sigma^2: the chi2 test's and the Huber kernel's
+    /// Multiplies inv_sigma2 in the optimisation only (and the observation's robust cost):
+    /// with weight != 1 a keypoint pulls on the pose more or less than its chi2 test says
+    /// (FrameFeatures::gate_exponent: a keypoint trusted less may be rejected sooner).
+    double weight = 1;
 };
 
 struct PnpRansacOptions {

@@ -27,10 +27,16 @@ struct FrameFeatures {
     std::vector<cv::Vec3b> colors;          ///< BGR at the keypoint
     int n_masked = 0;            ///< keypoints dropped because they fell in the dynamic mask
     double masked_fraction = 0;  ///< fraction of the image covered by the dynamic mask
-    /// Per keypoint, multiplies its 1/sigma^2 in tracking and bundle adjustment; empty: all
-    /// 1 (devslam-run gives keypoints on people the filter judged static a lower weight when
-    /// [dynamic_filter] static_person_weight < 1).
+    /// Per keypoint, multiplies its information (1/sigma^2) in the optimisations of tracking,
+    /// relocalisation, loop checks and bundle adjustment; empty: all 1 (devslam-run gives
+    /// keypoints on people the filter judged static a lower weight when [dynamic_filter]
+    /// static_person_weight < 1). What it does to their outlier tests: gate_exponent.
     std::vector<float> weight;
+    /// How a weight w acts on the chi2 tests (and Huber corners), which see w^p / sigma^2:
+    /// p = 1, as a noisier measurement: the gate in pixels widens by 1/sqrt(w); p = 0, as
+    /// any keypoint; p = -1, as a suspect: it narrows by sqrt(w). In the optimisation the
+    /// information is w / sigma^2 whatever p ([dynamic_filter] static_person_gate).
+    double gate_exponent = 1.0;
     [[nodiscard]] std::size_t size() const { return keypoints.size(); }
     /// Lowers the weight of the keypoints where `where` (CV_8UC1, the frame's size) is set
     /// to `w` (a lower weight already there is kept); the first call sets every other
@@ -48,10 +54,19 @@ struct FrameFeatures {
                 weight[i] = std::min(weight[i], w);
         }
     }
-    /// 1/sigma^2 of keypoint i: its pyramid level's (scale_factor^octave px) times its weight.
+    /// The information the outlier tests see for keypoint i: w^p / sigma^2 (sigma =
+    /// scale_factor^octave px, w its weight, p gate_exponent). PoseObservation::inv_sigma2.
     [[nodiscard]] double information(std::size_t i, double scale_factor) const {
         const double s = std::pow(scale_factor, keypoints[i].octave);
-        return (weight.empty() ? 1.0 : static_cast<double>(weight[i])) / (s * s);
+        if (weight.empty() || gate_exponent == 1.0)  // w / sigma^2, as before p existed
+            return (weight.empty() ? 1.0 : static_cast<double>(weight[i])) / (s * s);
+        return std::pow(static_cast<double>(weight[i]), gate_exponent) / (s * s);
+    }
+    /// What multiplies information(i) in the optimisations, so that they see w / sigma^2:
+    /// w^(1 - p) (1 with p = 1 or no weights). PoseObservation::weight.
+    [[nodiscard]] double weightOf(std::size_t i) const {
+        if (weight.empty() || gate_exponent == 1.0) return 1.0;
+        return std::pow(static_cast<double>(weight[i]), 1.0 - gate_exponent);
     }
 };
 
