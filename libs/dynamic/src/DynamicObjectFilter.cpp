@@ -11,6 +11,7 @@
 #include <opencv2/video/tracking.hpp>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <deque>
@@ -122,6 +123,18 @@ std::optional<float> personDepth(const cv::Mat& depth, const cv::Rect2f& box, do
 /// Half-width [m] of the depth band around a person's depth z that belongs to them.
 float depthBand(double band, float z) { return static_cast<float>(band) + 0.1f * z; }
 
+/// static_person_gate's INI names and the exponents (Options::static_person_gate) they stand
+/// for: read, written and checked from this one table.
+constexpr std::array<std::pair<const char*, double>, 3> kGates{
+    {{"wider", 1.0}, {"same", 0.0}, {"narrower", -1.0}}};
+
+/// The name of gate exponent `p`, nullptr for one the table does not hold.
+const char* gateName(double p) {
+    for (const auto& [name, e] : kGates)
+        if (e == p) return name;
+    return nullptr;
+}
+
 }  // namespace
 
 MaskMode parseMaskMode(const std::string& name) {
@@ -193,10 +206,11 @@ void DynamicObjectFilter::Options::loadFromConfig(const mrpt::config::CConfigFil
         core::readDouble(c, s, "static_person_weight", static_person_weight);
     if (c.keyExists(s, "static_person_gate")) {
         const std::string g = c.read_string(s, "static_person_gate", "");
-        core::requireValue(g == "wider" || g == "same" || g == "narrower", s,
-                           "static_person_gate",
+        const auto it = std::find_if(kGates.begin(), kGates.end(),
+                                     [&](const auto& gate) { return g == gate.first; });
+        core::requireValue(it != kGates.end(), s, "static_person_gate",
                            "must be wider, same or narrower (got '" + g + "')");
-        static_person_gate = g == "wider" ? 1.0 : g == "same" ? 0.0 : -1.0;
+        static_person_gate = it->second;
     }
     slow_frames = core::readInt(c, s, "slow_frames", slow_frames);
     slow_threshold = core::readDouble(c, s, "slow_threshold", slow_threshold);
@@ -254,9 +268,8 @@ void DynamicObjectFilter::Options::validate(const std::string& s) const {
                        "must be in [0, 1] (0 = the box only)");
     core::requireValue(static_person_weight > 0 && static_person_weight <= 1, s,
                        "static_person_weight", "must be in (0, 1] (1 = like any keypoint)");
-    core::requireValue(static_person_gate == 1.0 || static_person_gate == 0.0 ||
-                           static_person_gate == -1.0,
-                       s, "static_person_gate", "must be 1, 0 or -1 (wider, same, narrower)");
+    core::requireValue(gateName(static_person_gate) != nullptr, s, "static_person_gate",
+                       "must be 1, 0 or -1 (wider, same, narrower)");
     core::requireValue(slow_frames >= 0, s, "slow_frames", "must be >= 0 (0 = off)");
     core::requireValue(slow_threshold > 0, s, "slow_threshold", "must be > 0");
     core::requireValue(slow_speed >= 0, s, "slow_speed", "must be >= 0 (0 = off)");
@@ -302,10 +315,10 @@ void DynamicObjectFilter::Options::saveToConfig(mrpt::config::CConfigFileBase& c
     c.write(s, "silhouette_depth_band", silhouette_depth_band);
     c.write(s, "silhouette_grow", silhouette_grow);
     c.write(s, "static_person_weight", static_person_weight);
-    c.write(s, "static_person_gate",
-            std::string(static_person_gate > 0.5    ? "wider"
-                        : static_person_gate < -0.5 ? "narrower"
-                                                    : "same"));
+    // An exponent outside the table (options set in code, not validated) is written as a
+    // number, which loading refuses naming the key.
+    const char* gate = gateName(static_person_gate);
+    c.write(s, "static_person_gate", gate ? std::string(gate) : std::to_string(static_person_gate));
     c.write(s, "slow_frames", slow_frames);
     c.write(s, "slow_threshold", slow_threshold);
     c.write(s, "slow_speed", slow_speed);
