@@ -214,8 +214,37 @@ TEST(PoseSolver, GateExponentDecidesWhatAWeightDoesToTheOutlierTest) {
         const auto ref = refinePose(obs, T_true, K, {});
         for (std::size_t i = 0; i < 10; ++i) EXPECT_EQ(ref.inlier[i], p > 0 ? 1 : 0) << p << " " << i;
         for (std::size_t i = 10; i < obs.size(); ++i) EXPECT_EQ(ref.inlier[i], 1) << p << " " << i;
-        if (p <= 0) EXPECT_LT((ref.T_wc.translation() - T_true.translation()).norm(), 1e-4) << p;
+        if (p <= 0) {
+            EXPECT_LT((ref.T_wc.translation() - T_true.translation()).norm(), 1e-4) << p;
+        }
     }
+}
+
+// observationOf: what tracking, relocalisation, loop checks and the frame records give the
+// pose solver for a keypoint: its pixel, depth, the tests' information and the weight.
+TEST(PoseSolver, ObservationOfAKeypointCarriesItsInformationAndWeight) {
+    FrameFeatures f;
+    f.keypoints = {cv::KeyPoint(100.5f, 40.25f, 31.f, -1.f, 0.f, 0),
+                   cv::KeyPoint(300.f, 200.f, 31.f, -1.f, 0.f, 2)};
+    f.depth = {1.5f, 0.f};
+    f.weight = {1.f, 0.5f};
+    f.gate_exponent = -1.0;
+    const Eigen::Vector3d p_w(0.1, -0.2, 2.0);
+    const auto a = observationOf(f, 0, p_w, 1.2);
+    EXPECT_EQ(a.p_w, p_w);
+    EXPECT_DOUBLE_EQ(a.uv.x(), 100.5);
+    EXPECT_DOUBLE_EQ(a.uv.y(), 40.25);
+    EXPECT_DOUBLE_EQ(a.depth, 1.5);
+    EXPECT_DOUBLE_EQ(a.inv_sigma2, 1.0);
+    EXPECT_DOUBLE_EQ(a.weight, 1.0);
+    const auto b = observationOf(f, 1, p_w, 1.2);
+    EXPECT_DOUBLE_EQ(b.uv.x(), 300.0);
+    EXPECT_DOUBLE_EQ(b.depth, 0.0);
+    // octave 2, weight 0.5, narrower: the tests see 0.5^-1 / 1.2^4, the optimisation 0.5^2
+    // more, so 0.5 / 1.2^4 in all
+    EXPECT_DOUBLE_EQ(b.inv_sigma2, 2.0 / std::pow(1.2, 4));
+    EXPECT_DOUBLE_EQ(b.weight, 0.25);
+    EXPECT_DOUBLE_EQ(b.inv_sigma2 * b.weight, 0.5 / std::pow(1.2, 4));
 }
 
 TEST(PoseSolver, TooFewPointsGiveNoPose) {

@@ -106,14 +106,9 @@ std::optional<LoopConstraint> detectLoop(const Map& map, KeyframeId current,
             matchBruteForce(cur.features.descriptors, train, opts.max_hamming, opts.ratio);
         if (static_cast<int>(pairs.size()) < opts.min_inliers) continue;
         std::vector<PoseObservation> obs;
-        for (const auto& [q, t] : pairs) {
-            const auto& kp = cur.features.keypoints[q];
-            obs.push_back({old.features.points_c[rows[t]],
-                           {kp.pt.x, kp.pt.y},
-                           cur.features.depth[q],
-                           cur.features.information(q, opts.scale_factor),
-                           cur.features.weightOf(q)});
-        }
+        for (const auto& [q, t] : pairs)
+            obs.push_back(
+                observationOf(cur.features, q, old.features.points_c[rows[t]], opts.scale_factor));
         PnpRansacOptions pnp;
         pnp.iterations = 300;
         pnp.min_inliers = opts.min_inliers;

@@ -94,6 +94,12 @@ bool observationJacobians(const Eigen::Isometry3d& T_cw, const Eigen::Vector3d& 
     return true;
 }
 
+PoseObservation observationOf(const FrameFeatures& f, std::size_t i, const Eigen::Vector3d& p_w,
+                              double scale_factor) {
+    const auto& kp = f.keypoints[i];
+    return {p_w, {kp.pt.x, kp.pt.y}, f.depth[i], f.information(i, scale_factor), f.weightOf(i)};
+}
+
 PoseRefineResult refinePose(const std::vector<PoseObservation>& obs,
                             const Eigen::Isometry3d& T_wc_init, const core::CameraIntrinsics& K,
                             const PoseRefineOptions& opts) {

@@ -153,12 +153,8 @@ TrackResult Slam::track(const core::Frame& frame, const FrameFeatures& features,
         for (std::size_t i = 0; i < features.size(); ++i) {
             const LandmarkId lm = res.landmark_of_kp[i];
             if (lm == kNoId) continue;
-            const auto& kp = features.keypoints[i];
-            rec.obs.emplace_back(lm, PoseObservation{Eigen::Vector3d::Zero(),
-                                                     {kp.pt.x, kp.pt.y},
-                                                     features.depth[i],
-                                                     features.information(i, opts_.orb.scale_factor),
-                                                     features.weightOf(i)});
+            rec.obs.emplace_back(lm, observationOf(features, i, Eigen::Vector3d::Zero(),
+                                                   opts_.orb.scale_factor));
         }
     }
     records_.push_back(std::move(rec));

@@ -153,14 +153,8 @@ std::vector<PoseObservation> observationsOf(const Map& map, const FrameFeatures&
                                             double scale_factor) {
     std::vector<PoseObservation> obs;
     obs.reserve(matches.size());
-    for (const auto& m : matches) {
-        const auto& kp = f.keypoints[m.kp];
-        obs.push_back({map.landmark(m.landmark)->p_w,
-                       {kp.pt.x, kp.pt.y},
-                       f.depth[m.kp],
-                       f.information(m.kp, scale_factor),
-                       f.weightOf(m.kp)});
-    }
+    for (const auto& m : matches)
+        obs.push_back(observationOf(f, m.kp, map.landmark(m.landmark)->p_w, scale_factor));
     return obs;
 }
 }  // namespace
@@ -248,14 +242,9 @@ std::optional<Eigen::Isometry3d> Tracker::relocalize(const FrameFeatures& f, con
             matchBruteForce(f.descriptors, train, opts_.reloc_max_hamming, opts_.reloc_ratio);
         if (static_cast<int>(pairs.size()) < opts_.reloc_min_inliers) continue;
         std::vector<PoseObservation> obs;
-        for (const auto& [q, t] : pairs) {
-            const auto& kp = f.keypoints[q];
-            obs.push_back({map.landmark(kf.landmark_of_kp[rows[t]])->p_w,
-                           {kp.pt.x, kp.pt.y},
-                           f.depth[q],
-                           f.information(q, opts_.scale_factor),
-                           f.weightOf(q)});
-        }
+        for (const auto& [q, t] : pairs)
+            obs.push_back(observationOf(f, q, map.landmark(kf.landmark_of_kp[rows[t]])->p_w,
+                                        opts_.scale_factor));
         auto pnp_opts = opts_.pnp;
         pnp_opts.iterations = std::max(pnp_opts.iterations, 300);
         pnp_opts.min_inliers = opts_.reloc_min_inliers;

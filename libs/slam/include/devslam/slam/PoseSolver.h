@@ -4,6 +4,7 @@
 /// reprojection error plus, where depth is measured, the error of a virtual right-camera
 /// coordinate u_r = u - bf/z (the RGB-D residual of ORB-SLAM2). Pure functions.
 #include <devslam/core/Camera.h>
+#include <devslam/slam/Types.h>
 
 #include <Eigen/Geometry>
 
@@ -23,6 +24,12 @@ struct PoseObservation {
     /// (FrameFeatures::gate_exponent: a keypoint trusted less may be rejected sooner).
     double weight = 1;
 };
+
+/// Keypoint i of `f` as the measurement of the point p_w: its pixel and depth, the
+/// information its outlier tests see (FrameFeatures::information) and the weight the
+/// optimisation adds to it (FrameFeatures::weightOf).
+[[nodiscard]] PoseObservation observationOf(const FrameFeatures& f, std::size_t i,
+                                            const Eigen::Vector3d& p_w, double scale_factor);
 
 struct PnpRansacOptions {
     int iterations = 100;             ///< RANSAC iterations
