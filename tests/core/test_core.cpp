@@ -23,6 +23,10 @@
 #include <typeinfo>
 
 #include <sys/wait.h>
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+#include <chrono>
 #include <cmath>
 #include <csignal>
 #include <cstdlib>
@@ -486,6 +490,37 @@ TEST(Results, WritersAtOnceLoseNoSection) {
     }
     EXPECT_FALSE(std::filesystem::exists(path + ".part"));
     std::filesystem::remove(path);
+}
+
+// A writer reaching the results file through a link (here one whose file is not made yet,
+// in another folder) takes its turn on the folder the file is written in, as a writer naming
+// the file itself does: while that folder is locked, the writer through the link waits.
+TEST(Results, WriterThroughALinkWaitsForTheFoldersLock) {
+    namespace fs = std::filesystem;
+    const auto dir = devslam::test::scratchPath("results_lock_link");
+    fs::remove_all(dir);
+    fs::create_directories(dir / "a");
+    fs::create_directories(dir / "b");
+    fs::create_symlink("../b/RESULTS.md", dir / "a" / "RESULTS.md");
+    const int fd = ::open((dir / "b").c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    ASSERT_GE(fd, 0);
+    ASSERT_EQ(::flock(fd, LOCK_EX), 0);
+    std::atomic<bool> done{false};
+    std::thread writer([&] {
+        replaceResultsSection((dir / "a" / "RESULTS.md").string(), "s", "through the link");
+        done = true;
+    });
+    std::this_thread::sleep_for(std::chrono::milliseconds(300));
+    EXPECT_FALSE(done.load());  // it waits for b/, the folder it writes in
+    EXPECT_FALSE(fs::exists(dir / "b" / "RESULTS.md"));
+    ::close(fd);  // releases the lock
+    writer.join();
+    EXPECT_TRUE(done.load());
+    EXPECT_TRUE(fs::is_symlink(dir / "a" / "RESULTS.md"));
+    std::ifstream in(dir / "b" / "RESULTS.md");
+    const std::string text(std::istreambuf_iterator<char>(in), {});
+    EXPECT_NE(text.find("through the link"), std::string::npos) << text;
+    fs::remove_all(dir);
 }
 
 // A file is replaced whole or not at all; its hash tells a change of content.

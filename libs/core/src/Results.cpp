@@ -74,17 +74,38 @@ void checkResultsSection(const std::string& path, const std::string& name) {
 }
 
 namespace {
-/// Holds flock(LOCK_EX) on the folder of the results file (links followed) for a read, change
-/// and write of one section: two commands regenerating theirs at once would otherwise both
-/// read the old file and the second write would drop the first's section (and both would
-/// write the same .part). A folder, not a lock file beside RESULTS.md: nothing is left in the
-/// tree. Advisory: only writers that take it wait; a folder that cannot be opened is not
-/// locked (the write then names the problem).
+/// The file a write to `link` replaces: `link` with its chain of symbolic links followed to
+/// their end, which need not exist yet (a dangling link names the file to make, as for a
+/// shell's `>`). Only the links of the last component are followed: the folders on the way
+/// may be links too, and they lead to the same folder whichever way it is named. Throws
+/// std::runtime_error naming `link` for a link that cannot be read or a loop.
+std::filesystem::path followLinks(const std::string& link) {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    fs::path target = link;
+    for (int hops = 0; fs::is_symlink(target, ec); ++hops) {
+        const fs::path next = fs::read_symlink(target, ec);
+        if (ec || hops == 40)
+            throw std::runtime_error("cannot write '" + link + "': " +
+                                     (ec ? ec.message() : "too many levels of symbolic links"));
+        target = next.is_absolute() ? next : target.parent_path() / next;
+    }
+    return target;
+}
+
+/// Holds flock(LOCK_EX) on the folder of the file a write to the results file replaces
+/// (followLinks: the same folder writeFileWhole renames in, so two writers reaching one file
+/// through different links take turns) for a read, change and write of one section: two
+/// commands regenerating theirs at once would otherwise both read the old file and the
+/// second write would drop the first's section (and both would write the same .part). A
+/// folder, not a lock file beside RESULTS.md: nothing is left in the tree. Advisory: only
+/// writers that take it wait; a folder that cannot be opened is not locked (the write then
+/// names the problem).
 class FolderLock {
 public:
     explicit FolderLock(const std::string& file) {
         std::error_code ec;
-        auto abs = std::filesystem::weakly_canonical(std::filesystem::absolute(file, ec), ec);
+        const auto abs = std::filesystem::absolute(followLinks(file), ec);
         if (ec) return;
         fd_ = ::open(abs.parent_path().c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
         if (fd_ < 0) return;
@@ -114,15 +135,7 @@ void writeFileWhole(const std::string& link, const std::string& text) {
     // The rename would replace a symbolic link (say, a RESULTS.md linked from elsewhere) by a
     // plain file: the file it points to is written instead, beside itself (and made, as a
     // shell's `>` would, when the link's target does not exist yet).
-    fs::path target = link;
-    for (int hops = 0; fs::is_symlink(target, ec); ++hops) {
-        const fs::path next = fs::read_symlink(target, ec);
-        if (ec || hops == 40)
-            throw std::runtime_error("cannot write '" + link + "': " +
-                                     (ec ? ec.message() : "too many levels of symbolic links"));
-        target = next.is_absolute() ? next : target.parent_path() / next;
-    }
-    const std::string path = target.string();
+    const std::string path = followLinks(link).string();
     const std::string part = path + ".part";
     {
         errno = 0;
