@@ -518,13 +518,22 @@ void runRenders(const std::vector<RenderJob>& renders, int jobs) {
     if (!failure.empty()) throw std::runtime_error(failure);
 }
 
-int run(int argc, char** argv) {
-    std::string config = kRoot + "/config_ini/bench.ini", out_override,
-                results = kRoot + "/docs/RESULTS.md";
-    std::string bin = fs::absolute(argv[0]).parent_path().string();
-    int repeats = 0, render_jobs = 0;
-    bool reuse = false;
-    std::optional<std::size_t> max_frames;
+/// The command line.
+struct Args {
+    std::string config = kRoot + "/config_ini/bench.ini";
+    std::string out_override;                          ///< --out
+    std::string results = kRoot + "/docs/RESULTS.md";  ///< "" = none
+    std::string bin;                                   ///< devslam-run's and devslam-synth's folder
+    int repeats = 0;                                   ///< --repeats, 0 = the INI's
+    int render_jobs = 0;                               ///< --render-jobs, 0 = the INI's
+    bool reuse = false;                                ///< --reuse-runs
+    std::optional<std::size_t> max_frames;             ///< --max-frames
+};
+
+/// The command line's options; nullopt when it asked for --help (printed).
+std::optional<Args> parseArgs(int argc, char** argv) {
+    Args a;
+    a.bin = fs::absolute(argv[0]).parent_path().string();
     for (int i = 1; i < argc; ++i) {
         const std::string k = argv[i];
         const auto value = [&]() -> std::string {
@@ -532,35 +541,40 @@ int run(int argc, char** argv) {
             return argv[++i];
         };
         if (k == "--config")
-            config = value();
+            a.config = value();
         else if (k == "--repeats")
-            repeats = int(core::parseInteger(value(), "--repeats", 1, 100));
+            a.repeats = int(core::parseInteger(value(), "--repeats", 1, 100));
         else if (k == "--max-frames")
-            max_frames = std::size_t(core::parseInteger(value(), "--max-frames", 0));
+            a.max_frames = std::size_t(core::parseInteger(value(), "--max-frames", 0));
         else if (k == "--out")
-            out_override = value();
+            a.out_override = value();
         else if (k == "--results") {
-            results = value();
-            if (results.empty() || results == "none") results.clear();
+            a.results = value();
+            if (a.results.empty() || a.results == "none") a.results.clear();
         } else if (k == "--bin")
-            bin = value();
+            a.bin = value();
         else if (k == "--reuse-runs")
-            reuse = true;
+            a.reuse = true;
         else if (k == "--render-jobs")
-            render_jobs = int(core::parseInteger(value(), "--render-jobs", 1, 64));
+            a.render_jobs = int(core::parseInteger(value(), "--render-jobs", 1, 64));
         else if (k == "-h" || k == "--help") {
             std::cout << kUsage;
-            return 0;
+            return std::nullopt;
         } else
             throw std::invalid_argument("unknown option '" + k + "'\n" + kUsage);
     }
-    Bench b = loadBench(config);
-    if (repeats > 0) {  // for every sequence, also those with their own `repeats`
-        b.repeats = repeats;
+    return a;
+}
+
+/// The bench INI with the command line's overrides; its output folder made.
+Bench benchOf(const Args& a) {
+    Bench b = loadBench(a.config);
+    if (a.repeats > 0) {  // for every sequence, also those with their own `repeats`
+        b.repeats = a.repeats;
         for (auto& q : b.sequences) q.repeats = 0;
     }
-    if (max_frames) b.max_frames = *max_frames;
-    if (!out_override.empty()) b.out_dir = out_override;
+    if (a.max_frames) b.max_frames = *a.max_frames;
+    if (!a.out_override.empty()) b.out_dir = a.out_override;
     {  // One spelling of the folder ("./out/" is "out"): its runs' command lines, which
        // --reuse-runs compares, name it.
         fs::path o = fs::path(b.out_dir).lexically_normal();
@@ -568,14 +582,18 @@ int run(int argc, char** argv) {
         b.out_dir = o.string();
     }
     fs::create_directories(b.out_dir);
-    // Before hours of work (after the output folder is made: the results may go in it).
-    if (!results.empty()) core::checkResultsSection(results, "bench");
-    const auto repeatsOf = [&](const Sequence& q) { return q.repeats > 0 ? q.repeats : b.repeats; };
+    return b;
+}
 
-    // 1. Synthetic sequences: render the missing ones, and those whose scenario, room, seed,
-    //    frame count or renderer changed since (devslam-synth --if-changed, render.txt).
-    //    Renders are not timed, so `render_jobs` of them run at once; the SLAM runs below,
-    //    whose FPS is measured, run one at a time.
+int repeatsOf(const Bench& b, const Sequence& q) {
+    return q.repeats > 0 ? q.repeats : b.repeats;
+}
+
+/// 1. Synthetic sequences: renders the missing ones, and those whose scenario, room, seed,
+/// frame count or renderer changed since (devslam-synth --if-changed, render.txt). Renders
+/// are not timed, so several run at once; the SLAM runs, whose FPS is measured, run one at
+/// a time.
+void renderSequences(const Bench& b, const Args& a) {
     std::vector<RenderJob> renders;
     for (const auto& q : b.sequences) {
         if (q.scenario.empty()) continue;
@@ -584,7 +602,7 @@ int run(int argc, char** argv) {
             j.what = q.name + (in.seed ? " seed " + std::to_string(*in.seed) : std::string());
             j.log = in.path + ".log";
             fs::create_directories(fs::path(in.path).parent_path());
-            j.cmd = quote(bin + "/devslam-synth") + " " + quote(q.scenario) + " -o " +
+            j.cmd = quote(a.bin + "/devslam-synth") + " " + quote(q.scenario) + " -o " +
                     quote(in.path) + " --if-changed";
             if (in.seed) j.cmd += " --seed " + std::to_string(*in.seed);
             for (const auto& item : q.sets) j.cmd += " --set " + quote(item);
@@ -592,52 +610,94 @@ int run(int argc, char** argv) {
             renders.push_back(j);
         }
     }
-    if (render_jobs == 0) render_jobs = b.render_jobs;
-    if (render_jobs == 0)  // each render holds a sequence's images in memory: at most 8
-        render_jobs = int(std::clamp(std::thread::hardware_concurrency(), 1u, 8u));
-    runRenders(renders, render_jobs);
+    int jobs = a.render_jobs ? a.render_jobs : b.render_jobs;
+    if (jobs == 0)  // each render holds a sequence's images in memory: at most 8
+        jobs = int(std::clamp(std::thread::hardware_concurrency(), 1u, 8u));
+    runRenders(renders, jobs);
+}
 
-    // 2. SLAM runs.
-    std::map<std::pair<std::string, std::string>, std::vector<RunFigures>> runs;
+/// The SLAM runs of a bench: each (sequence, mode)'s runs, over its renders and repeats.
+struct Runs {
+    std::map<std::pair<std::string, std::string>, std::vector<RunFigures>> of;
+    std::string csv;  ///< runs.csv: a row a run
+    std::size_t total = 0, reused = 0;
+    /// When the runs kept from an earlier bench were made (their run.json files' times).
+    std::optional<std::time_t> kept_from, kept_to;
+    std::vector<std::string> failed;  ///< logs of the runs that failed
+    /// The runs of (seq, mode), of one render when `seed` is given.
+    [[nodiscard]] std::vector<RunFigures> get(const std::string& seq, const std::string& mode,
+                                              std::optional<std::uint64_t> seed) const {
+        std::vector<RunFigures> v;
+        const auto it = of.find({seq, mode});
+        if (it != of.end())
+            for (const auto& f : it->second)
+                if (!seed || f.seed == seed) v.push_back(f);
+        return v;
+    }
+};
+
+/// A run.json's modification time as a time_t (file_time_type's clock is not system_clock
+/// before C++20).
+std::time_t writtenAt(const fs::path& file) {
+    return std::chrono::system_clock::to_time_t(
+        std::chrono::system_clock::now() +
+        std::chrono::duration_cast<std::chrono::system_clock::duration>(
+            fs::last_write_time(file) - fs::file_time_type::clock::now()));
+}
+
+/// runs.csv's row for run `r` of `q` in mode `m` ("n/a" for the figures of a failed run,
+/// not the zeros of an empty RunFigures).
+std::string csvRow(const Sequence& q, const std::string& m, const std::string& seed, int r,
+                   const RunFigures& f) {
+    const auto fig = [&](double x, int prec) { return f.ok ? fmt(x, prec) : std::string("n/a"); };
+    std::ostringstream row;
+    row << q.name << "," << m << "," << seed << "," << r << "," << fig(f.ate_rmse, 6) << ","
+        << fig(f.ate_mean, 6) << "," << fig(f.ate_median, 6) << "," << fig(f.rpe_t_rmse, 6) << ","
+        << fig(f.rpe_t_mean, 6) << "," << fig(f.rpe_t_median, 6) << "," << fig(f.rpe_r_rmse, 4)
+        << "," << fig(f.rpe_r_mean, 4) << "," << fig(f.rpe_r_median, 4) << ","
+        << fig(f.fps_median, 2) << "," << fig(f.fps_mean, 2) << "," << fig(f.lost, 0) << "\n";
+    return row.str();
+}
+
+/// 2. The SLAM runs, one at a time (their FPS is measured), each in
+/// <out>/runs/SEQ/MODE/[seedS_]rR; with --reuse-runs a whole run made by this same command
+/// from the same files is kept. Throws Interrupted on Ctrl-C, keeping the runs that finished.
+Runs runSlam(const Bench& b, const Args& a) {
+    Runs runs;
     // Written when every run is done: an interrupted bench leaves the last one's.
-    std::ostringstream all_csv;
-    all_csv
-        << "sequence,mode,seed,repeat,ate_rmse_m,ate_mean_m,ate_median_m,rpe_t_rmse_m,rpe_t_mean_m,"
-           "rpe_t_median_m,rpe_r_rmse_deg,rpe_r_mean_deg,rpe_r_median_deg,fps_median,fps_mean,"
-           "lost_frames\n";
-    std::size_t total = 0;
+    runs.csv =
+        "sequence,mode,seed,repeat,ate_rmse_m,ate_mean_m,ate_median_m,rpe_t_rmse_m,rpe_t_mean_m,"
+        "rpe_t_median_m,rpe_r_rmse_deg,rpe_r_mean_deg,rpe_r_median_deg,fps_median,fps_mean,"
+        "lost_frames\n";
     for (const auto& q : b.sequences)
         for (const auto& m : b.modes)
-            total += runsMode(q, b.out_dir, m)
-                         ? std::size_t(repeatsOf(q)) * inputsOf(q, b.out_dir).size()
-                         : 0;
-    std::size_t done = 0, reused = 0;
+            runs.total += runsMode(q, b.out_dir, m)
+                              ? std::size_t(repeatsOf(b, q)) * inputsOf(q, b.out_dir).size()
+                              : 0;
+    std::size_t done = 0;
     std::map<std::string, std::string> hashes;  // file -> content hash, for command.txt
-    // When the kept runs were made (their run.json files' times), for the RESULTS text.
-    std::optional<std::time_t> kept_from, kept_to;
-    std::vector<std::string> failed;  // logs of the runs that failed
     for (const auto& q : b.sequences)
         for (const auto& m : b.modes)
             for (const auto& in : inputsOf(q, b.out_dir))
-                for (int r = 0; r < repeatsOf(q) && runsMode(q, b.out_dir, m); ++r) {
+                for (int r = 0; r < repeatsOf(b, q) && runsMode(q, b.out_dir, m); ++r) {
                     const std::string seed = in.seed ? std::to_string(*in.seed) : std::string();
                     const fs::path dir =
                         fs::path(b.out_dir) / "runs" / q.name / m /
                         ((in.seed ? "seed" + seed + "_" : std::string()) + "r" + std::to_string(r));
                     fs::create_directories(dir);
-                    std::string cmd = quote(bin + "/devslam-run") + " --input " + quote(in.path) +
+                    std::string cmd = quote(a.bin + "/devslam-run") + " --input " + quote(in.path) +
                                       " --config " + quote(q.slam_config) + " --mode " + m +
                                       " --out " + quote(dir.string()) + " --quiet";
                     if (b.max_frames) cmd += " --max-frames " + std::to_string(b.max_frames);
                     cmd += " > " + quote((dir / "log.txt").string()) + " 2>&1";
-                    std::cout << "[" << ++done << "/" << total << "] " << q.name << " " << m
+                    std::cout << "[" << ++done << "/" << runs.total << "] " << q.name << " " << m
                               << (in.seed ? " seed " + seed : std::string()) << " run " << r + 1
                               << "\n"
                               << std::flush;
                     const std::string json = (dir / "run.json").string();
-                    RunFigures f = reuse ? readRun(json) : RunFigures{};
+                    RunFigures f = a.reuse ? readRun(json) : RunFigures{};
                     const std::string made_from =
-                        provenance(cmd, runInputs(bin, q.slam_config, in.path), hashes);
+                        provenance(cmd, runInputs(a.bin, q.slam_config, in.path), hashes);
                     if (f.ok) {  // a whole run made earlier: kept if it is this one
                         if (const std::string why = staleRun(dir, made_from); !why.empty()) {
                             std::cout << "  not kept: its run.json was " << why << "\n";
@@ -657,89 +717,139 @@ int run(int argc, char** argv) {
                         throw Interrupted(sig, "interrupted (" + core::signalName(sig) + ") " +
                                                    (start ? "during" : "before") + " run " +
                                                    std::to_string(done) + " of " +
-                                                   std::to_string(total) +
+                                                   std::to_string(runs.total) +
                                                    "; the runs that finished are kept");
-                    reused += have;
+                    runs.reused += have;
                     if (have) {
-                        // file_time_type's clock is not system_clock before C++20.
-                        const auto written = std::chrono::system_clock::to_time_t(
-                            std::chrono::system_clock::now() +
-                            std::chrono::duration_cast<std::chrono::system_clock::duration>(
-                                fs::last_write_time(json) - fs::file_time_type::clock::now()));
-                        kept_from = std::min(kept_from.value_or(written), written);
-                        kept_to = std::max(kept_to.value_or(written), written);
+                        const std::time_t written = writtenAt(json);
+                        runs.kept_from = std::min(runs.kept_from.value_or(written), written);
+                        runs.kept_to = std::max(runs.kept_to.value_or(written), written);
                     }
                     if (!have) f = rc == 0 ? readRun(json) : RunFigures{};
                     f.seed = in.seed;
                     f.dir = dir;
                     if (!f.ok) {
-                        failed.push_back((dir / "log.txt").string());
+                        runs.failed.push_back((dir / "log.txt").string());
                         std::cerr << "  devslam-run failed ("
                                   << (rc == 0 ? std::string("no readable run.json") : endedBy(rc))
                                   << "):\n"
                                   << lastLines((dir / "log.txt").string(), 3)
                                   << "  (whole output: " << (dir / "log.txt").string() << ")\n";
                     }
-                    runs[{q.name, m}].push_back(f);
-                    // A failed run's figures are n/a, not the zeros of an empty RunFigures.
-                    const auto fig = [&](double x, int prec) {
-                        return f.ok ? fmt(x, prec) : std::string("n/a");
-                    };
-                    all_csv << q.name << "," << m << "," << seed << "," << r << ","
-                            << fig(f.ate_rmse, 6) << "," << fig(f.ate_mean, 6) << ","
-                            << fig(f.ate_median, 6) << "," << fig(f.rpe_t_rmse, 6) << ","
-                            << fig(f.rpe_t_mean, 6) << "," << fig(f.rpe_t_median, 6) << ","
-                            << fig(f.rpe_r_rmse, 4) << "," << fig(f.rpe_r_mean, 4) << ","
-                            << fig(f.rpe_r_median, 4) << "," << fig(f.fps_median, 2) << ","
-                            << fig(f.fps_mean, 2) << "," << fig(f.lost, 0) << "\n";
+                    runs.of[{q.name, m}].push_back(f);
+                    runs.csv += csvRow(q, m, seed, r, f);
                 }
+    return runs;
+}
 
-    // 3. Medians over the runs (renders x repeats); the median-ATE run's plot is kept.
-    // A figure of the runs that finished and have it (no ground truth, too short for the RPE).
-    const auto having = [](const std::vector<RunFigures>& v, double RunFigures::*field) {
-        std::vector<double> x;
-        for (const auto& f : v)
-            if (f.ok && !std::isnan(f.*field)) x.push_back(f.*field);
-        return x;
+/// A figure of the runs that finished and have it (no ground truth, too short for the RPE).
+std::vector<double> having(const std::vector<RunFigures>& v, double RunFigures::*field) {
+    std::vector<double> x;
+    for (const auto& f : v)
+        if (f.ok && !std::isnan(f.*field)) x.push_back(f.*field);
+    return x;
+}
+
+/// Its median over those runs; NaN when none has it.
+double med(const std::vector<RunFigures>& v, double RunFigures::*field) {
+    const auto x = having(v, field);
+    return x.empty() ? std::numeric_limits<double>::quiet_NaN() : core::median(x);
+}
+
+/// 3. The tables: medians over the runs (renders x repeats), as Markdown and CSV, and the
+/// trajectory plots of the median-ATE runs.
+struct Tables {
+    std::ostringstream t1, t2, t3, t4, t5;  ///< RPE, ATE, FPS, filter, ATE per render
+    std::ostringstream c1, c2, c3, c4;      ///< the CSV files of t1-t4
+    std::map<std::string, std::vector<std::string>> plots;      ///< sequence -> modes with a plot
+    std::vector<std::pair<fs::path, fs::path>> results_images;  ///< copied beside RESULTS.md
+};
+
+/// Copies the plot of the run of `v` whose ATE is nearest the median (with an even number of
+/// runs the median lies between two) into the output folder as <seq>_<mode>_trajectory.png,
+/// and lists it for RESULTS.md's images when there is a results file.
+void keepMedianPlot(const Bench& b, const Sequence& q, const std::string& m,
+                    const std::vector<RunFigures>& v, const std::string& results, Tables& t) {
+    const double target = med(v, &RunFigures::ate_rmse);
+    std::optional<std::size_t> nearest;
+    for (std::size_t r = 0; r < v.size(); ++r)
+        if (v[r].ok && !std::isnan(v[r].ate_rmse) &&
+            (!nearest ||
+             std::abs(v[r].ate_rmse - target) < std::abs(v[*nearest].ate_rmse - target)))
+            nearest = r;
+    if (!nearest || !fs::exists(v[*nearest].dir / "trajectory.png")) return;
+    const fs::path src = v[*nearest].dir / "trajectory.png";
+    fs::copy_file(src, fs::path(b.out_dir) / (q.name + "_" + m + "_trajectory.png"),
+                  fs::copy_options::overwrite_existing);
+    // Beside RESULTS.md, for its figures (the diagnostic truth mode's plots stay in the
+    // results folder).
+    if (!results.empty() && m != "truth") {  // copied with the section, if whole
+        const fs::path img = fs::path(results).parent_path() / "images";
+        t.results_images.emplace_back(src, img / ("bench_" + q.name + "_" + m + ".png"));
+        t.plots[q.name].push_back(m);
+    }
+}
+
+/// The filter's row of `v` against the renderer's person truth (t4, c4); none for the modes
+/// without a filter or sequences without person truth.
+void filterRow(const Sequence& q, const std::string& m, const std::vector<RunFigures>& v,
+               Tables& t) {
+    using R = RunFigures;
+    // none masks nothing and truth is the truth: no filter to score.
+    if (m == "none" || m == "truth" || std::isnan(med(v, &R::moving_instances))) return;
+    const auto pct = [](double x) {
+        return std::isnan(x) ? std::string("n/a") : fmt(100 * x, 1) + " %";
     };
-    const auto med = [&](const std::vector<RunFigures>& v, double RunFigures::*field) {
-        const auto x = having(v, field);
-        return x.empty() ? std::numeric_limits<double>::quiet_NaN() : core::median(x);
+    // "x % of N" for N person-frames; a sequence without such people says so.
+    const auto ofInstances = [&](double R::*frac, double R::*count, const char* none) {
+        const double n = med(v, count);
+        return n > 0 ? pct(med(v, frac)) + " of " + fmt(n, 0) : std::string(none);
     };
-    std::ostringstream t1, t2, t3, t4, t5;
-    std::map<std::string, std::vector<std::string>> plots;  // sequence -> modes with a plot
-    std::vector<std::pair<fs::path, fs::path>> results_images;  // copied beside RESULTS.md
-    // The CSV files, written with tables.md at the end, each whole or not at all.
-    std::ostringstream c1, c2, c3, c4, targets_csv;
-    t1 << "| sequence | mode | trans RMSE (m) | trans mean (m) | trans median (m) | rot RMSE (deg) "
-          "| rot mean (deg) | rot median (deg) |\n|---|---|---|---|---|---|---|---|\n";
-    t2 << "| sequence | mode | ATE RMSE (m) | ATE mean (m) | ATE median (m) | lost frames | runs "
-          "ok |\n|---|---|---|---|---|---|---|\n";
-    t3 << "| sequence | mode | median FPS | mean FPS |\n|---|---|---|---|\n";
-    t4 << "| sequence | mode | walking people masked (per person and frame) | walking area masked "
-          "| masked area on walkers (precision) | static people masked "
-          "|\n|---|---|---|---|---|---|\n";
-    c1 << "sequence,mode,rpe_t_rmse_m,rpe_t_mean_m,rpe_t_median_m,rpe_r_rmse_deg,rpe_r_mean_deg,"
-          "rpe_r_median_deg\n";
-    c2 << "sequence,mode,ate_rmse_m,ate_mean_m,ate_median_m,lost_frames,runs_ok\n";
-    c3 << "sequence,mode,fps_median,fps_mean\n";
-    c4 << "sequence,mode,moving_recall,moving_area_recall,precision,static_masked,moving_instances,"
-          "static_instances\n";
+    const bool walkers = med(v, &R::moving_instances) > 0;
+    t.t4 << "| " << q.name << " | " << m << " | "
+         << ofInstances(&R::moving_recall, &R::moving_instances, "n/a (no walkers)") << " | "
+         << (walkers ? pct(med(v, &R::moving_area_recall)) : "n/a") << " | "
+         << pct(med(v, &R::mask_precision)) << " | "
+         << ofInstances(&R::static_masked, &R::static_instances, "n/a (no static people)")
+         << " |\n";
+    t.c4 << q.name << "," << m << "," << fmt(med(v, &R::moving_recall), 4) << ","
+         << fmt(med(v, &R::moving_area_recall), 4) << "," << fmt(med(v, &R::mask_precision), 4)
+         << "," << fmt(med(v, &R::static_masked), 4) << "," << fmt(med(v, &R::moving_instances), 0)
+         << "," << fmt(med(v, &R::static_instances), 0) << "\n";
+}
+
+Tables makeTables(const Bench& b, const Runs& runs, const std::string& results) {
+    Tables t;
+    t.t1 << "| sequence | mode | trans RMSE (m) | trans mean (m) | trans median (m) | rot RMSE "
+            "(deg) | rot mean (deg) | rot median (deg) |\n|---|---|---|---|---|---|---|---|\n";
+    t.t2 << "| sequence | mode | ATE RMSE (m) | ATE mean (m) | ATE median (m) | lost frames | "
+            "runs ok |\n|---|---|---|---|---|---|---|\n";
+    t.t3 << "| sequence | mode | median FPS | mean FPS |\n|---|---|---|---|\n";
+    t.t4 << "| sequence | mode | walking people masked (per person and frame) | walking area "
+            "masked | masked area on walkers (precision) | static people masked "
+            "|\n|---|---|---|---|---|---|\n";
+    t.c1 << "sequence,mode,rpe_t_rmse_m,rpe_t_mean_m,rpe_t_median_m,rpe_r_rmse_deg,"
+            "rpe_r_mean_deg,rpe_r_median_deg\n";
+    t.c2 << "sequence,mode,ate_rmse_m,ate_mean_m,ate_median_m,lost_frames,runs_ok\n";
+    t.c3 << "sequence,mode,fps_median,fps_mean\n";
+    t.c4 << "sequence,mode,moving_recall,moving_area_recall,precision,static_masked,"
+            "moving_instances,static_instances\n";
     for (const auto& q : b.sequences)
         for (const auto& m : b.modes) {
             if (!runsMode(q, b.out_dir, m)) continue;
-            const auto& v = runs[{q.name, m}];
+            const auto v = runs.get(q.name, m, std::nullopt);
             int ok = 0;
             for (const auto& f : v) ok += f.ok;
             using R = RunFigures;
-            t1 << "| " << q.name << " | " << m << " | " << fmt(med(v, &R::rpe_t_rmse), 4) << " | "
-               << fmt(med(v, &R::rpe_t_mean), 4) << " | " << fmt(med(v, &R::rpe_t_median), 4)
-               << " | " << fmt(med(v, &R::rpe_r_rmse), 3) << " | " << fmt(med(v, &R::rpe_r_mean), 3)
-               << " | " << fmt(med(v, &R::rpe_r_median), 3) << " |\n";
-            c1 << q.name << "," << m << "," << fmt(med(v, &R::rpe_t_rmse), 6) << ","
-               << fmt(med(v, &R::rpe_t_mean), 6) << "," << fmt(med(v, &R::rpe_t_median), 6) << ","
-               << fmt(med(v, &R::rpe_r_rmse), 4) << "," << fmt(med(v, &R::rpe_r_mean), 4) << ","
-               << fmt(med(v, &R::rpe_r_median), 4) << "\n";
+            t.t1 << "| " << q.name << " | " << m << " | " << fmt(med(v, &R::rpe_t_rmse), 4) << " | "
+                 << fmt(med(v, &R::rpe_t_mean), 4) << " | " << fmt(med(v, &R::rpe_t_median), 4)
+                 << " | " << fmt(med(v, &R::rpe_r_rmse), 3) << " | "
+                 << fmt(med(v, &R::rpe_r_mean), 3) << " | " << fmt(med(v, &R::rpe_r_median), 3)
+                 << " |\n";
+            t.c1 << q.name << "," << m << "," << fmt(med(v, &R::rpe_t_rmse), 6) << ","
+                 << fmt(med(v, &R::rpe_t_mean), 6) << "," << fmt(med(v, &R::rpe_t_median), 6) << ","
+                 << fmt(med(v, &R::rpe_r_rmse), 4) << "," << fmt(med(v, &R::rpe_r_mean), 4) << ","
+                 << fmt(med(v, &R::rpe_r_median), 4) << "\n";
             // The medians are over the runs that have the figure: the table says how many.
             std::string runs_ok = std::to_string(ok) + "/" + std::to_string(v.size());
             if (const auto n = having(v, &R::ate_rmse).size(); n < std::size_t(ok))
@@ -747,76 +857,35 @@ int run(int argc, char** argv) {
             if (const auto n = having(v, &R::rpe_t_rmse).size(); n < std::size_t(ok))
                 runs_ok += "; RPE from " + std::to_string(n);
             // 5 decimals: sitting_xyz's modes differ by tenths of a millimetre.
-            t2 << "| " << q.name << " | " << m << " | " << fmt(med(v, &R::ate_rmse), 5) << " | "
-               << fmt(med(v, &R::ate_mean), 5) << " | " << fmt(med(v, &R::ate_median), 5) << " | "
-               << fmt(med(v, &R::lost), 0) << " | " << runs_ok << " |\n";
-            c2 << q.name << "," << m << "," << fmt(med(v, &R::ate_rmse), 6) << ","
-               << fmt(med(v, &R::ate_mean), 6) << "," << fmt(med(v, &R::ate_median), 6) << ","
-               << fmt(med(v, &R::lost), 0) << "," << ok << "\n";
-            t3 << "| " << q.name << " | " << m << " | " << fmt(med(v, &R::fps_median), 1) << " | "
-               << fmt(med(v, &R::fps_mean), 1) << " |\n";
-            c3 << q.name << "," << m << "," << fmt(med(v, &R::fps_median), 2) << ","
-               << fmt(med(v, &R::fps_mean), 2) << "\n";
+            t.t2 << "| " << q.name << " | " << m << " | " << fmt(med(v, &R::ate_rmse), 5) << " | "
+                 << fmt(med(v, &R::ate_mean), 5) << " | " << fmt(med(v, &R::ate_median), 5) << " | "
+                 << fmt(med(v, &R::lost), 0) << " | " << runs_ok << " |\n";
+            t.c2 << q.name << "," << m << "," << fmt(med(v, &R::ate_rmse), 6) << ","
+                 << fmt(med(v, &R::ate_mean), 6) << "," << fmt(med(v, &R::ate_median), 6) << ","
+                 << fmt(med(v, &R::lost), 0) << "," << ok << "\n";
+            t.t3 << "| " << q.name << " | " << m << " | " << fmt(med(v, &R::fps_median), 1) << " | "
+                 << fmt(med(v, &R::fps_mean), 1) << " |\n";
+            t.c3 << q.name << "," << m << "," << fmt(med(v, &R::fps_median), 2) << ","
+                 << fmt(med(v, &R::fps_mean), 2) << "\n";
             // Per render: the median over its repeats.
             if (!q.seeds.empty()) {
-                t5 << "| " << q.name << " | " << m << " |";
-                for (std::size_t k = 0; k < q.seeds.size(); ++k) {
-                    std::vector<RunFigures> of_seed;
-                    for (const auto& f : v)
-                        if (f.seed == q.seeds[k]) of_seed.push_back(f);
-                    t5 << (k ? ", " : " ") << fmt(med(of_seed, &R::ate_rmse), 5) << " ("
-                       << (k ? "" : "seed ") << q.seeds[k] << ")";
-                }
-                t5 << " |\n";
+                t.t5 << "| " << q.name << " | " << m << " |";
+                for (std::size_t k = 0; k < q.seeds.size(); ++k)
+                    t.t5 << (k ? ", " : " ")
+                         << fmt(med(runs.get(q.name, m, q.seeds[k]), &R::ate_rmse), 5) << " ("
+                         << (k ? "" : "seed ") << q.seeds[k] << ")";
+                t.t5 << " |\n";
             }
-            // Keep the plot of the run whose ATE is nearest the median (with an even number
-            // of runs the median lies between two).
-            const double target = med(v, &R::ate_rmse);
-            std::optional<std::size_t> nearest;
-            for (std::size_t r = 0; r < v.size(); ++r)
-                if (v[r].ok && !std::isnan(v[r].ate_rmse) &&
-                    (!nearest ||
-                     std::abs(v[r].ate_rmse - target) < std::abs(v[*nearest].ate_rmse - target)))
-                    nearest = r;
-            if (nearest && fs::exists(v[*nearest].dir / "trajectory.png")) {
-                const fs::path src = v[*nearest].dir / "trajectory.png";
-                fs::copy_file(src, fs::path(b.out_dir) / (q.name + "_" + m + "_trajectory.png"),
-                              fs::copy_options::overwrite_existing);
-                // Beside RESULTS.md, for its figures (the diagnostic truth mode's plots stay
-                // in the results folder).
-                if (!results.empty() && m != "truth") {  // copied with the section, if whole
-                    const fs::path img = fs::path(results).parent_path() / "images";
-                    results_images.emplace_back(src, img / ("bench_" + q.name + "_" + m + ".png"));
-                    plots[q.name].push_back(m);
-                }
-            }
-            // none masks nothing and truth is the truth: no filter to score.
-            if (m == "none" || m == "truth" || std::isnan(med(v, &R::moving_instances))) continue;
-            const auto pct = [](double x) {
-                return std::isnan(x) ? std::string("n/a") : fmt(100 * x, 1) + " %";
-            };
-            // "x % of N" for N person-frames; a sequence without such people says so.
-            const auto ofInstances = [&](double RunFigures::*frac, double RunFigures::*count,
-                                         const char* none) {
-                const double n = med(v, count);
-                return n > 0 ? pct(med(v, frac)) + " of " + fmt(n, 0) : std::string(none);
-            };
-            const bool walkers = med(v, &R::moving_instances) > 0;
-            t4 << "| " << q.name << " | " << m << " | "
-               << ofInstances(&R::moving_recall, &R::moving_instances, "n/a (no walkers)") << " | "
-               << (walkers ? pct(med(v, &R::moving_area_recall)) : "n/a") << " | "
-               << pct(med(v, &R::mask_precision)) << " | "
-               << ofInstances(&R::static_masked, &R::static_instances, "n/a (no static people)")
-               << " |\n";
-            c4 << q.name << "," << m << "," << fmt(med(v, &R::moving_recall), 4) << ","
-               << fmt(med(v, &R::moving_area_recall), 4) << ","
-               << fmt(med(v, &R::mask_precision), 4) << "," << fmt(med(v, &R::static_masked), 4)
-               << "," << fmt(med(v, &R::moving_instances), 0) << ","
-               << fmt(med(v, &R::static_instances), 0) << "\n";
+            keepMedianPlot(b, q, m, v, results, t);
+            filterRow(q, m, v, t);
         }
+    return t;
+}
 
+/// The trajectory plots beside RESULTS.md, a table per sequence.
+std::string plotsMarkdown(const Tables& t) {
     std::ostringstream figs;
-    for (const auto& [seq, modes] : plots) {
+    for (const auto& [seq, modes] : t.plots) {
         figs << "| " << seq << " |";
         for (const auto& m : modes) figs << " " << m << " |";
         figs << "\n|---|";
@@ -826,22 +895,18 @@ int run(int argc, char** argv) {
             figs << " ![" << seq << " " << m << "](images/bench_" << seq << "_" << m << ".png) |";
         figs << "\n\n";
     }
-    // Targets, checked on the same medians as the tables, and render by render.
-    // The runs of (sequence, mode), of one render when `seed` is given.
-    const auto runsOf = [&](const std::string& seq, const std::string& mode,
-                            std::optional<std::uint64_t> seed) {
-        std::vector<RunFigures> v;
-        const auto it = runs.find({seq, mode});
-        if (it != runs.end())
-            for (const auto& f : it->second)
-                if (!seed || f.seed == seed) v.push_back(f);
-        return v;
-    };
+    return figs.str();
+}
+
+/// The [targets], checked on the same medians as the tables, and render by render: the
+/// Markdown table and targets.csv ("" for both without targets).
+std::pair<std::string, std::string> checkTargets(const Bench& b, const Runs& runs) {
+    if (b.targets.empty()) return {};
     const bench::FigureOf figureOf = [&](const std::string& seq, const std::string& mode,
                                          const std::string& figure,
                                          std::optional<std::uint64_t> seed) {
         using R = RunFigures;
-        const auto v = runsOf(seq, mode, seed);
+        const auto v = runs.get(seq, mode, seed);
         if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
         if (figure == "ate") return med(v, &R::ate_rmse);
         if (figure == "fps") return med(v, &R::fps_median);
@@ -849,65 +914,68 @@ int run(int argc, char** argv) {
             return med(v, &R::moving_instances) > 0 ? med(v, &R::moving_recall) : NAN;
         if (figure == "static_masked")
             return med(v, &R::static_instances) > 0 ? med(v, &R::static_masked) : NAN;
-        const auto ref = runsOf(seq, figure.substr(figure.find('/') + 1), seed);  // ate/<mode>
+        const auto ref = runs.get(seq, figure.substr(figure.find('/') + 1), seed);  // ate/<mode>
         if (ref.empty()) return std::numeric_limits<double>::quiet_NaN();
         return med(v, &R::ate_rmse) / med(ref, &R::ate_rmse);
     };
-    std::ostringstream targets_md;
-    if (!b.targets.empty()) {
-        std::vector<bench::SequenceInputs> inputs;
-        for (const auto& q : b.sequences) inputs.push_back({q.name, q.seeds});
-        auto& csv = targets_csv;
-        csv << "target,sequence,mode,figure,op,value,measured,measured_on,met,inputs_met,"
-               "inputs,paired_geomean,paired_lo95,paired_hi95\n";
-        targets_md << "**Targets** (bench.ini `[targets]`, checked on the medians of the tables "
-                      "below; `*`: every sequence with the figure, the worst one shown; ate in "
-                      "m, masked as fractions of the people's frames; *renders meeting it*: "
-                      "each render's own figure, a ratio of two modes on the same render, a "
-                      "real sequence counting as one; *per-render ratio*: for a ratio, the "
-                      "geometric mean of the renders' own ratios and its 95 % confidence "
-                      "interval (Student's t on their logarithms), an interval holding 1 "
-                      "meaning the renders do not tell the two modes apart)\n\n"
-                      "| target | measured | met | renders meeting it | per-render ratio "
-                      "[95 % CI] |\n|---|---|---|---|---|\n";
-        int met = 0;
-        for (const auto& t : b.targets) {
-            const auto c = bench::check(t, inputs, figureOf);
-            const auto n = bench::tallyInputs(t, inputs, figureOf);
-            const auto p = bench::pairedRatio(t, c.sequence, inputs, figureOf);
-            met += c.met;
-            const int prec = t.figure == "fps" ? 1 : t.figure == "ate" ? 5 : 3;
-            targets_md << "| " << t.key << ": " << t.text() << " | " << fmt(c.measured, prec)
-                       << (t.sequence == "*" && !c.sequence.empty() ? " (" + c.sequence + ")"
-                                                                    : std::string())
-                       << " | " << (c.met ? "yes" : "**no**") << " | " << n.met << " of " << n.of
-                       << " | "
-                       << (p.count >= 2
-                               ? fmt(p.geomean, 3) + " [" + fmt(p.lo, 3) + ", " + fmt(p.hi, 3) + "]"
-                               : std::string())
-                       << " |\n";
-            csv << t.key << "," << t.sequence << "," << t.mode << "," << t.figure << "," << t.op
-                << "," << t.value << "," << fmt(c.measured, 6) << "," << c.sequence << ","
-                << (c.met ? 1 : 0) << "," << n.met << "," << n.of << "," << fmt(p.geomean, 6) << ","
-                << fmt(p.lo, 6) << "," << fmt(p.hi, 6) << "\n";
-        }
-        targets_md << "\n" << met << " of " << b.targets.size() << " targets met.\n\n";
+    std::vector<bench::SequenceInputs> inputs;
+    for (const auto& q : b.sequences) inputs.push_back({q.name, q.seeds});
+    std::ostringstream md, csv;
+    csv << "target,sequence,mode,figure,op,value,measured,measured_on,met,inputs_met,"
+           "inputs,paired_geomean,paired_lo95,paired_hi95\n";
+    md << "**Targets** (bench.ini `[targets]`, checked on the medians of the tables "
+          "below; `*`: every sequence with the figure, the worst one shown; ate in "
+          "m, masked as fractions of the people's frames; *renders meeting it*: "
+          "each render's own figure, a ratio of two modes on the same render, a "
+          "real sequence counting as one; *per-render ratio*: for a ratio, the "
+          "geometric mean of the renders' own ratios and its 95 % confidence "
+          "interval (Student's t on their logarithms), an interval holding 1 "
+          "meaning the renders do not tell the two modes apart)\n\n"
+          "| target | measured | met | renders meeting it | per-render ratio "
+          "[95 % CI] |\n|---|---|---|---|---|\n";
+    int met = 0;
+    for (const auto& t : b.targets) {
+        const auto c = bench::check(t, inputs, figureOf);
+        const auto n = bench::tallyInputs(t, inputs, figureOf);
+        const auto p = bench::pairedRatio(t, c.sequence, inputs, figureOf);
+        met += c.met;
+        const int prec = t.figure == "fps" ? 1 : t.figure == "ate" ? 5 : 3;
+        md << "| " << t.key << ": " << t.text() << " | " << fmt(c.measured, prec)
+           << (t.sequence == "*" && !c.sequence.empty() ? " (" + c.sequence + ")" : std::string())
+           << " | " << (c.met ? "yes" : "**no**") << " | " << n.met << " of " << n.of << " | "
+           << (p.count >= 2 ? fmt(p.geomean, 3) + " [" + fmt(p.lo, 3) + ", " + fmt(p.hi, 3) + "]"
+                            : std::string())
+           << " |\n";
+        csv << t.key << "," << t.sequence << "," << t.mode << "," << t.figure << "," << t.op << ","
+            << t.value << "," << fmt(c.measured, 6) << "," << c.sequence << "," << (c.met ? 1 : 0)
+            << "," << n.met << "," << n.of << "," << fmt(p.geomean, 6) << "," << fmt(p.lo, 6) << ","
+            << fmt(p.hi, 6) << "\n";
     }
-    // How often each sequence ran, for the text: "walking_xyz: 3 renders x 1 run, ...".
-    std::ostringstream runsLine;
+    md << "\n" << met << " of " << b.targets.size() << " targets met.\n\n";
+    return {md.str(), csv.str()};
+}
+
+/// How often each sequence ran, for the text: "walking_xyz 3 renders (seed 11 14 15) x 1
+/// run, ... per mode".
+std::string runsLine(const Bench& b) {
+    std::ostringstream line;
     for (std::size_t i = 0; i < b.sequences.size(); ++i) {
         const auto& q = b.sequences[i];
         const std::size_t n_in = inputsOf(q, b.out_dir).size();
-        runsLine << (i ? ", " : "") << q.name << " ";
+        line << (i ? ", " : "") << q.name << " ";
         if (!q.seeds.empty()) {
-            runsLine << n_in << " render" << (n_in > 1 ? "s" : "") << " (seed";
-            for (const auto s : q.seeds) runsLine << " " << s;
-            runsLine << ") x ";
+            line << n_in << " render" << (n_in > 1 ? "s" : "") << " (seed";
+            for (const auto s : q.seeds) line << " " << s;
+            line << ") x ";
         }
-        runsLine << repeatsOf(q) << " run" << (repeatsOf(q) > 1 ? "s" : "");
+        line << repeatsOf(b, q) << " run" << (repeatsOf(b, q) > 1 ? "s" : "");
     }
-    runsLine << " per mode";
-    // What each synthetic sequence renders, where its name does not say it alone.
+    line << " per mode";
+    return line.str();
+}
+
+/// What each synthetic sequence renders, where its name does not say it alone ("" if none).
+std::string scenesLine(const Bench& b) {
     std::ostringstream scenes;
     for (const auto& q : b.sequences) {
         if (q.scenario.empty() || (q.sets.empty() && q.name == q.scenario)) continue;
@@ -921,58 +989,65 @@ int run(int argc, char** argv) {
         if (!q.sets.empty()) scenes << "`";
     }
     if (scenes.tellp() > 0) scenes << ".\n\n";
+    return scenes.str();
+}
+
+/// The bench's section: how it was measured, the targets, Tables 1-3, the filter's table,
+/// the plots and the paper's figures for reference (tables.md, RESULTS.md's `bench`).
+std::string sectionMarkdown(const Args& a, const Bench& b, const Runs& runs, const Tables& t,
+                            const std::string& targets_md) {
     std::ostringstream md;
     md << "## Dynamic-SLAM benchmark: the paper's Tables 1-3 (`devslam-bench`)\n\n"
        << "Measured " << core::measuredOnLine() << " by `devslam-bench --config "
-       << core::shownPath(config, kRoot)
-       << (out_override.empty() ? std::string() : " --out " + quote(out_override))
-       << (repeats ? " --repeats " + std::to_string(b.repeats) : std::string())
-       << (max_frames ? " --max-frames " + std::to_string(b.max_frames) : std::string())
-       << (reuse ? " --reuse-runs" : "") << "`: " << runsLine.str()
+       << core::shownPath(a.config, kRoot)
+       << (a.out_override.empty() ? std::string() : " --out " + quote(a.out_override))
+       << (a.repeats ? " --repeats " + std::to_string(b.repeats) : std::string())
+       << (a.max_frames ? " --max-frames " + std::to_string(b.max_frames) : std::string())
+       << (a.reuse ? " --reuse-runs" : "") << "`: " << runsLine(b)
        << " with `devslam-run`; the tables give medians over all runs of a sequence and mode. "
-       << (reused ? std::to_string(reused) + " of " + std::to_string(total) +
-                        " runs were kept from an earlier invocation that made them "
-                        "(`--reuse-runs`: their figures, speed included, are from their "
-                        "run.json files, written " +
-                        core::utcMinute(*kept_from) +
-                        (core::utcMinute(*kept_to) == core::utcMinute(*kept_from)
-                             ? std::string()
-                             : " to " + core::utcMinute(*kept_to)) +
-                        "). "
-                  : std::string())
+       << (runs.reused ? std::to_string(runs.reused) + " of " + std::to_string(runs.total) +
+                             " runs were kept from an earlier invocation that made them "
+                             "(`--reuse-runs`: their figures, speed included, are from their "
+                             "run.json files, written " +
+                             core::utcMinute(*runs.kept_from) +
+                             (core::utcMinute(*runs.kept_to) == core::utcMinute(*runs.kept_from)
+                                  ? std::string()
+                                  : " to " + core::utcMinute(*runs.kept_to)) +
+                             "). "
+                       : std::string())
        << "Synthetic sequences are rendered by `devslam-synth` (exact ground truth; "
           "docs/render.md), each in the renders listed (`--seed`: the same scene and motion "
           "with other image and depth noise, docs/dynamic.md), because one render cannot rank "
           "two settings of this SLAM. RPE over 1 s.\n\n"
-       << scenes.str()
+       << scenesLine(b)
        << (std::find(b.modes.begin(), b.modes.end(), "truth") != b.modes.end()
                ? std::string("Mode `truth` is a diagnostic, not a method: the SLAM gets the "
                              "renderer's walking people (their pixels, dilated by the filter's "
                              "mask_margin) as the mask, i.e. what a perfect filter would give. "
                              "It bounds what any mask can do on a sequence (synthetic only).\n\n")
                : std::string())
-       << targets_md.str() << "**Table 1: RPE**\n\n"
-       << t1.str() << "\n**Table 2: ATE**\n\n"
-       << t2.str()
+       << targets_md << "**Table 1: RPE**\n\n"
+       << t.t1.str() << "\n**Table 2: ATE**\n\n"
+       << t.t2.str()
        << "\n*runs ok*: the runs that finished, of those made. Tables 1 and 2 give medians over "
           "the runs that have the figure; *runs ok* says so where fewer do (\"RPE from 3\": a "
           "run too short for pairs 1 s apart, or without ground truth).\n"
-       << (t5.str().empty()
+       << (t.t5.str().empty()
                ? std::string()
                : "\n**ATE RMSE (m) per render** (median over the render's runs; Table 2 gives "
                  "the median over all runs)\n\n| sequence | mode | ATE RMSE per render "
                  "|\n|---|---|---|\n" +
-                     t5.str())
+                     t.t5.str())
        << "\n**Table 3: speed** (wall clock, whole pipeline with the detector)\n\n"
-       << t3.str()
+       << t.t3.str()
        << "\n**Filter against the renderer's person truth**: the masks the SLAM runs used, "
           "scored by `devslam-run` frame by frame (medians over the runs). A person counts as "
           "masked in a frame when at least half of its visible pixels are masked; people with "
           "fewer than 500 visible pixels are not counted.\n\n"
-       << t4.str()
+       << t.t4.str()
        << "\n**Trajectories** (estimate vs ground truth after alignment, the run with the median "
           "ATE)\n\n"
-       << figs.str()
+       << plotsMarkdown(t)
        << "For reference, the paper's figures on the real TUM fr3 sequences (not comparable one "
           "to one: "
           "different scenes and sensors): walking_xyz ATE RMSE ORB-SLAM2 0.197 m (paper re-run), "
@@ -984,40 +1059,57 @@ int run(int argc, char** argv) {
        << "`; tables as CSV and the "
           "trajectory plots (`<sequence>_<mode>_trajectory.png`, median-ATE run) in `"
        << b.out_dir << "/`.\n";
+    return md.str();
+}
+
+int run(int argc, char** argv) {
+    const std::optional<Args> args = parseArgs(argc, argv);
+    if (!args) return 0;  // --help
+    const Args& a = *args;
+    const Bench b = benchOf(a);
+    // Before hours of work (after the output folder is made: the results may go in it).
+    if (!a.results.empty()) core::checkResultsSection(a.results, "bench");
+    renderSequences(b, a);
+    const Runs runs = runSlam(b, a);
+    const Tables t = makeTables(b, runs, a.results);
+    const auto [targets_md, targets_csv] = checkTargets(b, runs);
+    const std::string md = sectionMarkdown(a, b, runs, t, targets_md);
+
     const fs::path out(b.out_dir);
     for (const auto& [name, text] :
-         std::vector<std::pair<std::string, std::string>>{{"runs.csv", all_csv.str()},
-                                                          {"table1_rpe.csv", c1.str()},
-                                                          {"table2_ate.csv", c2.str()},
-                                                          {"table3_fps.csv", c3.str()},
-                                                          {"filter_truth.csv", c4.str()},
-                                                          {"tables.md", md.str()}})
+         std::vector<std::pair<std::string, std::string>>{{"runs.csv", runs.csv},
+                                                          {"table1_rpe.csv", t.c1.str()},
+                                                          {"table2_ate.csv", t.c2.str()},
+                                                          {"table3_fps.csv", t.c3.str()},
+                                                          {"filter_truth.csv", t.c4.str()},
+                                                          {"tables.md", md}})
         core::writeFileWhole((out / name).string(), text);
     if (!b.targets.empty())
-        core::writeFileWhole((out / "targets.csv").string(), targets_csv.str());
+        core::writeFileWhole((out / "targets.csv").string(), targets_csv);
     else
         fs::remove(out / "targets.csv");  // an earlier bench's, for targets no longer asked
-    std::cout << md.str();
-    if (!failed.empty()) {
+    std::cout << md;
+    if (!runs.failed.empty()) {
         // The tables count them as failed runs; a results file keeps its last whole bench.
-        std::cerr << "devslam-bench: " << failed.size() << " of " << total
-                  << " runs failed (the first: " << failed.front() << "); "
-                  << (results.empty() ? std::string("") : results + " left as it was; ")
+        std::cerr << "devslam-bench: " << runs.failed.size() << " of " << runs.total
+                  << " runs failed (the first: " << runs.failed.front() << "); "
+                  << (a.results.empty() ? std::string("") : a.results + " left as it was; ")
                   << "--reuse-runs runs only those again\n";
         return 1;
     }
-    if (!results.empty()) {
+    if (!a.results.empty()) {
         // The plots it shows with it (a bench with failed runs changed neither).
-        for (const auto& [src, dst] : results_images) {
+        for (const auto& [src, dst] : t.results_images) {
             fs::create_directories(dst.parent_path());
             fs::copy_file(src, dst, fs::copy_options::overwrite_existing);
         }
-        core::replaceResultsSection(results, "bench", md.str());
+        core::replaceResultsSection(a.results, "bench", md);
     }
     if (const int sig = core::stopSignal())  // the runs were all done by then
         std::cerr << "devslam-bench: " << core::signalName(sig)
                   << " came after the last run; the bench is whole"
-                  << (results.empty() ? std::string() : " and " + results + " was written") << "\n";
+                  << (a.results.empty() ? std::string() : " and " + a.results + " was written")
+                  << "\n";
     return 0;
 }
 
