@@ -169,11 +169,9 @@ void writeChart(const std::string& path, const std::vector<devslam::sim::Categor
                 cv::FONT_HERSHEY_SIMPLEX, 0.55, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
     if (!cv::imwrite(path, img)) throw std::runtime_error("cannot write " + path);
 }
-}  // namespace
-
-int main(int argc, char** argv) {
-    devslam::core::installStopHandler("devslam-nav-bench");
-    Args a;
+/// Reads the command line into `a`; the exit code when the program should end here (0 after
+/// --help, 2 for a bad argument, said on stderr with the usage).
+std::optional<int> parseArgs(int argc, char** argv, Args& a) {
     bool results_given = false, per_category_given = false, png_dir_given = false;
     try {
         for (int i = 1; i < argc; i++) {
@@ -234,7 +232,211 @@ int main(int argc, char** argv) {
     }
     if (!results_given && !a.quick)
         a.results = std::string(DEVSLAM_SOURCE_DIR) + "/docs/RESULTS.md";
+    return std::nullopt;
+}
 
+/// What the episodes gave: a tally per (category, method), the navigator's step times per
+/// method, and the first world of each category with its first method's run, to picture.
+struct Episodes {
+    struct Picture {
+        devslam::sim::WorldSpec world;
+        devslam::sim::EpisodeResult run;
+        std::string method;
+    };
+    std::map<std::pair<int, std::string>, Tally> tally;
+    std::map<std::string, std::vector<double>> step_ms;
+    std::vector<Picture> pictures;
+    std::size_t total = 0, done = 0;
+    double sim_seconds = 0, wall = 0;  ///< [s]
+    int stopped = 0;                   ///< the signal that stopped them (Ctrl-C), else 0
+    /// (category c, method m)'s tally; an empty one where none ran.
+    [[nodiscard]] const Tally& of(std::size_t c, const std::string& m) const {
+        static const Tally none;
+        const auto it = tally.find({static_cast<int>(c), m});
+        return it == tally.end() ? none : it->second;
+    }
+};
+
+/// Adds episode `r` of `world` to `t`.
+void count(Tally& t, const devslam::sim::WorldSpec& world, const devslam::sim::EpisodeResult& r) {
+    t.n++;
+    const double ot = r.astar_length / world.robot.max_v;  // optimal time
+    double score = 0;
+    switch (r.outcome) {
+        case devslam::sim::Outcome::Success:
+            t.success++;
+            t.success_time.push_back(r.time);
+            if (r.astar_length > 0) t.ratio.push_back(r.path_length / r.astar_length);
+            score = ot / std::clamp(r.time, ot, 8.0 * ot);
+            break;
+        case devslam::sim::Outcome::Collision:
+            t.collision++;
+            break;
+        default:
+            t.timeout++;
+            break;
+    }
+    t.static_collision += r.static_collisions > 0 ? 1 : 0;
+    t.person_collision += r.person_collisions > 0 ? 1 : 0;
+    t.score.push_back(score);
+    if (!world.pedestrians.empty()) t.people_clearance.push_back(r.min_clearance_people);
+}
+
+/// Every method on the same seeded worlds of every category, with a progress bar; Ctrl-C
+/// stops them before the next episode (Episodes::stopped).
+Episodes runEpisodes(const Args& a, const mrpt::config::CConfigFileBase& ini,
+                     const devslam::nav::NavigatorOptions& nav_opts,
+                     const std::vector<devslam::sim::Category>& cats) {
+    Episodes ep;
+    ep.total = cats.size() * a.per_category * a.methods.size();
+    devslam::core::ProgressBar bar("nav-bench", ep.total);
+    const auto t_start = Clock::now();
+    const auto run = [&]() -> int {
+        for (size_t c = 0; c < cats.size(); c++) {
+            for (int i = 0; i < a.per_category; i++) {
+                if (const int sig = devslam::core::stopSignal()) return sig;
+                auto planner_opts = nav_opts.planner;
+                const auto world = devslam::sim::randomWorld(cats[c], a.seed + i, planner_opts);
+                for (const auto& m : a.methods) {
+                    if (const int sig = devslam::core::stopSignal()) return sig;
+                    devslam::sim::EpisodeOptions eo;
+                    eo.holonomic_method = m;
+                    const auto r = devslam::sim::runEpisode(world, ini, nav_opts, eo);
+                    ep.sim_seconds += r.time;
+                    count(ep.tally[{static_cast<int>(c), m}], world, r);
+                    for (double s : r.step_seconds) ep.step_ms[m].push_back(1e3 * s);
+                    if (i == 0 && m == a.methods.front())  // pictured after the results
+                        ep.pictures.push_back({world, r, m});
+                    bar.update(++ep.done,
+                               std::string(devslam::sim::toString(cats[c])) + " " + shortName(m));
+                }
+            }
+        }
+        return 0;
+    };
+    ep.stopped = run();
+    bar.finish();
+    ep.wall = std::chrono::duration<double>(Clock::now() - t_start).count();
+    return ep;
+}
+
+/// The section's title and how it was measured.
+std::string headerMarkdown(const Args& a, const devslam::nav::NavigatorOptions& nav_opts,
+                           std::size_t n_categories) {
+    std::ostringstream md;
+    md << "## Navigation benchmark (`devslam-nav-bench`)\n\n"
+       << "Command: `devslam-nav-bench --per-category " << a.per_category << " --seed " << a.seed
+       << (a.person_margin ? " --person-margin " + num(*a.person_margin) : std::string())
+       << (a.methods.size() < 4 ? " --methods " + methodList(a.methods) : std::string())
+       << (a.quick ? " --quick" : "") << "` (config `"
+       << devslam::core::shownPath(a.config, DEVSLAM_SOURCE_DIR) << "`; people get "
+       << num(nav_opts.person_margin) << " m more room than walls, `person_margin`). "
+       << a.per_category << " seeded random worlds "
+       << "per category, " << a.per_category * n_categories
+       << " worlds in all, the same worlds for every method; Bullet simulation at 100 Hz, "
+          "navigator at 10 Hz, simulated clock. Success: within the goal tolerance before the "
+          "timeout without touching anything; a run ends at the first contact. Path ratio = "
+          "driven length / A* length, the A* cell path string-pulled (straight shortcuts "
+          "that keep its clearance). Score (BARN-style) = success x OT / clip(T, OT, 8 OT) "
+          "with OT = A* "
+          "length / max speed, averaged over all runs.\n\n";
+    return md.str();
+}
+
+/// A table per category reached, a row per method that ran there (and its picture, after a
+/// whole run).
+std::string categoryTables(const Args& a, const std::vector<devslam::sim::Category>& cats,
+                           const Episodes& ep) {
+    std::ostringstream md;
+    for (size_t c = 0; c < cats.size(); c++) {
+        // Stopped: a category not reached (its first world's first method did not run).
+        if (ep.of(c, a.methods.front()).n == 0) continue;
+        const bool people = devslam::sim::hasPeople(cats[c]);
+        md << "### " << devslam::sim::toString(cats[c])
+           << (people ? " (moving people)" : " (static)") << "\n\n"
+           << "| method | success | collision (static / people) | timeout | mean time to goal "
+              "(s) | path / A* | score |"
+           << (people ? " closest to a person (median / min of runs, m) | runs within " +
+                            num(kPersonalSpace) + " m of a person |"
+                      : std::string())
+           << "\n|---|---|---|---|---|---|---|" << (people ? "---|---|" : "") << "\n";
+        for (const auto& m : a.methods) {
+            const auto& t = ep.of(c, m);
+            if (t.n == 0) continue;  // stopped before this method's first run here
+            const auto st = devslam::core::summarize(t.success_time);
+            const auto rt = devslam::core::summarize(t.ratio);
+            const auto sc = devslam::core::summarize(t.score);
+            md << "| " << shortName(m) << " | " << pct(t.success, t.n) << " (" << t.success << "/"
+               << t.n << ") | " << pct(t.collision, t.n) << " (" << t.static_collision << " / "
+               << t.person_collision << ") | " << pct(t.timeout, t.n) << " | "
+               << (t.success_time.empty() ? "-" : num(st.mean, 1)) << " | "
+               << (t.ratio.empty() ? "-" : num(rt.mean, 2)) << " | " << num(sc.mean, 3) << " |";
+            if (people && !t.people_clearance.empty()) {
+                const auto pc = devslam::core::summarize(t.people_clearance);
+                const auto close =
+                    std::count_if(t.people_clearance.begin(), t.people_clearance.end(),
+                                  [](double d) { return d < kPersonalSpace; });
+                md << " " << num(pc.median, 2) << " / " << num(pc.min, 3) << " | "
+                   << pct(static_cast<int>(close), static_cast<int>(t.people_clearance.size()))
+                   << " |";
+            } else if (people)
+                md << " - | - |";
+            md << "\n";
+        }
+        md << "\n";
+        if (!ep.stopped)  // the pictures are made only by a whole run
+            md << "![" << devslam::sim::toString(cats[c]) << "](images/nav_bench_"
+               << devslam::sim::toString(cats[c]) << ".png)\n\n";
+    }
+    return md.str();
+}
+
+/// The timings: one VFH+ step, each method's navigationStep(), A* on a 400x400 grid, and the
+/// whole benchmark's simulated and wall time.
+std::string timingMarkdown(const Args& a, const Episodes& ep) {
+    double astar_len = 0;
+    const double vfh_ms = timeVfhStep();
+    const double astar_ms = timeAStar400(&astar_len);
+    std::ostringstream md;
+    md << "![success rates](images/nav_bench_success.png)\n\n"
+       << "### Timing (thread CPU time, so shared-machine load does not inflate it)\n\n| "
+          "measure | median |\n|---|---|\n"
+       << "| one VFH+ step (`vfhPlusStep`, 121 sectors, synthetic fields, 2000 calls) | "
+       << num(vfh_ms * 1e3, 1) << " us |\n";
+    for (const auto& m : a.methods) {
+        const auto it = ep.step_ms.find(m);
+        md << "| one MRPT `navigationStep()` with " << shortName(m)
+           << " (3 PTGs, 181-ray laser, all runs) | "
+           << num(devslam::core::median(it == ep.step_ms.end() ? std::vector<double>{}
+                                                               : it->second),
+                  3)
+           << " ms |\n";
+    }
+    md << "| A* on a 400x400 grid (20 m, 5 cm cells, 60 boxes, corner to corner, path "
+       << num(astar_len, 1) << " m; 15 plans) | " << num(astar_ms, 1) << " ms |\n"
+       << "| whole benchmark: simulated / wall time | " << num(ep.sim_seconds, 0) << " s / "
+       << num(ep.wall, 0) << " s |\n\n"
+       << devslam::core::measuredOnLine() << "\n";
+    return md.str();
+}
+
+/// Each category's first world with its first method's run, and the success-rate chart.
+void writePictures(const Args& a, const std::vector<devslam::sim::Category>& cats,
+                   const Episodes& ep) {
+    mrpt::system::createDirectory(a.png_dir);
+    for (std::size_t c = 0; c < ep.pictures.size(); ++c)
+        devslam::sim::writeEpisodePng(
+            ep.pictures[c].world, ep.pictures[c].run,
+            a.png_dir + "/nav_bench_" + devslam::sim::toString(cats[c]) + ".png",
+            ep.pictures[c].world.name + " / " + ep.pictures[c].method);
+    writeChart(a.png_dir + "/nav_bench_success.png", cats, a.methods, ep.tally);
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+    devslam::core::installStopHandler("devslam-nav-bench");
+    Args a;
+    if (const auto rc = parseArgs(argc, argv, a)) return *rc;
     try {
         // A results file that cannot take the section is found before minutes of work.
         if (!a.results.empty()) devslam::core::checkResultsSection(a.results, "nav");
@@ -247,171 +449,31 @@ int main(int argc, char** argv) {
             nav_opts.person_margin = *a.person_margin;
         }
         const auto cats = devslam::sim::allCategories();
-        struct Picture {
-            devslam::sim::WorldSpec world;
-            devslam::sim::EpisodeResult run;
-            std::string method;
-        };
-        std::vector<Picture> pictures;  // the first world of each category, first method
-
-        std::map<std::pair<int, std::string>, Tally> tally;
-        std::map<std::string, std::vector<double>> step_ms;
-        const size_t total = cats.size() * a.per_category * a.methods.size();
-        devslam::core::ProgressBar bar("nav-bench", total);
-        size_t done = 0;
-        const auto t_start = Clock::now();
-        double sim_seconds = 0;
-        // Returns the signal that stopped it (Ctrl-C, before an episode), else 0.
-        const auto runEpisodes = [&]() -> int {
-            for (size_t c = 0; c < cats.size(); c++) {
-                for (int i = 0; i < a.per_category; i++) {
-                    if (const int sig = devslam::core::stopSignal()) return sig;
-                    auto planner_opts = nav_opts.planner;
-                    const auto world = devslam::sim::randomWorld(cats[c], a.seed + i, planner_opts);
-                    for (const auto& m : a.methods) {
-                        if (const int sig = devslam::core::stopSignal()) return sig;
-                        devslam::sim::EpisodeOptions eo;
-                        eo.holonomic_method = m;
-                        const auto r = devslam::sim::runEpisode(world, *ini, nav_opts, eo);
-                        sim_seconds += r.time;
-                        auto& t = tally[{static_cast<int>(c), m}];
-                        t.n++;
-                        const double ot = r.astar_length / world.robot.max_v;  // optimal time
-                        double score = 0;
-                        switch (r.outcome) {
-                            case devslam::sim::Outcome::Success:
-                                t.success++;
-                                t.success_time.push_back(r.time);
-                                if (r.astar_length > 0)
-                                    t.ratio.push_back(r.path_length / r.astar_length);
-                                score = ot / std::clamp(r.time, ot, 8.0 * ot);
-                                break;
-                            case devslam::sim::Outcome::Collision:
-                                t.collision++;
-                                break;
-                            default:
-                                t.timeout++;
-                                break;
-                        }
-                        t.static_collision += r.static_collisions > 0 ? 1 : 0;
-                        t.person_collision += r.person_collisions > 0 ? 1 : 0;
-                        t.score.push_back(score);
-                        if (!world.pedestrians.empty())
-                            t.people_clearance.push_back(r.min_clearance_people);
-                        for (double s : r.step_seconds) step_ms[m].push_back(1e3 * s);
-                        if (i == 0 && m == a.methods.front())  // pictured after the results
-                            pictures.push_back({world, r, m});
-                        bar.update(++done, std::string(devslam::sim::toString(cats[c])) + " " +
-                                               shortName(m));
-                    }
-                }
-            }
-            return 0;
-        };
-        const int stopped = runEpisodes();
-        bar.finish();
-        const double wall = std::chrono::duration<double>(Clock::now() - t_start).count();
-
+        const Episodes ep = runEpisodes(a, *ini, nav_opts, cats);
         std::ostringstream md;
-        md << "## Navigation benchmark (`devslam-nav-bench`)\n\n"
-           << "Command: `devslam-nav-bench --per-category " << a.per_category << " --seed "
-           << a.seed
-           << (a.person_margin ? " --person-margin " + num(*a.person_margin) : std::string())
-           << (a.methods.size() < 4 ? " --methods " + methodList(a.methods) : std::string())
-           << (a.quick ? " --quick" : "") << "` (config `"
-           << devslam::core::shownPath(a.config, DEVSLAM_SOURCE_DIR) << "`; people get "
-           << num(nav_opts.person_margin) << " m more room than walls, `person_margin`). "
-           << a.per_category << " seeded random worlds "
-           << "per category, " << a.per_category * cats.size()
-           << " worlds in all, the same worlds for every method; Bullet simulation at 100 Hz, "
-              "navigator at 10 Hz, simulated clock. Success: within the goal tolerance before the "
-              "timeout without touching anything; a run ends at the first contact. Path ratio = "
-              "driven length / A* length, the A* cell path string-pulled (straight shortcuts "
-              "that keep its clearance). Score (BARN-style) = success x OT / clip(T, OT, 8 OT) "
-              "with OT = A* "
-              "length / max speed, averaged over all runs.\n\n";
-        if (stopped)
-            md << "**Interrupted (" << devslam::core::signalName(stopped) << ") after " << done
-               << " of " << total << " episodes: the tables below cover those only.**\n\n";
-        for (size_t c = 0; c < cats.size(); c++) {
-            // Stopped: a category not reached (its first world's first method did not run).
-            if (tally[{static_cast<int>(c), a.methods.front()}].n == 0) continue;
-            const bool people = devslam::sim::hasPeople(cats[c]);
-            md << "### " << devslam::sim::toString(cats[c])
-               << (people ? " (moving people)" : " (static)") << "\n\n"
-               << "| method | success | collision (static / people) | timeout | mean time to goal "
-                  "(s) | path / A* | score |"
-               << (people ? " closest to a person (median / min of runs, m) | runs within " +
-                                num(kPersonalSpace) + " m of a person |"
-                          : std::string())
-               << "\n|---|---|---|---|---|---|---|" << (people ? "---|---|" : "") << "\n";
-            for (const auto& m : a.methods) {
-                const auto& t = tally[{static_cast<int>(c), m}];
-                if (t.n == 0) continue;  // stopped before this method's first run here
-                const auto st = devslam::core::summarize(t.success_time);
-                const auto rt = devslam::core::summarize(t.ratio);
-                const auto sc = devslam::core::summarize(t.score);
-                md << "| " << shortName(m) << " | " << pct(t.success, t.n) << " (" << t.success
-                   << "/" << t.n << ") | " << pct(t.collision, t.n) << " (" << t.static_collision
-                   << " / " << t.person_collision << ") | " << pct(t.timeout, t.n) << " | "
-                   << (t.success_time.empty() ? "-" : num(st.mean, 1)) << " | "
-                   << (t.ratio.empty() ? "-" : num(rt.mean, 2)) << " | " << num(sc.mean, 3) << " |";
-                if (people && !t.people_clearance.empty()) {
-                    const auto pc = devslam::core::summarize(t.people_clearance);
-                    const auto close =
-                        std::count_if(t.people_clearance.begin(), t.people_clearance.end(),
-                                      [](double d) { return d < kPersonalSpace; });
-                    md << " " << num(pc.median, 2) << " / " << num(pc.min, 3) << " | "
-                       << pct(static_cast<int>(close), static_cast<int>(t.people_clearance.size()))
-                       << " |";
-                } else if (people)
-                    md << " - | - |";
-                md << "\n";
-            }
-            md << "\n";
-            if (!stopped)  // the pictures are made only by a whole run
-                md << "![" << devslam::sim::toString(cats[c]) << "](images/nav_bench_"
-                   << devslam::sim::toString(cats[c]) << ".png)\n\n";
-        }
-        if (stopped) {
+        md << headerMarkdown(a, nav_opts, cats.size());
+        if (ep.stopped)
+            md << "**Interrupted (" << devslam::core::signalName(ep.stopped) << ") after "
+               << ep.done << " of " << ep.total
+               << " episodes: the tables below cover those only.**\n\n";
+        md << categoryTables(a, cats, ep);
+        if (ep.stopped) {
             std::cout << md.str();
-            std::cerr << "devslam-nav-bench: interrupted (" << devslam::core::signalName(stopped)
-                      << ") after " << done << " of " << total
+            std::cerr << "devslam-nav-bench: interrupted (" << devslam::core::signalName(ep.stopped)
+                      << ") after " << ep.done << " of " << ep.total
                       << " episodes; the tables above cover those; "
                       << (a.results.empty() ? std::string() : a.results + " and ")
                       << "the pictures were left as they were\n";
-            devslam::core::exitBySignal(stopped);
+            devslam::core::exitBySignal(ep.stopped);
         }
-        double astar_len = 0;
-        const double vfh_ms = timeVfhStep();
-        const double astar_ms = timeAStar400(&astar_len);
-        md << "![success rates](images/nav_bench_success.png)\n\n"
-           << "### Timing (thread CPU time, so shared-machine load does not inflate it)\n\n| "
-              "measure | median |\n|---|---|\n"
-           << "| one VFH+ step (`vfhPlusStep`, 121 sectors, synthetic fields, 2000 calls) | "
-           << num(vfh_ms * 1e3, 1) << " us |\n";
-        for (const auto& m : a.methods)
-            md << "| one MRPT `navigationStep()` with " << shortName(m)
-               << " (3 PTGs, 181-ray laser, all runs) | "
-               << num(devslam::core::median(step_ms[m]), 3) << " ms |\n";
-        md << "| A* on a 400x400 grid (20 m, 5 cm cells, 60 boxes, corner to corner, path "
-           << num(astar_len, 1) << " m; 15 plans) | " << num(astar_ms, 1) << " ms |\n"
-           << "| whole benchmark: simulated / wall time | " << num(sim_seconds, 0) << " s / "
-           << num(wall, 0) << " s |\n\n"
-           << devslam::core::measuredOnLine() << "\n";
+        md << timingMarkdown(a, ep);
         std::cout << md.str();
         // The table first: pictures of a table that could not be written would not match it.
         if (!a.results.empty()) {
             devslam::core::replaceResultsSection(a.results, "nav", md.str());
             std::cerr << "devslam-nav-bench: updated section 'nav' of " << a.results << "\n";
         }
-        mrpt::system::createDirectory(a.png_dir);
-        for (std::size_t c = 0; c < pictures.size(); ++c)
-            devslam::sim::writeEpisodePng(
-                pictures[c].world, pictures[c].run,
-                a.png_dir + "/nav_bench_" + devslam::sim::toString(cats[c]) + ".png",
-                pictures[c].world.name + " / " + pictures[c].method);
-        writeChart(a.png_dir + "/nav_bench_success.png", cats, a.methods, tally);
+        writePictures(a, cats, ep);
         std::cerr << "devslam-nav-bench: pictures in " << a.png_dir << "\n";
         // Ctrl-C during the timings: all was written; end by the signal, as a script expects.
         if (const int sig = devslam::core::stopSignal()) devslam::core::exitBySignal(sig);
