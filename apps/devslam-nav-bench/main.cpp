@@ -255,6 +255,12 @@ struct Episodes {
         const auto it = tally.find({static_cast<int>(c), m});
         return it == tally.end() ? none : it->second;
     }
+    /// Method m's navigationStep() times [ms]; none where it made no step.
+    [[nodiscard]] const std::vector<double>& stepsOf(const std::string& m) const {
+        static const std::vector<double> none;
+        const auto it = step_ms.find(m);
+        return it == step_ms.end() ? none : it->second;
+    }
 };
 
 /// Adds episode `r` of `world` to `t`.
@@ -403,15 +409,10 @@ std::string timingMarkdown(const Args& a, const Episodes& ep) {
           "measure | median |\n|---|---|\n"
        << "| one VFH+ step (`vfhPlusStep`, 121 sectors, synthetic fields, 2000 calls) | "
        << num(vfh_ms * 1e3, 1) << " us |\n";
-    for (const auto& m : a.methods) {
-        const auto it = ep.step_ms.find(m);
+    for (const auto& m : a.methods)
         md << "| one MRPT `navigationStep()` with " << shortName(m)
            << " (3 PTGs, 181-ray laser, all runs) | "
-           << num(devslam::core::median(it == ep.step_ms.end() ? std::vector<double>{}
-                                                               : it->second),
-                  3)
-           << " ms |\n";
-    }
+           << num(devslam::core::median(ep.stepsOf(m)), 3) << " ms |\n";
     md << "| A* on a 400x400 grid (20 m, 5 cm cells, 60 boxes, corner to corner, path "
        << num(astar_len, 1) << " m; 15 plans) | " << num(astar_ms, 1) << " ms |\n"
        << "| whole benchmark: simulated / wall time | " << num(ep.sim_seconds, 0) << " s / "
