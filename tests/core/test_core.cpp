@@ -14,6 +14,7 @@
 #include <opencv2/core/utility.hpp>
 
 #include "Scratch.h"
+#include "ConfigRoundTrip.h"
 
 #include <atomic>
 #include <filesystem>
@@ -98,6 +99,33 @@ TEST(Camera, ConfigRoundTripAndErrors) {
     }
     mrpt::config::CConfigFileMemory bad("[camera]\npreset = fr1\ncx = 900\n");
     EXPECT_THROW((void)CameraIntrinsics::fromConfig(bad, "camera"), std::invalid_argument);
+}
+
+// Every key of [camera], from a preset (saved as its values): read back, at full precision.
+TEST(Camera, EveryKeyRoundTrips) {
+    devslam::test::expectEveryKeyRoundTrips(
+        [](const devslam::test::Ini& in, devslam::test::Ini& out) {
+            CameraIntrinsics::fromConfig(in, "camera").saveToConfig(out, "camera");
+        },
+        {{}, {}, {{"camera", "preset"}}},
+        devslam::test::Ini("[camera]\npreset = freiburg1\n"));
+}
+
+TEST(Config, WrittenRealsReadBackExactly) {
+    mrpt::config::CConfigFileMemory mem;
+    for (const double v : {0.000123456789, 123456.789, 1.0 / 3.0, -2.5e-9, 1e300, 0.1, 3.0}) {
+        writeKey(mem, "s", "v", v);
+        EXPECT_EQ(readDouble(mem, "s", "v", 0), v) << mem.read_string("s", "v", "");
+    }
+    writeKey(mem, "s", "v", 0.1);
+    EXPECT_EQ(mem.read_string("s", "v", ""), "0.1");  // no more digits than it needs
+    writeKey(mem, "s", "list", std::vector<double>{0.2624, -1.0 / 7.0, 0});
+    const auto back = parseNumberList(mem.read_string("s", "list", ""), "list");
+    EXPECT_EQ(back, (std::vector<double>{0.2624, -1.0 / 7.0, 0}));
+    writeKey(mem, "s", "n", 12);
+    writeKey(mem, "s", "b", true);
+    EXPECT_EQ(mem.read_string("s", "n", ""), "12");
+    EXPECT_EQ(mem.read_string("s", "b", ""), "true");
 }
 
 TEST(Config, UnknownKeyIsNamed) {

@@ -10,6 +10,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include "Scratch.h"
+#include "ConfigRoundTrip.h"
 
 #include <filesystem>
 #include <fstream>
@@ -253,6 +254,32 @@ TEST(DetectYolo, OptionsRoundTrip) {
     EXPECT_EQ(b.input_width, 416);
     EXPECT_FLOAT_EQ(b.conf_threshold, 0.2f);
     EXPECT_EQ(b.classes, a.classes);
+}
+
+// Every key of both detectors' sections: read back into its own field, at full precision.
+TEST(DetectYolo, EveryKeyRoundTrips) {
+    test::expectEveryKeyRoundTrips(
+        [](const test::Ini& in, test::Ini& out) {
+            detect::YoloDetector::Options o;
+            o.loadFromConfig(in, "detector");
+            o.saveToConfig(out, "detector");
+        },
+        {{{"detector", "model", {"models/other.cfg"}},
+          {"detector", "weights", {"models/other.weights"}},
+          {"detector", "names", {"models/other.names"}},
+          {"detector", "classes", {"person, dog", "car"}}},
+         {{"detector", "detector"}},
+         {}});
+}
+
+TEST(DetectHog, EveryKeyRoundTrips) {
+    test::expectEveryKeyRoundTrips(
+        [](const test::Ini& in, test::Ini& out) {
+            detect::HogDetector::Options o;
+            o.loadFromConfig(in, "detector");
+            o.saveToConfig(out, "detector");
+        },
+        {{}, {{"detector", "detector"}}, {}});
 }
 
 TEST(DetectFactory, UnknownNameListsKnownNames) {

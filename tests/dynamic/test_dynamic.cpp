@@ -17,6 +17,8 @@
 #include <set>
 #include <sstream>
 
+#include "ConfigRoundTrip.h"
+
 using namespace devslam;
 using dynamic::BoxState;
 using dynamic::DynamicObjectFilter;
@@ -768,6 +770,20 @@ TEST(DynamicConfig, ShippedIniLoadsAndRoundTrips) {
     }
     auto f = dynamic::makeFilterFromConfig(*cfg, MaskMode::None);
     EXPECT_EQ(f->options().mode, MaskMode::None);
+}
+
+// Every key of [dynamic_filter]: read back into its own field, at full precision.
+TEST(DynamicConfig, EveryKeyRoundTrips) {
+    test::expectEveryKeyRoundTrips(
+        [](const test::Ini& in, test::Ini& out) {
+            DynamicObjectFilter::Options o;
+            o.loadFromConfig(in);
+            o.saveToConfig(out);
+        },
+        {{{"dynamic_filter", "mode", {"all_persons", "none"}},
+          {"dynamic_filter", "static_person_gate", {"same", "narrower"}}},
+         {},
+         {}});
 }
 
 TEST(DynamicConfig, BadValuesAreRejected) {

@@ -5,6 +5,8 @@
 #include <devslam/nav/Replan.h>
 #include <devslam/nav/VfhPlus.h>
 
+#include "ConfigRoundTrip.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -390,4 +392,23 @@ TEST(NavConfig, UnknownKeyIsReported) {
     EXPECT_EQ(navError(mrpt::config::CConfigFileMemory("[navigator]\nnav_period = 0.1\n")),
               "x.ini: no [CAbstractPTGBasedReactive] section (MRPT's navigator needs it; see "
               "config_ini/nav_reactive.ini)");
+}
+
+// Every key of [global_planner] and [replan]: read back into its own field, at full precision.
+TEST(GridPlanner, EveryKeyRoundTrips) {
+    devslam::test::expectEveryKeyRoundTrips(
+        [](const devslam::test::Ini& in, devslam::test::Ini& out) {
+            GridPlannerOptions o;
+            o.loadFromConfigFile(in, "global_planner");
+            o.saveToConfigFile(out, "global_planner");
+        });
+}
+
+TEST(Replan, EveryKeyRoundTrips) {
+    devslam::test::expectEveryKeyRoundTrips(
+        [](const devslam::test::Ini& in, devslam::test::Ini& out) {
+            ReplanOptions o;
+            o.loadFromConfigFile(in, "replan");
+            o.saveToConfigFile(out, "replan");
+        });
 }

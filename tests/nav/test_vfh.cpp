@@ -2,6 +2,8 @@
 #include <devslam/nav/CHolonomicVFHPlus.h>
 #include <devslam/nav/VfhPlus.h>
 
+#include "ConfigRoundTrip.h"
+
 #include <gtest/gtest.h>
 #include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/rtti/CObject.h>
@@ -138,6 +140,16 @@ TEST(VfhPlus, AllBlockedStops) {
     const auto out = vfhPlusStep(in, {}, {});
     EXPECT_EQ(out.sector, -1);
     EXPECT_EQ(out.speed, 0.0);
+}
+
+// Every key of [CHolonomicVFHPlus]: read back into its own field, at full precision.
+TEST(VfhPlus, EveryKeyRoundTrips) {
+    devslam::test::expectEveryKeyRoundTrips(
+        [](const devslam::test::Ini& in, devslam::test::Ini& out) {
+            VfhPlusOptions o;
+            o.loadFromConfigFile(in, "CHolonomicVFHPlus");
+            o.saveToConfigFile(out, "CHolonomicVFHPlus");
+        });
 }
 
 TEST(VfhPlus, OptionsValidateAndRoundTrip) {

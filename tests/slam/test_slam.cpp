@@ -12,6 +12,8 @@
 #include <devslam/slam/Slam.h>
 #include <devslam/slam/Tracker.h>
 
+#include "ConfigRoundTrip.h"
+
 #include <gtest/gtest.h>
 #include <mrpt/config/CConfigFileMemory.h>
 #include <opencv2/imgproc.hpp>
@@ -766,4 +768,10 @@ TEST(Config, SaveLoadRoundTrip) {
     EXPECT_EQ(back.local_ba.window, 7);
     EXPECT_EQ(back.loop.min_inliers, 55);
     EXPECT_FALSE(back.mapping.depth_time_compensation);
+}
+
+// Every key of every SLAM section: saved, read back into its own field, at full precision.
+TEST(Config, EveryKeyRoundTrips) {
+    test::expectEveryKeyRoundTrips(
+        [](const test::Ini& in, test::Ini& out) { SlamOptions::fromConfig(in).saveToConfig(out); });
 }

@@ -92,13 +92,13 @@ CameraIntrinsics CameraIntrinsics::fromConfig(const mrpt::config::CConfigFileBas
 }
 
 void CameraIntrinsics::saveToConfig(mrpt::config::CConfigFileBase& c, const std::string& s) const {
-    c.write(s, "fx", fx);
-    c.write(s, "fy", fy);
-    c.write(s, "cx", cx);
-    c.write(s, "cy", cy);
-    c.write(s, "width", width);
-    c.write(s, "height", height);
-    c.write(s, "dist", std::vector<double>(dist.begin(), dist.end()));
+    core::writeKey(c, s, "fx", fx);
+    core::writeKey(c, s, "fy", fy);
+    core::writeKey(c, s, "cx", cx);
+    core::writeKey(c, s, "cy", cy);
+    core::writeKey(c, s, "width", width);
+    core::writeKey(c, s, "height", height);
+    core::writeKey(c, s, "dist", std::vector<double>(dist.begin(), dist.end()));
 }
 
 Eigen::Matrix3d CameraIntrinsics::matrix() const {

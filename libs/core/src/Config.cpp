@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <charconv>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -278,6 +279,27 @@ std::vector<std::string> unknownKeys(const mrpt::config::CConfigFileBase& cfg,
     for (const auto& k : keys)
         if (std::find(known.begin(), known.end(), k) == known.end()) unknown.push_back(k);
     return unknown;
+}
+
+namespace {
+std::string shortestReal(double v) {
+    char buf[32];
+    const auto r = std::to_chars(buf, buf + sizeof buf, v);  // shortest form that reads back
+    return std::string(buf, r.ptr);
+}
+}  // namespace
+
+void writeKey(mrpt::config::CConfigFileBase& cfg, const std::string& section,
+              const std::string& key, double value) {
+    cfg.write(section, key, shortestReal(value));
+}
+
+void writeKey(mrpt::config::CConfigFileBase& cfg, const std::string& section,
+              const std::string& key, const std::vector<double>& values) {
+    std::string text = "[";
+    for (std::size_t i = 0; i < values.size(); ++i)
+        text += (i ? " " : "") + shortestReal(values[i]);
+    cfg.write(section, key, text + "]");
 }
 
 void requireKnownKeys(const mrpt::config::CConfigFileBase& cfg, const std::string& section,

@@ -35,13 +35,13 @@ void HogDetector::Options::loadFromConfig(const mrpt::config::CConfigFileBase& c
 
 void HogDetector::Options::saveToConfig(mrpt::config::CConfigFileBase& c,
                                         const std::string& s) const {
-    c.write(s, "detector", std::string("hog"));
-    c.write(s, "hit_threshold", hit_threshold);
-    c.write(s, "win_stride", win_stride);
-    c.write(s, "scale", scale);
-    c.write(s, "group_threshold", group_threshold);
-    c.write(s, "min_score", min_score);
-    c.write(s, "resize", resize);
+    core::writeKey(c, s, "detector", std::string("hog"));
+    core::writeKey(c, s, "hit_threshold", hit_threshold);
+    core::writeKey(c, s, "win_stride", win_stride);
+    core::writeKey(c, s, "scale", scale);
+    core::writeKey(c, s, "group_threshold", group_threshold);
+    core::writeKey(c, s, "min_score", min_score);
+    core::writeKey(c, s, "resize", resize);
 }
 
 HogDetector::HogDetector(const Options& opts) : opts_(opts) {

@@ -118,8 +118,8 @@ void YoloDetector::Options::loadFromConfig(const mrpt::config::CConfigFileBase& 
     names = c.read_string(s, "names", names);
     input_width = core::readInt(c, s, "input_width", input_width);
     input_height = core::readInt(c, s, "input_height", input_height);
-    conf_threshold = static_cast<float>(core::readDouble(c, s, "conf_threshold", conf_threshold));
-    nms_threshold = static_cast<float>(core::readDouble(c, s, "nms_threshold", nms_threshold));
+    conf_threshold = core::readDouble(c, s, "conf_threshold", conf_threshold);
+    nms_threshold = core::readDouble(c, s, "nms_threshold", nms_threshold);
     if (c.keyExists(s, "classes")) classes = splitList(c.read_string(s, "classes", ""));
     validate_on_load = core::readBool(c, s, "validate_on_load", validate_on_load);
     fast_convolutions = core::readBool(c, s, "fast_convolutions", fast_convolutions);
@@ -136,19 +136,19 @@ void YoloDetector::Options::loadFromConfig(const mrpt::config::CConfigFileBase& 
 
 void YoloDetector::Options::saveToConfig(mrpt::config::CConfigFileBase& c,
                                          const std::string& s) const {
-    c.write(s, "detector", std::string("yolo"));
-    c.write(s, "model", model);
-    c.write(s, "weights", weights);
-    c.write(s, "names", names);
-    c.write(s, "input_width", input_width);
-    c.write(s, "input_height", input_height);
-    c.write(s, "conf_threshold", conf_threshold);
-    c.write(s, "nms_threshold", nms_threshold);
+    core::writeKey(c, s, "detector", std::string("yolo"));
+    core::writeKey(c, s, "model", model);
+    core::writeKey(c, s, "weights", weights);
+    core::writeKey(c, s, "names", names);
+    core::writeKey(c, s, "input_width", input_width);
+    core::writeKey(c, s, "input_height", input_height);
+    core::writeKey(c, s, "conf_threshold", conf_threshold);
+    core::writeKey(c, s, "nms_threshold", nms_threshold);
     std::string list;
     for (const auto& n : classes) list += (list.empty() ? "" : ", ") + n;
-    c.write(s, "classes", list);
-    c.write(s, "validate_on_load", validate_on_load);
-    c.write(s, "fast_convolutions", fast_convolutions);
+    core::writeKey(c, s, "classes", list);
+    core::writeKey(c, s, "validate_on_load", validate_on_load);
+    core::writeKey(c, s, "fast_convolutions", fast_convolutions);
 }
 
 YoloDetector::YoloDetector(const Options& opts) : opts_(opts) {
@@ -179,7 +179,8 @@ YoloDetector::YoloDetector(const Options& opts) : opts_(opts) {
                                          " bytes) to be a darknet weights file");
             // A threshold the network never reaches down to would promise weak boxes (those
             // that only continue tracks) that never come.
-            if (const float lowest = darknetScoreFloor(model); opts_.conf_threshold < lowest) {
+            const float lowest = darknetScoreFloor(model);
+            if (static_cast<float>(opts_.conf_threshold) < lowest) {
                 std::ostringstream msg;
                 msg << "conf_threshold: " << opts_.conf_threshold << " is below the " << lowest
                     << " of the [yolo] layers of '" << model
@@ -244,6 +245,9 @@ std::vector<Detection> YoloDetector::detect(const cv::Mat& bgr) {
     std::vector<cv::Mat> outs;
     net_.forward(outs, out_names_);
 
+    // The network's scores are floats: the thresholds compare at their precision.
+    const auto conf = static_cast<float>(opts_.conf_threshold);
+    const auto nms = static_cast<float>(opts_.nms_threshold);
     const int n_classes = static_cast<int>(names_.size());
     std::vector<std::vector<cv::Rect2d>> boxes(wanted_.size());
     std::vector<std::vector<float>> scores(wanted_.size());
@@ -257,13 +261,13 @@ std::vector<Detection> YoloDetector::detect(const cv::Mat& bgr) {
         for (int r = 0; r < out.rows; ++r) {
             const float* row = out.ptr<float>(r);
             const float obj = row[4];
-            if (obj < opts_.conf_threshold) continue;
+            if (obj < conf) continue;
             for (std::size_t k = 0; k < wanted_.size(); ++k) {
                 // cv::dnn's darknet region layer already multiplies class scores by
                 // objectness; ONNX (YOLOv5-style) outputs keep them separate.
                 const float cls = row[5 + wanted_[k]];
                 const float score = onnx_ ? obj * cls : cls;
-                if (score < opts_.conf_threshold) continue;
+                if (score < conf) continue;
                 double cx = row[0], cy = row[1], w = row[2], h = row[3];
                 if (onnx_) {  // input pixels -> normalized
                     cx /= opts_.input_width;
@@ -281,7 +285,7 @@ std::vector<Detection> YoloDetector::detect(const cv::Mat& bgr) {
     const cv::Rect2f image(0.f, 0.f, static_cast<float>(bgr.cols), static_cast<float>(bgr.rows));
     for (std::size_t k = 0; k < wanted_.size(); ++k) {
         std::vector<int> keep;
-        cv::dnn::NMSBoxes(boxes[k], scores[k], opts_.conf_threshold, opts_.nms_threshold, keep);
+        cv::dnn::NMSBoxes(boxes[k], scores[k], conf, nms, keep);
         for (int i : keep) {
             const cv::Rect2f b = cv::Rect2f(boxes[k][i]) & image;
             if (b.area() <= 0.f) continue;

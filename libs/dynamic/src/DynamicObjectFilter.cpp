@@ -290,53 +290,56 @@ void DynamicObjectFilter::Options::validate(const std::string& s) const {
 
 void DynamicObjectFilter::Options::saveToConfig(mrpt::config::CConfigFileBase& c,
                                                 const std::string& s) const {
-    c.write(s, "mode", toString(mode));
-    c.write(s, "detect_every", detect_every);
-    c.write(s, "flow_scale", flow_scale);
-    c.write(s, "max_corners", max_corners);
-    c.write(s, "max_corners_per_box", max_corners_per_box);
-    c.write(s, "corner_quality", corner_quality);
-    c.write(s, "corner_min_distance", corner_min_distance);
-    c.write(s, "lk_window", lk_window);
-    c.write(s, "lk_levels", lk_levels);
-    c.write(s, "fb_max_error", fb_max_error);
-    c.write(s, "refine_ego_motion", refine_ego_motion);
-    c.write(s, "min_background_points", min_background_points);
-    c.write(s, "ransac_reprojection", ransac_reprojection);
-    c.write(s, "max_depth", max_depth);
-    c.write(s, "threshold1", threshold1);
-    c.write(s, "background_factor", background_factor);
-    c.write(s, "threshold2_count", threshold2_count);
-    c.write(s, "threshold2_fraction", threshold2_fraction);
-    c.write(s, "min_points", min_points);
-    c.write(s, "box_shrink", box_shrink);
-    c.write(s, "fg_depth_band", fg_depth_band);
-    c.write(s, "mask_silhouette", mask_silhouette);
-    c.write(s, "silhouette_depth_band", silhouette_depth_band);
-    c.write(s, "silhouette_grow", silhouette_grow);
-    c.write(s, "static_person_weight", static_person_weight);
+    core::writeKey(c, s, "mode", toString(mode));
+    core::writeKey(c, s, "detect_every", detect_every);
+    core::writeKey(c, s, "flow_scale", flow_scale);
+    core::writeKey(c, s, "max_corners", max_corners);
+    core::writeKey(c, s, "max_corners_per_box", max_corners_per_box);
+    core::writeKey(c, s, "corner_quality", corner_quality);
+    core::writeKey(c, s, "corner_min_distance", corner_min_distance);
+    core::writeKey(c, s, "lk_window", lk_window);
+    core::writeKey(c, s, "lk_levels", lk_levels);
+    core::writeKey(c, s, "fb_max_error", fb_max_error);
+    core::writeKey(c, s, "refine_ego_motion", refine_ego_motion);
+    core::writeKey(c, s, "min_background_points", min_background_points);
+    core::writeKey(c, s, "ransac_reprojection", ransac_reprojection);
+    core::writeKey(c, s, "max_depth", max_depth);
+    core::writeKey(c, s, "threshold1", threshold1);
+    core::writeKey(c, s, "background_factor", background_factor);
+    core::writeKey(c, s, "threshold2_count", threshold2_count);
+    core::writeKey(c, s, "threshold2_fraction", threshold2_fraction);
+    core::writeKey(c, s, "min_points", min_points);
+    core::writeKey(c, s, "box_shrink", box_shrink);
+    core::writeKey(c, s, "fg_depth_band", fg_depth_band);
+    core::writeKey(c, s, "mask_silhouette", mask_silhouette);
+    core::writeKey(c, s, "silhouette_depth_band", silhouette_depth_band);
+    core::writeKey(c, s, "silhouette_grow", silhouette_grow);
+    core::writeKey(c, s, "static_person_weight", static_person_weight);
     // An exponent outside the table (options set in code, not validated) is written as a
     // number, which loading refuses naming the key.
     const char* gate = gateName(static_person_gate);
-    c.write(s, "static_person_gate", gate ? std::string(gate) : std::to_string(static_person_gate));
-    c.write(s, "slow_frames", slow_frames);
-    c.write(s, "slow_threshold", slow_threshold);
-    c.write(s, "slow_speed", slow_speed);
-    c.write(s, "depth_frames", depth_frames);
-    c.write(s, "depth_rate_threshold", depth_rate_threshold);
-    c.write(s, "depth_noise_z2", depth_noise_z2);
-    c.write(s, "new_track_score", new_track_score);
-    c.write(s, "iou_match", iou_match);
-    c.write(s, "release_frames", release_frames);
-    c.write(s, "confirm_border_frames", confirm_border_frames);
-    c.write(s, "max_missed_detections", max_missed_detections);
-    c.write(s, "hide_unseen_frames", hide_unseen_frames);
-    c.write(s, "forget_unseen_frames", forget_unseen_frames);
-    c.write(s, "keep_border_tracks", keep_border_tracks);
-    c.write(s, "mask_margin", mask_margin);
-    c.write(s, "mask_unknown", mask_unknown);
-    c.write(s, "mask_unknown_first_frame", mask_unknown_first_frame);
-    c.write(s, "mask_border_snap", mask_border_snap);
+    if (gate)
+        core::writeKey(c, s, "static_person_gate", std::string(gate));
+    else
+        core::writeKey(c, s, "static_person_gate", static_person_gate);
+    core::writeKey(c, s, "slow_frames", slow_frames);
+    core::writeKey(c, s, "slow_threshold", slow_threshold);
+    core::writeKey(c, s, "slow_speed", slow_speed);
+    core::writeKey(c, s, "depth_frames", depth_frames);
+    core::writeKey(c, s, "depth_rate_threshold", depth_rate_threshold);
+    core::writeKey(c, s, "depth_noise_z2", depth_noise_z2);
+    core::writeKey(c, s, "new_track_score", new_track_score);
+    core::writeKey(c, s, "iou_match", iou_match);
+    core::writeKey(c, s, "release_frames", release_frames);
+    core::writeKey(c, s, "confirm_border_frames", confirm_border_frames);
+    core::writeKey(c, s, "max_missed_detections", max_missed_detections);
+    core::writeKey(c, s, "hide_unseen_frames", hide_unseen_frames);
+    core::writeKey(c, s, "forget_unseen_frames", forget_unseen_frames);
+    core::writeKey(c, s, "keep_border_tracks", keep_border_tracks);
+    core::writeKey(c, s, "mask_margin", mask_margin);
+    core::writeKey(c, s, "mask_unknown", mask_unknown);
+    core::writeKey(c, s, "mask_unknown_first_frame", mask_unknown_first_frame);
+    core::writeKey(c, s, "mask_border_snap", mask_border_snap);
 }
 
 namespace {

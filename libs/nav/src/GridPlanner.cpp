@@ -41,13 +41,13 @@ void GridPlannerOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase&
 
 void GridPlannerOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c,
                                           const std::string& s) const {
-    c.write(s, "robot_radius", robot_radius);
-    c.write(s, "inflation_margin", inflation_margin);
-    c.write(s, "inflation_penalty", inflation_penalty);
-    c.write(s, "clearance_distance", clearance_distance);
-    c.write(s, "clearance_weight", clearance_weight);
-    c.write(s, "occupied_threshold", occupied_threshold);
-    c.write(s, "waypoint_spacing", waypoint_spacing);
+    core::writeKey(c, s, "robot_radius", robot_radius);
+    core::writeKey(c, s, "inflation_margin", inflation_margin);
+    core::writeKey(c, s, "inflation_penalty", inflation_penalty);
+    core::writeKey(c, s, "clearance_distance", clearance_distance);
+    core::writeKey(c, s, "clearance_weight", clearance_weight);
+    core::writeKey(c, s, "occupied_threshold", occupied_threshold);
+    core::writeKey(c, s, "waypoint_spacing", waypoint_spacing);
 }
 
 void GridPlannerOptions::validate() const {

@@ -31,13 +31,13 @@ void ReplanOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, c
 }
 
 void ReplanOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c, const std::string& s) const {
-    c.write(s, "density_threshold", density_threshold);
-    c.write(s, "density_time", density_time);
-    c.write(s, "min_interval", min_interval);
-    c.write(s, "blocked_lookahead", blocked_lookahead);
-    c.write(s, "blocked_margin", blocked_margin);
-    c.write(s, "obstacle_inflation", obstacle_inflation);
-    c.write(s, "sensed_range", sensed_range);
+    core::writeKey(c, s, "density_threshold", density_threshold);
+    core::writeKey(c, s, "density_time", density_time);
+    core::writeKey(c, s, "min_interval", min_interval);
+    core::writeKey(c, s, "blocked_lookahead", blocked_lookahead);
+    core::writeKey(c, s, "blocked_margin", blocked_margin);
+    core::writeKey(c, s, "obstacle_inflation", obstacle_inflation);
+    core::writeKey(c, s, "sensed_range", sensed_range);
 }
 
 const char* toString(ReplanReason r) {

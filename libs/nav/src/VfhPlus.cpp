@@ -51,20 +51,20 @@ void VfhPlusOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c,
 
 void VfhPlusOptions::saveToConfigFile(mrpt::config::CConfigFileBase& c,
                                       const std::string& s) const {
-    c.write(s, "window", window);
-    c.write(s, "certainty", certainty);
-    c.write(s, "enlargement_radius", enlargement_radius);
-    c.write(s, "tau_low", tau_low);
-    c.write(s, "tau_high", tau_high);
-    c.write(s, "min_free_distance", min_free_distance);
-    c.write(s, "mask_distance", mask_distance);
-    c.write(s, "wide_valley_sectors", wide_valley_sectors);
-    c.write(s, "mu1", mu1);
-    c.write(s, "mu2", mu2);
-    c.write(s, "mu3", mu3);
-    c.write(s, "hm", hm);
-    c.write(s, "min_speed_ratio", min_speed_ratio);
-    c.write(s, "target_slowdown_distance", target_slowdown_distance);
+    core::writeKey(c, s, "window", window);
+    core::writeKey(c, s, "certainty", certainty);
+    core::writeKey(c, s, "enlargement_radius", enlargement_radius);
+    core::writeKey(c, s, "tau_low", tau_low);
+    core::writeKey(c, s, "tau_high", tau_high);
+    core::writeKey(c, s, "min_free_distance", min_free_distance);
+    core::writeKey(c, s, "mask_distance", mask_distance);
+    core::writeKey(c, s, "wide_valley_sectors", wide_valley_sectors);
+    core::writeKey(c, s, "mu1", mu1);
+    core::writeKey(c, s, "mu2", mu2);
+    core::writeKey(c, s, "mu3", mu3);
+    core::writeKey(c, s, "hm", hm);
+    core::writeKey(c, s, "min_speed_ratio", min_speed_ratio);
+    core::writeKey(c, s, "target_slowdown_distance", target_slowdown_distance);
 }
 
 void VfhPlusOptions::validate() const {

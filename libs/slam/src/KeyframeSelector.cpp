@@ -30,14 +30,14 @@ void KeyframeSelectorOptions::loadFromConfig(const mrpt::config::CConfigFileBase
 
 void KeyframeSelectorOptions::saveToConfig(mrpt::config::CConfigFileBase& c,
                                            const std::string& s) const {
-    c.write(s, "min_frames", min_frames);
-    c.write(s, "max_frames", max_frames);
-    c.write(s, "min_tracked_ratio", min_tracked_ratio);
-    c.write(s, "min_tracked", min_tracked);
-    c.write(s, "close_tracked_below", close_tracked_below);
-    c.write(s, "close_untracked_above", close_untracked_above);
-    c.write(s, "max_translation", max_translation);
-    c.write(s, "max_rotation_deg", max_rotation_deg);
+    core::writeKey(c, s, "min_frames", min_frames);
+    core::writeKey(c, s, "max_frames", max_frames);
+    core::writeKey(c, s, "min_tracked_ratio", min_tracked_ratio);
+    core::writeKey(c, s, "min_tracked", min_tracked);
+    core::writeKey(c, s, "close_tracked_below", close_tracked_below);
+    core::writeKey(c, s, "close_untracked_above", close_untracked_above);
+    core::writeKey(c, s, "max_translation", max_translation);
+    core::writeKey(c, s, "max_rotation_deg", max_rotation_deg);
 }
 
 std::string toString(KeyframeReason r) {

@@ -37,14 +37,14 @@ void LocalBaOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, cons
 }
 
 void LocalBaOptions::saveToConfig(mrpt::config::CConfigFileBase& c, const std::string& s) const {
-    c.write(s, "enabled", enabled);
-    c.write(s, "window", window);
-    c.write(s, "outlier_rounds", outlier_rounds);
-    c.write(s, "iterations", iterations);
-    c.write(s, "bf", bf);
-    c.write(s, "chi2_mono", chi2_mono);
-    c.write(s, "chi2_stereo", chi2_stereo);
-    c.write(s, "max_keyframe_shift", max_keyframe_shift);
+    core::writeKey(c, s, "enabled", enabled);
+    core::writeKey(c, s, "window", window);
+    core::writeKey(c, s, "outlier_rounds", outlier_rounds);
+    core::writeKey(c, s, "iterations", iterations);
+    core::writeKey(c, s, "bf", bf);
+    core::writeKey(c, s, "chi2_mono", chi2_mono);
+    core::writeKey(c, s, "chi2_stereo", chi2_stereo);
+    core::writeKey(c, s, "max_keyframe_shift", max_keyframe_shift);
 }
 
 namespace {

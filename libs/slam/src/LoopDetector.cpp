@@ -48,21 +48,21 @@ void LoopOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, const s
 }
 
 void LoopOptions::saveToConfig(mrpt::config::CConfigFileBase& c, const std::string& s) const {
-    c.write(s, "enabled", enabled);
-    c.write(s, "min_keyframe_gap", min_keyframe_gap);
-    c.write(s, "cooldown_keyframes", cooldown_keyframes);
-    c.write(s, "max_distance", max_distance);
-    c.write(s, "max_candidates", max_candidates);
-    c.write(s, "max_hamming", max_hamming);
-    c.write(s, "ratio", ratio);
-    c.write(s, "min_inliers", min_inliers);
-    c.write(s, "max_correction", max_correction);
-    c.write(s, "max_correction_deg", max_correction_deg);
-    c.write(s, "confirm_keyframes", confirm_keyframes);
-    c.write(s, "confirm_t", confirm_t);
-    c.write(s, "confirm_deg", confirm_deg);
-    c.write(s, "sigma_t", sigma_t);
-    c.write(s, "sigma_r_deg", sigma_r_deg);
+    core::writeKey(c, s, "enabled", enabled);
+    core::writeKey(c, s, "min_keyframe_gap", min_keyframe_gap);
+    core::writeKey(c, s, "cooldown_keyframes", cooldown_keyframes);
+    core::writeKey(c, s, "max_distance", max_distance);
+    core::writeKey(c, s, "max_candidates", max_candidates);
+    core::writeKey(c, s, "max_hamming", max_hamming);
+    core::writeKey(c, s, "ratio", ratio);
+    core::writeKey(c, s, "min_inliers", min_inliers);
+    core::writeKey(c, s, "max_correction", max_correction);
+    core::writeKey(c, s, "max_correction_deg", max_correction_deg);
+    core::writeKey(c, s, "confirm_keyframes", confirm_keyframes);
+    core::writeKey(c, s, "confirm_t", confirm_t);
+    core::writeKey(c, s, "confirm_deg", confirm_deg);
+    core::writeKey(c, s, "sigma_t", sigma_t);
+    core::writeKey(c, s, "sigma_r_deg", sigma_r_deg);
 }
 
 bool loopsAgree(const Map& map, const LoopConstraint& a, const LoopConstraint& b, double max_t,

@@ -45,19 +45,19 @@ void OrbExtractor::Options::loadFromConfig(const mrpt::config::CConfigFileBase& 
 
 void OrbExtractor::Options::saveToConfig(mrpt::config::CConfigFileBase& c,
                                          const std::string& s) const {
-    c.write(s, "n_features", n_features);
-    c.write(s, "scale_factor", scale_factor);
-    c.write(s, "n_levels", n_levels);
-    c.write(s, "fast_threshold", fast_threshold);
-    c.write(s, "min_fast_threshold", min_fast_threshold);
-    c.write(s, "oversample", oversample);
-    c.write(s, "detect_outside_mask", detect_outside_mask);
-    c.write(s, "depth_edge_threshold", depth_edge_threshold);
-    c.write(s, "grid_cols", grid_cols);
-    c.write(s, "grid_rows", grid_rows);
-    c.write(s, "min_depth", min_depth);
-    c.write(s, "max_depth", max_depth);
-    c.write(s, "depth_factor", depth_factor);
+    core::writeKey(c, s, "n_features", n_features);
+    core::writeKey(c, s, "scale_factor", scale_factor);
+    core::writeKey(c, s, "n_levels", n_levels);
+    core::writeKey(c, s, "fast_threshold", fast_threshold);
+    core::writeKey(c, s, "min_fast_threshold", min_fast_threshold);
+    core::writeKey(c, s, "oversample", oversample);
+    core::writeKey(c, s, "detect_outside_mask", detect_outside_mask);
+    core::writeKey(c, s, "depth_edge_threshold", depth_edge_threshold);
+    core::writeKey(c, s, "grid_cols", grid_cols);
+    core::writeKey(c, s, "grid_rows", grid_rows);
+    core::writeKey(c, s, "min_depth", min_depth);
+    core::writeKey(c, s, "max_depth", max_depth);
+    core::writeKey(c, s, "depth_factor", depth_factor);
 }
 
 OrbExtractor::OrbExtractor(const Options& opts) : opts_(opts) {

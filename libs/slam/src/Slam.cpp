@@ -35,14 +35,14 @@ void MappingOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, cons
 }
 
 void MappingOptions::saveToConfig(mrpt::config::CConfigFileBase& c, const std::string& s) const {
-    c.write(s, "min_init_points", min_init_points);
-    c.write(s, "cull_min_found_ratio", cull_min_found_ratio);
-    c.write(s, "cull_min_visible", cull_min_visible);
-    c.write(s, "cull_keyframe_age", cull_keyframe_age);
-    c.write(s, "odometry_sigma_t", odometry_sigma_t);
-    c.write(s, "odometry_sigma_r_deg", odometry_sigma_r_deg);
-    c.write(s, "depth_time_compensation", depth_time_compensation);
-    c.write(s, "refine_frames", refine_frames);
+    core::writeKey(c, s, "min_init_points", min_init_points);
+    core::writeKey(c, s, "cull_min_found_ratio", cull_min_found_ratio);
+    core::writeKey(c, s, "cull_min_visible", cull_min_visible);
+    core::writeKey(c, s, "cull_keyframe_age", cull_keyframe_age);
+    core::writeKey(c, s, "odometry_sigma_t", odometry_sigma_t);
+    core::writeKey(c, s, "odometry_sigma_r_deg", odometry_sigma_r_deg);
+    core::writeKey(c, s, "depth_time_compensation", depth_time_compensation);
+    core::writeKey(c, s, "refine_frames", refine_frames);
 }
 
 std::optional<double> depthStamp(const core::Frame& frame) {
@@ -98,7 +98,7 @@ void SlamOptions::saveToConfig(mrpt::config::CConfigFileBase& cfg) const {
     mapping.saveToConfig(cfg, "mapping");
     local_ba.saveToConfig(cfg, "local_ba");
     loop.saveToConfig(cfg, "loop_closure");
-    cfg.write("pose_graph", "max_iterations", pose_graph.max_iterations);
+    core::writeKey(cfg, "pose_graph", "max_iterations", pose_graph.max_iterations);
 }
 
 Slam::Slam(const SlamOptions& opts) : opts_(opts), orb_(opts.orb), tracker_(opts.tracker) {}

@@ -91,30 +91,30 @@ void TrackerOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, cons
 }
 
 void TrackerOptions::saveToConfig(mrpt::config::CConfigFileBase& c, const std::string& s) const {
-    c.write(s, "search_radius", projection.radius);
-    c.write(s, "fine_radius", fine_radius);
-    c.write(s, "wide_radius_factor", wide_radius_factor);
-    c.write(s, "max_hamming", projection.max_hamming);
-    c.write(s, "match_ratio", projection.ratio);
-    c.write(s, "max_depth", projection.max_depth);
-    c.write(s, "pnp_iterations", pnp.iterations);
-    c.write(s, "pnp_reprojection_px", pnp.reprojection_px);
-    c.write(s, "pnp_confidence", pnp.confidence);
-    c.write(s, "bf", refine.bf);
-    c.write(s, "refine_rounds", refine.rounds);
-    c.write(s, "refine_iterations", refine.iterations);
-    c.write(s, "min_matches", min_matches);
-    c.write(s, "min_inliers", min_inliers);
-    c.write(s, "local_keyframes", local_keyframes);
-    c.write(s, "max_motion_dt", max_motion_dt);
-    c.write(s, "reloc_keyframes", reloc_keyframes);
-    c.write(s, "reloc_min_inliers", reloc_min_inliers);
-    c.write(s, "reloc_max_hamming", reloc_max_hamming);
-    c.write(s, "reloc_ratio", reloc_ratio);
-    c.write(s, "reloc_max_jump", reloc_max_jump);
-    c.write(s, "reloc_max_speed", reloc_max_speed);
-    c.write(s, "reloc_max_jump_deg", reloc_max_jump_deg);
-    c.write(s, "reloc_max_rate_deg", reloc_max_rate_deg);
+    core::writeKey(c, s, "search_radius", projection.radius);
+    core::writeKey(c, s, "fine_radius", fine_radius);
+    core::writeKey(c, s, "wide_radius_factor", wide_radius_factor);
+    core::writeKey(c, s, "max_hamming", projection.max_hamming);
+    core::writeKey(c, s, "match_ratio", projection.ratio);
+    core::writeKey(c, s, "max_depth", projection.max_depth);
+    core::writeKey(c, s, "pnp_iterations", pnp.iterations);
+    core::writeKey(c, s, "pnp_reprojection_px", pnp.reprojection_px);
+    core::writeKey(c, s, "pnp_confidence", pnp.confidence);
+    core::writeKey(c, s, "bf", refine.bf);
+    core::writeKey(c, s, "refine_rounds", refine.rounds);
+    core::writeKey(c, s, "refine_iterations", refine.iterations);
+    core::writeKey(c, s, "min_matches", min_matches);
+    core::writeKey(c, s, "min_inliers", min_inliers);
+    core::writeKey(c, s, "local_keyframes", local_keyframes);
+    core::writeKey(c, s, "max_motion_dt", max_motion_dt);
+    core::writeKey(c, s, "reloc_keyframes", reloc_keyframes);
+    core::writeKey(c, s, "reloc_min_inliers", reloc_min_inliers);
+    core::writeKey(c, s, "reloc_max_hamming", reloc_max_hamming);
+    core::writeKey(c, s, "reloc_ratio", reloc_ratio);
+    core::writeKey(c, s, "reloc_max_jump", reloc_max_jump);
+    core::writeKey(c, s, "reloc_max_speed", reloc_max_speed);
+    core::writeKey(c, s, "reloc_max_jump_deg", reloc_max_jump_deg);
+    core::writeKey(c, s, "reloc_max_rate_deg", reloc_max_rate_deg);
 }
 
 void Tracker::initialize(const Eigen::Isometry3d& T_wc, double timestamp) {

@@ -15,6 +15,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 namespace devslam::core {
@@ -111,6 +112,22 @@ void applyOverrides(mrpt::config::CConfigFileMemory& cfg, const std::vector<std:
                                 bool required = false);
 [[nodiscard]] bool readBool(const mrpt::config::CConfigFileBase& cfg, const std::string& section,
                             const std::string& key, bool def, bool required = false);
+
+/// Writes [section] key so that the reads above give `value` back exactly. MRPT's write prints
+/// a real number with six decimals ("%f", "%e" outside [1e-4, 1e4]), so a saved 0.000123456
+/// came back as 0.000123 and 123456.789 as 123456.8: a real number here gets the fewest digits
+/// that read back to the same double (std::to_chars), a list of them "[a b c]". Anything else
+/// is written as MRPT writes it (an int as digits, a bool as true/false). The saveToConfig of
+/// every options class writes through this.
+void writeKey(mrpt::config::CConfigFileBase& cfg, const std::string& section,
+              const std::string& key, double value);
+void writeKey(mrpt::config::CConfigFileBase& cfg, const std::string& section,
+              const std::string& key, const std::vector<double>& values);
+template <class T, class = std::enable_if_t<!std::is_floating_point_v<T>>>
+void writeKey(mrpt::config::CConfigFileBase& cfg, const std::string& section,
+              const std::string& key, const T& value) {
+    cfg.write(section, key, value);
+}
 
 /// Runs `load()` and returns what it returns. A std::invalid_argument whose message names
 /// only the field ("[section] key: ...", as the reads above and requireValue throw) comes

@@ -27,8 +27,8 @@ class YoloDetector final : public PersonDetector {
         std::string names = "models/yolo-fastest-1.1/coco.names";   ///< one class name a line
         int input_width = 320;         ///< [px] network input (multiple of 32)
         int input_height = 320;        ///< [px]
-        float conf_threshold = 0.35f;  ///< min score (objectness * class score)
-        float nms_threshold = 0.45f;   ///< IoU above which the weaker box is suppressed
+        double conf_threshold = 0.35;  ///< min score (objectness * class score)
+        double nms_threshold = 0.45;   ///< IoU above which the weaker box is suppressed
         std::vector<std::string> classes{"person"};  ///< classes reported (potentially dynamic)
         bool validate_on_load = true;  ///< run one forward pass at load to catch bad weights
         /// Depthwise and 1x1 convolutions by detect::withFastConvolutions (AVX2 kernels, same
