@@ -48,13 +48,9 @@ WorldSpec loadWorld(const std::string& path) {
 
 namespace {
 
-WorldSpec parseWorldFields(const mrpt::config::CConfigFileBase& c, const std::string& source) {
-    WorldSpec w;
-    w.source = source;
-    for (const char* s : {"world", "robot", "goal"})
-        if (!c.sectionExists(s)) fail(source, s, "", "required section is missing");
-
-    std::string s = "world";
+void parseWorldSection(const mrpt::config::CConfigFileBase& c, const std::string& source,
+                       WorldSpec& w) {
+    const std::string s = "world";
     core::requireKnownKeys(c, s,
                            {"name", "x_min", "x_max", "y_min", "y_max", "boundary_walls",
                             "grid_resolution", "time_step", "timeout", "seed", "pedestrians_yield"},
@@ -72,8 +68,11 @@ WorldSpec parseWorldFields(const mrpt::config::CConfigFileBase& c, const std::st
     if (seed > UINT32_MAX) fail(source, s, "seed", "must be < 2^32, got " + std::to_string(seed));
     w.seed = static_cast<uint32_t>(seed);
     w.pedestrians_yield = core::readBool(c, s, "pedestrians_yield", w.pedestrians_yield);
+}
 
-    s = "robot";
+void parseRobotGoalLaser(const mrpt::config::CConfigFileBase& c, const std::string& source,
+                         WorldSpec& w) {
+    std::string s = "robot";
     core::requireKnownKeys(c, s,
                            {"start_x", "start_y", "start_yaw_deg", "radius", "max_v", "max_w_deg",
                             "max_acc", "max_ang_acc_deg"},
@@ -106,72 +105,87 @@ WorldSpec parseWorldFields(const mrpt::config::CConfigFileBase& c, const std::st
     w.laser.rate = core::readDouble(c, s, "rate_hz", w.laser.rate);
     w.laser.height = core::readDouble(c, s, "height", w.laser.height);
     w.laser.detect_people = core::readBool(c, s, "detect_people", w.laser.detect_people);
+}
 
+/// [obstacles] key = "box|block|wall cx cy size_x size_y [yaw_deg]" or "cylinder cx cy radius".
+Obstacle parseObstacle(const mrpt::config::CConfigFileBase& c, const std::string& source,
+                       const std::string& k) {
+    const std::string s = "obstacles";
+    const auto words = splitWords(c.read_string(s, k, ""));
+    if (words.empty()) fail(source, s, k, "empty obstacle");
+    const auto v = parseNumbers(words, 1, source, s, k);
+    Obstacle o;
+    o.name = k;
+    o.kind = words[0];
+    if (o.kind == "box" || o.kind == "block" || o.kind == "wall") {
+        if (v.size() != 4 && v.size() != 5)
+            fail(source, s, k, "expected '" + o.kind + " cx cy size_x size_y [yaw_deg]'");
+        o.shape = Obstacle::Shape::Box;
+        o.cx = v[0];
+        o.cy = v[1];
+        o.sx = v[2];
+        o.sy = v[3];
+        o.yaw = v.size() == 5 ? mrpt::DEG2RAD(v[4]) : 0.0;
+        if (o.sx <= 0 || o.sy <= 0) fail(source, s, k, "sizes must be > 0 m");
+        o.height = o.kind == "block" ? 0.4 : 1.0;
+    } else if (o.kind == "cylinder") {
+        if (v.size() != 3) fail(source, s, k, "expected 'cylinder cx cy radius'");
+        o.shape = Obstacle::Shape::Cylinder;
+        o.cx = v[0];
+        o.cy = v[1];
+        o.radius = v[2];
+        if (o.radius <= 0) fail(source, s, k, "radius must be > 0 m");
+    } else {
+        fail(source, s, k,
+             "unknown obstacle kind '" + o.kind + "' (known: box, block, wall, cylinder)");
+    }
+    return o;
+}
+
+/// [pedestrians] key = "scripted speed radius delay x1 y1 x2 y2 [...]" or
+/// "random speed radius delay x y".
+Pedestrian parsePedestrian(const mrpt::config::CConfigFileBase& c, const std::string& source,
+                           const std::string& k) {
+    const std::string s = "pedestrians";
+    const auto words = splitWords(c.read_string(s, k, ""));
+    if (words.empty()) fail(source, s, k, "empty pedestrian");
+    Pedestrian p;
+    p.name = k;
+    const auto v = parseNumbers(words, 1, source, s, k);
+    if (words[0] == "scripted") {
+        // scripted speed radius delay x1 y1 x2 y2 ...
+        if (v.size() < 7 || (v.size() - 3) % 2 != 0)
+            fail(source, s, k,
+                 "expected 'scripted speed radius delay x1 y1 x2 y2 [...]' (>= 2 points)");
+        p.mode = Pedestrian::Mode::Scripted;
+    } else if (words[0] == "random") {
+        if (v.size() != 5) fail(source, s, k, "expected 'random speed radius delay x y'");
+        p.mode = Pedestrian::Mode::RandomWalk;
+    } else {
+        fail(source, s, k, "unknown pedestrian mode '" + words[0] + "' (known: scripted, random)");
+    }
+    p.speed = v[0];
+    p.radius = v[1];
+    p.start_delay = v[2];
+    for (size_t i = 3; i + 1 < v.size(); i += 2) p.path.emplace_back(v[i], v[i + 1]);
+    if (p.speed < 0 || p.radius <= 0 || p.start_delay < 0)
+        fail(source, s, k, "speed and delay must be >= 0, radius > 0");
+    return p;
+}
+
+WorldSpec parseWorldFields(const mrpt::config::CConfigFileBase& c, const std::string& source) {
+    WorldSpec w;
+    w.source = source;
+    for (const char* s : {"world", "robot", "goal"})
+        if (!c.sectionExists(s)) fail(source, s, "", "required section is missing");
+    parseWorldSection(c, source, w);
+    parseRobotGoalLaser(c, source, w);
     std::vector<std::string> keys;
-    s = "obstacles";
-    c.getAllKeys(s, keys);
-    for (const auto& k : keys) {
-        const auto words = splitWords(c.read_string(s, k, ""));
-        if (words.empty()) fail(source, s, k, "empty obstacle");
-        const auto v = parseNumbers(words, 1, source, s, k);
-        Obstacle o;
-        o.name = k;
-        o.kind = words[0];
-        if (o.kind == "box" || o.kind == "block" || o.kind == "wall") {
-            if (v.size() != 4 && v.size() != 5)
-                fail(source, s, k, "expected '" + o.kind + " cx cy size_x size_y [yaw_deg]'");
-            o.shape = Obstacle::Shape::Box;
-            o.cx = v[0];
-            o.cy = v[1];
-            o.sx = v[2];
-            o.sy = v[3];
-            o.yaw = v.size() == 5 ? mrpt::DEG2RAD(v[4]) : 0.0;
-            if (o.sx <= 0 || o.sy <= 0) fail(source, s, k, "sizes must be > 0 m");
-            o.height = o.kind == "block" ? 0.4 : 1.0;
-        } else if (o.kind == "cylinder") {
-            if (v.size() != 3) fail(source, s, k, "expected 'cylinder cx cy radius'");
-            o.shape = Obstacle::Shape::Cylinder;
-            o.cx = v[0];
-            o.cy = v[1];
-            o.radius = v[2];
-            if (o.radius <= 0) fail(source, s, k, "radius must be > 0 m");
-        } else {
-            fail(source, s, k,
-                 "unknown obstacle kind '" + o.kind + "' (known: box, block, wall, cylinder)");
-        }
-        w.obstacles.push_back(o);
-    }
-
-    s = "pedestrians";
+    c.getAllKeys("obstacles", keys);
+    for (const auto& k : keys) w.obstacles.push_back(parseObstacle(c, source, k));
     keys.clear();
-    c.getAllKeys(s, keys);
-    for (const auto& k : keys) {
-        const auto words = splitWords(c.read_string(s, k, ""));
-        if (words.empty()) fail(source, s, k, "empty pedestrian");
-        Pedestrian p;
-        p.name = k;
-        const auto v = parseNumbers(words, 1, source, s, k);
-        if (words[0] == "scripted") {
-            // scripted speed radius delay x1 y1 x2 y2 ...
-            if (v.size() < 7 || (v.size() - 3) % 2 != 0)
-                fail(source, s, k,
-                     "expected 'scripted speed radius delay x1 y1 x2 y2 [...]' (>= 2 points)");
-            p.mode = Pedestrian::Mode::Scripted;
-        } else if (words[0] == "random") {
-            if (v.size() != 5) fail(source, s, k, "expected 'random speed radius delay x y'");
-            p.mode = Pedestrian::Mode::RandomWalk;
-        } else {
-            fail(source, s, k,
-                 "unknown pedestrian mode '" + words[0] + "' (known: scripted, random)");
-        }
-        p.speed = v[0];
-        p.radius = v[1];
-        p.start_delay = v[2];
-        for (size_t i = 3; i + 1 < v.size(); i += 2) p.path.emplace_back(v[i], v[i + 1]);
-        if (p.speed < 0 || p.radius <= 0 || p.start_delay < 0)
-            fail(source, s, k, "speed and delay must be >= 0, radius > 0");
-        w.pedestrians.push_back(p);
-    }
+    c.getAllKeys("pedestrians", keys);
+    for (const auto& k : keys) w.pedestrians.push_back(parsePedestrian(c, source, k));
     validateWorld(w);
     return w;
 }
@@ -184,7 +198,14 @@ WorldSpec parseWorld(const mrpt::config::CConfigFileBase& c, const std::string& 
     return core::namingSource(source, [&] { return parseWorldFields(c, source); });
 }
 
-void validateWorld(const WorldSpec& w) {
+namespace {
+
+bool insideBounds(const WorldSpec& w, const mrpt::math::TPoint2D& p) {
+    return p.x > w.x_min && p.x < w.x_max && p.y > w.y_min && p.y < w.y_max;
+}
+
+/// [world]: the bounds, the grid and the physics step, and what they cost to run.
+void validateBoundsAndTiming(const WorldSpec& w) {
     const auto& src = w.source;
     if (!(w.x_max > w.x_min)) fail(src, "world", "x_max", "must be > x_min");
     if (!(w.y_max > w.y_min)) fail(src, "world", "y_max", "must be > y_min");
@@ -211,6 +232,11 @@ void validateWorld(const WorldSpec& w) {
           << w.timeout / w.time_step << " physics steps (at most 1e6)";
         fail(src, "world", "timeout", m.str());
     }
+}
+
+/// [robot], [laser] and the goal's tolerance.
+void validateRobotAndLaser(const WorldSpec& w) {
+    const auto& src = w.source;
     if (w.robot.radius <= 0) fail(src, "robot", "radius", "must be > 0 m");
     for (const auto& [key, v] : {std::pair{"max_v", w.robot.max_v},
                                  {"max_w_deg", w.robot.max_w},
@@ -235,9 +261,13 @@ void validateWorld(const WorldSpec& w) {
         fail(src, "laser", "rays", m.str());
     }
     if (w.goal_tolerance <= 0) fail(src, "goal", "tolerance", "must be > 0 m");
-    auto inside = [&](const mrpt::math::TPoint2D& p) {
-        return p.x > w.x_min && p.x < w.x_max && p.y > w.y_min && p.y < w.y_max;
-    };
+}
+
+/// The start and the goal: inside the bounds, off the obstacles, and usable on the planner's
+/// grid.
+void validateEndpoints(const WorldSpec& w, const std::vector<Obstacle>& statics) {
+    const auto& src = w.source;
+    const auto inside = [&](const mrpt::math::TPoint2D& p) { return insideBounds(w, p); };
     // The coordinate that is out names the key (x first when both are).
     const auto outKey = [&](const mrpt::math::TPoint2D& p, const char* kx, const char* ky) {
         return p.x > w.x_min && p.x < w.x_max ? ky : kx;
@@ -247,7 +277,6 @@ void validateWorld(const WorldSpec& w) {
              "start is outside the world bounds");
     if (!inside(w.goal))
         fail(src, "goal", outKey(w.goal, "x", "y"), "goal is outside the world bounds");
-    const auto statics = staticObstacles(w);
     for (const auto& o : statics) {
         const double dg = distanceToObstacle(o, w.goal);
         if (dg <= 0) fail(src, "goal", "x", "the goal lies inside obstacle '" + o.name + "'");
@@ -288,6 +317,11 @@ void validateWorld(const WorldSpec& w) {
             fail(src, section, key, m.str());
         }
     }
+}
+
+/// Each pedestrian: inside the bounds, off the robot's start, and never through an obstacle.
+void validatePedestrians(const WorldSpec& w, const std::vector<Obstacle>& statics) {
+    const auto& src = w.source;
     const auto at = [](const mrpt::math::TPoint2D& q) {
         std::ostringstream m;
         m << "(" << q.x << ", " << q.y << ")";
@@ -296,7 +330,8 @@ void validateWorld(const WorldSpec& w) {
     for (const auto& p : w.pedestrians) {
         if (p.path.empty()) fail(src, "pedestrians", p.name, "no position given");
         for (const auto& q : p.path)
-            if (!inside(q)) fail(src, "pedestrians", p.name, "a point is outside the world bounds");
+            if (!insideBounds(w, q))
+                fail(src, "pedestrians", p.name, "a point is outside the world bounds");
         const auto& p0 = p.path.front();
         if (std::hypot(p0.x - w.robot.start.x, p0.y - w.robot.start.y) < p.radius + w.robot.radius)
             fail(src, "pedestrians", p.name,
@@ -322,6 +357,16 @@ void validateWorld(const WorldSpec& w) {
             }
         }
     }
+}
+
+}  // namespace
+
+void validateWorld(const WorldSpec& w) {
+    validateBoundsAndTiming(w);
+    validateRobotAndLaser(w);
+    const auto statics = staticObstacles(w);
+    validateEndpoints(w, statics);
+    validatePedestrians(w, statics);
 }
 
 std::vector<Obstacle> staticObstacles(const WorldSpec& w) {
