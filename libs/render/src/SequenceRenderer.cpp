@@ -84,6 +84,61 @@ cv::Mat panelCrop(const cv::Mat& img, std::mt19937_64& rng, double aspect) {
     return crop;
 }
 
+/// Adds Gaussian noise of `sigma` grey levels to each channel (saturating), seeded.
+void addRgbNoise(cv::Mat& bgr, double sigma, std::uint64_t seed) {
+    cv::Mat noise(bgr.size(), CV_32FC3);
+    std::mt19937_64 rng(seed);
+    std::normal_distribution<float> g(0.f, float(sigma));
+    for (auto it = noise.begin<cv::Vec3f>(); it != noise.end<cv::Vec3f>(); ++it)
+        *it = cv::Vec3f(g(rng), g(rng), g(rng));
+    cv::Mat f;
+    bgr.convertTo(f, CV_32FC3);
+    f += noise;
+    f.convertTo(bgr, CV_8UC3);  // saturating
+}
+
+/// One planar part of a person (the body, or the hand in front of it when it gestures).
+struct PersonPart {
+    mrpt::poses::CPose3D P;
+    Eigen::Matrix3d R = Eigen::Matrix3d::Identity();  // columns: local x, y (normal), z
+    Eigen::Vector3d p0 = Eigen::Vector3d::Zero();
+    bool hand = false;
+};
+
+PersonPart personPart(const mrpt::poses::CPose3D& P, bool hand) {
+    PersonPart part;
+    part.P = P;
+    const auto Rp = P.getRotationMatrix();
+    for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) part.R(r, c) = Rp(r, c);
+    part.p0 = {P.x(), P.y(), P.z()};
+    part.hand = hand;
+    return part;
+}
+
+/// The image rectangle that holds the projection of the parts' corners (a width x height
+/// photo each), one pixel wider all round; the whole image when a corner is behind the camera.
+cv::Rect projectedBox(const std::vector<PersonPart>& parts, double width, double height,
+                      const mrpt::poses::CPose3D& T_wc, const core::CameraIntrinsics& K) {
+    cv::Rect roi(0, 0, K.width, K.height);
+    double u0 = 1e9, v0 = 1e9, u1 = -1e9, v1 = -1e9;
+    for (const auto& part : parts) {
+        for (double lx : {-width / 2, width / 2})
+            for (double lz : {0.0, height}) {
+                mrpt::math::TPoint3D w;
+                part.P.composePoint(lx, 0, lz, w.x, w.y, w.z);
+                mrpt::math::TPoint3D c;
+                T_wc.inverseComposePoint(w, c);
+                if (c.z < 1e-3) return roi;
+                const double u = K.fx * c.x / c.z + K.cx, v = K.fy * c.y / c.z + K.cy;
+                u0 = std::min(u0, u), u1 = std::max(u1, u), v0 = std::min(v0, v),
+                v1 = std::max(v1, v);
+            }
+    }
+    return roi & cv::Rect(int(std::floor(u0)) - 1, int(std::floor(v0)) - 1,
+                          int(std::ceil(u1 - u0)) + 3, int(std::ceil(v1 - v0)) + 3);
+}
+
 }  // namespace
 
 struct SequenceRenderer::Impl {
@@ -178,6 +233,55 @@ struct SequenceRenderer::Impl {
         }
     }
 
+    /// Person k's truth in one frame: the pixels whose ray, at the rendered depth, meets the
+    /// person's solid cells, written as k + 1 into `labels`, and their box.
+    PersonTruth labelPerson(std::size_t k, const std::vector<PersonPart>& parts,
+                            const mrpt::poses::CPose3D& T_wc, const core::CameraIntrinsics& K,
+                            const cv::Mat& clean_depth, cv::Mat& labels) const {
+        const auto& person = people[k];
+        PersonTruth pt;
+        pt.id = int(k + 1);
+        const Eigen::Vector3d eye(T_wc.x(), T_wc.y(), T_wc.z());
+        const auto Rwc = T_wc.getRotationMatrix();
+        const cv::Rect roi = projectedBox(parts, person.width, person.height, T_wc, K);
+        const auto& m = person.tex.cell_mask;
+        const double tw = person.tex.bgr.cols, th = person.tex.bgr.rows, cp = person.tex.cell_px;
+        // Pixel (u, v) at rendered depth zr along world ray dw lies on the part's solid cells.
+        const auto onPart = [&](const PersonPart& part, const Eigen::Vector3d& dw, float zr) {
+            const Eigen::Vector3d n = part.R.col(1);
+            const double den = n.dot(dw);
+            if (std::abs(den) < 1e-9) return false;
+            const double s = n.dot(part.p0 - eye) / den;  // = depth along the optical axis
+            if (s <= 0 || std::abs(zr - s) > std::max(0.01, 0.005 * s)) return false;
+            const Eigen::Vector3d q = eye + s * dw - part.p0;
+            const double lx = part.R.col(0).dot(q), lz = part.R.col(2).dot(q);
+            const double col = (person.width / 2 - lx) / person.width * tw;
+            const double row = (person.height - lz) / person.height * th;
+            if (col < 0 || row < 0 || col >= tw || row >= th) return false;
+            const int r = int(row / cp), c = int(col / cp);
+            return m.at<uchar>(r, c) && (person.hand_cell.at<uchar>(r, c) != 0) == part.hand;
+        };
+        int umin = K.width, vmin = K.height, umax = -1, vmax = -1;
+        for (int v = roi.y; v < roi.y + roi.height; ++v)
+            for (int u = roi.x; u < roi.x + roi.width; ++u) {
+                const float zr = clean_depth.at<float>(v, u);
+                if (zr <= 0) continue;
+                const Eigen::Vector3d dc((u - K.cx) / K.fx, (v - K.cy) / K.fy, 1.0);
+                Eigen::Vector3d dw;
+                for (int r = 0; r < 3; ++r)
+                    dw[r] = Rwc(r, 0) * dc[0] + Rwc(r, 1) * dc[1] + Rwc(r, 2) * dc[2];
+                bool hit = false;
+                for (const auto& part : parts) hit = hit || onPart(part, dw, zr);
+                if (!hit) continue;
+                labels.at<uchar>(v, u) = uchar(pt.id);
+                ++pt.visible_pixels;
+                umin = std::min(umin, u), umax = std::max(umax, u);
+                vmin = std::min(vmin, v), vmax = std::max(vmax, v);
+            }
+        if (pt.visible_pixels > 0) pt.box = cv::Rect(umin, vmin, umax - umin + 1, vmax - vmin + 1);
+        return pt;
+    }
+
     void buildPeople(const Scenario& sc) {
         for (const auto& spec : sc.people) {
             Person p;
@@ -267,17 +371,20 @@ RenderedFrame SequenceRenderer::render(std::size_t i) {
     out.T_wc = cameraPoseAt(sc_.trajectory, t);
     const Eigen::Vector3d eye(out.T_wc.x(), out.T_wc.y(), out.T_wc.z());
 
-    std::vector<mrpt::poses::CPose3D> person_pose(sc_.people.size()), hand_pose(sc_.people.size());
+    // Each person's planar parts at t: the hand first (it is in front), then the body.
+    std::vector<std::vector<PersonPart>> parts(sc_.people.size());
     std::vector<PersonState> state(sc_.people.size());
     for (std::size_t k = 0; k < sc_.people.size(); ++k) {
         state[k] = personStateAt(sc_.people[k], t);
-        person_pose[k] = personPhotoPose(sc_.people[k], state[k], eye, impl_->first_eye);
+        const auto body = personPhotoPose(sc_.people[k], state[k], eye, impl_->first_eye);
         auto& person = impl_->people[k];
-        person.mesh->setPose(person_pose[k]);
+        person.mesh->setPose(body);
         if (person.hand) {
-            hand_pose[k] = person_pose[k] + gestureLocalPose(sc_.people[k], state[k], person.width);
-            person.hand->setPose(hand_pose[k]);
+            const auto hand = body + gestureLocalPose(sc_.people[k], state[k], person.width);
+            person.hand->setPose(hand);
+            parts[k].push_back(personPart(hand, true));
         }
+        parts[k].push_back(personPart(body, false));
     }
 
     auto& cam = impl_->fbo->getCamera(*impl_->scene);
@@ -292,108 +399,13 @@ RenderedFrame SequenceRenderer::render(std::size_t i) {
     out.clean_depth = cv::Mat(K.height, K.width, CV_32FC1);
     for (int v = 0; v < K.height; ++v)
         for (int u = 0; u < K.width; ++u) out.clean_depth.at<float>(v, u) = depth(v, u);
+    if (sc_.rgb_noise_sigma > 0) addRgbNoise(bgr, sc_.rgb_noise_sigma, mixSeed(sc_.seed, i, 1));
 
-    if (sc_.rgb_noise_sigma > 0) {
-        cv::Mat noise(bgr.size(), CV_32FC3);
-        std::mt19937_64 rng(mixSeed(sc_.seed, i, 1));
-        std::normal_distribution<float> g(0.f, float(sc_.rgb_noise_sigma));
-        for (auto it = noise.begin<cv::Vec3f>(); it != noise.end<cv::Vec3f>(); ++it)
-            *it = cv::Vec3f(g(rng), g(rng), g(rng));
-        cv::Mat f;
-        bgr.convertTo(f, CV_32FC3);
-        f += noise;
-        f.convertTo(bgr, CV_8UC3);  // saturating
-    }
-
-    // Person truth: pixels whose ray hits the person's solid cells at the rendered depth.
     out.labels = cv::Mat(K.height, K.width, CV_8UC1, cv::Scalar(0));
-    const auto Rwc = out.T_wc.getRotationMatrix();
     for (std::size_t k = 0; k < sc_.people.size(); ++k) {
-        const auto& person = impl_->people[k];
-        PersonTruth pt;
-        pt.id = int(k + 1);
+        PersonTruth pt = impl_->labelPerson(k, parts[k], out.T_wc, K, out.clean_depth, out.labels);
         pt.name = sc_.people[k].name;
         pt.moving = state[k].moving;
-        // The person's planar parts: the body, and the hand in front of it when it gestures.
-        struct Part {
-            mrpt::poses::CPose3D P;
-            Eigen::Matrix3d R = Eigen::Matrix3d::Identity();  // columns: local x, y (normal), z
-            Eigen::Vector3d p0 = Eigen::Vector3d::Zero();
-            bool hand = false;
-        };
-        std::vector<Part> parts;
-        const auto addPart = [&](const mrpt::poses::CPose3D& P, bool hand) {
-            Part part;
-            part.P = P;
-            const auto Rp = P.getRotationMatrix();
-            for (int r = 0; r < 3; ++r)
-                for (int c = 0; c < 3; ++c) part.R(r, c) = Rp(r, c);
-            part.p0 = {P.x(), P.y(), P.z()};
-            part.hand = hand;
-            parts.push_back(part);
-        };
-        if (person.hand) addPart(hand_pose[k], true);
-        addPart(person_pose[k], false);
-        // Projected bounding box of the parts' corners (whole image if one is behind).
-        cv::Rect roi(0, 0, K.width, K.height);
-        {
-            double u0 = 1e9, v0 = 1e9, u1 = -1e9, v1 = -1e9;
-            bool behind = false;
-            for (const auto& part : parts) {
-                for (double lx : {-person.width / 2, person.width / 2})
-                    for (double lz : {0.0, person.height}) {
-                        mrpt::math::TPoint3D w;
-                        part.P.composePoint(lx, 0, lz, w.x, w.y, w.z);
-                        mrpt::math::TPoint3D c;
-                        out.T_wc.inverseComposePoint(w, c);
-                        if (c.z < 1e-3) {
-                            behind = true;
-                            continue;
-                        }
-                        const double u = K.fx * c.x / c.z + K.cx, v = K.fy * c.y / c.z + K.cy;
-                        u0 = std::min(u0, u), u1 = std::max(u1, u), v0 = std::min(v0, v),
-                        v1 = std::max(v1, v);
-                    }
-            }
-            if (!behind)
-                roi &= cv::Rect(int(std::floor(u0)) - 1, int(std::floor(v0)) - 1,
-                                int(std::ceil(u1 - u0)) + 3, int(std::ceil(v1 - v0)) + 3);
-        }
-        const auto& m = person.tex.cell_mask;
-        const double tw = person.tex.bgr.cols, th = person.tex.bgr.rows, cp = person.tex.cell_px;
-        // Pixel (u, v) at rendered depth zr along world ray dw lies on the part's solid cells.
-        const auto onPart = [&](const Part& part, const Eigen::Vector3d& dw, float zr) {
-            const Eigen::Vector3d n = part.R.col(1);
-            const double den = n.dot(dw);
-            if (std::abs(den) < 1e-9) return false;
-            const double s = n.dot(part.p0 - eye) / den;  // = depth along the optical axis
-            if (s <= 0 || std::abs(zr - s) > std::max(0.01, 0.005 * s)) return false;
-            const Eigen::Vector3d q = eye + s * dw - part.p0;
-            const double lx = part.R.col(0).dot(q), lz = part.R.col(2).dot(q);
-            const double col = (person.width / 2 - lx) / person.width * tw;
-            const double row = (person.height - lz) / person.height * th;
-            if (col < 0 || row < 0 || col >= tw || row >= th) return false;
-            const int r = int(row / cp), c = int(col / cp);
-            return m.at<uchar>(r, c) && (person.hand_cell.at<uchar>(r, c) != 0) == part.hand;
-        };
-        int umin = K.width, vmin = K.height, umax = -1, vmax = -1;
-        for (int v = roi.y; v < roi.y + roi.height; ++v)
-            for (int u = roi.x; u < roi.x + roi.width; ++u) {
-                const float zr = out.clean_depth.at<float>(v, u);
-                if (zr <= 0) continue;
-                const Eigen::Vector3d dc((u - K.cx) / K.fx, (v - K.cy) / K.fy, 1.0);
-                Eigen::Vector3d dw;
-                for (int r = 0; r < 3; ++r)
-                    dw[r] = Rwc(r, 0) * dc[0] + Rwc(r, 1) * dc[1] + Rwc(r, 2) * dc[2];
-                bool hit = false;
-                for (const auto& part : parts) hit = hit || onPart(part, dw, zr);
-                if (!hit) continue;
-                out.labels.at<uchar>(v, u) = uchar(pt.id);
-                ++pt.visible_pixels;
-                umin = std::min(umin, u), umax = std::max(umax, u);
-                vmin = std::min(vmin, v), vmax = std::max(vmax, v);
-            }
-        if (pt.visible_pixels > 0) pt.box = cv::Rect(umin, vmin, umax - umin + 1, vmax - vmin + 1);
         out.persons.push_back(pt);
     }
 
