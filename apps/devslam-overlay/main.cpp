@@ -27,6 +27,7 @@
 #include <filesystem>
 #include <iostream>
 #include <string>
+#include <variant>
 
 namespace fs = std::filesystem;
 using namespace devslam;
@@ -96,59 +97,141 @@ cv::Mat drawOverlay(const core::Frame& f, const dynamic::FilterOutput& out) {
     return img;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+struct Args {
     std::string input, out_dir, mode;
     std::string config = std::string(DEVSLAM_SOURCE_DIR) + "/config_ini/dynamic_filter.ini";
     int every = 1, frames = 0, threads = 1;  // frames 0: synthetic 30, real input all
     bool use_prior = true;
+};
+
+/// The command line, or the exit code to return now (0 after --help, 2 for a bad argument).
+std::variant<Args, int> parseArgs(int argc, char** argv) {
+    Args a;
     for (int i = 1; i < argc; ++i) {
-        const std::string a = argv[i];
+        const std::string arg = argv[i];
         auto next = [&]() -> std::string {
-            if (i + 1 >= argc) throw std::invalid_argument(a + " needs a value");
+            if (i + 1 >= argc) throw std::invalid_argument(arg + " needs a value");
             return argv[++i];
         };
         try {
-            if (a == "--input")
-                input = next();
-            else if (a == "--out")
-                out_dir = next();
-            else if (a == "--config")
-                config = next();
-            else if (a == "--mode")
-                mode = next();
-            else if (a == "--every")
-                every = int(devslam::core::parseInteger(next(), "--every", 1, 1000000));
-            else if (a == "--frames")
-                frames = int(devslam::core::parseInteger(next(), "--frames", 0, 100000000));
-            else if (a == "--threads")
-                threads = int(devslam::core::parseInteger(next(), "--threads", 1, 256));
-            else if (a == "--no-prior")
-                use_prior = false;
-            else if (a == "-h" || a == "--help") {
+            if (arg == "--input")
+                a.input = next();
+            else if (arg == "--out")
+                a.out_dir = next();
+            else if (arg == "--config")
+                a.config = next();
+            else if (arg == "--mode")
+                a.mode = next();
+            else if (arg == "--every")
+                a.every = int(devslam::core::parseInteger(next(), "--every", 1, 1000000));
+            else if (arg == "--frames")
+                a.frames = int(devslam::core::parseInteger(next(), "--frames", 0, 100000000));
+            else if (arg == "--threads")
+                a.threads = int(devslam::core::parseInteger(next(), "--threads", 1, 256));
+            else if (arg == "--no-prior")
+                a.use_prior = false;
+            else if (arg == "-h" || arg == "--help") {
                 std::cout << kUsage;
                 return 0;
             } else
-                throw std::invalid_argument("unknown argument '" + a + "'");
+                throw std::invalid_argument("unknown argument '" + arg + "'");
         } catch (const std::exception& e) {
             std::cerr << "devslam-overlay: " << e.what() << "\n" << kUsage;
             return 2;
         }
     }
-    if (input.empty() || out_dir.empty()) {
+    if (a.input.empty() || a.out_dir.empty()) {
         std::cerr << kUsage;
         return 2;
     }
+    return a;
+}
+
+/// What the overlays are drawn on: a synthetic sequence made in memory, or a reader.
+struct Input {
+    std::vector<dynamic::SyntheticFrame> synth;
+    std::unique_ptr<io::RgbdReader> reader;
+    bool fixed_camera = false;  // video: the camera's motion is known to be the identity
+    std::size_t total = 0;      // frames to expect (0: unknown), for the progress bar
+};
+
+/// synthetic:walking|static, made from the shipped images (the whole sequence in memory).
+std::vector<dynamic::SyntheticFrame> syntheticInput(const std::string& kind, int frames) {
+    dynamic::SyntheticOptions so;
+    if (frames > dynamic::kMaxSyntheticFrames)
+        throw std::invalid_argument("--frames: a synthetic sequence has at most " +
+                                    std::to_string(dynamic::kMaxSyntheticFrames) +
+                                    " frames, got " + std::to_string(frames));
+    so.n_frames = frames > 0 ? frames : 30;
+    if (kind == "walking")
+        so.person = dynamic::PersonMotion::Walking;
+    else if (kind == "static") {
+        so.person = dynamic::PersonMotion::Static;
+        so.person_x0 = 0.3;
+    } else
+        throw std::invalid_argument("unknown synthetic sequence '" + kind +
+                                    "' (known: walking, static)");
+    const cv::Mat wall = cv::imread(std::string(DEVSLAM_SOURCE_DIR) +
+                                    "/data/tum/fr1_xyz_first37/rgb/1305031102.175304.png");
+    const cv::Mat person = cv::imread(std::string(DEVSLAM_SOURCE_DIR) + "/data/images/person.jpg");
+    if (wall.empty() || person.empty()) throw std::runtime_error("shipped images missing");
+    return dynamic::makeSyntheticSequence(so, wall, person(cv::Rect(180, 90, 105, 295)).clone());
+}
+
+Input openInput(const Args& a) {
+    Input in;
+    if (a.input.rfind("synthetic:", 0) == 0) {
+        in.synth = syntheticInput(a.input.substr(10), a.frames);
+        in.total = in.synth.size();
+        return in;
+    }
+    if (a.input.rfind("video:", 0) == 0) {
+        in.reader =
+            std::make_unique<io::VideoReader>(a.input.substr(6), io::VideoReader::Options{});
+        in.fixed_camera = true;
+    } else {
+        in.reader = io::openRgbd(a.input, {});
+    }
+    in.total = in.reader->size().value_or(0);
+    if (a.frames > 0 && (in.total == 0 || static_cast<std::size_t>(a.frames) < in.total))
+        in.total = static_cast<std::size_t>(a.frames);
+    return in;
+}
+
+/// Frame k's overlay as DIR/overlay_<k>.png; `written` overlays came before it.
+void writeOverlay(const std::string& out_dir, std::size_t k, const core::Frame& f,
+                  const dynamic::FilterOutput& out, std::size_t written) {
+    char name[64];
+    std::snprintf(name, sizeof name, "overlay_%05zu.png", k);
+    const std::string file = (fs::path(out_dir) / name).string();
+    // Drawn outside the write's try: a drawing error is not a write error.
+    const cv::Mat picture = drawOverlay(f, out);
+    std::string why;
     try {
-        cv::setNumThreads(threads);
+        if (!cv::imwrite(file, picture)) why = "imwrite failed";
+    } catch (const cv::Exception& e) {
+        why = e.what();
+    }
+    if (!why.empty())
+        throw std::runtime_error("cannot write " + file + " (" + std::to_string(written) +
+                                 " overlays written before it): " + why);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    const auto parsed = parseArgs(argc, argv);
+    if (const int* rc = std::get_if<int>(&parsed)) return *rc;
+    const Args& a = std::get<Args>(parsed);
+    try {
+        cv::setNumThreads(a.threads);
         // A filter INI, or a SLAM INI naming one ([run] filter_config, filter_overrides).
         std::string filter_source;
-        auto cfg = core::loadFilterConfig(config, &filter_source);
+        auto cfg = core::loadFilterConfig(a.config, &filter_source);
         std::optional<dynamic::MaskMode> mode_override;
-        if (!mode.empty()) {
+        if (!a.mode.empty()) {
             try {
-                mode_override = dynamic::parseMaskMode(mode);
+                mode_override = dynamic::parseMaskMode(a.mode);
             } catch (const std::invalid_argument& e) {
                 std::cerr << "devslam-overlay: --mode: " << e.what() << "\n" << kUsage;
                 return 2;
@@ -156,85 +239,31 @@ int main(int argc, char** argv) {
         }
         auto filter = core::namingSource(
             filter_source, [&] { return dynamic::makeFilterFromConfig(*cfg, mode_override); });
-        fs::create_directories(out_dir);
+        fs::create_directories(a.out_dir);
 
-        std::vector<dynamic::SyntheticFrame> synth;
-        std::unique_ptr<io::RgbdReader> reader;
-        bool fixed_camera = false;  // video: the camera's motion is known to be the identity
-        if (input.rfind("synthetic:", 0) == 0) {
-            dynamic::SyntheticOptions so;
-            // The whole sequence is made in memory before the first overlay.
-            if (frames > dynamic::kMaxSyntheticFrames)
-                throw std::invalid_argument("--frames: a synthetic sequence has at most " +
-                                            std::to_string(dynamic::kMaxSyntheticFrames) +
-                                            " frames, got " + std::to_string(frames));
-            so.n_frames = frames > 0 ? frames : 30;
-            const std::string kind = input.substr(10);
-            if (kind == "walking")
-                so.person = dynamic::PersonMotion::Walking;
-            else if (kind == "static") {
-                so.person = dynamic::PersonMotion::Static;
-                so.person_x0 = 0.3;
-            } else
-                throw std::invalid_argument("unknown synthetic sequence '" + kind +
-                                            "' (known: walking, static)");
-            const cv::Mat wall = cv::imread(std::string(DEVSLAM_SOURCE_DIR) +
-                                            "/data/tum/fr1_xyz_first37/rgb/1305031102.175304.png");
-            const cv::Mat person =
-                cv::imread(std::string(DEVSLAM_SOURCE_DIR) + "/data/images/person.jpg");
-            if (wall.empty() || person.empty()) throw std::runtime_error("shipped images missing");
-            synth = dynamic::makeSyntheticSequence(so, wall,
-                                                   person(cv::Rect(180, 90, 105, 295)).clone());
-        } else if (input.rfind("video:", 0) == 0) {
-            reader = std::make_unique<io::VideoReader>(input.substr(6), io::VideoReader::Options{});
-            fixed_camera = true;
-        } else {
-            reader = io::openRgbd(input, {});
-        }
-        std::size_t total = synth.size();
-        if (reader) {
-            total = reader->size().value_or(0);
-            if (frames > 0 && (total == 0 || static_cast<std::size_t>(frames) < total))
-                total = static_cast<std::size_t>(frames);
-        }
-        core::ProgressBar bar("overlay", total);
+        Input in = openInput(a);
+        core::ProgressBar bar("overlay", in.total);
         std::size_t k = 0, written = 0;
         while (true) {
             std::optional<core::Frame> f;
             std::optional<Eigen::Isometry3d> prior;
-            if (!synth.empty()) {
-                if (k >= synth.size()) break;
-                f = synth[k].frame;
-                if (use_prior) prior = synth[k].T_prev_cur;
+            if (!in.synth.empty()) {
+                if (k >= in.synth.size()) break;
+                f = in.synth[k].frame;
+                if (a.use_prior) prior = in.synth[k].T_prev_cur;
             } else {
-                if (frames > 0 && k >= static_cast<std::size_t>(frames)) break;
-                f = reader->next();
+                if (a.frames > 0 && k >= static_cast<std::size_t>(a.frames)) break;
+                f = in.reader->next();
                 if (!f) break;
-                if (fixed_camera && use_prior) prior = Eigen::Isometry3d::Identity();
+                if (in.fixed_camera && a.use_prior) prior = Eigen::Isometry3d::Identity();
             }
             const auto out = filter->step(*f, prior);
-            if (k % static_cast<std::size_t>(every) == 0) {
-                char name[64];
-                std::snprintf(name, sizeof name, "overlay_%05zu.png", k);
-                const std::string file = (fs::path(out_dir) / name).string();
-                // Drawn outside the write's try: a drawing error is not a write error.
-                const cv::Mat picture = drawOverlay(*f, out);
-                std::string why;
-                try {
-                    if (!cv::imwrite(file, picture)) why = "imwrite failed";
-                } catch (const cv::Exception& e) {
-                    why = e.what();
-                }
-                if (!why.empty())
-                    throw std::runtime_error("cannot write " + file + " (" +
-                                             std::to_string(written) +
-                                             " overlays written before it): " + why);
-                ++written;
-            }
+            if (k % static_cast<std::size_t>(a.every) == 0)
+                writeOverlay(a.out_dir, k, *f, out, written++);
             bar.update(++k);
         }
         bar.finish();
-        std::cout << "wrote " << written << " overlays to " << out_dir << "\n";
+        std::cout << "wrote " << written << " overlays to " << a.out_dir << "\n";
     } catch (const std::exception& e) {
         std::cerr << "devslam-overlay: " << e.what() << "\n";
         return 1;
