@@ -271,7 +271,8 @@ void requireWhole(const run::RunReport& rep) {
         throw std::runtime_error("interrupted (" + rep.interrupted + "); the bench wrote nothing");
 }
 
-int runBench(const Args& a) {
+/// The bench section's title and the head of its mode table.
+std::string benchHeader(const Args& a) {
     // The command that makes the section again, run from the repository: every option that
     // is not its default (the paths relative to the repository when they lie in it).
     const Args defaults;
@@ -299,57 +300,87 @@ int runBench(const Args& a) {
           "median CPU ms/frame | keyframes | landmarks | lost | peak RSS [MB] | map KiB/keyframe "
           "|\n"
        << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
-    std::ostringstream stages;
-    stages << "\nPer-stage time [ms], median / mean over frames (median over runs); with detection "
-              "every 3rd frame the median frame runs no detector, the mean shows its cost:\n\n"
-           << "| mode | detect | filter | features | tracking | mapping | backend |\n"
-           << "|---|---|---|---|---|---|---|\n";
-    for (const std::string mode : {"none", "all_persons", "dynamic"}) {
-        std::vector<double> ate, ate_max, rpe, mfps, afps, cpu, kfs, lms, lost, rss, kib;
-        std::vector<double> st[6], stm[6];
-        for (int r = 0; r < a.bench; ++r) {
-            auto l = loadConfig(a);
-            auto reader = io::openRgbd(a.input, l.reader);
-            const auto rc = runConfig(a, l, mode);
-            const auto rep = run::runSequence(*reader, rc, *l.cfg, *l.filter_cfg);
-            requireWhole(rep);
-            if (rep.ate) {
-                ate.push_back(rep.ate->trans.rmse);
-                ate_max.push_back(rep.ate->trans.max);
-            }
-            if (rep.rpe_frame) rpe.push_back(rep.rpe_frame->trans.rmse);
-            mfps.push_back(rep.median_fps);
-            afps.push_back(rep.mean_fps);
-            cpu.push_back(rep.median_cpu_ms);
-            kfs.push_back(static_cast<double>(rep.keyframes));
-            lms.push_back(static_cast<double>(rep.landmarks));
-            lost.push_back(static_cast<double>(rep.lost.size()));
-            rss.push_back(rep.peak_rss_mb);
-            kib.push_back(rep.bytes_per_keyframe / 1024.0);
-            const auto& m = rep.stage_median_ms;
-            const double v[6] = {m.detect, m.filter, m.features, m.tracking, m.mapping, m.backend};
-            for (int k = 0; k < 6; ++k) st[k].push_back(v[k]);
-            const auto& mm = rep.stage_mean_ms;
-            const double w[6] = {mm.detect,   mm.filter,  mm.features,
-                                 mm.tracking, mm.mapping, mm.backend};
-            for (int k = 0; k < 6; ++k) stm[k].push_back(w[k]);
-            std::cerr << "bench " << mode << " run " << r + 1 << "/" << a.bench << ": ATE "
-                      << (rep.ate ? fmt(rep.ate->trans.rmse, 4) : "-") << " m, median "
-                      << fmt(rep.median_fps, 1) << " FPS\n";
+    return md.str();
+}
+
+/// One mode's figures over the bench's runs.
+struct ModeRuns {
+    std::vector<double> ate, ate_max, rpe, mfps, afps, cpu, kfs, lms, lost, rss, kib;
+    std::vector<double> st[6], stm[6];  // per-stage median / mean ms
+
+    void add(const run::RunReport& rep) {
+        if (rep.ate) {
+            ate.push_back(rep.ate->trans.rmse);
+            ate_max.push_back(rep.ate->trans.max);
         }
+        if (rep.rpe_frame) rpe.push_back(rep.rpe_frame->trans.rmse);
+        mfps.push_back(rep.median_fps);
+        afps.push_back(rep.mean_fps);
+        cpu.push_back(rep.median_cpu_ms);
+        kfs.push_back(static_cast<double>(rep.keyframes));
+        lms.push_back(static_cast<double>(rep.landmarks));
+        lost.push_back(static_cast<double>(rep.lost.size()));
+        rss.push_back(rep.peak_rss_mb);
+        kib.push_back(rep.bytes_per_keyframe / 1024.0);
+        const auto& m = rep.stage_median_ms;
+        const double v[6] = {m.detect, m.filter, m.features, m.tracking, m.mapping, m.backend};
+        for (int k = 0; k < 6; ++k) st[k].push_back(v[k]);
+        const auto& mm = rep.stage_mean_ms;
+        const double w[6] = {mm.detect,   mm.filter,  mm.features,
+                             mm.tracking, mm.mapping, mm.backend};
+        for (int k = 0; k < 6; ++k) stm[k].push_back(w[k]);
+    }
+    /// The mode table's row: medians over the runs.
+    [[nodiscard]] std::string row(const std::string& mode) const {
         using core::median;
+        std::ostringstream md;
         md << "| " << mode << " | " << (ate.empty() ? "-" : fmt(median(ate), 4)) << " | "
            << (ate_max.empty() ? "-" : fmt(median(ate_max), 4)) << " | "
            << (rpe.empty() ? "-" : fmt(median(rpe), 4)) << " | " << fmt(median(mfps), 1) << " | "
            << fmt(median(afps), 1) << " | " << fmt(median(cpu), 1) << " | " << fmt(median(kfs), 0)
            << " | " << fmt(median(lms), 0) << " | " << fmt(median(lost), 0) << " | "
            << fmt(median(rss), 0) << " | " << fmt(median(kib), 0) << " |\n";
-        stages << "| " << mode;
-        for (int k = 0; k < 6; ++k)
-            stages << " | " << fmt(median(st[k]), 2) << " / " << fmt(median(stm[k]), 2);
-        stages << " |\n";
+        return md.str();
     }
-    // Ablation: one design choice changed at a time (mode none; ATE is deterministic).
+    /// The per-stage table's row.
+    [[nodiscard]] std::string stageRow(const std::string& mode) const {
+        std::ostringstream md;
+        md << "| " << mode;
+        for (int k = 0; k < 6; ++k)
+            md << " | " << fmt(core::median(st[k]), 2) << " / " << fmt(core::median(stm[k]), 2);
+        md << " |\n";
+        return md.str();
+    }
+};
+
+/// The three modes, a.bench runs each: the mode table's rows, then the per-stage table.
+std::string benchModes(const Args& a) {
+    std::ostringstream md, stages;
+    stages << "\nPer-stage time [ms], median / mean over frames (median over runs); with detection "
+              "every 3rd frame the median frame runs no detector, the mean shows its cost:\n\n"
+           << "| mode | detect | filter | features | tracking | mapping | backend |\n"
+           << "|---|---|---|---|---|---|---|\n";
+    for (const std::string mode : {"none", "all_persons", "dynamic"}) {
+        ModeRuns runs;
+        for (int r = 0; r < a.bench; ++r) {
+            auto l = loadConfig(a);
+            auto reader = io::openRgbd(a.input, l.reader);
+            const auto rc = runConfig(a, l, mode);
+            const auto rep = run::runSequence(*reader, rc, *l.cfg, *l.filter_cfg);
+            requireWhole(rep);
+            runs.add(rep);
+            std::cerr << "bench " << mode << " run " << r + 1 << "/" << a.bench << ": ATE "
+                      << (rep.ate ? fmt(rep.ate->trans.rmse, 4) : "-") << " m, median "
+                      << fmt(rep.median_fps, 1) << " FPS\n";
+        }
+        md << runs.row(mode);
+        stages << runs.stageRow(mode);
+    }
+    return md.str() + stages.str();
+}
+
+/// Ablation: one design choice changed at a time (mode none; ATE is deterministic).
+std::string benchAblations(const Args& a) {
     std::ostringstream abl;
     abl << "\nAblation (mode none, one run each, `devslam-run --mode none --set KEY=VALUE`):\n\n"
         << "| change | ATE RMSE [m] | keyframes | median FPS |\n|---|---|---|---|\n";
@@ -364,7 +395,6 @@ int runBench(const Args& a) {
         {"keyframes.max_frames=1 (every frame a keyframe)", {"keyframes.max_frames=1"}},
     };
     for (const auto& [name, sets] : ablations) {
-        if (a.modes_only) break;
         auto l = loadConfig(a, sets);
         auto reader = io::openRgbd(a.input, l.reader);
         const auto rc = runConfig(a, l, "none");
@@ -375,36 +405,43 @@ int runBench(const Args& a) {
         std::cerr << "ablation " << name << ": ATE "
                   << (rep.ate ? fmt(rep.ate->trans.rmse, 4) : "-") << "\n";
     }
-    // Memory on the longest sequence we have: the input replayed forward/backward.
+    return abl.str();
+}
+
+/// Memory on the longest sequence we have: the input replayed forward/backward.
+std::string benchLongRun(const Args& a) {
+    constexpr int kPasses = 9;
+    auto l = loadConfig(a);
+    auto src = io::openRgbd(a.input, l.reader);
+    run::ReplayReader reader(*src, kPasses);
+    auto rc = runConfig(a, l, "dynamic");
+    rc.max_frames = 0;       // every replayed frame
+    rc.score_masks = false;  // replayed: timestamps are not the truth's
+    const auto rep = run::runSequence(reader, rc, *l.cfg, *l.filter_cfg);
+    requireWhole(rep);
     std::ostringstream mem;
-    if (!a.modes_only) {
-        constexpr int kPasses = 9;
-        auto l = loadConfig(a);
-        auto src = io::openRgbd(a.input, l.reader);
-        run::ReplayReader reader(*src, kPasses);
-        auto rc = runConfig(a, l, "dynamic");
-        rc.max_frames = 0;       // every replayed frame
-        rc.score_masks = false;  // replayed: timestamps are not the truth's
-        const auto rep = run::runSequence(reader, rc, *l.cfg, *l.filter_cfg);
-        requireWhole(rep);
-        mem << "\nLong run (memory): the input replayed forward/backward " << kPasses
-            << " times (`devslam-run --replay " << kPasses << " --mode dynamic`): " << rep.frames
-            << " frames, " << rep.keyframes << " keyframes, " << rep.landmarks << " landmarks, "
-            << rep.loops << " loops closed, " << rep.lost.size() << " lost; peak RSS "
-            << fmt(rep.peak_rss_mb, 0)
-            << " MB (whole process: libraries, detector network, the source frames held by the "
-               "replay), map "
-            << fmt(rep.map_mb, 2) << " MB = " << fmt(rep.bytes_per_keyframe / 1024.0, 0)
-            << " KiB per keyframe (keypoints, descriptors, depths, landmarks); ATE "
-            << (rep.ate ? fmt(rep.ate->trans.rmse, 4) : "-") << " m.\n";
-    }
-    md << stages.str() << (a.modes_only ? std::string() : abl.str()) << mem.str()
-       << "\nPeak RSS is per run (VmHWM reset before each run). Wall-clock FPS depends on the load "
-          "and the drifting speed of this 2-core VM; the CPU time per frame (all threads) is "
-          "printed by `devslam-run` beside it. Measured on "
-       << core::measuredOnLine() << ".\n";
-    core::replaceResultsSection(a.results, a.section, md.str());
-    std::cout << md.str();
+    mem << "\nLong run (memory): the input replayed forward/backward " << kPasses
+        << " times (`devslam-run --replay " << kPasses << " --mode dynamic`): " << rep.frames
+        << " frames, " << rep.keyframes << " keyframes, " << rep.landmarks << " landmarks, "
+        << rep.loops << " loops closed, " << rep.lost.size() << " lost; peak RSS "
+        << fmt(rep.peak_rss_mb, 0)
+        << " MB (whole process: libraries, detector network, the source frames held by the "
+           "replay), map "
+        << fmt(rep.map_mb, 2) << " MB = " << fmt(rep.bytes_per_keyframe / 1024.0, 0)
+        << " KiB per keyframe (keypoints, descriptors, depths, landmarks); ATE "
+        << (rep.ate ? fmt(rep.ate->trans.rmse, 4) : "-") << " m.\n";
+    return mem.str();
+}
+
+int runBench(const Args& a) {
+    std::string md = benchHeader(a) + benchModes(a);
+    if (!a.modes_only) md += benchAblations(a) + benchLongRun(a);
+    md += "\nPeak RSS is per run (VmHWM reset before each run). Wall-clock FPS depends on the "
+          "load and the drifting speed of this 2-core VM; the CPU time per frame (all threads) "
+          "is printed by `devslam-run` beside it. Measured on " +
+          core::measuredOnLine() + ".\n";
+    core::replaceResultsSection(a.results, a.section, md);
+    std::cout << md;
     return 0;
 }
 
