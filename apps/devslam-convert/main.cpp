@@ -15,6 +15,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <variant>
 #include <vector>
 
 namespace {
@@ -53,132 +54,158 @@ void refuseOverwritingInput(const std::string& in, const std::string& out) {
                                     "another folder");
 }
 
-}  // namespace
+struct Args {
+    std::string input, output;
+    devslam::io::ReaderOptions ro;
+    devslam::io::RawlogWriterOptions wo;
+    std::size_t max_frames = static_cast<std::size_t>(-1);
+};
 
-namespace {
-int convert(int argc, char** argv) {
-    try {
-        std::vector<std::string> pos;
-        devslam::io::ReaderOptions ro;
-        devslam::io::RawlogWriterOptions wo;
-        std::size_t max_frames = static_cast<std::size_t>(-1);
-        for (int i = 1; i < argc; ++i) {
-            const std::string a = argv[i];
-            auto value = [&]() -> std::string {
-                if (i + 1 >= argc) throw std::invalid_argument(a + " needs a value");
-                return argv[++i];
-            };
-            if (a == "-h" || a == "--help") {
-                std::cout << kUsage;
-                return 0;
-            } else if (a == "--camera")
-                ro.camera = value();
-            else if (a == "--sensory-frames")
-                wo.sensory_frames = true;
-            else if (a == "--external")
-                wo.external_images = true;
-            else if (a == "--compression")
-                wo.compression = int(devslam::core::parseInteger(value(), "--compression", 0, 9));
-            else if (a == "--label")
-                wo.sensor_label = value();
-            else if (a == "--allow-damaged")
-                ro.allow_damaged = true;
-            else if (a == "--max-frames")
-                max_frames = std::size_t(devslam::core::parseInteger(value(), "--max-frames", 0));
-            else if (!a.empty() && a[0] == '-')
-                throw std::invalid_argument("unknown option " + a);
-            else
-                pos.push_back(a);
-        }
-        if (pos.size() != 2) {
-            std::cerr << kUsage;
-            return 2;
-        }
-        refuseOverwritingInput(pos[0], pos[1]);
-        auto reader = devslam::io::openRgbd(pos[0], ro);
-        if (const int sig = devslam::core::stopSignal()) {  // before the output is opened
-            std::cerr << "devslam-convert: interrupted (" << devslam::core::signalName(sig)
-                      << ") before the first frame; nothing written\n";
-            return 1;
-        }
-        std::cerr << "reading " << reader->describe() << "\n";
-        const std::size_t total = std::min(reader->size().value_or(0), max_frames);
-        devslam::core::ProgressBar bar("converting", total);
-        std::size_t n = 0;
-        // A frame the reader finds bad only when it reads it (an image that is there but
-        // does not decode) stops the conversion with the frames before it written, or, with
-        // --allow-damaged, is left out and the rest converted. The readers pass such a frame.
-        std::string stopped;
-        std::vector<std::string> undecodable;
-        int interrupted = 0;  // the signal that stopped the conversion
-        double depth_gap = 0;  // [s] the largest colour-depth stamp difference written
-        bool to_rawlog = false;
-        const auto convertAll = [&](auto& out) {
-            while (n < max_frames) {
-                std::optional<devslam::core::Frame> f;
-                try {
-                    f = reader->next();
-                } catch (const devslam::io::InputBroken& e) {
-                    stopped = e.what();  // nothing after it can be read, --allow-damaged or not
-                    break;
-                } catch (const std::exception& e) {
-                    if (!ro.allow_damaged) {
-                        stopped = e.what();
-                        break;
-                    }
-                    undecodable.push_back(e.what());
-                    if ((interrupted = devslam::core::stopSignal())) break;
-                    continue;
-                }
-                if (!f) break;
-                // Ctrl-C (core/Interrupt.h) ends the conversion before this frame, the output
-                // closed whole; one after the last frame leaves it whole.
-                if ((interrupted = devslam::core::stopSignal())) break;
-                if (f->depth_timestamp)
-                    depth_gap = std::max(depth_gap, std::abs(*f->depth_timestamp - f->timestamp));
-                out.write(*f);
-                bar.update(++n);
-            }
+/// The command line, or the exit code to return now (0 after --help, 2 without two paths).
+/// Throws std::invalid_argument for a bad option.
+std::variant<Args, int> parseArgs(int argc, char** argv) {
+    Args args;
+    std::vector<std::string> pos;
+    for (int i = 1; i < argc; ++i) {
+        const std::string a = argv[i];
+        auto value = [&]() -> std::string {
+            if (i + 1 >= argc) throw std::invalid_argument(a + " needs a value");
+            return argv[++i];
         };
-        if (endsWith(pos[1], ".rawlog")) {
-            devslam::io::RawlogWriter out(pos[1], wo);
-            convertAll(out);
-            out.close();
-            to_rawlog = true;
-        } else {
-            devslam::io::TumWriter out(pos[1], "converted by devslam-convert from " + pos[0]);
-            convertAll(out);
-            if (auto gt = reader->groundTruth()) out.writeGroundTruth(*gt);
-            out.close();
+        if (a == "-h" || a == "--help") {
+            std::cout << kUsage;
+            return 0;
+        } else if (a == "--camera")
+            args.ro.camera = value();
+        else if (a == "--sensory-frames")
+            args.wo.sensory_frames = true;
+        else if (a == "--external")
+            args.wo.external_images = true;
+        else if (a == "--compression")
+            args.wo.compression = int(devslam::core::parseInteger(value(), "--compression", 0, 9));
+        else if (a == "--label")
+            args.wo.sensor_label = value();
+        else if (a == "--allow-damaged")
+            args.ro.allow_damaged = true;
+        else if (a == "--max-frames")
+            args.max_frames = std::size_t(devslam::core::parseInteger(value(), "--max-frames", 0));
+        else if (!a.empty() && a[0] == '-')
+            throw std::invalid_argument("unknown option " + a);
+        else
+            pos.push_back(a);
+    }
+    if (pos.size() != 2) {
+        std::cerr << kUsage;
+        return 2;
+    }
+    args.input = pos[0];
+    args.output = pos[1];
+    return args;
+}
+
+/// Copies frames from a reader to a writer and keeps what the summary reports.
+struct Conversion {
+    std::size_t n = 0;  // frames written
+    // A frame the reader finds bad only when it reads it (an image that is there but does not
+    // decode) stops the conversion with the frames before it written, or, with
+    // --allow-damaged, is left out and the rest converted. The readers pass such a frame.
+    std::string stopped;
+    std::vector<std::string> undecodable;
+    int interrupted = 0;   // the signal that stopped the conversion
+    double depth_gap = 0;  // [s] the largest colour-depth stamp difference written
+
+    template <class Writer>
+    void copy(devslam::io::RgbdReader& reader, Writer& out, const Args& args,
+              devslam::core::ProgressBar& bar) {
+        while (n < args.max_frames) {
+            std::optional<devslam::core::Frame> f;
+            try {
+                f = reader.next();
+            } catch (const devslam::io::InputBroken& e) {
+                stopped = e.what();  // nothing after it can be read, --allow-damaged or not
+                break;
+            } catch (const std::exception& e) {
+                if (!args.ro.allow_damaged) {
+                    stopped = e.what();
+                    break;
+                }
+                undecodable.push_back(e.what());
+                if ((interrupted = devslam::core::stopSignal())) break;
+                continue;
+            }
+            if (!f) break;
+            // Ctrl-C (core/Interrupt.h) ends the conversion before this frame, the output
+            // closed whole; one after the last frame leaves it whole.
+            if ((interrupted = devslam::core::stopSignal())) break;
+            if (f->depth_timestamp)
+                depth_gap = std::max(depth_gap, std::abs(*f->depth_timestamp - f->timestamp));
+            out.write(*f);
+            bar.update(++n);
         }
-        bar.finish();
-        std::cout << "wrote " << n << " frames to " << pos[1] << "\n";
-        if (to_rawlog) {  // a rawlog observation has one stamp, and a rawlog no ground truth
+    }
+
+    /// What was written and what was not; the exit code.
+    int report(const devslam::io::RgbdReader& reader, const Args& args) const {
+        std::cout << "wrote " << n << " frames to " << args.output << "\n";
+        if (endsWith(args.output, ".rawlog")) {  // one stamp per observation, no ground truth
             if (depth_gap > 0)
                 std::cout << "not kept: the depth images' own stamps (up to "
                           << std::lround(1e3 * depth_gap)
                           << " ms from the colour image's; a rawlog keeps one per frame)\n";
-            if (reader->groundTruth())
+            if (reader.groundTruth())
                 std::cout << "not kept: groundtruth.txt (a rawlog holds no ground truth)\n";
         }
-        if (const std::string lost = reader->damage(); !lost.empty())
+        if (const std::string lost = reader.damage(); !lost.empty())
             std::cout << "left out (damaged input): " << lost << "\n";
         if (!undecodable.empty())
             std::cout << "left out (frames that do not decode): " << undecodable.size()
                       << ", the first: " << undecodable.front() << "\n";
         if (!stopped.empty()) {
             std::cerr << "devslam-convert: " << stopped << "\ndevslam-convert: stopped there; "
-                      << pos[1] << " holds the " << n
+                      << args.output << " holds the " << n
                       << " frames before it (--allow-damaged leaves such frames out and "
                          "converts the rest)\n";
             return 1;
         }
         if (interrupted) {
             std::cerr << "devslam-convert: interrupted (" << devslam::core::signalName(interrupted)
-                      << "); " << pos[1] << " holds the " << n << " frames converted before it\n";
+                      << "); " << args.output << " holds the " << n
+                      << " frames converted before it\n";
             return 1;
         }
         return 0;
+    }
+};
+
+int convert(int argc, char** argv) {
+    try {
+        const auto parsed = parseArgs(argc, argv);
+        if (const int* rc = std::get_if<int>(&parsed)) return *rc;
+        const Args& args = std::get<Args>(parsed);
+        refuseOverwritingInput(args.input, args.output);
+        auto reader = devslam::io::openRgbd(args.input, args.ro);
+        if (const int sig = devslam::core::stopSignal()) {  // before the output is opened
+            std::cerr << "devslam-convert: interrupted (" << devslam::core::signalName(sig)
+                      << ") before the first frame; nothing written\n";
+            return 1;
+        }
+        std::cerr << "reading " << reader->describe() << "\n";
+        const std::size_t total = std::min(reader->size().value_or(0), args.max_frames);
+        devslam::core::ProgressBar bar("converting", total);
+        Conversion c;
+        if (endsWith(args.output, ".rawlog")) {
+            devslam::io::RawlogWriter out(args.output, args.wo);
+            c.copy(*reader, out, args, bar);
+            out.close();
+        } else {
+            devslam::io::TumWriter out(args.output,
+                                       "converted by devslam-convert from " + args.input);
+            c.copy(*reader, out, args, bar);
+            if (auto gt = reader->groundTruth()) out.writeGroundTruth(*gt);
+            out.close();
+        }
+        bar.finish();
+        return c.report(*reader, args);
     } catch (const devslam::io::DamagedInput& e) {
         std::cerr << "devslam-convert: " << e.what() << "\n";
         if (e.intact() > 0)
@@ -190,6 +217,7 @@ int convert(int argc, char** argv) {
         return 1;
     }
 }
+
 }  // namespace
 
 int main(int argc, char** argv) {
