@@ -7,7 +7,9 @@
 #include <devslam/io/VideoReader.h>
 
 #include <gtest/gtest.h>
+#include <mrpt/io/CMemoryStream.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
+#include <mrpt/serialization/CArchive.h>
 
 #include "Scratch.h"
 
@@ -451,6 +453,34 @@ TEST(Rawlog, LaterObservationsNameTheFileAndObservation) {
     o.rangeImage_setSize(4, 4);
     expectError([&] { (void)io::frameFromObservation(o, "obs 7"); },
                 R"(obs 7: colour image has 4 channels)");
+}
+
+TEST(Rawlog, ADamagedImageSizeIsAnErrorNotACrash) {
+    // MRPT allocates the range image from the size fields before reading its pixels: rows
+    // 0x7fffffff made its allocator return null and segfaulted in serializeFrom (Rawlog.cpp,
+    // mrpt::aligned_malloc), and 100000 x 100000 made it zero 20 GB first.
+    mrpt::obs::CObservation3DRangeScan o;
+    o.hasRangeImage = true;
+    o.rangeImage_setSize(6, 8);
+    o.rangeImage.fill(1000);
+    mrpt::io::CMemoryStream mem;
+    mrpt::serialization::archiveFrom(mem) << o;
+    const auto* bytes = static_cast<const char*>(mem.getRawBufferData());
+    const std::string clean(bytes, bytes + mem.getTotalBytesCount());
+    const std::uint32_t size[2] = {6, 8};
+    const auto at = clean.find(std::string(reinterpret_cast<const char*>(size), sizeof size));
+    ASSERT_NE(at, std::string::npos) << "the range image's rows and cols";
+    TempDir d;
+    for (const auto& [rows, cols] : std::vector<std::pair<std::uint32_t, std::uint32_t>>{
+             {0x7fffffffu, 8u}, {100000u, 100000u}}) {
+        std::string damaged = clean;
+        const std::uint32_t bad[2] = {rows, cols};
+        damaged.replace(at, sizeof bad, reinterpret_cast<const char*>(bad), sizeof bad);
+        const std::string path = d.str("damaged.rawlog");
+        std::ofstream(path, std::ios::binary) << damaged;
+        expectError([&] { io::RawlogReader r(path); },
+                    R"(damaged\.rawlog: cannot decode object 0 .*bytes could not be allocated)");
+    }
 }
 
 TEST(Rawlog, ReadsMrptsOwnOpenNiObservation) {

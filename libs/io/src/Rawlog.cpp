@@ -3,6 +3,7 @@
 #include <devslam/core/GzFile.h>
 #include <devslam/core/Pose.h>
 
+#include <mrpt/core/aligned_allocator.h>
 #include <mrpt/img/CImage.h>
 #include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/io/CFileGZOutputStream.h>
@@ -18,8 +19,10 @@
 
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <limits>
+#include <new>
 #include <stdexcept>
 
 namespace fs = std::filesystem;
@@ -379,3 +382,36 @@ void RawlogWriter::close() {
 }
 
 }  // namespace devslam::io
+
+// ---------------------------------------------------------------------------------------
+// MRPT 2.5's mrpt::aligned_malloc (the allocator of its matrices and images) returns nullptr
+// when ::aligned_alloc fails, and its containers then write through the null pointer: a
+// rawlog whose range-image size field is damaged (rows 0x7fffffff) segfaulted inside
+// CObservation3DRangeScan::serializeFrom, before any of our code could look at the size, and
+// one claiming 100000 x 100000 pixels made it zero 20 GB before the stream ran out. This
+// definition takes the place of libmrpt-core's for every MRPT library in a program that reads
+// rawlogs (the program's own symbol interposes the shared library's, as for malloc): the same
+// allocation (the size rounded up to the alignment, freed by mrpt::aligned_free's ::free), but
+// a failure or a single block over 4 GiB, which no image or map of this project comes near,
+// throws std::bad_alloc, which the reader reports as an object that does not decode.
+namespace {
+class MrptAllocationRefused : public std::bad_alloc {
+  public:
+    explicit MrptAllocationRefused(std::size_t bytes)
+        : msg_("a block of " + std::to_string(bytes) +
+               " bytes could not be allocated (a damaged size field?)") {}
+    [[nodiscard]] const char* what() const noexcept override { return msg_.c_str(); }
+
+  private:
+    std::string msg_;
+};
+}  // namespace
+
+void* mrpt::aligned_malloc(std::size_t size, std::size_t alignment) {
+    constexpr std::size_t kMaxBlock = std::size_t(4) << 30;
+    if (alignment != 0 && size % alignment != 0) size = (size / alignment + 1) * alignment;
+    if (size > kMaxBlock) throw MrptAllocationRefused(size);
+    void* p = ::aligned_alloc(alignment, size);
+    if (!p && size > 0) throw MrptAllocationRefused(size);
+    return p;
+}
