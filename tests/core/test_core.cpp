@@ -99,6 +99,24 @@ TEST(Camera, ConfigRoundTripAndErrors) {
     }
     mrpt::config::CConfigFileMemory bad("[camera]\npreset = fr1\ncx = 900\n");
     EXPECT_THROW((void)CameraIntrinsics::fromConfig(bad, "camera"), std::invalid_argument);
+    // A focal length that passed "> 0" but made the SLAM's grid map loop forever.
+    mrpt::config::CConfigFileMemory tiny("[camera]\npreset = fr1\nfx = 1e-300\n");
+    try {
+        (void)CameraIntrinsics::fromConfig(tiny, "camera");
+        ADD_FAILURE() << "fx = 1e-300 accepted";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_EQ(std::string(e.what()), "[camera] fx/fy: must be in [1, 1e5] px");
+    }
+    EXPECT_EQ(CameraIntrinsics::fromPreset("fr3").problem(), "");
+    auto B = CameraIntrinsics::fromPreset("fr1");
+    B.fy = std::numeric_limits<double>::infinity();
+    EXPECT_EQ(B.problem(), "focal lengths fx 517.3, fy inf px: must be in [1, 1e5]");
+    B = CameraIntrinsics::fromPreset("fr1");
+    B.cx = 640;
+    EXPECT_EQ(B.problem(), "principal point (640, 255.3) lies outside the 640x480 image");
+    B = CameraIntrinsics::fromPreset("fr1");
+    B.dist[2] = std::nan("");
+    EXPECT_EQ(B.problem(), "a distortion coefficient is nan");
 }
 
 // Every key of [camera], from a preset (saved as its values): read back, at full precision.

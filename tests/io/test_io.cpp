@@ -7,6 +7,8 @@
 #include <devslam/io/VideoReader.h>
 
 #include <gtest/gtest.h>
+#include <mrpt/io/CFileGZInputStream.h>
+#include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/io/CMemoryStream.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
 #include <mrpt/serialization/CArchive.h>
@@ -20,6 +22,8 @@
 #include <filesystem>
 #include <algorithm>
 #include <fstream>
+#include <functional>
+#include <limits>
 #include <regex>
 
 
@@ -481,6 +485,41 @@ TEST(Rawlog, ADamagedImageSizeIsAnErrorNotACrash) {
         expectError([&] { io::RawlogReader r(path); },
                     R"(damaged\.rawlog: cannot decode object 0 .*bytes could not be allocated)");
     }
+}
+
+TEST(Rawlog, ImpossibleCamerasAndDepthUnitsAreErrors) {
+    // A focal length of 0, inf or 1e-300 made devslam-run's grid map loop forever; a depth
+    // unit of 0 m read every depth as 0 without a word.
+    io::TumReader tum(kTum);
+    const core::Frame good = tum.read(0);
+    TempDir d;
+    const auto written = [&](const std::function<void(mrpt::obs::CObservation3DRangeScan&)>& f) {
+        const std::string path = d.str("one.rawlog");
+        {
+            io::RawlogWriter w(path, {});
+            w.write(good);
+            w.close();
+        }
+        mrpt::io::CFileGZInputStream in(path);
+        const auto o = std::dynamic_pointer_cast<mrpt::obs::CObservation3DRangeScan>(
+            mrpt::serialization::archiveFrom(in).ReadObject());
+        in.close();
+        f(*o);
+        mrpt::io::CFileGZOutputStream out(path);
+        mrpt::serialization::archiveFrom(out) << *o;
+        return path;
+    };
+    for (const double fx : {0.0, std::numeric_limits<double>::infinity(), 1e-300}) {
+        const auto path = written([&](auto& o) { o.cameraParamsIntensity.fx(fx); });
+        expectError([&] { io::RawlogReader r(path); },
+                    R"(observation 0: colour camera: focal lengths fx .* must be in \[1, 1e5\])");
+    }
+    const auto depth_cam = written([](auto& o) { o.cameraParams.cy(-5); });
+    expectError([&] { io::RawlogReader r(depth_cam); },
+                R"(observation 0: depth camera: principal point \(.*, -5\) lies outside)");
+    const auto no_unit = written([](auto& o) { o.rangeUnits = 0; });
+    expectError([&] { io::RawlogReader r(no_unit); },
+                R"(observation 0: depth_scale must be finite and > 0)");
 }
 
 TEST(Rawlog, ReadsMrptsOwnOpenNiObservation) {

@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <map>
+#include <sstream>
 #include <stdexcept>
 
 namespace devslam::core {
@@ -56,6 +57,26 @@ CameraIntrinsics CameraIntrinsics::fromPreset(const std::string& name) {
     return it->second;
 }
 
+namespace {
+constexpr double kMinFocal = 1.0, kMaxFocal = 1e5;  // [px]
+}  // namespace
+
+std::string CameraIntrinsics::problem() const {
+    const auto str = [](double v) {
+        std::ostringstream o;
+        o << v;
+        return o.str();
+    };
+    if (!(fx >= kMinFocal && fx <= kMaxFocal && fy >= kMinFocal && fy <= kMaxFocal))
+        return "focal lengths fx " + str(fx) + ", fy " + str(fy) + " px: must be in [1, 1e5]";
+    if (!(cx >= 0 && cx < width && cy >= 0 && cy < height))
+        return "principal point (" + str(cx) + ", " + str(cy) + ") lies outside the " +
+               std::to_string(width) + "x" + std::to_string(height) + " image";
+    for (const double d : dist)
+        if (!std::isfinite(d)) return "a distortion coefficient is " + str(d);
+    return {};
+}
+
 CameraIntrinsics CameraIntrinsics::fromConfig(const mrpt::config::CConfigFileBase& c,
                                               const std::string& s) {
     requireKnownKeys(c, s, {"preset", "fx", "fy", "cx", "cy", "width", "height", "dist"});
@@ -81,7 +102,8 @@ CameraIntrinsics CameraIntrinsics::fromConfig(const mrpt::config::CConfigFileBas
         requireValue(d.size() == 5, s, "dist", "must have 5 values k1 k2 p1 p2 k3");
         std::copy(d.begin(), d.end(), K.dist.begin());
     }
-    requireValue(K.fx > 0 && K.fy > 0, s, "fx/fy", "must be > 0");
+    requireValue(K.fx >= kMinFocal && K.fy >= kMinFocal && K.fx <= kMaxFocal && K.fy <= kMaxFocal,
+                 s, "fx/fy", "must be in [1, 1e5] px");
     // An image buffer per frame (and the renderer's framebuffer) is width x height: 16000^2
     // took 8 GB before anything was drawn.
     requireValue(K.width > 0 && K.height > 0 && K.width <= 4096 && K.height <= 4096, s,

@@ -2,6 +2,7 @@
 
 #include <opencv2/core.hpp>
 
+#include <cmath>
 #include <stdexcept>
 
 namespace devslam::core {
@@ -29,7 +30,10 @@ void validateFrame(const Frame& f, const std::string& what) {
     if (f.K.width != f.bgr.cols || f.K.height != f.bgr.rows)
         fail("intrinsics are for " + std::to_string(f.K.width) + "x" + std::to_string(f.K.height) +
              " but the image is " + std::to_string(f.bgr.cols) + "x" + std::to_string(f.bgr.rows));
-    if (!(f.depth_scale > 0)) fail("depth_scale must be > 0");
+    if (const std::string p = f.K.problem(); !p.empty()) fail("intrinsics: " + p);
+    // inf: a rawlog's rangeUnits of 0 (every depth 0 m without a word before)
+    if (!(f.depth_scale > 0 && std::isfinite(f.depth_scale)))
+        fail("depth_scale must be finite and > 0 (a depth unit of 0 m?)");
 }
 
 }  // namespace devslam::core

@@ -24,6 +24,7 @@
 #include <limits>
 #include <new>
 #include <stdexcept>
+#include <tuple>
 
 namespace fs = std::filesystem;
 using mrpt::obs::CObservation3DRangeScan;
@@ -137,6 +138,18 @@ core::Frame frameFromObservation(const CObservation3DRangeScan& o, const std::st
             std::to_string(o.rangeUnits) +
             " m: metres truncated to integers (MRPT rgbd_dataset2rawlog bug)?");
     f.depth_scale = roundedScale(o.rangeUnits);
+    // Both cameras' models before any pixel is projected with them: a focal length of 0 or
+    // inf (a damaged file) made the SLAM's grid map loop forever, with no error on the way.
+    for (const auto& [name, cam, w, h] :
+         {std::tuple{"colour", &o.cameraParamsIntensity, f.bgr.cols, f.bgr.rows},
+          std::tuple{"depth", &o.cameraParams, static_cast<int>(o.rangeImage.cols()),
+                     static_cast<int>(o.rangeImage.rows())}}) {
+        auto K = core::CameraIntrinsics::fromMrpt(*cam);
+        K.width = w;
+        K.height = h;
+        if (const std::string p = K.problem(); !p.empty())
+            throw std::runtime_error(what + ": " + name + " camera: " + p);
+    }
     const cv::Mat depth = depthInDepthCamera(o);
     const bool same_camera = o.doDepthAndIntensityCamerasCoincide() &&
                              o.cameraParams.fx() == o.cameraParamsIntensity.fx() &&
@@ -150,6 +163,7 @@ core::Frame frameFromObservation(const CObservation3DRangeScan& o, const std::st
     f.K.height = f.bgr.rows;
     f.rgb_source = what;
     f.depth_source = what;
+    core::validateFrame(f, what);
     return f;
 }
 

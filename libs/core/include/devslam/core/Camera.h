@@ -57,6 +57,11 @@ struct CameraIntrinsics {
     [[nodiscard]] mrpt::img::TCamera toMrpt() const;
     [[nodiscard]] static CameraIntrinsics fromMrpt(const mrpt::img::TCamera& cam);
 
+    /// What makes these intrinsics unusable, or "" when nothing does: focal lengths finite and
+    /// in [1, 1e5] px (0, inf or 1e-300 from a damaged file made the SLAM's grid map loop
+    /// forever), a principal point finite and inside the image, a finite distortion.
+    [[nodiscard]] std::string problem() const;
+
     bool operator==(const CameraIntrinsics& o) const;
 };
 
