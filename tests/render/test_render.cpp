@@ -791,6 +791,26 @@ TEST(Scenario, ShippedFilesLoadAndTyposAreReported) {
     expectMessage(
         [&] { (void)loadScenario(withEdit(text, "n_frames        = 60", "duration = 0.01")); },
         tmp.str("s.ini") + " [scenario] duration: gives no frame at rate_hz");
+    // Bounds (fuzz): a billion frames started a render of days, t0 = 1e300 gave every frame
+    // one stamp (each overwrote the last), rate_hz = 1e-300 gave 300-digit stamps.
+    (void)withEdit(text, "n_frames", "n_frames");  // s.ini (= base) as it was
+    expectMessage([&] { (void)loadScenario(base, {"scenario.n_frames=1000000000"}); },
+                  tmp.str("s.ini") + " [scenario] n_frames: must be at most 100000");
+    expectMessage([&] { (void)loadScenario(base, {"scenario.n_frames=100001"}); },
+                  "[scenario] n_frames: must be at most 100000");
+    EXPECT_EQ(loadScenario(base, {"scenario.n_frames=100000"}).n_frames, 100000u);
+    expectMessage(
+        [&] { (void)loadScenario(withEdit(text, "n_frames        = 60", "duration = 1e9")); },
+        tmp.str("s.ini") + " [scenario] duration: gives more than 100000 frames");
+    (void)withEdit(text, "n_frames", "n_frames");  // s.ini (= base) as it was
+    expectMessage([&] { (void)loadScenario(base, {"scenario.t0=1e300"}); },
+                  tmp.str("s.ini") + " [scenario] t0: must be in [0, 1e10] [s]");
+    expectMessage([&] { (void)loadScenario(base, {"scenario.t0=-1"}); },
+                  "[scenario] t0: must be in [0, 1e10] [s]");
+    expectMessage([&] { (void)loadScenario(base, {"scenario.rate_hz=1e-300"}); },
+                  tmp.str("s.ini") + " [scenario] rate_hz: must be in [1, 1000] [Hz]");
+    expectMessage([&] { (void)loadScenario(base, {"scenario.rate_hz=1001"}); },
+                  "[scenario] rate_hz: must be in [1, 1000] [Hz]");
     expectMessage(
         [&] {
             (void)loadScenario(
