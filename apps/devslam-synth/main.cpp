@@ -158,6 +158,7 @@ int run(int argc, char** argv) {
     o.rawlog_path = rawlog;
     o.write_labels = labels;
     o.max_frames = frames;
+    render::checkOutputs(sc, o);  // before the preview: a real TUM folder is left as it was
     if (if_changed && render::isRenderCurrent(sc, o)) {
         std::cout << "scenario " << sc.name << ": " << out_dir
                   << " holds this render already (render.txt), not rendered again\n";

@@ -18,6 +18,7 @@
 
 #include <gtest/gtest.h>
 
+#include "Command.h"
 #include "Scratch.h"
 
 #include <cmath>
@@ -25,6 +26,8 @@
 #include <fstream>
 #include <iostream>
 #include <sstream>
+#include <utility>
+#include <vector>
 
 namespace fs = std::filesystem;
 using namespace devslam;
@@ -414,6 +417,70 @@ TEST(RenderSequence, StopEndsTheRenderWithTheFramesBeforeItWritten) {
     o.stop = nullptr;
     EXPECT_TRUE(isRenderCurrent(sc, o));
     EXPECT_EQ(readFile(o.out_dir + "/rgb.txt"), list);
+}
+
+// A real TUM folder (rgb.txt, no render.txt or persons.txt) is not written over, and a
+// rawlog that is not named .rawlog, or is the scenario file, is refused (fuzz: both were
+// overwritten with rc 0); a render's own folder, whole or stopped, is rendered again.
+TEST(RenderSequence, RefusesToOverwriteWhatItDidNotRender) {
+    TempDir tmp;
+    Scenario sc = smallShort();
+    WriteOptions o;
+    o.out_dir = tmp.str("tum");
+    o.max_frames = 1;
+    fs::create_directories(o.out_dir);
+    const std::string list = "# color images\n1305031102.175304 rgb/1305031102.175304.png\n";
+    std::ofstream(o.out_dir + "/rgb.txt") << list;
+    expectMessage([&] { (void)writeSequence(sc, o); },
+                  "output folder '" + o.out_dir + "' already holds a TUM sequence (rgb.txt)");
+    EXPECT_EQ(readFile(o.out_dir + "/rgb.txt"), list);
+    EXPECT_FALSE(fs::exists(o.out_dir + "/persons.txt"));
+    // A stopped render of ours (persons.txt, no render.txt), and a whole one: rendered again.
+    std::ofstream(o.out_dir + "/persons.txt") << "# person truth\n";
+    EXPECT_NO_THROW(checkOutputs(sc, o));
+    EXPECT_EQ(writeSequence(sc, o).n_frames, 1u);
+    EXPECT_TRUE(isRenderCurrent(sc, o));
+    fs::remove(o.out_dir + "/persons.txt");
+    EXPECT_NO_THROW(checkOutputs(sc, o));  // render.txt
+    EXPECT_EQ(writeSequence(sc, o).n_frames, 1u);
+
+    const std::string ini = tmp.str("s.ini");
+    std::ofstream(ini) << "[scenario]\n";
+    o.rawlog_path = ini;
+    expectMessage([&] { (void)writeSequence(sc, o); },
+                  "rawlog '" + ini + "': the name must end in .rawlog");
+    EXPECT_EQ(readFile(ini), "[scenario]\n");
+    sc.source = tmp.str("s.rawlog");  // a scenario of that name is not written over either
+    std::ofstream(sc.source) << "[scenario]\n";
+    o.rawlog_path = tmp.str("./s.rawlog");
+    expectMessage([&] { checkOutputs(sc, o); }, "is the scenario file");
+    EXPECT_EQ(readFile(sc.source), "[scenario]\n");
+}
+
+// devslam-synth refuses, before it writes anything (no preview.png either), outputs that
+// would destroy what it did not make (fuzz: a real TUM folder's lists, the scenario INI
+// given as --rawlog).
+TEST(DevslamSynth, RefusesOutputsThatAreNotItsOwn) {
+    TempDir tmp;
+    const std::string tum = tmp.str("tum"), list = "# color images\n";
+    fs::create_directories(tum);
+    std::ofstream(tum + "/rgb.txt") << list;
+    const std::string ini = tmp.str("s.ini");
+    std::ofstream(ini) << "[scenario]\n";
+    for (const auto& [args, says] : std::vector<std::pair<std::string, std::string>>{
+             {"short_walking -o " + tum + " --frames 2",
+              "output folder '" + tum + "' already holds a TUM sequence (rgb.txt) that "
+              "devslam-synth did not render"},
+             {"short_walking -o " + tmp.str("so") + " --frames 2 --rawlog " + ini,
+              "rawlog '" + ini + "': the name must end in .rawlog"}}) {
+        const auto r = devslam::test::runApp("devslam-synth", args);
+        EXPECT_EQ(r.rc, 1) << args << "\n" << r.out;
+        EXPECT_NE(r.out.find(says), std::string::npos) << args << "\n" << r.out;
+    }
+    EXPECT_EQ(readFile(tum + "/rgb.txt"), list);
+    EXPECT_FALSE(fs::exists(tum + "/preview.png"));
+    EXPECT_EQ(readFile(ini), "[scenario]\n");
+    EXPECT_FALSE(fs::exists(tmp.str("so")));
 }
 
 // A seated person who moves a hand: the labelled pixels follow the hand (they differ between
