@@ -77,6 +77,14 @@ cv::Mat preview(const render::RenderedFrame& f) {
 
 int cutTexture(const std::vector<std::string>& a) {
     if (a.size() != 4) throw std::invalid_argument("--cut-texture needs IMAGE X,Y,W,H OUT.png");
+    // The texture's alpha mask needs PNG (a .jpg dropped it, a .txt failed in OpenCV), and
+    // the photo is not written over.
+    if (!core::endsWithNoCase(a[3], ".png"))
+        throw std::invalid_argument("--cut-texture OUT '" + a[3] + "': the name must end in .png");
+    std::error_code ec;
+    if (fs::exists(a[3]) && fs::equivalent(a[1], a[3], ec))
+        throw std::invalid_argument("--cut-texture OUT '" + a[3] + "' is the IMAGE '" + a[1] +
+                                    "': writing it would destroy the photo; name another");
     const cv::Mat img = cv::imread(a[1], cv::IMREAD_COLOR);
     if (img.empty()) throw std::runtime_error("cannot read '" + a[1] + "'");
     const auto v = core::parseNumberList(a[2], "--cut-texture box", 4);

@@ -459,12 +459,15 @@ TEST(RenderSequence, RefusesToOverwriteWhatItDidNotRender) {
 
 // devslam-synth refuses, before it writes anything (no preview.png either), outputs that
 // would destroy what it did not make (fuzz: a real TUM folder's lists, the scenario INI
-// given as --rawlog).
+// given as --rawlog, the photo given as --cut-texture OUT).
 TEST(DevslamSynth, RefusesOutputsThatAreNotItsOwn) {
     TempDir tmp;
     const std::string tum = tmp.str("tum"), list = "# color images\n";
     fs::create_directories(tum);
     std::ofstream(tum + "/rgb.txt") << list;
+    const std::string photo = tmp.str("p.png");
+    cv::imwrite(photo, cv::imread(kRoot + "/data/images/dog.jpg"));
+    const std::string photo_text = readFile(photo);
     const std::string ini = tmp.str("s.ini");
     std::ofstream(ini) << "[scenario]\n";
     for (const auto& [args, says] : std::vector<std::pair<std::string, std::string>>{
@@ -472,7 +475,11 @@ TEST(DevslamSynth, RefusesOutputsThatAreNotItsOwn) {
               "output folder '" + tum + "' already holds a TUM sequence (rgb.txt) that "
               "devslam-synth did not render"},
              {"short_walking -o " + tmp.str("so") + " --frames 2 --rawlog " + ini,
-              "rawlog '" + ini + "': the name must end in .rawlog"}}) {
+              "rawlog '" + ini + "': the name must end in .rawlog"},
+             {"--cut-texture " + photo + " 178,88,102,292 " + photo,
+              "--cut-texture OUT '" + photo + "' is the IMAGE"},
+             {"--cut-texture " + photo + " 178,88,102,292 " + tmp.str("out.txt"),
+              "--cut-texture OUT '" + tmp.str("out.txt") + "': the name must end in .png"}}) {
         const auto r = devslam::test::runApp("devslam-synth", args);
         EXPECT_EQ(r.rc, 1) << args << "\n" << r.out;
         EXPECT_NE(r.out.find(says), std::string::npos) << args << "\n" << r.out;
@@ -481,6 +488,8 @@ TEST(DevslamSynth, RefusesOutputsThatAreNotItsOwn) {
     EXPECT_FALSE(fs::exists(tum + "/preview.png"));
     EXPECT_EQ(readFile(ini), "[scenario]\n");
     EXPECT_FALSE(fs::exists(tmp.str("so")));
+    EXPECT_EQ(readFile(photo), photo_text);
+    EXPECT_FALSE(fs::exists(tmp.str("out.txt")));
 }
 
 // A seated person who moves a hand: the labelled pixels follow the hand (they differ between
