@@ -50,7 +50,9 @@ int main(int argc, char** argv) {
         for (int i = 1; i < argc; ++i) {
             const std::string a = argv[i];
             auto value = [&]() -> const char* {
-                if (i + 1 >= argc) throw std::invalid_argument(a + " needs a value");
+                // "--json --plot p.png": --json's value is missing, not "--plot".
+                if (i + 1 >= argc || std::string(argv[i + 1]).rfind("--", 0) == 0)
+                    throw std::invalid_argument(a + " needs a value");
                 return argv[++i];
             };
             if (a == "-h" || a == "--help") {

@@ -128,7 +128,9 @@ int run(int argc, char** argv) {
     bool labels = true, if_changed = false;
     for (std::size_t i = 0; i < a.size(); ++i) {
         const auto value = [&]() -> std::string {
-            if (i + 1 >= a.size()) throw std::invalid_argument(a[i] + " needs a value");
+            // "-o --frames 2": -o's value is missing, not a folder named "--frames".
+            if (i + 1 >= a.size() || a[i + 1].rfind("--", 0) == 0)
+                throw std::invalid_argument(a[i] + " needs a value");
             return a[++i];
         };
         if (a[i] == "-o" || a[i] == "--out")

@@ -356,7 +356,7 @@ TEST(Report, TableJsonPlotAndApp) {
 
 // Fuzz: --scale 1e308, or positions near 1e200, overflowed the alignment and wrote
 // "rmse": -nan (no JSON) under exit status 0; --json EST replaced the estimate with the
-// figures.
+// figures; "--json --plot p.png" took "--plot" for the JSON's name.
 TEST(Report, RefusesOverflowNonFiniteJsonAndOutputsThatAreInputs) {
     devslam::test::TempDir d("devslam_eval_");
     const auto gt = helix(60, 30);
@@ -392,7 +392,8 @@ TEST(Report, RefusesOverflowNonFiniteJsonAndOutputsThatAreInputs) {
               "--scale: must be in [1e-6, 1e6], got '1e308'"},
              {g + " " + far + " --json " + d.str("j.json"), "far.txt line 2: tx 1e200"},
              {g + " " + e + " --json " + e, "--json '" + e + "' is the input '" + e + "'"},
-             {g + " " + e + " --json " + g, "--json '" + g + "' is the input '" + g + "'"}}) {
+             {g + " " + e + " --json " + g, "--json '" + g + "' is the input '" + g + "'"},
+             {g + " " + e + " --json --plot " + d.str("p.png"), "--json needs a value"}}) {
         const auto r = devslam::test::runApp("devslam-eval", args);
         EXPECT_EQ(r.rc, 1) << args << "\n" << r.out;
         EXPECT_NE(r.out.find(says), std::string::npos) << args << "\n" << r.out;

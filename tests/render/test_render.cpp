@@ -458,9 +458,9 @@ TEST(RenderSequence, RefusesToOverwriteWhatItDidNotRender) {
 }
 
 // devslam-synth refuses, before it writes anything (no preview.png either), outputs that
-// would destroy what it did not make (fuzz: a real TUM folder's lists, the scenario INI
-// given as --rawlog, the photo given as --cut-texture OUT).
-TEST(DevslamSynth, RefusesOutputsThatAreNotItsOwn) {
+// would destroy what it did not make, and an option whose value is missing (fuzz: a real TUM
+// folder's lists, the scenario INI given as --rawlog, the photo given as --cut-texture OUT).
+TEST(DevslamSynth, RefusesOutputsThatAreNotItsOwnAndMissingValues) {
     TempDir tmp;
     const std::string tum = tmp.str("tum"), list = "# color images\n";
     fs::create_directories(tum);
@@ -479,7 +479,9 @@ TEST(DevslamSynth, RefusesOutputsThatAreNotItsOwn) {
              {"--cut-texture " + photo + " 178,88,102,292 " + photo,
               "--cut-texture OUT '" + photo + "' is the IMAGE"},
              {"--cut-texture " + photo + " 178,88,102,292 " + tmp.str("out.txt"),
-              "--cut-texture OUT '" + tmp.str("out.txt") + "': the name must end in .png"}}) {
+              "--cut-texture OUT '" + tmp.str("out.txt") + "': the name must end in .png"},
+             {"short_walking -o --frames 2", "devslam-synth: -o needs a value"},
+             {"short_walking --rawlog --frames 2", "devslam-synth: --rawlog needs a value"}}) {
         const auto r = devslam::test::runApp("devslam-synth", args);
         EXPECT_EQ(r.rc, 1) << args << "\n" << r.out;
         EXPECT_NE(r.out.find(says), std::string::npos) << args << "\n" << r.out;
@@ -490,6 +492,7 @@ TEST(DevslamSynth, RefusesOutputsThatAreNotItsOwn) {
     EXPECT_FALSE(fs::exists(tmp.str("so")));
     EXPECT_EQ(readFile(photo), photo_text);
     EXPECT_FALSE(fs::exists(tmp.str("out.txt")));
+    EXPECT_FALSE(fs::exists("--frames"));
 }
 
 // A seated person who moves a hand: the labelled pixels follow the hand (they differ between
