@@ -7,9 +7,11 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <iostream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace {
@@ -19,7 +21,7 @@ const char* kUsage = R"(usage: devslam-eval GROUNDTRUTH ESTIMATE [options]
 options:
   --max-dt S        association window [s] (default 0.02, as associate.py)
   --offset S        time offset added to the estimate [s] (default 0)
-  --scale K         scale applied to the estimate's translations (default 1)
+  --scale K         scale applied to the estimate's translations (default 1, 1e-6..1e6)
   --delta D         RPE interval (default 1)
   --delta-unit U    s (seconds, default) or f (frames)
   --json FILE       also write the figures as JSON
@@ -48,7 +50,9 @@ int main(int argc, char** argv) {
         for (int i = 1; i < argc; ++i) {
             const std::string a = argv[i];
             auto value = [&]() -> const char* {
-                if (i + 1 >= argc) throw std::invalid_argument(a + " needs a value");
+                // "--json --plot p.png": --json's value is missing, not "--plot".
+                if (i + 1 >= argc || std::string(argv[i + 1]).rfind("--", 0) == 0)
+                    throw std::invalid_argument(a + " needs a value");
                 return argv[++i];
             };
             if (a == "-h" || a == "--help") {
@@ -58,8 +62,13 @@ int main(int argc, char** argv) {
                 ao.max_dt = number(a, value(), true);
             else if (a == "--offset")
                 ao.offset = ro.offset = number(a, value());
-            else if (a == "--scale")
+            else if (a == "--scale") {
                 ao.scale = number(a, value(), true);
+                // 1e308 overflowed the alignment (an rmse of -nan, under exit status 0).
+                if (ao.scale < devslam::eval::kMinScale || ao.scale > devslam::eval::kMaxScale)
+                    throw std::invalid_argument("--scale: must be in [1e-6, 1e6], got '" +
+                                                std::string(argv[i]) + "'");
+            }
             else if (a == "--delta")
                 ro.delta = number(a, value(), true);
             else if (a == "--delta-unit") {
@@ -86,6 +95,17 @@ int main(int argc, char** argv) {
         }
         if (!plot.empty() && !devslam::core::endsWithNoCase(plot, ".png"))
             throw std::invalid_argument("--plot '" + plot + "': the plot's name must end in .png");
+        // The outputs are written after the inputs are read: one that is an input (--json
+        // EST) replaced the estimate with the figures.
+        for (const auto& [opt, out] : {std::pair{"--json", json}, {"--plot", plot}})
+            for (const auto& in : pos) {
+                std::error_code ec;
+                if (!out.empty() && std::filesystem::exists(out) &&
+                    std::filesystem::equivalent(in, out, ec))
+                    throw std::invalid_argument(std::string(opt) + " '" + out +
+                                                "' is the input '" + in +
+                                                "': writing it would destroy it; name another");
+            }
         const auto gt = devslam::io::readTumTrajectory(pos[0]);
         auto est = devslam::io::readTumTrajectory(pos[1]);
         const auto ate = devslam::eval::computeAte(gt, est, ao);

@@ -177,7 +177,8 @@ std::optional<int> parseArgs(int argc, char** argv, Args& a) {
         for (int i = 1; i < argc; i++) {
             const std::string s = argv[i];
             auto next = [&]() -> std::string {
-                if (i + 1 >= argc) throw std::invalid_argument("missing value after " + s);
+                if (i + 1 >= argc || std::string(argv[i + 1]).rfind("--", 0) == 0)
+                    throw std::invalid_argument(s + " needs a value");
                 return argv[++i];
             };
             if (s == "--per-category") {

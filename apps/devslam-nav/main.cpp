@@ -121,7 +121,9 @@ int main(int argc, char** argv) {
     for (int i = 1; i < argc; i++) {
         const std::string a = argv[i];
         auto next = [&]() -> std::string {
-            if (i + 1 >= argc) throw std::invalid_argument("missing value after " + a);
+            // "--method --png x.png": the option's value is missing, not "--png" a method.
+            if (i + 1 >= argc || std::string(argv[i + 1]).rfind("--", 0) == 0)
+                throw std::invalid_argument(a + " needs a value");
             return argv[++i];
         };
         try {

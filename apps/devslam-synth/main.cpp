@@ -77,6 +77,14 @@ cv::Mat preview(const render::RenderedFrame& f) {
 
 int cutTexture(const std::vector<std::string>& a) {
     if (a.size() != 4) throw std::invalid_argument("--cut-texture needs IMAGE X,Y,W,H OUT.png");
+    // The texture's alpha mask needs PNG (a .jpg dropped it, a .txt failed in OpenCV), and
+    // the photo is not written over.
+    if (!core::endsWithNoCase(a[3], ".png"))
+        throw std::invalid_argument("--cut-texture OUT '" + a[3] + "': the name must end in .png");
+    std::error_code ec;
+    if (fs::exists(a[3]) && fs::equivalent(a[1], a[3], ec))
+        throw std::invalid_argument("--cut-texture OUT '" + a[3] + "' is the IMAGE '" + a[1] +
+                                    "': writing it would destroy the photo; name another");
     const cv::Mat img = cv::imread(a[1], cv::IMREAD_COLOR);
     if (img.empty()) throw std::runtime_error("cannot read '" + a[1] + "'");
     const auto v = core::parseNumberList(a[2], "--cut-texture box", 4);
@@ -120,7 +128,9 @@ int run(int argc, char** argv) {
     bool labels = true, if_changed = false;
     for (std::size_t i = 0; i < a.size(); ++i) {
         const auto value = [&]() -> std::string {
-            if (i + 1 >= a.size()) throw std::invalid_argument(a[i] + " needs a value");
+            // "-o --frames 2": -o's value is missing, not a folder named "--frames".
+            if (i + 1 >= a.size() || a[i + 1].rfind("--", 0) == 0)
+                throw std::invalid_argument(a[i] + " needs a value");
             return a[++i];
         };
         if (a[i] == "-o" || a[i] == "--out")
@@ -158,6 +168,7 @@ int run(int argc, char** argv) {
     o.rawlog_path = rawlog;
     o.write_labels = labels;
     o.max_frames = frames;
+    render::checkOutputs(sc, o);  // before the preview: a real TUM folder is left as it was
     if (if_changed && render::isRenderCurrent(sc, o)) {
         std::cout << "scenario " << sc.name << ": " << out_dir
                   << " holds this render already (render.txt), not rendered again\n";

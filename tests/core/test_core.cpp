@@ -374,6 +374,21 @@ TEST(Config, RepeatedKeysAndSectionsAreRefused) {
     std::filesystem::remove_all(path);
 }
 
+// A NUL byte in a line hid the key before it from requireKnownKeys (fuzz: "bogus_key\0 = 1"
+// appended to a SLAM INI ran with rc 0): refused, naming the file and the line.
+TEST(Config, NulByteIsRefusedWithItsLine) {
+    devslam::test::TempDir d("devslam_core_");
+    const std::string path = d.str("nul.ini");
+    std::ofstream(path, std::ios::binary) << std::string("[a]\nk = 1\nbogus_key\0 = 1\n", 25);
+    try {
+        (void)loadIni(path);
+        FAIL() << "no error for a NUL byte";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_EQ(std::string(e.what()),
+                  path + " line 3: a NUL byte (a binary file, or a damaged INI)");
+    }
+}
+
 TEST(Config, UnknownSectionsAndKeysBeforeAnySectionAreErrors) {
     const std::vector<std::string> known{"room", "box_*"};
     mrpt::config::CConfigFileMemory ok("[room]\nsize = 1\n[box_desk]\nx = 2\n[box_]\n");

@@ -13,12 +13,14 @@
 
 #include <gtest/gtest.h>
 
+#include "Command.h"
 #include "Scratch.h"
 
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <random>
 
 
@@ -350,6 +352,55 @@ TEST(Report, TableJsonPlotAndApp) {
     EXPECT_NE(text("err.txt").find("RPE: no pose pair"), std::string::npos) << text("err.txt");
     EXPECT_NE(text("err.txt").find("the ATE above is written"), std::string::npos);
     std::filesystem::remove_all(dir);
+}
+
+// Fuzz: --scale 1e308, or positions near 1e200, overflowed the alignment and wrote
+// "rmse": -nan (no JSON) under exit status 0; --json EST replaced the estimate with the
+// figures; "--json --plot p.png" took "--plot" for the JSON's name.
+TEST(Report, RefusesOverflowNonFiniteJsonAndOutputsThatAreInputs) {
+    devslam::test::TempDir d("devslam_eval_");
+    const auto gt = helix(60, 30);
+    EXPECT_THROW((void)eval::computeAte(gt, gt, {0.02, 0.0, 1e308}), std::invalid_argument);
+    EXPECT_NO_THROW((void)eval::computeAte(gt, gt, {0.02, 0.0, 1e6}));
+    eval::AteResult nan = eval::computeAte(gt, gt);
+    nan.trans.rmse = std::nan("");
+    nan.trans.max = -std::numeric_limits<double>::infinity();
+    const std::string json = eval::toJson(&nan, nullptr, nullptr);
+    EXPECT_NE(json.find("\"rmse\": null"), std::string::npos) << json;
+    EXPECT_NE(json.find("\"max\": null"), std::string::npos) << json;
+    EXPECT_EQ(json.find("nan"), std::string::npos) << json;
+    EXPECT_EQ(json.find("inf"), std::string::npos) << json;
+
+    const std::string g = d.str("gt.txt"), e = d.str("est.txt"), far = d.str("far.txt");
+    io::writeTumTrajectory(g, gt);
+    io::writeTumTrajectory(e, gt);
+    std::ofstream(far) << "1 0 0 0 0 0 0 1\n2 1e200 0 0 0 0 0 1\n";
+    try {
+        (void)io::readTumTrajectory(far);
+        ADD_FAILURE() << "no error for a position of 1e200 m";
+    } catch (const std::runtime_error& x) {
+        EXPECT_EQ(std::string(x.what()).find(far + " line 2: tx 1e200 is beyond +-1e6 m"), 0u)
+            << x.what();
+    }
+    const auto text = [](const std::string& f) {
+        std::ifstream in(f);
+        return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    };
+    const std::string est_text = text(e);
+    for (const auto& [args, says] : std::vector<std::pair<std::string, std::string>>{
+             {g + " " + g + " --scale 1e308 --json " + d.str("j.json"),
+              "--scale: must be in [1e-6, 1e6], got '1e308'"},
+             {g + " " + far + " --json " + d.str("j.json"), "far.txt line 2: tx 1e200"},
+             {g + " " + e + " --json " + e, "--json '" + e + "' is the input '" + e + "'"},
+             {g + " " + e + " --json " + g, "--json '" + g + "' is the input '" + g + "'"},
+             {g + " " + e + " --json --plot " + d.str("p.png"), "--json needs a value"}}) {
+        const auto r = devslam::test::runApp("devslam-eval", args);
+        EXPECT_EQ(r.rc, 1) << args << "\n" << r.out;
+        EXPECT_NE(r.out.find(says), std::string::npos) << args << "\n" << r.out;
+        EXPECT_FALSE(std::filesystem::exists(d.str("j.json"))) << args;
+        EXPECT_FALSE(std::filesystem::exists(d.str("p.png"))) << args;
+    }
+    EXPECT_EQ(text(e), est_text);
 }
 
 TEST(MaskScore, CountsWalkersStaticPeopleAndArea) {

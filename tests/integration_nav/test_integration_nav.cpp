@@ -28,9 +28,12 @@
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <regex>
 #include <sstream>
+#include <tuple>
+#include <vector>
 
 namespace {
 const std::string kSrc = DEVSLAM_SOURCE_DIR;
@@ -306,4 +309,24 @@ TEST(IntegrationNav, NavBenchCtrlCPrintsTheEpisodesDone) {
     results << in.rdbuf();
     EXPECT_EQ(results.str(), "# R\n");
     EXPECT_FALSE(mrpt::system::directoryExists(out + "/png"));
+}
+
+// An option's value that is the next option ("--method --png x.png") was read as the value,
+// or as a second world ("more than one world file given"): the option is named instead.
+TEST(IntegrationNav, OptionWithoutValueIsNamed) {
+    const std::string world = kSrc + "/sim_worlds/paper_fig6.ini";
+    for (const auto& [app, args, says] : std::vector<std::tuple<std::string, std::string,
+                                                                std::string>>{
+             {"devslam-nav", world + " --method --png x.png",
+              "devslam-nav: --method needs a value"},
+             {"devslam-nav", world + " --png", "devslam-nav: --png needs a value"},
+             {"devslam-nav", "--map --to 1,0", "devslam-nav: --map needs a value"},
+             {"devslam-nav-bench", "--quick --png-dir --methods CHolonomicND",
+              "--png-dir needs a value"}}) {
+        const auto r = devslam::test::runApp(app, args);
+        EXPECT_EQ(r.rc, 2) << app << " " << args << "\n" << r.out;
+        EXPECT_NE(r.out.find(says), std::string::npos) << app << " " << args << "\n" << r.out;
+        EXPECT_EQ(r.out.find("result="), std::string::npos) << r.out;
+    }
+    EXPECT_FALSE(std::filesystem::exists("x.png"));
 }

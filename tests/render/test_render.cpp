@@ -18,6 +18,7 @@
 
 #include <gtest/gtest.h>
 
+#include "Command.h"
 #include "Scratch.h"
 
 #include <cmath>
@@ -25,6 +26,8 @@
 #include <fstream>
 #include <iostream>
 #include <sstream>
+#include <utility>
+#include <vector>
 
 namespace fs = std::filesystem;
 using namespace devslam;
@@ -416,6 +419,82 @@ TEST(RenderSequence, StopEndsTheRenderWithTheFramesBeforeItWritten) {
     EXPECT_EQ(readFile(o.out_dir + "/rgb.txt"), list);
 }
 
+// A real TUM folder (rgb.txt, no render.txt or persons.txt) is not written over, and a
+// rawlog that is not named .rawlog, or is the scenario file, is refused (fuzz: both were
+// overwritten with rc 0); a render's own folder, whole or stopped, is rendered again.
+TEST(RenderSequence, RefusesToOverwriteWhatItDidNotRender) {
+    TempDir tmp;
+    Scenario sc = smallShort();
+    WriteOptions o;
+    o.out_dir = tmp.str("tum");
+    o.max_frames = 1;
+    fs::create_directories(o.out_dir);
+    const std::string list = "# color images\n1305031102.175304 rgb/1305031102.175304.png\n";
+    std::ofstream(o.out_dir + "/rgb.txt") << list;
+    expectMessage([&] { (void)writeSequence(sc, o); },
+                  "output folder '" + o.out_dir + "' already holds a TUM sequence (rgb.txt)");
+    EXPECT_EQ(readFile(o.out_dir + "/rgb.txt"), list);
+    EXPECT_FALSE(fs::exists(o.out_dir + "/persons.txt"));
+    // A stopped render of ours (persons.txt, no render.txt), and a whole one: rendered again.
+    std::ofstream(o.out_dir + "/persons.txt") << "# person truth\n";
+    EXPECT_NO_THROW(checkOutputs(sc, o));
+    EXPECT_EQ(writeSequence(sc, o).n_frames, 1u);
+    EXPECT_TRUE(isRenderCurrent(sc, o));
+    fs::remove(o.out_dir + "/persons.txt");
+    EXPECT_NO_THROW(checkOutputs(sc, o));  // render.txt
+    EXPECT_EQ(writeSequence(sc, o).n_frames, 1u);
+
+    const std::string ini = tmp.str("s.ini");
+    std::ofstream(ini) << "[scenario]\n";
+    o.rawlog_path = ini;
+    expectMessage([&] { (void)writeSequence(sc, o); },
+                  "rawlog '" + ini + "': the name must end in .rawlog");
+    EXPECT_EQ(readFile(ini), "[scenario]\n");
+    sc.source = tmp.str("s.rawlog");  // a scenario of that name is not written over either
+    std::ofstream(sc.source) << "[scenario]\n";
+    o.rawlog_path = tmp.str("./s.rawlog");
+    expectMessage([&] { checkOutputs(sc, o); }, "is the scenario file");
+    EXPECT_EQ(readFile(sc.source), "[scenario]\n");
+}
+
+// devslam-synth refuses, before it writes anything (no preview.png either), outputs that
+// would destroy what it did not make, and an option whose value is missing (fuzz: a real TUM
+// folder's lists, the scenario INI given as --rawlog, the photo given as --cut-texture OUT).
+TEST(DevslamSynth, RefusesOutputsThatAreNotItsOwnAndMissingValues) {
+    TempDir tmp;
+    const std::string tum = tmp.str("tum"), list = "# color images\n";
+    fs::create_directories(tum);
+    std::ofstream(tum + "/rgb.txt") << list;
+    const std::string photo = tmp.str("p.png");
+    cv::imwrite(photo, cv::imread(kRoot + "/data/images/dog.jpg"));
+    const std::string photo_text = readFile(photo);
+    const std::string ini = tmp.str("s.ini");
+    std::ofstream(ini) << "[scenario]\n";
+    for (const auto& [args, says] : std::vector<std::pair<std::string, std::string>>{
+             {"short_walking -o " + tum + " --frames 2",
+              "output folder '" + tum + "' already holds a TUM sequence (rgb.txt) that "
+              "devslam-synth did not render"},
+             {"short_walking -o " + tmp.str("so") + " --frames 2 --rawlog " + ini,
+              "rawlog '" + ini + "': the name must end in .rawlog"},
+             {"--cut-texture " + photo + " 178,88,102,292 " + photo,
+              "--cut-texture OUT '" + photo + "' is the IMAGE"},
+             {"--cut-texture " + photo + " 178,88,102,292 " + tmp.str("out.txt"),
+              "--cut-texture OUT '" + tmp.str("out.txt") + "': the name must end in .png"},
+             {"short_walking -o --frames 2", "devslam-synth: -o needs a value"},
+             {"short_walking --rawlog --frames 2", "devslam-synth: --rawlog needs a value"}}) {
+        const auto r = devslam::test::runApp("devslam-synth", args);
+        EXPECT_EQ(r.rc, 1) << args << "\n" << r.out;
+        EXPECT_NE(r.out.find(says), std::string::npos) << args << "\n" << r.out;
+    }
+    EXPECT_EQ(readFile(tum + "/rgb.txt"), list);
+    EXPECT_FALSE(fs::exists(tum + "/preview.png"));
+    EXPECT_EQ(readFile(ini), "[scenario]\n");
+    EXPECT_FALSE(fs::exists(tmp.str("so")));
+    EXPECT_EQ(readFile(photo), photo_text);
+    EXPECT_FALSE(fs::exists(tmp.str("out.txt")));
+    EXPECT_FALSE(fs::exists("--frames"));
+}
+
 // A seated person who moves a hand: the labelled pixels follow the hand (they differ between
 // the swing's two extremes only near the hand, and lie on the photo's plane), the person stays
 // static in the truth, and a person whose gesture_deg is 0 renders exactly as one without.
@@ -791,6 +870,26 @@ TEST(Scenario, ShippedFilesLoadAndTyposAreReported) {
     expectMessage(
         [&] { (void)loadScenario(withEdit(text, "n_frames        = 60", "duration = 0.01")); },
         tmp.str("s.ini") + " [scenario] duration: gives no frame at rate_hz");
+    // Bounds (fuzz): a billion frames started a render of days, t0 = 1e300 gave every frame
+    // one stamp (each overwrote the last), rate_hz = 1e-300 gave 300-digit stamps.
+    (void)withEdit(text, "n_frames", "n_frames");  // s.ini (= base) as it was
+    expectMessage([&] { (void)loadScenario(base, {"scenario.n_frames=1000000000"}); },
+                  tmp.str("s.ini") + " [scenario] n_frames: must be at most 100000");
+    expectMessage([&] { (void)loadScenario(base, {"scenario.n_frames=100001"}); },
+                  "[scenario] n_frames: must be at most 100000");
+    EXPECT_EQ(loadScenario(base, {"scenario.n_frames=100000"}).n_frames, 100000u);
+    expectMessage(
+        [&] { (void)loadScenario(withEdit(text, "n_frames        = 60", "duration = 1e9")); },
+        tmp.str("s.ini") + " [scenario] duration: gives more than 100000 frames");
+    (void)withEdit(text, "n_frames", "n_frames");  // s.ini (= base) as it was
+    expectMessage([&] { (void)loadScenario(base, {"scenario.t0=1e300"}); },
+                  tmp.str("s.ini") + " [scenario] t0: must be in [0, 1e10] [s]");
+    expectMessage([&] { (void)loadScenario(base, {"scenario.t0=-1"}); },
+                  "[scenario] t0: must be in [0, 1e10] [s]");
+    expectMessage([&] { (void)loadScenario(base, {"scenario.rate_hz=1e-300"}); },
+                  tmp.str("s.ini") + " [scenario] rate_hz: must be in [1, 1000] [Hz]");
+    expectMessage([&] { (void)loadScenario(base, {"scenario.rate_hz=1001"}); },
+                  "[scenario] rate_hz: must be in [1, 1000] [Hz]");
     expectMessage(
         [&] {
             (void)loadScenario(

@@ -154,6 +154,49 @@ TEST(World, BadEntriesNameTheKey) {
               "pedestrians)");
 }
 
+// Fuzz: these ran with exit status 0 (start_yaw_deg = 1e300 with path=-nan, goal.tolerance
+// = 1000 a success at t = 0, a box at (500, 400) in a 5 x 5 m world ignored); each is an
+// error naming its key, and values inside the bounds still load.
+TEST(World, AbsurdValuesAreErrorsNamingTheKey) {
+    const auto errorOf = [](const std::string& text) {
+        const mrpt::config::CConfigFileMemory c(text);
+        try {
+            (void)parseWorld(c, "w.ini");
+        } catch (const std::invalid_argument& e) {
+            return std::string(e.what());
+        }
+        return std::string();
+    };
+    const std::string world = "[world]\nx_min=0\nx_max=5\ny_min=0\ny_max=5\n";
+    const std::string head = world + "[robot]\nstart_x=1\nstart_y=1\n";
+    const std::string goal = "[goal]\nx=4\ny=4\n";
+    EXPECT_EQ(errorOf(head + "start_yaw_deg = 1e300\n" + goal),
+              "w.ini [robot] start_yaw_deg: must be in [-360, 360] deg");
+    EXPECT_EQ(errorOf(head + "start_yaw_deg = -360\n" + goal), "");
+    EXPECT_EQ(errorOf(head + "max_v = 1e9\n" + goal), "w.ini [robot] max_v: must be at most 5 m/s");
+    EXPECT_EQ(errorOf(head + "max_v = 5\n" + goal), "");
+    EXPECT_EQ(errorOf(head + "max_w_deg = 1e12\n" + goal),
+              "w.ini [robot] max_w_deg: must be at most 720 deg/s");
+    EXPECT_EQ(errorOf(head + "max_w_deg = 720\n" + goal), "");
+    EXPECT_EQ(errorOf(head + goal + "tolerance = 1000\n"),
+              "w.ini [goal] tolerance: must be at most 2 m");
+    EXPECT_EQ(errorOf(head + "[goal]\nx=2\ny=1\ntolerance = 1.5\n"),
+              "w.ini [goal] tolerance: the robot's start is within it of the goal: the run "
+              "would end at once");
+    EXPECT_EQ(errorOf(head + goal + "tolerance = 2\n"), "");
+    EXPECT_EQ(errorOf(head + goal + "[obstacles]\nfar = box 500 400 1 1\n"),
+              "w.ini [obstacles] far: lies entirely outside the world bounds");
+    EXPECT_EQ(errorOf(head + goal + "[obstacles]\nfar = cylinder -0.6 2 0.5\n"),
+              "w.ini [obstacles] far: lies entirely outside the world bounds");
+    EXPECT_EQ(errorOf(head + goal + "[obstacles]\nedge = box 5.2 2 1 1\n"), "")
+        << "half of it inside";
+    EXPECT_EQ(errorOf(head + goal + "[pedestrians]\np = random 1e9 0.2 0 3 1\n"),
+              "w.ini [pedestrians] p: speed must be at most 5 m/s");
+    EXPECT_EQ(errorOf(head + goal + "[pedestrians]\np = random 0.5 0.2 1e300 3 1\n"),
+              "w.ini [pedestrians] p: delay must be at most the world's timeout (60 s)");
+    EXPECT_EQ(errorOf(head + goal + "[pedestrians]\np = random 5 0.2 60 3 1\n"), "");
+}
+
 TEST(World, DistanceToRotatedBox) {
     Obstacle o;
     o.cx = 1;

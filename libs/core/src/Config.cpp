@@ -47,6 +47,11 @@ void refuseMisreadLines(const std::string& text, const std::string& path) {
     };
     for (std::string line; std::getline(in, line);) {
         ++n;
+        // A NUL byte hid a key from the checks ("bogus_key\0 = 1" passed requireKnownKeys):
+        // no INI holds one, so it is refused where it is.
+        if (line.find('\0') != std::string::npos)
+            throw std::invalid_argument(path + " line " + std::to_string(n) +
+                                        ": a NUL byte (a binary file, or a damaged INI)");
         if (!line.empty() && line.back() == '\r') line.pop_back();
         const bool continuation = continued;
         continued = !line.empty() && line.back() == '\\';  // MRPT joins only there

@@ -31,6 +31,10 @@ Eigen::Isometry3d hornAlign(const std::vector<Eigen::Vector3d>& model,
 
 AteResult computeAte(const core::Trajectory& gt, const core::Trajectory& est,
                      const AteOptions& opts) {
+    // 1e308 overflowed the alignment: an rmse of -nan.
+    if (!(opts.scale >= kMinScale && opts.scale <= kMaxScale))
+        throw std::invalid_argument("ATE: scale " + std::to_string(opts.scale) +
+                                    " is outside [1e-6, 1e6]");
     std::vector<double> tg, te;
     for (const auto& p : gt) tg.push_back(p.t);
     for (const auto& p : est) te.push_back(p.t);
@@ -66,6 +70,9 @@ AteResult computeAte(const core::Trajectory& gt, const core::Trajectory& est,
     }
     r.gt_xyz = std::move(model);
     r.trans = core::summarize(r.errors);
+    if (!std::isfinite(r.trans.rmse) || !std::isfinite(r.trans.max))
+        throw std::invalid_argument("ATE: the alignment overflowed (positions or scale too "
+                                    "large): the figures are not finite");
     return r;
 }
 

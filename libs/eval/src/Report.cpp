@@ -4,6 +4,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
@@ -19,12 +20,20 @@ std::string fmt(const char* f, double v) {
     return buf;
 }
 
-std::string summaryJson(const core::Summary& s) {
+/// A JSON number; JSON has none for nan and inf (printed as "-nan", the file was invalid).
+std::string num(double v) {
+    if (!std::isfinite(v)) return "null";
     std::ostringstream o;
     o.precision(9);
-    o << "{\"count\": " << s.count << ", \"rmse\": " << s.rmse << ", \"mean\": " << s.mean
-      << ", \"median\": " << s.median << ", \"std\": " << s.std << ", \"min\": " << s.min
-      << ", \"max\": " << s.max << "}";
+    o << v;
+    return o.str();
+}
+
+std::string summaryJson(const core::Summary& s) {
+    std::ostringstream o;
+    o << "{\"count\": " << s.count << ", \"rmse\": " << num(s.rmse) << ", \"mean\": "
+      << num(s.mean) << ", \"median\": " << num(s.median) << ", \"std\": " << num(s.std)
+      << ", \"min\": " << num(s.min) << ", \"max\": " << num(s.max) << "}";
     return o.str();
 }
 
@@ -73,7 +82,7 @@ std::string toJson(const AteResult* ate, const RpeResult* rpe, const RpeOptions*
         if (ate) o << ", ";
         o << "\"rpe\": {";
         if (ro)
-            o << "\"delta\": " << ro->delta << ", \"delta_unit\": \""
+            o << "\"delta\": " << num(ro->delta) << ", \"delta_unit\": \""
               << (ro->delta_in_frames ? "f" : "s") << "\", ";
         o << "\"translation_m\": " << summaryJson(rpe->trans)
           << ", \"rotation_deg\": " << summaryJson(rpe->rot) << ", \"pairs\": " << rpe->n_pairs

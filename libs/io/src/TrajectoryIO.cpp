@@ -7,6 +7,7 @@
 #include <mrpt/math/CQuaternion.h>
 #include <mrpt/poses/CPose3DQuat.h>
 
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <stdexcept>
@@ -24,6 +25,12 @@ core::Trajectory readTumTrajectory(const std::string& path) {
         double v[8];
         static const char* kNames[8] = {"timestamp", "tx", "ty", "tz", "qx", "qy", "qz", "qw"};
         for (int k = 0; k < 8; ++k) v[k] = detail::parseNumber(tok[k], path, line, kNames[k]);
+        // Beyond it the ATE's sums of squares overflowed: rmse -nan under exit status 0.
+        for (int k = 1; k <= 3; ++k)
+            if (std::abs(v[k]) > kMaxTrajectoryCoordinate)
+                throw std::runtime_error(detail::lineError(
+                    path, line,
+                    std::string(kNames[k]) + " " + tok[k] + " is beyond +-1e6 m (not metres?)"));
         if (!traj.empty() && v[0] <= traj.back().t)
             throw std::runtime_error(detail::lineError(
                 path, line,

@@ -242,8 +242,10 @@ Scenario readScenario(const std::string& path, const std::vector<std::string>& o
                        "must be a non-empty name without '/', not '.' or '..' (it names the "
                        "output folder)");
     sc.rate_hz = core::readDouble(*cfg, s, "rate_hz", sc.rate_hz);
-    core::requireValue(sc.rate_hz > 0 && sc.rate_hz <= 1000, "scenario", "rate_hz",
-                       "must be in (0, 1000] [Hz]");
+    // Stamps and file names are written with 6 decimals: below 1 Hz frames are far apart
+    // (1e-300 Hz gave 300-digit stamps).
+    core::requireValue(sc.rate_hz >= 1 && sc.rate_hz <= 1000, "scenario", "rate_hz",
+                       "must be in [1, 1000] [Hz]");
     const double duration = core::readDouble(*cfg, s, "duration", 0.0);
     const int n = core::readInt(*cfg, s, "n_frames", 0);
     core::requireValue(!cfg->keyExists(s, "duration") || duration > 0, s, "duration",
@@ -252,10 +254,20 @@ Scenario readScenario(const std::string& path, const std::vector<std::string>& o
     if ((duration > 0) == (n > 0))
         throw std::invalid_argument(
             path + " [scenario]: give exactly one of 'duration' [s] or 'n_frames'");
+    // A sequence is minutes long: a billion frames started a render of days.
+    core::requireValue(n <= kMaxFrames, s, "n_frames",
+                       "must be at most " + std::to_string(kMaxFrames) + " (" +
+                           std::to_string(n) + " given)");
+    core::requireValue(duration * sc.rate_hz <= kMaxFrames + 0.5, s, "duration",
+                       "gives more than " + std::to_string(kMaxFrames) +
+                           " frames at rate_hz (duration * rate_hz)");
     sc.n_frames = n > 0 ? std::size_t(n) : std::size_t(std::lround(duration * sc.rate_hz));
     core::requireValue(sc.n_frames > 0, s, "duration",
                        "gives no frame at rate_hz (at least one: duration >= 0.5 / rate_hz)");
     sc.t0 = core::readDouble(*cfg, s, "t0", sc.t0);
+    // Beyond 1e10 s a frame's 1 / rate_hz is lost in the double: frames got one stamp, one
+    // file name, and overwrote each other.
+    core::requireValue(sc.t0 >= 0 && sc.t0 <= 1e10, s, "t0", "must be in [0, 1e10] [s]");
     sc.seed = core::readUint64(*cfg, s, "seed", sc.seed);
     sc.rgb_noise_sigma = core::readDouble(*cfg, s, "rgb_noise_sigma", sc.rgb_noise_sigma);
     sc.near_clip = core::readDouble(*cfg, s, "near_clip", sc.near_clip);

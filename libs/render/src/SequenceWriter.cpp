@@ -15,6 +15,7 @@
 #include <memory>
 #include <sstream>
 #include <stdexcept>
+#include <utility>
 
 namespace devslam::render {
 namespace fs = std::filesystem;
@@ -84,9 +85,33 @@ bool isRenderCurrent(const Scenario& sc, const WriteOptions& o) {
     return ss.str() == renderSignature(sc, o);
 }
 
+void checkOutputs(const Scenario& sc, const WriteOptions& o) {
+    const fs::path dir(o.out_dir);
+    // A real TUM folder's lists and ground truth would be overwritten (devslam-convert refuses
+    // one too); a render of ours, whole or stopped, has persons.txt (written before rgb.txt).
+    if (!o.out_dir.empty() && fs::exists(dir / "rgb.txt") && !fs::exists(dir / "render.txt") &&
+        !fs::exists(dir / "persons.txt"))
+        throw std::invalid_argument(
+            "output folder '" + o.out_dir +
+            "' already holds a TUM sequence (rgb.txt) that devslam-synth did not render (no "
+            "render.txt or persons.txt); remove it or name another folder");
+    if (o.rawlog_path.empty()) return;
+    const std::string ext = ".rawlog";
+    const auto& r = o.rawlog_path;
+    if (r.size() <= ext.size() || r.compare(r.size() - ext.size(), ext.size(), ext) != 0)
+        throw std::invalid_argument("rawlog '" + r + "': the name must end in .rawlog");
+    for (const auto& [what, file] : {std::pair{"scenario", sc.source}, {"room", sc.room.source}}) {
+        std::error_code ec;
+        if (!file.empty() && fs::exists(r) && fs::equivalent(r, file, ec))
+            throw std::invalid_argument("rawlog '" + r + "' is the " + what + " file '" + file +
+                                        "': writing it would destroy it; name another");
+    }
+}
+
 WriteSummary writeSequence(const Scenario& sc, const WriteOptions& o,
                            const std::function<void(std::size_t, std::size_t)>& progress) {
     if (o.out_dir.empty()) throw std::invalid_argument("writeSequence: empty output folder");
+    checkOutputs(sc, o);
     const std::string signature = renderSignature(sc, o);
     // Stopped before it began: the folder (perhaps a whole earlier render) is left as it was.
     if (o.stop && o.stop()) {
@@ -98,6 +123,14 @@ WriteSummary writeSequence(const Scenario& sc, const WriteOptions& o,
     std::error_code ec;
     fs::remove(signaturePath(o), ec);
     const std::size_t n = o.max_frames > 0 ? std::min(o.max_frames, sc.n_frames) : sc.n_frames;
+    // persons.txt before rgb.txt: a folder with rgb.txt and neither it nor render.txt is
+    // no render of ours (checkOutputs), even when a run ended between the two.
+    fs::create_directories(o.out_dir, ec);
+    const std::string persons_path = (fs::path(o.out_dir) / "persons.txt").string();
+    std::ofstream persons(persons_path);
+    if (!persons) throw std::runtime_error("cannot write '" + persons_path + "'");
+    persons << "# person truth of devslam-synth scenario " << sc.name << "\n"
+            << kPersonsHeader << "\n";
     io::TumWriter tum(o.out_dir, "devslam-synth scenario " + sc.name);
     std::unique_ptr<io::RawlogWriter> rawlog;
     if (!o.rawlog_path.empty())
@@ -105,12 +138,6 @@ WriteSummary writeSequence(const Scenario& sc, const WriteOptions& o,
     // Another render's labels would pass for this one's truth (PersonTruth reads the folder).
     fs::remove_all(fs::path(o.out_dir) / "labels");
     if (o.write_labels) fs::create_directories(fs::path(o.out_dir) / "labels");
-
-    const std::string persons_path = (fs::path(o.out_dir) / "persons.txt").string();
-    std::ofstream persons(persons_path);
-    if (!persons) throw std::runtime_error("cannot write '" + persons_path + "'");
-    persons << "# person truth of devslam-synth scenario " << sc.name << "\n"
-            << kPersonsHeader << "\n";
 
     SequenceRenderer renderer(sc);
     core::Trajectory gt;

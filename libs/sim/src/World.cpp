@@ -243,6 +243,13 @@ void validateRobotAndLaser(const WorldSpec& w) {
                                  {"max_acc", w.robot.max_acc},
                                  {"max_ang_acc_deg", w.robot.max_ang_acc}})
         if (!(v > 0)) fail(src, "robot", key, "speed and acceleration limits must be > 0");
+    // Unbounded, these ran: a yaw of 1e300 deg gave path=-nan, max_v = 1e9 m/s and
+    // max_w_deg = 1e12 a robot that jumps across the world in one step.
+    if (!(std::abs(w.robot.start.phi) <= 2 * M_PI + 1e-9))
+        fail(src, "robot", "start_yaw_deg", "must be in [-360, 360] deg");
+    if (w.robot.max_v > 5) fail(src, "robot", "max_v", "must be at most 5 m/s");
+    if (w.robot.max_w > mrpt::DEG2RAD(720.0) + 1e-9)
+        fail(src, "robot", "max_w_deg", "must be at most 720 deg/s");
     if (!(w.laser.range > 0)) fail(src, "laser", "range", "must be > 0 m");
     if (w.laser.rays < 2 || w.laser.rays > 100000)
         fail(src, "laser", "rays", "must be in [2, 100000]");
@@ -261,6 +268,26 @@ void validateRobotAndLaser(const WorldSpec& w) {
         fail(src, "laser", "rays", m.str());
     }
     if (w.goal_tolerance <= 0) fail(src, "goal", "tolerance", "must be > 0 m");
+    // A tolerance of 1000 m was a success at t = 0.
+    if (w.goal_tolerance > 2) fail(src, "goal", "tolerance", "must be at most 2 m");
+    if (std::hypot(w.goal.x - w.robot.start.x, w.goal.y - w.robot.start.y) <= w.goal_tolerance)
+        fail(src, "goal", "tolerance",
+             "the robot's start is within it of the goal: the run would end at once");
+}
+
+/// Each obstacle reaches into the bounds (one wholly outside was accepted, and did nothing).
+void validateObstacles(const WorldSpec& w) {
+    for (const auto& o : w.obstacles) {
+        double hx = o.radius, hy = o.radius;  // half extents of its axis-aligned box
+        if (o.shape == Obstacle::Shape::Box) {
+            const double c = std::abs(std::cos(o.yaw)), s = std::abs(std::sin(o.yaw));
+            hx = 0.5 * (c * o.sx + s * o.sy);
+            hy = 0.5 * (s * o.sx + c * o.sy);
+        }
+        if (o.cx + hx <= w.x_min || o.cx - hx >= w.x_max || o.cy + hy <= w.y_min ||
+            o.cy - hy >= w.y_max)
+            fail(w.source, "obstacles", o.name, "lies entirely outside the world bounds");
+    }
 }
 
 /// The start and the goal: inside the bounds, off the obstacles, and usable on the planner's
@@ -329,6 +356,12 @@ void validatePedestrians(const WorldSpec& w, const std::vector<Obstacle>& static
     };
     for (const auto& p : w.pedestrians) {
         if (p.path.empty()) fail(src, "pedestrians", p.name, "no position given");
+        if (p.speed > 5) fail(src, "pedestrians", p.name, "speed must be at most 5 m/s");
+        if (p.start_delay > w.timeout) {
+            std::ostringstream m;
+            m << "delay must be at most the world's timeout (" << w.timeout << " s)";
+            fail(src, "pedestrians", p.name, m.str());
+        }
         for (const auto& q : p.path)
             if (!insideBounds(w, q))
                 fail(src, "pedestrians", p.name, "a point is outside the world bounds");
@@ -364,6 +397,7 @@ void validatePedestrians(const WorldSpec& w, const std::vector<Obstacle>& static
 void validateWorld(const WorldSpec& w) {
     validateBoundsAndTiming(w);
     validateRobotAndLaser(w);
+    validateObstacles(w);
     const auto statics = staticObstacles(w);
     validateEndpoints(w, statics);
     validatePedestrians(w, statics);

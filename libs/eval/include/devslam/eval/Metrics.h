@@ -18,6 +18,9 @@
 
 namespace devslam::eval {
 
+/// The range of AteOptions::scale (computeAte refuses others).
+inline constexpr double kMinScale = 1e-6, kMaxScale = 1e6;
+
 struct AteOptions {
     double max_dt = 0.02;  ///< [s] association window (associate.py --max_difference)
     double offset = 0.0;   ///< [s] added to the estimate's stamps (--offset)
@@ -36,7 +39,8 @@ struct AteResult {
 
 /// Associates est to gt, aligns with Horn's closed-form rigid transform (no scale) and
 /// summarises the translational residuals. Throws std::invalid_argument when fewer than 3
-/// pairs associate.
+/// pairs associate, for a scale outside [kMinScale, kMaxScale], and when the figures are not
+/// finite.
 [[nodiscard]] AteResult computeAte(const core::Trajectory& gt, const core::Trajectory& est,
                                    const AteOptions& opts = {});
 

@@ -11,9 +11,12 @@
 
 namespace devslam::io {
 
+/// Positions beyond this [m] are refused by readTumTrajectory.
+inline constexpr double kMaxTrajectoryCoordinate = 1e6;
+
 /// Throws std::runtime_error "<path> line N: ..." for a line without 8 numbers, a
-/// non-unit quaternion, or a timestamp not greater than the previous one; "<path>: no poses"
-/// for a file without any.
+/// non-unit quaternion, a position coordinate beyond +-1e6 m, or a timestamp not greater
+/// than the previous one; "<path>: no poses" for a file without any.
 [[nodiscard]] core::Trajectory readTumTrajectory(const std::string& path);
 
 /// Writes with full precision (timestamps with 6 decimals like TUM, poses with 9 digits).

@@ -48,6 +48,9 @@ struct RoomSpec {
     std::vector<BoxSpec> boxes;
 };
 
+/// The most frames a scenario may have (loadScenario): 55 min at 30 Hz.
+inline constexpr int kMaxFrames = 100000;
+
 struct Scenario {
     std::string name;          ///< [scenario] name
     std::string source;        ///< the INI file it was read from (the room's: room.source)

@@ -36,8 +36,16 @@ struct WriteSummary {
     bool stopped = false;           ///< WriteOptions::stop ended it before the last frame
 };
 
+/// Refuses outputs whose writing would destroy what is not a render: an `out_dir` holding
+/// a TUM sequence (rgb.txt) that devslam-synth did not write (neither render.txt nor
+/// persons.txt, one of which every render, even a stopped one, leaves before rgb.txt), and a
+/// `rawlog_path` not ending in .rawlog or that is the scenario or its room file. Throws
+/// std::invalid_argument naming the path. writeSequence checks this first.
+void checkOutputs(const Scenario& sc, const WriteOptions& o);
+
 /// Renders and writes every frame; `progress(done, total)` is called after each frame.
-/// Throws std::runtime_error naming the path when a file cannot be written.
+/// Throws std::runtime_error naming the path when a file cannot be written, and
+/// std::invalid_argument for the outputs checkOutputs refuses.
 WriteSummary writeSequence(const Scenario& sc, const WriteOptions& o,
                            const std::function<void(std::size_t, std::size_t)>& progress = {});
 
