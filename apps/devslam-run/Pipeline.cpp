@@ -18,6 +18,7 @@
 #include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <future>
 #include <sstream>
 
@@ -361,7 +362,15 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
             gt_in_est = g;
         }
         slam::write3DScene(out("map.3Dscene"), slam.map(), rep.trajectory, gt_in_est);
-        if (auto grid = slam::buildOccupancyGrid(slam.map(), grid_opts)) {
+        // A grid too large for its [grid_map] resolution is left out, not the run's other
+        // outputs.
+        std::optional<mrpt::maps::COccupancyGridMap2D> grid;
+        try {
+            grid = slam::buildOccupancyGrid(slam.map(), grid_opts);
+        } catch (const std::invalid_argument& e) {
+            std::cerr << "devslam-run: map_grid not written: " << e.what() << "\n";
+        }
+        if (grid) {
             const std::string stem = (fs::path(rc.out_dir) / "map_grid").string();
             slam::saveGrid(*grid, stem);
             rep.outputs.push_back(stem + ".png");

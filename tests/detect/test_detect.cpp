@@ -193,6 +193,8 @@ TEST(DetectYolo, BadOptionsAreRejected) {
     mrpt::config::CConfigFileMemory cfg2;
     cfg2.write("detector", "input_width", 300);
     EXPECT_THROW((void)detect::makeDetector(cfg2), std::invalid_argument);
+    cfg2.write("detector", "input_width", 32000);  // a multiple of 32: minutes per frame
+    EXPECT_THROW((void)detect::makeDetector(cfg2), std::invalid_argument);
     mrpt::config::CConfigFileMemory cfg3;
     cfg3.write("detector", "classes", std::string("unicorn"));
     try {  // named by section and key, as the other values (the apps add the file)

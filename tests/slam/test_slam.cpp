@@ -728,6 +728,18 @@ TEST(Config, EveryShippedSlamIniLoadsAndUnknownKeysAreRejected) {
     } catch (const std::invalid_argument& e) {
         EXPECT_NE(std::string(e.what()).find("serch_radius"), std::string::npos);
     }
+    for (const auto& [text, message] : std::vector<std::pair<std::string, std::string>>{
+             {"[grid_map]\nresolution = 1e9\n", "[grid_map] resolution: must be in"},
+             {"[grid_map]\nmargin = 1e9\n", "[grid_map] margin/max_range: must be in"}}) {
+        mrpt::config::CConfigFileMemory c(text);
+        GridMapOptions g;
+        try {
+            g.loadFromConfig(c);
+            ADD_FAILURE() << "accepted: " << text;
+        } catch (const std::invalid_argument& e) {
+            EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
+        }
+    }
     mrpt::config::CConfigFileMemory neg("[orb]\nn_features = -5\n");
     EXPECT_THROW((void)SlamOptions::fromConfig(neg), std::invalid_argument);
     // Values that broke a run part-way (a vector resized to -1, an OpenCV assertion, every
@@ -736,7 +748,18 @@ TEST(Config, EveryShippedSlamIniLoadsAndUnknownKeysAreRejected) {
              {"[loop_closure]\nmax_candidates = -1\n", "[loop_closure] max_candidates: must be"},
              {"[tracker]\npnp_confidence = 1\n", "[tracker] pnp_confidence: must be in (0, 1)"},
              {"[mapping]\ncull_keyframe_age = 0\n", "[mapping] cull_keyframe_age: must be >= 1"},
-             {"[tracker]\nrefine_rounds = 0\n", "[tracker] refine_rounds: must be >= 1"},
+             {"[tracker]\nrefine_rounds = 0\n", "[tracker] refine_rounds: must be in [1, 10]"},
+             // Values so large that a run crashed (grid_cols), ran out of memory or ran for
+             // good (refine_rounds, n_levels) before saying which key was wrong.
+             {"[tracker]\nrefine_rounds = 1e9\n", "[tracker] refine_rounds: must be in [1, 10]"},
+             {"[orb]\ngrid_cols = 1e9\n", "[orb] grid_cols/grid_rows: must be in [1, 200]"},
+             {"[orb]\nn_levels = 1e9\n", "[orb] n_levels: must be in [1, 32]"},
+             {"[orb]\nn_levels = 20\nscale_factor = 1.3\n", "[orb] n_levels: with this scale"},
+             {"[orb]\nn_features = 1e9\n", "[orb] n_features: must be in [1, 100000]"},
+             {"[orb]\noversample = 1e9\n", "[orb] oversample: must be in [1, 10]"},
+             {"[orb]\nscale_factor = 1e9\n", "[orb] scale_factor: must be in (1, 4]"},
+             {"[orb]\nfast_threshold = -1\n", "[orb] fast_threshold: must be in [1, 255]"},
+             {"[pose_graph]\nmax_iterations = 1e9\n", "[pose_graph] max_iterations: must be in"},
              {"[tracker]\nmax_depth = 0\n", "[tracker] max_depth: must be > 0"},
              {"[tracker]\nfine_radius = 0\n", "[tracker] fine_radius: must be > 0"},
              {"[loop_closure]\nsigma_r_deg = 0\n", "[loop_closure] sigma_r_deg: must be > 0"},

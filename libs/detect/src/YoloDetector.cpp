@@ -123,10 +123,11 @@ void YoloDetector::Options::loadFromConfig(const mrpt::config::CConfigFileBase& 
     if (c.keyExists(s, "classes")) classes = splitList(c.read_string(s, "classes", ""));
     validate_on_load = core::readBool(c, s, "validate_on_load", validate_on_load);
     fast_convolutions = core::readBool(c, s, "fast_convolutions", fast_convolutions);
-    core::requireValue(input_width > 0 && input_width % 32 == 0, s, "input_width",
-                       "must be a positive multiple of 32");
-    core::requireValue(input_height > 0 && input_height % 32 == 0, s, "input_height",
-                       "must be a positive multiple of 32");
+    // 32000 x 32000 ran for minutes per frame: no darknet model is trained above ~1280.
+    core::requireValue(input_width > 0 && input_width <= 2048 && input_width % 32 == 0, s,
+                       "input_width", "must be a multiple of 32 in [32, 2048]");
+    core::requireValue(input_height > 0 && input_height <= 2048 && input_height % 32 == 0, s,
+                       "input_height", "must be a multiple of 32 in [32, 2048]");
     core::requireValue(conf_threshold >= 0 && conf_threshold <= 1, s, "conf_threshold",
                        "must be in [0, 1]");
     core::requireValue(nms_threshold >= 0 && nms_threshold <= 1, s, "nms_threshold",

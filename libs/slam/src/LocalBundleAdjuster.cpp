@@ -28,7 +28,8 @@ void LocalBaOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, cons
     chi2_mono = core::readDouble(c, s, "chi2_mono", chi2_mono);
     chi2_stereo = core::readDouble(c, s, "chi2_stereo", chi2_stereo);
     core::requireValue(window >= 1 && window <= 30, s, "window", "must be in [1, 30]");
-    core::requireValue(iterations >= 0, s, "iterations", "must be >= 0");
+    core::requireValue(iterations >= 0 && iterations <= 1000, s, "iterations",
+                       "must be in [0, 1000]");
     core::requireValue(bf > 0, s, "bf", "must be > 0");
     core::requireValue(chi2_mono > 0, s, "chi2_mono", "must be > 0");
     core::requireValue(chi2_stereo > 0, s, "chi2_stereo", "must be > 0");

@@ -32,7 +32,8 @@ void LoopOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, const s
     sigma_r_deg = core::readDouble(c, s, "sigma_r_deg", sigma_r_deg);
     core::requireValue(min_keyframe_gap >= 1, s, "min_keyframe_gap", "must be >= 1");
     core::requireValue(cooldown_keyframes >= 0, s, "cooldown_keyframes", "must be >= 0");
-    core::requireValue(max_candidates >= 1, s, "max_candidates", "must be >= 1");
+    core::requireValue(max_candidates >= 1 && max_candidates <= 1000, s, "max_candidates",
+                       "must be in [1, 1000]");
     core::requireValue(max_hamming > 0 && max_hamming <= 256, s, "max_hamming",
                        "must be in (0, 256]");
     core::requireValue(ratio > 0 && ratio <= 1, s, "ratio", "must be in (0, 1]");

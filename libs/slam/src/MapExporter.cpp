@@ -16,6 +16,7 @@
 #include <cstdio>
 #include <fstream>
 #include <memory>
+#include <sstream>
 #include <stdexcept>
 
 namespace devslam::slam {
@@ -97,10 +98,12 @@ void GridMapOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, cons
     max_height = core::readDouble(c, s, "max_height", max_height);
     margin = core::readDouble(c, s, "margin", margin);
     max_range = core::readDouble(c, s, "max_range", max_range);
-    core::requireValue(resolution > 0, s, "resolution", "must be > 0");
+    core::requireValue(resolution >= 0.001 && resolution <= 10, s, "resolution",
+                       "must be in [0.001, 10] [m]");
     core::requireValue(max_height > min_height, s, "min_height/max_height",
                        "need min_height < max_height");
-    core::requireValue(margin >= 0 && max_range > 0, s, "margin/max_range", "must be >= 0 / > 0");
+    core::requireValue(margin >= 0 && margin <= 100 && max_range > 0 && max_range <= 1000, s,
+                       "margin/max_range", "must be in [0, 100] / (0, 1000] [m]");
 }
 
 std::optional<mrpt::maps::COccupancyGridMap2D> buildOccupancyGrid(const Map& map,
@@ -108,6 +111,7 @@ std::optional<mrpt::maps::COccupancyGridMap2D> buildOccupancyGrid(const Map& map
     if (map.landmarks().empty() || map.keyframes().empty()) return std::nullopt;
     double x0 = 1e9, x1 = -1e9, y0 = 1e9, y1 = -1e9;
     auto extend = [&](const Eigen::Vector3d& p) {
+        if (!p.allFinite()) return;
         x0 = std::min(x0, p.x());
         x1 = std::max(x1, p.x());
         y0 = std::min(y0, p.y());
@@ -117,6 +121,18 @@ std::optional<mrpt::maps::COccupancyGridMap2D> buildOccupancyGrid(const Map& map
     for (const auto& [id, l] : map.landmarks()) {
         const auto p = opticalToNav(l.p_w);
         if (p.z() >= opts.min_height && p.z() <= opts.max_height) extend(p);
+    }
+    if (x1 < x0 || y1 < y0) return std::nullopt;  // no finite point
+    // A grid MRPT can hold, drawn in seconds: 1e8 cells is 10 x 10 km at 1 m or 100 x 100 m at
+    // 1 cm. (Points far from the rest made it loop for good before the cameras were checked.)
+    const double cells = (x1 - x0 + 2 * opts.margin) / opts.resolution *
+                         ((y1 - y0 + 2 * opts.margin) / opts.resolution);
+    if (!(cells <= 1e8)) {
+        std::ostringstream m;
+        m << "[grid_map] resolution: the map spans " << x1 - x0 << " x " << y1 - y0
+          << " m, which at " << opts.resolution << " m (margin " << opts.margin << " m) is "
+          << cells << " cells (at most 1e8)";
+        throw std::invalid_argument(m.str());
     }
     mrpt::maps::COccupancyGridMap2D grid;
     grid.setSize(static_cast<float>(x0 - opts.margin), static_cast<float>(x1 + opts.margin),

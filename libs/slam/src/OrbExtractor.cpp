@@ -6,6 +6,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 #include <stdexcept>
 
@@ -34,11 +35,24 @@ void OrbExtractor::Options::loadFromConfig(const mrpt::config::CConfigFileBase& 
     depth_factor = core::readDouble(c, s, "depth_factor", depth_factor);
     core::requireValue(depth_factor > 0.5 && depth_factor < 2.0, s, "depth_factor",
                        "must be in (0.5, 2)");
-    core::requireValue(n_features > 0, s, "n_features", "must be > 0");
-    core::requireValue(scale_factor > 1.0, s, "scale_factor", "must be > 1");
-    core::requireValue(n_levels >= 1, s, "n_levels", "must be >= 1");
-    core::requireValue(oversample >= 1.0, s, "oversample", "must be >= 1");
-    core::requireValue(grid_cols >= 1 && grid_rows >= 1, s, "grid_cols/grid_rows", "must be >= 1");
+    // Upper bounds too: 1e9 features, levels or grid cells ran out of memory, crashed
+    // (grid_cols) or ran for minutes per frame instead of saying which key was wrong.
+    core::requireValue(n_features > 0 && n_features <= 100000, s, "n_features",
+                       "must be in [1, 100000]");
+    core::requireValue(scale_factor > 1.0 && scale_factor <= 4.0, s, "scale_factor",
+                       "must be in (1, 4]");
+    core::requireValue(n_levels >= 1 && n_levels <= 32, s, "n_levels", "must be in [1, 32]");
+    core::requireValue(std::pow(scale_factor, n_levels - 1) <= 64.0, s, "n_levels",
+                       "with this scale_factor the coarsest level would be under 1/64 of the "
+                       "image (scale_factor^(n_levels-1) must be <= 64)");
+    core::requireValue(oversample >= 1.0 && oversample <= 10.0, s, "oversample",
+                       "must be in [1, 10]");
+    core::requireValue(fast_threshold >= 1 && fast_threshold <= 255, s, "fast_threshold",
+                       "must be in [1, 255] (grey levels)");
+    core::requireValue(min_fast_threshold >= 1 && min_fast_threshold <= fast_threshold, s,
+                       "min_fast_threshold", "must be in [1, fast_threshold]");
+    core::requireValue(grid_cols >= 1 && grid_rows >= 1 && grid_cols <= 200 && grid_rows <= 200,
+                       s, "grid_cols/grid_rows", "must be in [1, 200]");
     core::requireValue(max_depth > min_depth && min_depth >= 0, s, "min_depth/max_depth",
                        "need 0 <= min_depth < max_depth");
 }

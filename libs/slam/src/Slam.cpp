@@ -82,8 +82,8 @@ SlamOptions SlamOptions::fromConfig(const mrpt::config::CConfigFileBase& cfg) {
     o.loop.loadFromConfig(cfg, "loop_closure");
     core::requireKnownKeys(cfg, "pose_graph", {"max_iterations"});
     o.pose_graph.max_iterations = core::readInt(cfg, "pose_graph", "max_iterations", 100);
-    core::requireValue(o.pose_graph.max_iterations > 0, "pose_graph", "max_iterations",
-                       "must be > 0");
+    core::requireValue(o.pose_graph.max_iterations > 0 && o.pose_graph.max_iterations <= 10000,
+                       "pose_graph", "max_iterations", "must be in [1, 10000]");
     // The level sigmas of tracking and BA follow the ORB pyramid.
     o.local_ba.scale_factor = o.orb.scale_factor;
     o.tracker.scale_factor = o.orb.scale_factor;

@@ -67,19 +67,25 @@ void TrackerOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, cons
     core::requireValue(projection.ratio > 0 && projection.ratio <= 1, s, "match_ratio",
                        "must be in (0, 1]");
     core::requireValue(projection.max_depth > 0, s, "max_depth", "must be > 0 [m]");
-    core::requireValue(pnp.iterations > 0, s, "pnp_iterations", "must be > 0");
+    core::requireValue(pnp.iterations > 0 && pnp.iterations <= 100000, s, "pnp_iterations",
+                       "must be in [1, 100000]");
     core::requireValue(pnp.reprojection_px > 0, s, "pnp_reprojection_px", "must be > 0");
     core::requireValue(pnp.confidence > 0 && pnp.confidence < 1, s, "pnp_confidence",
                        "must be in (0, 1)");
     core::requireValue(refine.bf > 0, s, "bf", "must be > 0");
-    core::requireValue(refine.rounds >= 1, s, "refine_rounds", "must be >= 1");
-    core::requireValue(refine.iterations >= 1, s, "refine_iterations", "must be >= 1");
+    // Per frame: a billion rounds ran forever, deaf to Ctrl-C between frames.
+    core::requireValue(refine.rounds >= 1 && refine.rounds <= 10, s, "refine_rounds",
+                       "must be in [1, 10]");
+    core::requireValue(refine.iterations >= 1 && refine.iterations <= 1000, s,
+                       "refine_iterations", "must be in [1, 1000]");
     core::requireValue(min_matches >= 6, s, "min_matches", "must be >= 6");
     core::requireValue(min_inliers >= 6, s, "min_inliers", "must be >= 6");
-    core::requireValue(local_keyframes >= 1, s, "local_keyframes", "must be >= 1");
+    core::requireValue(local_keyframes >= 1 && local_keyframes <= 1000, s, "local_keyframes",
+                       "must be in [1, 1000]");
     core::requireValue(max_motion_dt >= 0, s, "max_motion_dt",
                        "must be >= 0 [s] (0: no motion model)");
-    core::requireValue(reloc_keyframes >= 1, s, "reloc_keyframes", "must be >= 1");
+    core::requireValue(reloc_keyframes >= 1 && reloc_keyframes <= 1000, s, "reloc_keyframes",
+                       "must be in [1, 1000]");
     core::requireValue(reloc_min_inliers >= 6, s, "reloc_min_inliers", "must be >= 6");
     core::requireValue(reloc_max_hamming > 0 && reloc_max_hamming <= 256, s, "reloc_max_hamming",
                        "must be in (0, 256]");
