@@ -246,6 +246,12 @@ TEST(Parse, NumberListsNameTheBadToken) {
                   std::string("[a] k: '") + t + "' is not a finite number");
     EXPECT_EQ(invalidArgument([] { (void)parseNumberList("1 2", "[a] k", 3); }),
               "[a] k: expected 3 numbers, got 2");
+    // A ']' lost in an edit was read as if it were there.
+    EXPECT_EQ(parseNumberList(" [1 2] ", "x"), (std::vector<double>{1, 2}));
+    for (const char* t : {"[2.4 1.6 2.4 4.4", "1 2]", "[1 2] [3 4]", "1 [2 3]", "]1 2["})
+        EXPECT_EQ(invalidArgument([&] { (void)parseNumberList(t, "[a] k"); }),
+                  std::string("[a] k: '") + t + "' has unmatched brackets (write [a b c] or a b c)")
+            << t;
 }
 
 TEST(Parse, ExtensionsInAnyCase) {

@@ -974,6 +974,24 @@ TEST(Scenario, ShippedFilesLoadAndTyposAreReported) {
 
 // sitting_bare is sitting_xyz's room with every box blurred through room_set: the same
 // room file, boxes and walls, only the boxes' blur differs.
+TEST(Scenario, TheCameraAndThePeopleStayInTheRoom) {
+    // Outside the room they rendered walls seen from behind, or nobody, without a word.
+    const std::string path = kRoot + "/sim_worlds/synth/walking_xyz.ini";
+    for (const auto& [item, message] : std::vector<std::pair<std::string, std::string>>{
+             {"person_1.path=[100 100 200 200]",
+              "[person_1] path: the point (100, 100) lies outside the room (0..5.5 x 0..5 m)"},
+             {"trajectory.position=[100 100 100]",
+              "[trajectory] position: the camera at t = 0 s is at ("},
+             {"person_.height=1.7", "[person_]: a person's section needs a name"}}) {
+        try {
+            (void)render::loadScenario(path, {item});
+            ADD_FAILURE() << "accepted: " << item;
+        } catch (const std::invalid_argument& e) {
+            EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
+        }
+    }
+}
+
 TEST(Scenario, SittingBareBlursTheOfficeRoomsFurniture) {
     const auto xyz = loadScenario(kSynth + "/sitting_xyz.ini");
     const auto bare = loadScenario(kSynth + "/sitting_bare.ini");

@@ -91,6 +91,16 @@ bool parseBool(const std::string& text, const std::string& what) {
 
 std::vector<double> parseNumberList(const std::string& text, const std::string& what,
                                     std::size_t expected) {
+    // At most one pair of brackets around the whole list: "[2.4 1.6 2.4 4.4" (a ']' lost in an
+    // edit) was read as if it were closed.
+    const auto open = std::count(text.begin(), text.end(), '[');
+    const auto close = std::count(text.begin(), text.end(), ']');
+    if (open != close || open > 1 ||
+        (open == 1 && (text.find('[') > text.find(']') ||
+                       text.find_first_not_of(" \t") != text.find('[') ||
+                       text.find_last_not_of(" \t") != text.find(']'))))
+        throw std::invalid_argument(what + ": '" + text +
+                                    "' has unmatched brackets (write [a b c] or a b c)");
     std::string t = text;
     for (char& c : t)
         if (c == '[' || c == ']' || c == ',' || c == ';') c = ' ';

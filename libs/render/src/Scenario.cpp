@@ -304,8 +304,37 @@ Scenario readScenario(const std::string& path, const std::vector<std::string>& o
 
     if (cfg->sectionExists("trajectory")) sc.trajectory.loadFromConfig(*cfg, "trajectory");
     if (cfg->sectionExists("depth_noise")) sc.depth_noise.loadFromConfig(*cfg, "depth_noise");
-    for (const auto& p : sectionsWithPrefix(*cfg, "person_"))
+    for (const auto& p : sectionsWithPrefix(*cfg, "person_")) {
+        if (p.size() <= std::string("person_").size())
+            throw std::invalid_argument("[" + p + "]: a person's section needs a name after "
+                                        "'person_'");
         sc.people.push_back(loadPerson(*cfg, p, path));
+    }
+    // The camera and the people inside the room: outside it they rendered walls seen from
+    // behind, or nobody, without a word.
+    const auto& R = sc.room.size;
+    const auto inRoom = [&](double x, double y) {
+        return x > 0 && x < R.x() && y > 0 && y < R.y();
+    };
+    const auto where = [&](double x, double y) {
+        std::ostringstream m;
+        m << "(" << x << ", " << y << ") lies outside the room (0.." << R.x() << " x 0.." << R.y()
+          << " m)";
+        return m.str();
+    };
+    for (std::size_t k = 0; k < sc.people.size(); ++k)
+        for (const auto& q : sc.people[k].path)
+            core::requireValue(inRoom(q.x(), q.y()), sc.people[k].name, "path",
+                               "the point " + where(q.x(), q.y()));
+    for (std::size_t i = 0; i < sc.n_frames; i += std::max<std::size_t>(1, sc.n_frames / 200)) {
+        const auto T = cameraPoseAt(sc.trajectory, sc.elapsed(i));
+        if (inRoom(T.x(), T.y()) && T.z() > 0 && T.z() < R.z()) continue;
+        std::ostringstream m;
+        m << "the camera at t = " << sc.elapsed(i) << " s is at (" << T.x() << ", " << T.y()
+          << ", " << T.z() << "), outside the room (0.." << R.x() << " x 0.." << R.y() << " x 0.."
+          << R.z() << " m)";
+        core::requireValue(false, "trajectory", "position", m.str());
+    }
 
     core::requireKnownSections(
         *cfg, {"scenario", "camera", "trajectory", "depth_noise", "person_*"}, path);
