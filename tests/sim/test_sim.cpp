@@ -178,6 +178,14 @@ TEST(World, AbsurdValuesAreErrorsNamingTheKey) {
     EXPECT_EQ(errorOf(head + "max_w_deg = 1e12\n" + goal),
               "w.ini [robot] max_w_deg: must be at most 720 deg/s");
     EXPECT_EQ(errorOf(head + "max_w_deg = 720\n" + goal), "");
+    EXPECT_EQ(errorOf(head + "max_acc = 1e9\n" + goal),
+              "w.ini [robot] max_acc: must be at most 20 m/s^2");
+    EXPECT_EQ(errorOf(head + "max_ang_acc_deg = 1e9\n" + goal),
+              "w.ini [robot] max_ang_acc_deg: must be at most 3600 deg/s^2");
+    EXPECT_EQ(errorOf(head + goal + "[obstacles]\nhuge = box 2 2 1e300 1\n"),
+              "w.ini [obstacles] huge: sizes must be in (0, 1000] m");
+    EXPECT_EQ(errorOf(head + goal + "[obstacles]\nhuge = cylinder 2 2 1e300\n"),
+              "w.ini [obstacles] huge: radius must be in (0, 1000] m");
     EXPECT_EQ(errorOf(head + goal + "tolerance = 1000\n"),
               "w.ini [goal] tolerance: must be at most 2 m");
     EXPECT_EQ(errorOf(head + "[goal]\nx=2\ny=1\ntolerance = 1.5\n"),

@@ -126,7 +126,9 @@ Obstacle parseObstacle(const mrpt::config::CConfigFileBase& c, const std::string
         o.sx = v[2];
         o.sy = v[3];
         o.yaw = v.size() == 5 ? mrpt::DEG2RAD(v[4]) : 0.0;
-        if (o.sx <= 0 || o.sy <= 0) fail(source, s, k, "sizes must be > 0 m");
+        // 1e300 reached the rasterizer's integer cell indices
+        if (!(o.sx > 0 && o.sy > 0 && o.sx <= 1000 && o.sy <= 1000))
+            fail(source, s, k, "sizes must be in (0, 1000] m");
         o.height = o.kind == "block" ? 0.4 : 1.0;
     } else if (o.kind == "cylinder") {
         if (v.size() != 3) fail(source, s, k, "expected 'cylinder cx cy radius'");
@@ -134,7 +136,8 @@ Obstacle parseObstacle(const mrpt::config::CConfigFileBase& c, const std::string
         o.cx = v[0];
         o.cy = v[1];
         o.radius = v[2];
-        if (o.radius <= 0) fail(source, s, k, "radius must be > 0 m");
+        if (!(o.radius > 0 && o.radius <= 1000))
+            fail(source, s, k, "radius must be in (0, 1000] m");
     } else {
         fail(source, s, k,
              "unknown obstacle kind '" + o.kind + "' (known: box, block, wall, cylinder)");
@@ -248,6 +251,9 @@ void validateRobotAndLaser(const WorldSpec& w) {
     if (!(std::abs(w.robot.start.phi) <= 2 * M_PI + 1e-9))
         fail(src, "robot", "start_yaw_deg", "must be in [-360, 360] deg");
     if (w.robot.max_v > 5) fail(src, "robot", "max_v", "must be at most 5 m/s");
+    if (w.robot.max_acc > 20) fail(src, "robot", "max_acc", "must be at most 20 m/s^2");
+    if (w.robot.max_ang_acc > mrpt::DEG2RAD(3600.0) + 1e-9)
+        fail(src, "robot", "max_ang_acc_deg", "must be at most 3600 deg/s^2");
     if (w.robot.max_w > mrpt::DEG2RAD(720.0) + 1e-9)
         fail(src, "robot", "max_w_deg", "must be at most 720 deg/s");
     if (!(w.laser.range > 0)) fail(src, "laser", "range", "must be > 0 m");
