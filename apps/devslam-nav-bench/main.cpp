@@ -225,6 +225,9 @@ std::optional<int> parseArgs(int argc, char** argv, Args& a) {
         if (a.quick) a.per_category = 2;
         // A smoke test leaves the committed pictures alone, as it leaves RESULTS.md.
         if (a.quick && !png_dir_given) a.png_dir = "out/devslam-nav-bench";
+        // Found now, not after the whole benchmark has run.
+        if (std::filesystem::exists(a.png_dir) && !std::filesystem::is_directory(a.png_dir))
+            throw std::invalid_argument("--png-dir '" + a.png_dir + "' is a file, not a folder");
         if (a.methods.empty()) throw std::invalid_argument("--methods is empty");
     } catch (const std::exception& e) {
         std::cerr << "devslam-nav-bench: " << e.what() << "\n";

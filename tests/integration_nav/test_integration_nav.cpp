@@ -268,6 +268,14 @@ TEST(IntegrationNav, AppsSmokeTest) {
     EXPECT_NE(r.out.find("section 'nav' needs"), std::string::npos) << r.out;
     EXPECT_EQ(r.out.find("nav-bench ["), std::string::npos) << "ran before refusing: " << r.out;
     EXPECT_FALSE(mrpt::system::directoryExists(out + "/refused"));
+    // A --png-dir that is a file: refused with the options, not after the benchmark has run
+    // (the usage it prints names "nav-bench [options]", so no progress-bar check here).
+    std::ofstream(out + "/a_file") << "x";
+    r = devslam::test::runApp("devslam-nav-bench", "--quick --png-dir " + out + "/a_file");
+    EXPECT_EQ(r.rc, 2);
+    EXPECT_NE(r.out.find("--png-dir '" + out + "/a_file' is a file, not a folder"),
+              std::string::npos)
+        << r.out;
 }
 
 // Ctrl-C stops devslam-nav-bench after the current episode: the tables of the episodes done
