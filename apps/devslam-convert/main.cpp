@@ -30,7 +30,7 @@ options:
   --external          rawlog with images in <name>_Images/ (default: inline)
   --compression N     gzip level 0..9 (default 1)
   --label TEXT        sensor label of the observations (default RGBD)
-  --max-frames N      stop after N frames
+  --max-frames N      stop after N frames (N >= 1)
   --allow-damaged     a damaged input (a rawlog cut short by a crash or a full disk, a TUM
                       folder missing images, a frame whose image does not decode): convert
                       what is intact, say what was left out
@@ -94,7 +94,7 @@ std::variant<Args, int> parseArgs(int argc, char** argv) {
         else if (a == "--allow-damaged")
             args.ro.allow_damaged = true;
         else if (a == "--max-frames")
-            args.max_frames = std::size_t(devslam::core::parseInteger(value(), "--max-frames", 0));
+            args.max_frames = std::size_t(devslam::core::parseInteger(value(), "--max-frames", 1));
         else if (!a.empty() && a[0] == '-')
             throw std::invalid_argument("unknown option " + a);
         else

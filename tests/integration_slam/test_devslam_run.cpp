@@ -231,6 +231,21 @@ TEST(DevslamConvert, RefusesToWriteOverAnExistingRawlog) {
     fs::remove_all(dir);
 }
 
+// --max-frames 0 wrote a rawlog of no frames, which no reader opens.
+TEST(DevslamConvert, MaxFramesMustBeAtLeastOne) {
+    const fs::path dir = devslam::test::scratchPath("devslam_convert_max_frames");
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    const auto c = devslam::test::runApp(
+        "devslam-convert", std::string(DEVSLAM_SOURCE_DIR) + "/data/tum/fr1_xyz_first37 " +
+                               (dir / "x.rawlog").string() + " --max-frames 0");
+    EXPECT_EQ(c.rc, 1) << c.out;
+    EXPECT_NE(c.out.find("--max-frames: expected an integer >= 1, got '0'"), std::string::npos)
+        << c.out;
+    EXPECT_FALSE(fs::exists(dir / "x.rawlog"));
+    fs::remove_all(dir);
+}
+
 TEST(DevslamRun, TruncatedRawlogRunsOnItsIntactPartWhenAsked) {
     const fs::path dir = devslam::test::scratchPath("devslam_run_truncated");
     fs::remove_all(dir);
