@@ -19,6 +19,7 @@
 
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <limits>
@@ -231,10 +232,25 @@ RawlogReader::RawlogReader(std::string path, ReaderOptions opts)
     bool saw_sf = false, saw_obs = false;
     try {
         Stream s(path_);
+        double last_t = 0;
         while (auto o = s.next(opts_.sensor_label, skipped, saw_sf, saw_obs)) {
             if (const std::string m = missingExternalFile(*o); !m.empty())
                 throw std::runtime_error("observation " + std::to_string(n_frames_) +
                                          ": external file '" + m + "' not found");
+            // As in a TUM list: a stamp not after the previous one is refused (the frames
+            // before it are the intact part).
+            const double t = mrpt::Clock::toDouble(o->timestamp);
+            if (n_frames_ > 0 && !(t > last_t)) {
+                char now[32], before[32];
+                std::snprintf(now, sizeof now, "%.6f", t);
+                std::snprintf(before, sizeof before, "%.6f", last_t);
+                throw std::runtime_error(
+                    "observation " + std::to_string(n_frames_) + ": " +
+                    (t == last_t ? "duplicate timestamp " : "unsorted timestamp ") + now +
+                    " (previous observation " + std::to_string(n_frames_ - 1) + " at " +
+                    before + ")");
+            }
+            last_t = t;
             if (n_frames_ == 0) {
                 o->load();
                 K_ = frameFromObservation(*o, path_ + " observation 0").K;
