@@ -571,6 +571,32 @@ TEST(Rawlog, RejectsFramesThatCannotBeWritten) {
     EXPECT_THROW(io::RawlogWriter(d.str("y.rawlog"), bad), std::invalid_argument);
 }
 
+// Binary garbage read as an object's class name was echoed to the terminal in the error.
+TEST(Rawlog, AGarbageClassNameIsNotEchoed) {
+    TempDir d;
+    const std::string path = d.str("junk.rawlog");
+    {
+        std::ofstream out(path, std::ios::binary);
+        out << char(0x80 | 100);  // MRPT's header: a class name of 100 bytes follows
+        for (int c = 130; c < 230; ++c) out << char(c);
+        out << std::string(200, '\x01');
+    }
+    try {
+        io::RawlogReader r(path);
+        ADD_FAILURE() << "garbage opened as a rawlog";
+    } catch (const std::runtime_error& e) {
+        const std::string m = e.what();
+        EXPECT_NE(m.find("junk.rawlog: cannot decode object 0 at byte 0"), std::string::npos) << m;
+        for (const char c : m)
+            EXPECT_TRUE(c >= 0x20 && c <= 0x7e) << "byte " << int(static_cast<unsigned char>(c));
+        const auto a = m.find("class '"), b = m.find("' which");
+        ASSERT_NE(a, std::string::npos) << m;
+        ASSERT_NE(b, std::string::npos) << m;
+        EXPECT_LE(b - a - 7, 60u) << m;
+        EXPECT_NE(m.find("class '?????"), std::string::npos) << m;
+    }
+}
+
 // Frames are named and listed by their stamps: one not after the previous frame's lost a
 // frame (two entries, one image pair) or wrote an unsorted rgb.txt. Refused as TumReader
 // refuses such lists, by the rawlog reader (the frames before it are the intact part) and by

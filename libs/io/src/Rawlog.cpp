@@ -108,6 +108,20 @@ std::string missingExternalFile(const CObservation3DRangeScan& o) {
     return "";
 }
 
+// MRPT's message for an unknown class quotes the name as read: in a damaged or foreign file,
+// garbage bytes sent to the terminal. Only printable ASCII is kept ('?' for others), and a
+// quoted class name is cut to 60 characters.
+std::string printable(std::string m) {
+    for (char& c : m)
+        if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) > 0x7e) c = '?';
+    const std::string open = "class '";
+    if (const auto a = m.find(open); a != std::string::npos) {
+        const auto from = a + open.size(), to = m.find("' which", from);
+        if (to != std::string::npos && to - from > 60) m.replace(from + 57, to - from - 57, "...");
+    }
+    return m;
+}
+
 }  // namespace
 
 core::Frame frameFromObservation(const CObservation3DRangeScan& o, const std::string& what) {
@@ -199,7 +213,7 @@ struct RawlogReader::Stream {
                 throw std::runtime_error("cannot decode object " + std::to_string(objects) +
                                          " at byte " + std::to_string(pos) +
                                          " of the uncompressed stream (" +
-                                         core::innermostMessage(e.what()) + ")");
+                                         printable(core::innermostMessage(e.what())) + ")");
             }
             ++objects;
             if (auto sf = std::dynamic_pointer_cast<mrpt::obs::CSensoryFrame>(obj)) {
