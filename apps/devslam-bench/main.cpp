@@ -26,6 +26,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <ctime>
@@ -35,8 +36,10 @@
 #include <sys/wait.h>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <map>
 #include <mutex>
@@ -196,9 +199,13 @@ Bench readBench(const std::string& path) {
             throw std::invalid_argument(path + " [" + s + "] name: '" + q.name +
                                         "' (letters, digits, '_', '.', '-' only: it names "
                                         "folders, files and a CSV column)");
-        if (q.scenario.empty() == q.path.empty() && !(q.path.size() && q.scenario.size()))
+        if (q.scenario.empty() && q.path.empty())
             throw std::invalid_argument(path + " [" + s +
                                         "]: give 'path' (a TUM folder) or 'scenario' (synthetic)");
+        if (!q.scenario.empty() && !q.path.empty())  // the path was ignored without a word
+            throw std::invalid_argument(path + " [" + s +
+                                        "]: give 'path' (a TUM folder) or 'scenario' "
+                                        "(synthetic), not both");
         const std::string where = path + " [" + s + "]";
         std::istringstream seeds(cfg->read_string(s, "seeds", ""));
         for (std::string w; seeds >> w;) {
@@ -241,6 +248,15 @@ Bench readBench(const std::string& path) {
         b.sequences.push_back(q);
     }
     if (b.sequences.empty()) throw std::invalid_argument(path + ": no [sequence_*] section");
+    // Mode truth runs only where there is person truth (renders); with none it would run
+    // nothing and leave its column empty.
+    if (std::find(b.modes.begin(), b.modes.end(), "truth") != b.modes.end() &&
+        std::none_of(b.sequences.begin(), b.sequences.end(), [](const Sequence& q) {
+            return !q.scenario.empty() || eval::PersonTruth::available(q.path);
+        }))
+        throw std::invalid_argument(path + " [bench] modes: truth needs person truth, which "
+                                           "no sequence has (a scenario, or a devslam-synth "
+                                           "folder as path)");
     b.targets = bench::loadTargets(*cfg, path, b.names(), b.modes);
     return b;
 }
@@ -270,6 +286,54 @@ std::optional<double> jsonNumber(const std::string& js, const std::string& objec
     return std::strtod(js.c_str() + k + key.size() + 3, nullptr);
 }
 
+/// Whether `js` is one whole JSON value (and only that): a run.json that is empty, cut or
+/// garbage has no figures to keep.
+bool wholeJson(const std::string& js) {
+    std::size_t i = 0;
+    const auto ws = [&] {
+        while (i < js.size() && std::isspace(static_cast<unsigned char>(js[i]))) ++i;
+    };
+    std::function<bool(int)> value = [&](int depth) -> bool {
+        ws();
+        if (i >= js.size() || depth > 200) return false;
+        const char c = js[i];
+        if (c == '{' || c == '[') {
+            const char close = c == '{' ? '}' : ']';
+            ++i;
+            ws();
+            if (i < js.size() && js[i] == close) return ++i, true;
+            for (;;) {
+                if (c == '{') {
+                    ws();
+                    if (i >= js.size() || js[i] != '"' || !value(depth + 1)) return false;
+                    ws();
+                    if (i >= js.size() || js[i++] != ':') return false;
+                }
+                if (!value(depth + 1)) return false;
+                ws();
+                if (i >= js.size()) return false;
+                if (js[i] == close) return ++i, true;
+                if (js[i++] != ',') return false;
+            }
+        }
+        if (c == '"') {
+            for (++i; i < js.size() && js[i] != '"'; ++i)
+                if (js[i] == '\\') ++i;
+            return i++ < js.size();
+        }
+        for (const char* word : {"true", "false", "null"})
+            if (js.compare(i, std::strlen(word), word) == 0) return i += std::strlen(word), true;
+        char* end = nullptr;
+        std::strtod(js.c_str() + i, &end);
+        if (end == js.c_str() + i) return false;
+        i = std::size_t(end - js.c_str());
+        return true;
+    };
+    if (!value(0)) return false;
+    ws();
+    return i == js.size();
+}
+
 struct RunFigures {
     double ate_rmse = 0, ate_mean = 0, ate_median = 0;
     double rpe_t_rmse = 0, rpe_t_mean = 0, rpe_t_median = 0;
@@ -281,6 +345,7 @@ struct RunFigures {
     std::optional<std::uint64_t> seed;  ///< the render it ran on (synthetic, seeded)
     fs::path dir;                       ///< its output folder
     bool ok = false;
+    std::string unreadable;  ///< a run.json that is there but no whole JSON object: why
 };
 
 RunFigures readRun(const std::string& json_path) {
@@ -290,6 +355,11 @@ RunFigures readRun(const std::string& json_path) {
     std::stringstream ss;
     ss << in.rdbuf();
     const std::string js = ss.str();
+    const auto first = js.find_first_not_of(" \t\r\n");
+    if (first == std::string::npos || js[first] != '{' || !wholeJson(js)) {
+        f.unreadable = json_path + " is not a whole JSON object (empty, cut short or garbage)";
+        return f;
+    }
     const auto get = [&](const std::string& obj, const std::string& key) {
         return jsonNumber(js, obj, key).value_or(std::numeric_limits<double>::quiet_NaN());
     };
@@ -696,6 +766,8 @@ Runs runSlam(const Bench& b, const Args& a) {
                               << std::flush;
                     const std::string json = (dir / "run.json").string();
                     RunFigures f = a.reuse ? readRun(json) : RunFigures{};
+                    if (!f.unreadable.empty())  // run again, as a failed run is
+                        std::cerr << "  WARNING: not kept: " << f.unreadable << "\n";
                     const std::string made_from =
                         provenance(cmd, runInputs(a.bin, q.slam_config, in.path), hashes);
                     if (f.ok) {  // a whole run made earlier: kept if it is this one
@@ -731,7 +803,9 @@ Runs runSlam(const Bench& b, const Args& a) {
                     if (!f.ok) {
                         runs.failed.push_back((dir / "log.txt").string());
                         std::cerr << "  devslam-run failed ("
-                                  << (rc == 0 ? std::string("no readable run.json") : endedBy(rc))
+                                  << (rc != 0                 ? endedBy(rc)
+                                      : f.unreadable.empty() ? std::string("no readable run.json")
+                                                             : f.unreadable)
                                   << "):\n"
                                   << lastLines((dir / "log.txt").string(), 3)
                                   << "  (whole output: " << (dir / "log.txt").string() << ")\n";

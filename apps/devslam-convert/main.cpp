@@ -22,14 +22,15 @@ namespace {
 
 const char* kUsage = R"(usage: devslam-convert INPUT OUTPUT [options]
   INPUT   a TUM RGB-D folder (with rgb.txt) or a .rawlog file
-  OUTPUT  a path ending in .rawlog (write a rawlog) or a folder (write a TUM folder)
+  OUTPUT  a path ending in .rawlog (write a rawlog) or a folder (write a TUM folder); an
+          existing rawlog or a folder that holds a TUM sequence is refused
 options:
   --camera NAME       intrinsics preset for a TUM input (auto|freiburg1|freiburg2|freiburg3|ros_default)
   --sensory-frames    rawlog in the action/sensory-frame layout (default: observations only)
   --external          rawlog with images in <name>_Images/ (default: inline)
   --compression N     gzip level 0..9 (default 1)
   --label TEXT        sensor label of the observations (default RGBD)
-  --max-frames N      stop after N frames
+  --max-frames N      stop after N frames (N >= 1)
   --allow-damaged     a damaged input (a rawlog cut short by a crash or a full disk, a TUM
                       folder missing images, a frame whose image does not decode): convert
                       what is intact, say what was left out
@@ -48,6 +49,11 @@ void refuseOverwritingInput(const std::string& in, const std::string& out) {
     if (fs::exists(out) && fs::equivalent(in, out, ec))
         throw std::invalid_argument("OUTPUT '" + out + "' is the input '" + in +
                                     "': writing it would destroy what is read; name another");
+    // A conversion that fails midway (a frame that does not decode) leaves a partial rawlog:
+    // it must not be written over one that was there.
+    if (endsWith(out, ".rawlog") && (fs::exists(out) || fs::is_symlink(out)))
+        throw std::invalid_argument("OUTPUT '" + out +
+                                    "' already exists; remove it or name another");
     if (!endsWith(out, ".rawlog") && fs::exists(fs::path(out) / "rgb.txt"))
         throw std::invalid_argument("OUTPUT '" + out +
                                     "' already holds a TUM sequence (rgb.txt); remove it or name "
@@ -88,7 +94,7 @@ std::variant<Args, int> parseArgs(int argc, char** argv) {
         else if (a == "--allow-damaged")
             args.ro.allow_damaged = true;
         else if (a == "--max-frames")
-            args.max_frames = std::size_t(devslam::core::parseInteger(value(), "--max-frames", 0));
+            args.max_frames = std::size_t(devslam::core::parseInteger(value(), "--max-frames", 1));
         else if (!a.empty() && a[0] == '-')
             throw std::invalid_argument("unknown option " + a);
         else

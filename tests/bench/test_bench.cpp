@@ -355,6 +355,43 @@ TEST(DevslamBench, CtrlCStopsTheBenchAndReuseRunsResumes) {
 }
 
 // A bad bench INI stops the bench before anything runs, naming the file, section and key.
+// --reuse-runs kept a run whose run.json was garbage or empty (its figures n/a, "runs ok
+// 1/1", no word): such a run is not kept but made again, with a warning naming the file.
+TEST(DevslamBench, ReuseRunsDoesNotKeepAnUnreadableRunJson) {
+    const std::string root = DEVSLAM_SOURCE_DIR;
+    const fs::path tmp = devslam::test::scratchPath("devslam_bench_unreadable_run");
+    fs::remove_all(tmp);
+    fs::create_directories(tmp);
+    std::ofstream(tmp / "bench.ini")
+        << "[bench]\nmodes = none\nrepeats = 1\nmax_frames = 3\n[sequence_tiny]\npath = "
+        << root << "/data/tum/fr1_xyz_first37\nslam_config = " << root
+        << "/config_ini/slam_tum_fr1.ini\n";
+    const std::string args = "--config '" + (tmp / "bench.ini").string() +
+                             "' --results none --out '" + (tmp / "out").string() + "'";
+    const fs::path json = tmp / "out/runs/tiny/none/r0/run.json";
+    auto r = devslam::test::runApp("devslam-bench", args);
+    ASSERT_EQ(r.rc, 0) << r.out;
+    ASSERT_TRUE(fs::exists(json));
+    for (const char* bad : {"{garbage\n", "", "{\"ate\": {\"rmse\": 0.1}"}) {
+        std::ofstream(json) << bad;
+        r = devslam::test::runApp("devslam-bench", args + " --reuse-runs");
+        EXPECT_EQ(r.rc, 0) << r.out;
+        EXPECT_NE(r.out.find("WARNING: not kept: " + json.string() +
+                             " is not a whole JSON object"),
+                  std::string::npos)
+            << bad << "\n" << r.out;
+        EXPECT_EQ(r.out.find("runs were kept from an earlier invocation"), std::string::npos)
+            << r.out;
+        EXPECT_NE(readFile(json).find("\"per_frame\""), std::string::npos) << "made again";
+    }
+    // A whole one is kept, without a warning.
+    r = devslam::test::runApp("devslam-bench", args + " --reuse-runs");
+    EXPECT_EQ(r.rc, 0) << r.out;
+    EXPECT_EQ(r.out.find("WARNING"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("1 of 1 runs were kept"), std::string::npos) << r.out;
+    fs::remove_all(tmp);
+}
+
 TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
     const std::string root = DEVSLAM_SOURCE_DIR, bin = DEVSLAM_BIN_DIR;
     const fs::path tmp =
@@ -402,6 +439,10 @@ TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
          "bench.ini [sequence_b] name: its render a_seed1 would share a folder with sequence "
          "'a''s"},
         {real + "set = person_1.speed=1\n", "[sequence_a] set: only a synthetic sequence"},
+        {synth + fr1,
+         "bench.ini [sequence_a]: give 'path' (a TUM folder) or 'scenario' (synthetic), not both"},
+        {"[bench]\nmodes = truth\n" + real,
+         "bench.ini [bench] modes: truth needs person truth, which no sequence has"},
         {synth + "set = person_1.speed=1 speed=2\n",
          "[sequence_a] set item 'speed=2': expected SECTION.KEY=VALUE"},
         {synth + "set = person_2.path=[3.5 2.8\n",

@@ -196,6 +196,56 @@ TEST(DevslamConvert, SaysWhatARawlogDoesNotKeep) {
     fs::remove_all(dir);
 }
 
+// A conversion that stops midway leaves a partial rawlog: it must never replace a good one.
+TEST(DevslamConvert, RefusesToWriteOverAnExistingRawlog) {
+    const fs::path dir = devslam::test::scratchPath("devslam_convert_existing");
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    const std::string tum = std::string(DEVSLAM_SOURCE_DIR) + "/data/tum/fr1_xyz_first37";
+    const fs::path keep = dir / "keep.rawlog";
+    auto c = devslam::test::runApp("devslam-convert",
+                                   tum + " " + keep.string() + " --max-frames 5");
+    ASSERT_EQ(c.rc, 0) << c.out;
+    const auto size = fs::file_size(keep);
+    // a TUM folder whose second depth image does not decode
+    c = devslam::test::runApp("devslam-convert",
+                              tum + " " + (dir / "bad").string() + " --max-frames 3");
+    ASSERT_EQ(c.rc, 0) << c.out;
+    std::ifstream list(dir / "bad" / "depth.txt");
+    std::string line, image;
+    for (int k = 0; k <= 1 && std::getline(list, line);)
+        if (!line.empty() && line[0] != '#' && k++ == 1) image = line.substr(line.find(' ') + 1);
+    ASSERT_FALSE(image.empty());
+    std::ofstream(dir / "bad" / image) << "not a png";
+
+    c = devslam::test::runApp("devslam-convert", (dir / "bad").string() + " " + keep.string());
+    EXPECT_EQ(c.rc, 1) << c.out;
+    EXPECT_NE(c.out.find("OUTPUT '" + keep.string() +
+                         "' already exists; remove it or name another"),
+              std::string::npos)
+        << c.out;
+    EXPECT_EQ(fs::file_size(keep), size);
+    c = devslam::test::runApp("devslam-convert", keep.string() + " " + (dir / "x").string());
+    EXPECT_EQ(c.rc, 0) << c.out;
+    EXPECT_NE(c.out.find("wrote 5 frames"), std::string::npos) << c.out;
+    fs::remove_all(dir);
+}
+
+// --max-frames 0 wrote a rawlog of no frames, which no reader opens.
+TEST(DevslamConvert, MaxFramesMustBeAtLeastOne) {
+    const fs::path dir = devslam::test::scratchPath("devslam_convert_max_frames");
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    const auto c = devslam::test::runApp(
+        "devslam-convert", std::string(DEVSLAM_SOURCE_DIR) + "/data/tum/fr1_xyz_first37 " +
+                               (dir / "x.rawlog").string() + " --max-frames 0");
+    EXPECT_EQ(c.rc, 1) << c.out;
+    EXPECT_NE(c.out.find("--max-frames: expected an integer >= 1, got '0'"), std::string::npos)
+        << c.out;
+    EXPECT_FALSE(fs::exists(dir / "x.rawlog"));
+    fs::remove_all(dir);
+}
+
 TEST(DevslamRun, TruncatedRawlogRunsOnItsIntactPartWhenAsked) {
     const fs::path dir = devslam::test::scratchPath("devslam_run_truncated");
     fs::remove_all(dir);

@@ -25,6 +25,8 @@
 #include <functional>
 #include <limits>
 #include <regex>
+#include <tuple>
+#include <vector>
 
 
 namespace fs = std::filesystem;
@@ -567,6 +569,101 @@ TEST(Rawlog, RejectsFramesThatCannotBeWritten) {
     io::RawlogWriterOptions bad;
     bad.compression = 11;
     EXPECT_THROW(io::RawlogWriter(d.str("y.rawlog"), bad), std::invalid_argument);
+}
+
+// Binary garbage read as an object's class name was echoed to the terminal in the error.
+TEST(Rawlog, AGarbageClassNameIsNotEchoed) {
+    TempDir d;
+    const std::string path = d.str("junk.rawlog");
+    {
+        std::ofstream out(path, std::ios::binary);
+        out << char(0x80 | 100);  // MRPT's header: a class name of 100 bytes follows
+        for (int c = 130; c < 230; ++c) out << char(c);
+        out << std::string(200, '\x01');
+    }
+    try {
+        io::RawlogReader r(path);
+        ADD_FAILURE() << "garbage opened as a rawlog";
+    } catch (const std::runtime_error& e) {
+        const std::string m = e.what();
+        EXPECT_NE(m.find("junk.rawlog: cannot decode object 0 at byte 0"), std::string::npos) << m;
+        for (const char c : m)
+            EXPECT_TRUE(c >= 0x20 && c <= 0x7e) << "byte " << int(static_cast<unsigned char>(c));
+        const auto a = m.find("class '"), b = m.find("' which");
+        ASSERT_NE(a, std::string::npos) << m;
+        ASSERT_NE(b, std::string::npos) << m;
+        EXPECT_LE(b - a - 7, 60u) << m;
+        EXPECT_NE(m.find("class '?????"), std::string::npos) << m;
+    }
+}
+
+// Frames are named and listed by their stamps: one not after the previous frame's lost a
+// frame (two entries, one image pair) or wrote an unsorted rgb.txt. Refused as TumReader
+// refuses such lists, by the rawlog reader (the frames before it are the intact part) and by
+// the TUM writer (nothing of that frame written).
+TEST(Rawlog, StampsThatDoNotIncreaseAreRefused) {
+    TempDir d;
+    copyTumSubset(d.str("s"), 4);
+    io::TumReader tum(d.str("s"));
+    std::vector<core::Frame> frames;
+    while (auto f = tum.next()) frames.push_back(*f);
+    ASSERT_EQ(frames.size(), 4u);
+    const double t0 = frames[0].timestamp;
+    for (const auto& [name, t2, kind] :
+         {std::tuple{"dup.rawlog", t0 + 0.1, "duplicate"},
+          std::tuple{"back.rawlog", t0 - 1.0, "unsorted"}}) {
+        const std::string path = d.str(name);
+        {
+            io::RawlogWriter w(path, {});
+            const double stamps[] = {t0, t0 + 0.1, t2, t0 + 0.3};
+            for (std::size_t k = 0; k < 4; ++k) {
+                core::Frame f = frames[k];
+                f.timestamp = stamps[k];
+                w.write(f);
+            }
+        }
+        char a[32], b[32];
+        std::snprintf(a, sizeof a, "%.6f", t2);
+        std::snprintf(b, sizeof b, "%.6f", t0 + 0.1);
+        const std::string msg = std::string(kind) + " timestamp " + a +
+                                " \\(previous observation 1 at " + b +
+                                "\\) after 2 RGB-D observations";
+        expectError([&] { io::RawlogReader r(path); },
+                    std::string(name).replace(std::string(name).find('.'), 1, "\\.") +
+                        ": observation 2: " + msg);
+        io::ReaderOptions allow;
+        allow.allow_damaged = true;
+        io::RawlogReader partial(path, allow);
+        EXPECT_EQ(partial.size(), 2u);
+        std::size_t n = 0;
+        while (partial.next()) ++n;
+        EXPECT_EQ(n, 2u);
+    }
+
+    // The TUM writer: a duplicate (also one within the microsecond the names keep) or an
+    // earlier stamp names both frames; the frames before it stay listed.
+    int folder = 0;
+    for (const double t1 : {t0, t0 + 4e-7, t0 - 0.5}) {
+        const std::string out = d.str("tum" + std::to_string(folder++));
+        io::TumWriter w(out, "test");
+        core::Frame f = frames[0];
+        f.index = 7;
+        f.depth_timestamp.reset();
+        w.write(f);
+        f = frames[1];
+        f.index = 8;
+        f.timestamp = t1;
+        f.depth_timestamp.reset();
+        char a[32];
+        std::snprintf(a, sizeof a, "%.6f", t0);
+        expectError([&] { w.write(f); }, std::string("frame 8: ") +
+                                             (t1 < t0 - 0.1 ? "unsorted" : "duplicate") +
+                                             " timestamp .* \\(previous frame 7 at " + a + "\\)");
+        w.close();
+        EXPECT_EQ(io::readTumList(out + "/rgb.txt").size(), 1u);
+        EXPECT_EQ(std::distance(fs::directory_iterator(out + "/rgb"), fs::directory_iterator{}),
+                  1);
+    }
 }
 
 TEST(VideoReader, ReadsVtestAsFixedCameraFramesWithAPlaneOfDepth) {

@@ -19,6 +19,7 @@
 
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <limits>
@@ -105,6 +106,20 @@ std::string missingExternalFile(const CObservation3DRangeScan& o) {
         if (!fs::is_regular_file(p)) return p;
     }
     return "";
+}
+
+// MRPT's message for an unknown class quotes the name as read: in a damaged or foreign file,
+// garbage bytes sent to the terminal. Only printable ASCII is kept ('?' for others), and a
+// quoted class name is cut to 60 characters.
+std::string printable(std::string m) {
+    for (char& c : m)
+        if (static_cast<unsigned char>(c) < 0x20 || static_cast<unsigned char>(c) > 0x7e) c = '?';
+    const std::string open = "class '";
+    if (const auto a = m.find(open); a != std::string::npos) {
+        const auto from = a + open.size(), to = m.find("' which", from);
+        if (to != std::string::npos && to - from > 60) m.replace(from + 57, to - from - 57, "...");
+    }
+    return m;
 }
 
 }  // namespace
@@ -198,7 +213,7 @@ struct RawlogReader::Stream {
                 throw std::runtime_error("cannot decode object " + std::to_string(objects) +
                                          " at byte " + std::to_string(pos) +
                                          " of the uncompressed stream (" +
-                                         core::innermostMessage(e.what()) + ")");
+                                         printable(core::innermostMessage(e.what())) + ")");
             }
             ++objects;
             if (auto sf = std::dynamic_pointer_cast<mrpt::obs::CSensoryFrame>(obj)) {
@@ -231,10 +246,25 @@ RawlogReader::RawlogReader(std::string path, ReaderOptions opts)
     bool saw_sf = false, saw_obs = false;
     try {
         Stream s(path_);
+        double last_t = 0;
         while (auto o = s.next(opts_.sensor_label, skipped, saw_sf, saw_obs)) {
             if (const std::string m = missingExternalFile(*o); !m.empty())
                 throw std::runtime_error("observation " + std::to_string(n_frames_) +
                                          ": external file '" + m + "' not found");
+            // As in a TUM list: a stamp not after the previous one is refused (the frames
+            // before it are the intact part).
+            const double t = mrpt::Clock::toDouble(o->timestamp);
+            if (n_frames_ > 0 && !(t > last_t)) {
+                char now[32], before[32];
+                std::snprintf(now, sizeof now, "%.6f", t);
+                std::snprintf(before, sizeof before, "%.6f", last_t);
+                throw std::runtime_error(
+                    "observation " + std::to_string(n_frames_) + ": " +
+                    (t == last_t ? "duplicate timestamp " : "unsorted timestamp ") + now +
+                    " (previous observation " + std::to_string(n_frames_ - 1) + " at " +
+                    before + ")");
+            }
+            last_t = t;
             if (n_frames_ == 0) {
                 o->load();
                 K_ = frameFromObservation(*o, path_ + " observation 0").K;

@@ -10,6 +10,7 @@
 #include <fstream>
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <stdexcept>
 
@@ -72,6 +73,22 @@ void TumWriter::write(const core::Frame& f) {
     std::snprintf(stamp, sizeof stamp, "%.6f", f.timestamp);
     // A depth image with its own stamp (a TUM source) keeps it, as TUM names and lists it.
     std::snprintf(depth_stamp, sizeof depth_stamp, "%.6f", f.depth_timestamp.value_or(f.timestamp));
+    // Images are named by their stamp as written (microseconds): a stamp not after the
+    // previous frame's would write over its images, or list them out of order, which
+    // TumReader refuses.
+    const double t = std::strtod(stamp, nullptr), td = std::strtod(depth_stamp, nullptr);
+    if (count_ > 0 && (!(t > last_t_) || !(td > last_depth_t_))) {
+        const bool colour = !(t > last_t_);
+        const double now = colour ? t : td, before = colour ? last_t_ : last_depth_t_;
+        char prev[32];
+        std::snprintf(prev, sizeof prev, "%.6f", before);
+        throw std::runtime_error("frame " + std::to_string(f.index) + ": " +
+                                 (now == before ? "duplicate " : "unsorted ") +
+                                 (colour ? "timestamp " : "depth timestamp ") +
+                                 (colour ? stamp : depth_stamp) + " (previous frame " +
+                                 std::to_string(last_index_) + " at " + prev +
+                                 "): a TUM folder's stamps must increase");
+    }
     const std::string rgb = std::string("rgb/") + stamp + ".png";
     const std::string depth = std::string("depth/") + depth_stamp + ".png";
     if (!cv::imwrite(folder_ + "/" + rgb, f.bgr))
@@ -80,6 +97,9 @@ void TumWriter::write(const core::Frame& f) {
         throw std::runtime_error("cannot write '" + folder_ + "/" + depth + "'");
     std::fprintf(rgb_list_.get(), "%s %s\n", stamp, rgb.c_str());
     std::fprintf(depth_list_.get(), "%s %s\n", depth_stamp, depth.c_str());
+    last_t_ = t;
+    last_depth_t_ = td;
+    last_index_ = f.index;
     ++count_;
 }
 

@@ -25,7 +25,8 @@ class TumWriter {
     TumWriter(const TumWriter&) = delete;
     TumWriter& operator=(const TumWriter&) = delete;
 
-    /// Depth is written as round(depth * 5000); throws for depth beyond 13.1 m (16 bits).
+    /// Depth is written as round(depth * 5000); throws for depth beyond 13.1 m (16 bits),
+    /// and for a frame whose (colour or depth) stamp is not after the previous frame's.
     void write(const core::Frame& f);
     void writeGroundTruth(const core::Trajectory& gt);
     void close();
@@ -35,6 +36,8 @@ class TumWriter {
     std::string folder_;
     std::unique_ptr<std::FILE, int (*)(std::FILE*)> rgb_list_, depth_list_;
     std::size_t count_ = 0;
+    double last_t_ = 0, last_depth_t_ = 0;  // the previous frame's stamps, as written
+    std::size_t last_index_ = 0;
 };
 
 }  // namespace devslam::io
