@@ -287,7 +287,9 @@ std::optional<double> jsonNumber(const std::string& js, const std::string& objec
 }
 
 /// Whether `js` is one whole JSON value (and only that): a run.json that is empty, cut or
-/// garbage has no figures to keep.
+/// garbage has no figures to keep. Written by hand: no dependency reads JSON strictly;
+/// MRPT 2.5.8's yaml::FromText (libfyaml) reads JSON, but took a run.json cut in the middle of
+/// a string for a whole map, printing the error and throwing nothing.
 bool wholeJson(const std::string& js) {
     std::size_t i = 0;
     const auto ws = [&] {
