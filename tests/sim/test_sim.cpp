@@ -65,17 +65,20 @@ TEST(World, ObstacleOnGoalIsAClearError) {
     }
 }
 
+namespace {
+/// The message of parsing `text` as "w.ini", "" when it is accepted.
+std::string errorOf(const std::string& text) {
+    const mrpt::config::CConfigFileMemory c(text);
+    try {
+        (void)parseWorld(c, "w.ini");
+    } catch (const std::invalid_argument& e) {
+        return std::string(e.what());
+    }
+    return std::string();
+}
+}  // namespace
+
 TEST(World, BadEntriesNameTheKey) {
-    // The message of parsing `text` as "w.ini", "" when it is accepted.
-    const auto errorOf = [](const std::string& text) {
-        const mrpt::config::CConfigFileMemory c(text);
-        try {
-            (void)parseWorld(c, "w.ini");
-        } catch (const std::invalid_argument& e) {
-            return std::string(e.what());
-        }
-        return std::string();
-    };
     const std::string head =
         "[world]\nx_min=0\nx_max=5\ny_min=0\ny_max=5\n[robot]\nstart_x=1\nstart_y=1\n"
         "[goal]\nx=4\ny=4\n";
@@ -158,15 +161,6 @@ TEST(World, BadEntriesNameTheKey) {
 // = 1000 a success at t = 0, a box at (500, 400) in a 5 x 5 m world ignored); each is an
 // error naming its key, and values inside the bounds still load.
 TEST(World, AbsurdValuesAreErrorsNamingTheKey) {
-    const auto errorOf = [](const std::string& text) {
-        const mrpt::config::CConfigFileMemory c(text);
-        try {
-            (void)parseWorld(c, "w.ini");
-        } catch (const std::invalid_argument& e) {
-            return std::string(e.what());
-        }
-        return std::string();
-    };
     const std::string world = "[world]\nx_min=0\nx_max=5\ny_min=0\ny_max=5\n";
     const std::string head = world + "[robot]\nstart_x=1\nstart_y=1\n";
     const std::string goal = "[goal]\nx=4\ny=4\n";
