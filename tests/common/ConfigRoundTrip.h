@@ -26,7 +26,6 @@
 #include <cstdio>
 #include <functional>
 #include <map>
-#include <regex>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -88,8 +87,12 @@ inline std::vector<std::string> candidatesFor(const std::string& text) {
     if (text == "true") return {"false"};
     if (text == "false") return {"true"};
     std::vector<std::string> out;
-    static const std::regex integer(R"(\s*-?\d+\s*)");
-    if (std::regex_match(text, integer)) {  // an integer, or a real number that prints as one
+    const auto b = text.find_first_not_of(" \t"), e = text.find_last_not_of(" \t");
+    const std::string t = b == std::string::npos ? "" : text.substr(b, e - b + 1);
+    const std::size_t digits = !t.empty() && t[0] == '-' ? 1 : 0;
+    if (t.size() > digits && t.size() < 19 &&
+        std::all_of(t.begin() + digits, t.end(), [](char c) { return c >= '0' && c <= '9'; })) {
+        // an integer, or a real number that prints as one
         const long long v = std::stoll(text);
         out = {std::to_string(v + 1), std::to_string(v - 1), std::to_string(v + 2),
                std::to_string(v * 2), std::to_string(v / 2)};
