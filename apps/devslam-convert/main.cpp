@@ -166,6 +166,11 @@ struct Conversion {
         if (!undecodable.empty())
             std::cout << "left out (frames that do not decode): " << undecodable.size()
                       << ", the first: " << undecodable.front() << "\n";
+        if (n == 0 && stopped.empty() && !interrupted) {  // every frame left out
+            std::cerr << "devslam-convert: no frame converted; " << args.output
+                      << " holds none\n";
+            return 1;
+        }
         if (!stopped.empty()) {
             std::cerr << "devslam-convert: " << stopped << "\ndevslam-convert: stopped there; "
                       << args.output << " holds the " << n

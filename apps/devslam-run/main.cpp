@@ -41,6 +41,7 @@ const char* kUsage =
     "          --config " DEVSLAM_SOURCE_DIR
     "/config_ini/slam_tum_fr1.ini\n"
     "          --mode from the INI's [run] mode (dynamic), --out ./out/devslam-run\n"
+    "          (--out '' writes no files: the summary only)\n"
     "mode truth (diagnostic, devslam-synth folders only): the mask is the renderer's\n"
     "walking people, dilated by [dynamic_filter] mask_margin - a perfect filter.\n";
 

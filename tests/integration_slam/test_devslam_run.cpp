@@ -246,6 +246,43 @@ TEST(DevslamConvert, MaxFramesMustBeAtLeastOne) {
     fs::remove_all(dir);
 }
 
+// --allow-damaged with no frame that decodes: an empty output is a failure, not rc 0.
+TEST(DevslamConvert, NoFrameConvertedIsAFailure) {
+    const fs::path dir = devslam::test::scratchPath("devslam_convert_none");
+    fs::remove_all(dir);
+    const fs::path src = std::string(DEVSLAM_SOURCE_DIR) + "/data/tum/fr1_xyz_first37";
+    fs::create_directories(dir / "in" / "rgb");
+    fs::create_directories(dir / "in" / "depth");
+    std::ifstream rgb_in(src / "rgb.txt"), depth_in(src / "depth.txt");
+    std::ofstream rgb_out(dir / "in" / "rgb.txt"), depth_out(dir / "in" / "depth.txt");
+    int n = 0;
+    for (std::string line; n < 2 && std::getline(rgb_in, line);) {
+        if (line.empty() || line[0] == '#') continue;
+        rgb_out << line << "\n";
+        std::ofstream(dir / "in" / line.substr(line.find(' ') + 1)) << "not a png";
+        ++n;
+    }
+    n = 0;
+    for (std::string line; n < 2 && std::getline(depth_in, line);) {
+        if (line.empty() || line[0] == '#') continue;
+        depth_out << line << "\n";
+        const std::string f = line.substr(line.find(' ') + 1);
+        fs::copy_file(src / f, dir / "in" / f);
+        ++n;
+    }
+    rgb_out.close();
+    depth_out.close();
+    const auto c = devslam::test::runApp(
+        "devslam-convert", (dir / "in").string() + " " + (dir / "out").string() +
+                               " --allow-damaged --camera freiburg1");
+    EXPECT_EQ(c.rc, 1) << c.out;
+    EXPECT_NE(c.out.find("left out (frames that do not decode): 2"), std::string::npos) << c.out;
+    EXPECT_NE(c.out.find("no frame converted; " + (dir / "out").string() + " holds none"),
+              std::string::npos)
+        << c.out;
+    fs::remove_all(dir);
+}
+
 TEST(DevslamRun, TruncatedRawlogRunsOnItsIntactPartWhenAsked) {
     const fs::path dir = devslam::test::scratchPath("devslam_run_truncated");
     fs::remove_all(dir);
