@@ -58,7 +58,9 @@ CameraIntrinsics CameraIntrinsics::fromPreset(const std::string& name) {
 }
 
 namespace {
-constexpr double kMinFocal = 1.0, kMaxFocal = 1e5;  // [px]
+/// A focal length in [1, 1e5] px: 0, inf or 1e-300 from a damaged file made the SLAM's grid map
+/// loop forever.
+bool usableFocal(double f) { return f >= 1.0 && f <= 1e5; }
 }  // namespace
 
 std::string CameraIntrinsics::problem() const {
@@ -67,7 +69,7 @@ std::string CameraIntrinsics::problem() const {
         o << v;
         return o.str();
     };
-    if (!(fx >= kMinFocal && fx <= kMaxFocal && fy >= kMinFocal && fy <= kMaxFocal))
+    if (!usableFocal(fx) || !usableFocal(fy))
         return "focal lengths fx " + str(fx) + ", fy " + str(fy) + " px: must be in [1, 1e5]";
     if (!(cx >= 0 && cx < width && cy >= 0 && cy < height))
         return "principal point (" + str(cx) + ", " + str(cy) + ") lies outside the " +
@@ -102,8 +104,7 @@ CameraIntrinsics CameraIntrinsics::fromConfig(const mrpt::config::CConfigFileBas
         requireValue(d.size() == 5, s, "dist", "must have 5 values k1 k2 p1 p2 k3");
         std::copy(d.begin(), d.end(), K.dist.begin());
     }
-    requireValue(K.fx >= kMinFocal && K.fy >= kMinFocal && K.fx <= kMaxFocal && K.fy <= kMaxFocal,
-                 s, "fx/fy", "must be in [1, 1e5] px");
+    requireValue(usableFocal(K.fx) && usableFocal(K.fy), s, "fx/fy", "must be in [1, 1e5] px");
     // An image buffer per frame (and the renderer's framebuffer) is width x height: 16000^2
     // took 8 GB before anything was drawn.
     requireValue(K.width > 0 && K.height > 0 && K.width <= 4096 && K.height <= 4096, s,
