@@ -1,5 +1,7 @@
 #include <devslam/io/Rawlog.h>
 
+#include "TextFile.h"
+
 #include <devslam/core/GzFile.h>
 #include <devslam/core/Pose.h>
 
@@ -254,16 +256,12 @@ RawlogReader::RawlogReader(std::string path, ReaderOptions opts)
             // As in a TUM list: a stamp not after the previous one is refused (the frames
             // before it are the intact part).
             const double t = mrpt::Clock::toDouble(o->timestamp);
-            if (n_frames_ > 0 && !(t > last_t)) {
-                char now[32], before[32];
-                std::snprintf(now, sizeof now, "%.6f", t);
-                std::snprintf(before, sizeof before, "%.6f", last_t);
+            if (n_frames_ > 0 && !(t > last_t))
                 throw std::runtime_error(
                     "observation " + std::to_string(n_frames_) + ": " +
-                    (t == last_t ? "duplicate timestamp " : "unsorted timestamp ") + now +
+                    detail::stampNotAfter(t, last_t, detail::stampText(t)) +
                     " (previous observation " + std::to_string(n_frames_ - 1) + " at " +
-                    before + ")");
-            }
+                    detail::stampText(last_t) + ")");
             last_t = t;
             if (n_frames_ == 0) {
                 o->load();

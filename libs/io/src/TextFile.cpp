@@ -40,6 +40,17 @@ double parseNumber(const std::string& token, const std::string& path, int line,
     return v;
 }
 
+std::string stampText(double t) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "%.6f", t);
+    return buf;
+}
+
+std::string stampNotAfter(double t, double previous, const std::string& text,
+                          const std::string& kind) {
+    return (t == previous ? "duplicate " : "unsorted ") + kind + " " + text;
+}
+
 std::string lineError(const std::string& path, int line, const std::string& msg) {
     return path + " line " + std::to_string(line) + ": " + msg;
 }

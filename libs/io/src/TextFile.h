@@ -22,6 +22,15 @@ void forEachDataLine(const std::string& path,
 
 [[nodiscard]] std::string lineError(const std::string& path, int line, const std::string& msg);
 
+/// A stamp as TUM writes it: "%.6f" (microseconds).
+[[nodiscard]] std::string stampText(double t);
+
+/// Why `t` (written `text`) may not follow `previous` in a sequence whose stamps must increase:
+/// "duplicate <kind> <text>" or "unsorted <kind> <text>" (TUM lists, rawlog observations and
+/// written TUM folders word it alike).
+[[nodiscard]] std::string stampNotAfter(double t, double previous, const std::string& text,
+                                        const std::string& kind = "timestamp");
+
 using WrittenFile = std::unique_ptr<std::FILE, int (*)(std::FILE*)>;
 
 /// fopen(path, "w"); throws std::runtime_error "cannot write '<path>'".

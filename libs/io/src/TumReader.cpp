@@ -29,8 +29,8 @@ std::vector<TumListEntry> readTumList(const std::string& path) {
         if (!out.empty() && t <= out.back().t)
             throw std::runtime_error(detail::lineError(
                 path, line,
-                (t == out.back().t ? "duplicate timestamp " : "unsorted timestamp ") + tok[0] +
-                    " (previous entry at line " + std::to_string(out.back().line) + ")"));
+                detail::stampNotAfter(t, out.back().t, tok[0]) + " (previous entry at line " +
+                    std::to_string(out.back().line) + ")"));
         out.push_back({t, tok[1], line});
     });
     if (out.empty()) throw std::runtime_error(path + ": no entries");

@@ -79,15 +79,13 @@ void TumWriter::write(const core::Frame& f) {
     const double t = std::strtod(stamp, nullptr), td = std::strtod(depth_stamp, nullptr);
     if (count_ > 0 && (!(t > last_t_) || !(td > last_depth_t_))) {
         const bool colour = !(t > last_t_);
-        const double now = colour ? t : td, before = colour ? last_t_ : last_depth_t_;
-        char prev[32];
-        std::snprintf(prev, sizeof prev, "%.6f", before);
-        throw std::runtime_error("frame " + std::to_string(f.index) + ": " +
-                                 (now == before ? "duplicate " : "unsorted ") +
-                                 (colour ? "timestamp " : "depth timestamp ") +
-                                 (colour ? stamp : depth_stamp) + " (previous frame " +
-                                 std::to_string(last_index_) + " at " + prev +
-                                 "): a TUM folder's stamps must increase");
+        const double before = colour ? last_t_ : last_depth_t_;
+        throw std::runtime_error(
+            "frame " + std::to_string(f.index) + ": " +
+            (colour ? detail::stampNotAfter(t, before, stamp)
+                    : detail::stampNotAfter(td, before, depth_stamp, "depth timestamp")) +
+            " (previous frame " + std::to_string(last_index_) + " at " +
+            detail::stampText(before) + "): a TUM folder's stamps must increase");
     }
     const std::string rgb = std::string("rgb/") + stamp + ".png";
     const std::string depth = std::string("depth/") + depth_stamp + ".png";
