@@ -31,10 +31,10 @@ options:
 )";
 
 /// A finite number (core::parseNumber refuses "nan" and "inf"); `positive`: also > 0.
-double number(const std::string& opt, const char* v, bool positive = false) {
+double number(const std::string& opt, const std::string& v, bool positive = false) {
     const double x = devslam::core::parseNumber(v, opt);
     if (positive && !(x > 0))
-        throw std::invalid_argument(opt + ": must be > 0, got '" + std::string(v) + "'");
+        throw std::invalid_argument(opt + ": must be > 0, got '" + v + "'");
     return x;
 }
 
@@ -49,12 +49,7 @@ int main(int argc, char** argv) {
         bool rpe = true;
         for (int i = 1; i < argc; ++i) {
             const std::string a = argv[i];
-            auto value = [&]() -> const char* {
-                // "--json --plot p.png": --json's value is missing, not "--plot".
-                if (i + 1 >= argc || std::string(argv[i + 1]).rfind("--", 0) == 0)
-                    throw std::invalid_argument(a + " needs a value");
-                return argv[++i];
-            };
+            auto value = [&] { return devslam::core::optionValue(argc, argv, i); };
             if (a == "-h" || a == "--help") {
                 std::cout << kUsage;
                 return 0;

@@ -176,11 +176,7 @@ std::optional<int> parseArgs(int argc, char** argv, Args& a) {
     try {
         for (int i = 1; i < argc; i++) {
             const std::string s = argv[i];
-            auto next = [&]() -> std::string {
-                if (i + 1 >= argc || std::string(argv[i + 1]).rfind("--", 0) == 0)
-                    throw std::invalid_argument(s + " needs a value");
-                return argv[++i];
-            };
+            auto next = [&] { return devslam::core::optionValue(argc, argv, i); };
             if (s == "--per-category") {
                 a.per_category =
                     int(devslam::core::parseInteger(next(), "--per-category", 1, 100000));

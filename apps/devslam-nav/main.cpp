@@ -120,12 +120,7 @@ int main(int argc, char** argv) {
     bool verbose = false;
     for (int i = 1; i < argc; i++) {
         const std::string a = argv[i];
-        auto next = [&]() -> std::string {
-            // "--method --png x.png": the option's value is missing, not "--png" a method.
-            if (i + 1 >= argc || std::string(argv[i + 1]).rfind("--", 0) == 0)
-                throw std::invalid_argument(a + " needs a value");
-            return argv[++i];
-        };
+        auto next = [&] { return devslam::core::optionValue(argc, argv, i); };
         try {
             if (a == "--config")
                 config = next();

@@ -127,12 +127,7 @@ int run(int argc, char** argv) {
     std::vector<std::string> sets;
     bool labels = true, if_changed = false;
     for (std::size_t i = 0; i < a.size(); ++i) {
-        const auto value = [&]() -> std::string {
-            // "-o --frames 2": -o's value is missing, not a folder named "--frames".
-            if (i + 1 >= a.size() || a[i + 1].rfind("--", 0) == 0)
-                throw std::invalid_argument(a[i] + " needs a value");
-            return a[++i];
-        };
+        const auto value = [&] { return devslam::core::optionValue(a, i); };
         if (a[i] == "-o" || a[i] == "--out")
             out_dir = value();
         else if (a[i] == "--rawlog")

@@ -236,6 +236,17 @@ TEST(Parse, NumbersAreReadInFullOrRejected) {
         EXPECT_NE(invalidArgument([&] { (void)parseNumber(bad, "x"); }), "") << bad;
 }
 
+TEST(Parse, AnOptionsValueIsNotTheNextOption) {
+    const std::vector<std::string> args{"app", "--from", "-1,2", "--method", "--png", "x.png"};
+    std::size_t i = 1;
+    EXPECT_EQ(optionValue(args, i), "-1,2");  // one dash: a value
+    EXPECT_EQ(i, 2u);
+    i = 3;
+    EXPECT_EQ(invalidArgument([&] { (void)optionValue(args, i); }), "--method needs a value");
+    i = 5;
+    EXPECT_EQ(invalidArgument([&] { (void)optionValue(args, i); }), "x.png needs a value");
+}
+
 TEST(Parse, NumberListsNameTheBadToken) {
     EXPECT_EQ(parseNumberList("[1 2.5, -3]", "x"), (std::vector<double>{1, 2.5, -3}));
     EXPECT_TRUE(parseNumberList("  ", "x").empty());

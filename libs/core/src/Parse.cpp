@@ -130,4 +130,20 @@ bool endsWithNoCase(const std::string& text, const std::string& suffix) {
            lowercase(text.substr(text.size() - suffix.size())) == lowercase(suffix);
 }
 
+namespace {
+bool anOption(const std::string& word) { return word.rfind("--", 0) == 0; }
+}  // namespace
+
+std::string optionValue(const std::vector<std::string>& args, std::size_t& i) {
+    if (i + 1 >= args.size() || anOption(args[i + 1]))
+        throw std::invalid_argument(args[i] + " needs a value");
+    return args[++i];
+}
+
+std::string optionValue(int argc, char** argv, int& i) {
+    if (i + 1 >= argc || anOption(argv[i + 1]))
+        throw std::invalid_argument(std::string(argv[i]) + " needs a value");
+    return argv[++i];
+}
+
 }  // namespace devslam::core

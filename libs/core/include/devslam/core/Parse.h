@@ -49,4 +49,12 @@ namespace devslam::core {
 /// (OpenCV picks an image's format by it, ".PNG" as ".png").
 [[nodiscard]] bool endsWithNoCase(const std::string& text, const std::string& suffix);
 
+/// The value of the command-line option args[i], which is args[i + 1]; `i` moves onto it.
+/// Throws std::invalid_argument "<option> needs a value" when there is none or the next word
+/// is another option ("--method --png x.png": the value is missing, not "--png"); words with
+/// one dash ("-1,2") are values.
+[[nodiscard]] std::string optionValue(const std::vector<std::string>& args, std::size_t& i);
+/// The same for main's argc/argv.
+[[nodiscard]] std::string optionValue(int argc, char** argv, int& i);
+
 }  // namespace devslam::core
