@@ -300,15 +300,14 @@ void validateObstacles(const WorldSpec& w) {
 /// grid.
 void validateEndpoints(const WorldSpec& w, const std::vector<Obstacle>& statics) {
     const auto& src = w.source;
-    const auto inside = [&](const mrpt::math::TPoint2D& p) { return insideBounds(w, p); };
     // The coordinate that is out names the key (x first when both are).
     const auto outKey = [&](const mrpt::math::TPoint2D& p, const char* kx, const char* ky) {
         return p.x > w.x_min && p.x < w.x_max ? ky : kx;
     };
-    if (!inside({w.robot.start.x, w.robot.start.y}))
+    if (!insideBounds(w, {w.robot.start.x, w.robot.start.y}))
         fail(src, "robot", outKey({w.robot.start.x, w.robot.start.y}, "start_x", "start_y"),
              "start is outside the world bounds");
-    if (!inside(w.goal))
+    if (!insideBounds(w, w.goal))
         fail(src, "goal", outKey(w.goal, "x", "y"), "goal is outside the world bounds");
     for (const auto& o : statics) {
         const double dg = distanceToObstacle(o, w.goal);
