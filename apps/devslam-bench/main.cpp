@@ -608,10 +608,7 @@ std::optional<Args> parseArgs(int argc, char** argv) {
     a.bin = fs::absolute(argv[0]).parent_path().string();
     for (int i = 1; i < argc; ++i) {
         const std::string k = argv[i];
-        const auto value = [&]() -> std::string {
-            if (i + 1 >= argc) throw std::invalid_argument(k + " needs a value");
-            return argv[++i];
-        };
+        const auto value = [&] { return core::optionValue(argc, argv, i); };
         if (k == "--config")
             a.config = value();
         else if (k == "--repeats")

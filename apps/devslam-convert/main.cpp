@@ -74,10 +74,7 @@ std::variant<Args, int> parseArgs(int argc, char** argv) {
     std::vector<std::string> pos;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
-        auto value = [&]() -> std::string {
-            if (i + 1 >= argc) throw std::invalid_argument(a + " needs a value");
-            return argv[++i];
-        };
+        auto value = [&] { return devslam::core::optionValue(argc, argv, i); };
         if (a == "-h" || a == "--help") {
             std::cout << kUsage;
             return 0;

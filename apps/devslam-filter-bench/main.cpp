@@ -136,15 +136,16 @@ std::optional<int> parseArgs(int argc, char** argv, Args& a) {
     try {
         for (int i = 1; i < argc; ++i) {
             const std::string k = argv[i];
-            if (i + 1 < argc && k == "--threads")
-                a.threads = int(devslam::core::parseInteger(argv[++i], "--threads", 1, 256));
-            else if (i + 1 < argc && k == "--frames")
-                a.n_frames = int(devslam::core::parseInteger(argv[++i], "--frames", 2,
+            const auto value = [&] { return devslam::core::optionValue(argc, argv, i); };
+            if (k == "--threads")
+                a.threads = int(devslam::core::parseInteger(value(), "--threads", 1, 256));
+            else if (k == "--frames")
+                a.n_frames = int(devslam::core::parseInteger(value(), "--frames", 2,
                                                              dynamic::kMaxSyntheticFrames));
-            else if (i + 1 < argc && k == "--results")
-                a.results = argv[++i];
-            else if (i + 1 < argc && k == "--config")
-                a.filter_ini = argv[++i];
+            else if (k == "--results")
+                a.results = value();
+            else if (k == "--config")
+                a.filter_ini = value();
             else if (k == "-h" || k == "--help") {
                 std::cout << kUsage
                           << "  the detectors and the dynamic-object filter on synthetic and "
@@ -152,11 +153,7 @@ std::optional<int> parseArgs(int argc, char** argv, Args& a) {
                              "(default docs/RESULTS.md)\n";
                 return 0;
             } else {
-                const bool known =
-                    k == "--threads" || k == "--frames" || k == "--results" || k == "--config";
-                std::cerr << "devslam-filter-bench: "
-                          << (known ? k + " needs a value" : "unknown argument '" + k + "'") << "\n"
-                          << kUsage;
+                std::cerr << "devslam-filter-bench: unknown argument '" << k << "'\n" << kUsage;
                 return 2;
             }
         }

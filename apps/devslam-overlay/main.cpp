@@ -109,10 +109,7 @@ std::variant<Args, int> parseArgs(int argc, char** argv) {
     Args a;
     for (int i = 1; i < argc; ++i) {
         const std::string arg = argv[i];
-        auto next = [&]() -> std::string {
-            if (i + 1 >= argc) throw std::invalid_argument(arg + " needs a value");
-            return argv[++i];
-        };
+        auto next = [&] { return devslam::core::optionValue(argc, argv, i); };
         try {
             if (arg == "--input")
                 a.input = next();

@@ -64,10 +64,7 @@ struct Args {
 
 Args parse(int argc, char** argv) {
     Args a;
-    auto value = [&](int& i) -> std::string {
-        if (i + 1 >= argc) throw std::invalid_argument(std::string(argv[i]) + " needs a value");
-        return argv[++i];
-    };
+    auto value = [&](int& i) { return core::optionValue(argc, argv, i); };
     for (int i = 1; i < argc; ++i) {
         const std::string k = argv[i];
         if (k == "--input")

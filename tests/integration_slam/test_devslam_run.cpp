@@ -16,6 +16,8 @@
 #include <regex>
 #include <sstream>
 #include <string>
+#include <tuple>
+#include <vector>
 
 
 namespace fs = std::filesystem;
@@ -173,6 +175,28 @@ TEST(DevslamRun, BadInputIsReported) {
     r = run("--frobnicate");
     EXPECT_EQ(r.rc, 1);
     EXPECT_NE(r.out.find("usage"), std::string::npos);
+}
+
+// An option whose value is the next option was taken as the value: "--out --quiet" made a
+// folder named "--quiet" and ran. Every app names the option instead, and runs nothing.
+TEST(Apps, AnOptionsValueIsNotTheNextOption) {
+    const std::string fr1 = std::string(DEVSLAM_SOURCE_DIR) + "/data/tum/fr1_xyz_first37";
+    for (const auto& [app, args, says] : std::vector<std::tuple<std::string, std::string,
+                                                                std::string>>{
+             {"devslam-run", "--mode none --out --quiet", "--out needs a value"},
+             {"devslam-run", "--input --mode none --quiet --out ''", "--input needs a value"},
+             {"devslam-overlay", "--input synthetic:walking --frames 2 --out --quiet",
+              "--out needs a value"},
+             {"devslam-convert", "--camera --max-frames 2 " + fr1 + " x.rawlog",
+              "--camera needs a value"},
+             {"devslam-bench", "--config --reuse-runs", "--config needs a value"},
+             {"devslam-filter-bench", "--results --threads 1", "--results needs a value"}}) {
+        const auto r = devslam::test::runApp(app, args);
+        EXPECT_NE(r.rc, 0) << app << " " << args << "\n" << r.out;
+        EXPECT_NE(r.out.find(says), std::string::npos) << app << " " << args << "\n" << r.out;
+    }
+    EXPECT_FALSE(fs::exists("--quiet"));
+    EXPECT_FALSE(fs::exists("x.rawlog"));
 }
 
 // A rawlog cut short (a recording that crashed): refused with how much is intact, and run
