@@ -19,6 +19,7 @@
 #include <devslam/eval/MaskScore.h>
 #include <devslam/io/RgbdReader.h>
 
+#include "RunJson.h"
 #include "Targets.h"
 
 #include <mrpt/config/CConfigFileMemory.h>
@@ -50,6 +51,8 @@
 
 namespace fs = std::filesystem;
 using namespace devslam;
+using bench::readRun;
+using bench::RunFigures;
 
 namespace {
 
@@ -271,136 +274,6 @@ Bench loadBench(const std::string& path) {
 /// person truth that devslam-synth writes; sequences without it skip that mode.
 bool runsMode(const Sequence& q, const std::string& out_dir, const std::string& mode) {
     return mode != "truth" || eval::PersonTruth::available(inputsOf(q, out_dir).front().path);
-}
-
-/// The number after "key": inside the object that follows "object": (or at top level).
-std::optional<double> jsonNumber(const std::string& js, const std::string& object,
-                                 const std::string& key) {
-    std::size_t from = 0;
-    if (!object.empty()) {
-        from = js.find("\"" + object + "\":");
-        if (from == std::string::npos) return std::nullopt;
-    }
-    const auto k = js.find("\"" + key + "\":", from);
-    if (k == std::string::npos) return std::nullopt;
-    return std::strtod(js.c_str() + k + key.size() + 3, nullptr);
-}
-
-/// Whether `js` is one whole JSON value (and only that): a run.json that is empty, cut or
-/// garbage has no figures to keep. Written by hand: no dependency reads JSON strictly;
-/// MRPT 2.5.8's yaml::FromText (libfyaml) reads JSON, but took a run.json cut in the middle of
-/// a string for a whole map, printing the error and throwing nothing.
-bool wholeJson(const std::string& js) {
-    std::size_t i = 0;
-    const auto ws = [&] {
-        while (i < js.size() && std::isspace(static_cast<unsigned char>(js[i]))) ++i;
-    };
-    std::function<bool(int)> value = [&](int depth) -> bool {
-        ws();
-        if (i >= js.size() || depth > 200) return false;
-        const char c = js[i];
-        if (c == '{' || c == '[') {
-            const char close = c == '{' ? '}' : ']';
-            ++i;
-            ws();
-            if (i < js.size() && js[i] == close) return ++i, true;
-            for (;;) {
-                if (c == '{') {
-                    ws();
-                    if (i >= js.size() || js[i] != '"' || !value(depth + 1)) return false;
-                    ws();
-                    if (i >= js.size() || js[i++] != ':') return false;
-                }
-                if (!value(depth + 1)) return false;
-                ws();
-                if (i >= js.size()) return false;
-                if (js[i] == close) return ++i, true;
-                if (js[i++] != ',') return false;
-            }
-        }
-        if (c == '"') {
-            for (++i; i < js.size() && js[i] != '"'; ++i)
-                if (js[i] == '\\') ++i;
-            return i++ < js.size();
-        }
-        for (const char* word : {"true", "false", "null"})
-            if (js.compare(i, std::strlen(word), word) == 0) return i += std::strlen(word), true;
-        char* end = nullptr;
-        std::strtod(js.c_str() + i, &end);
-        if (end == js.c_str() + i) return false;
-        i = std::size_t(end - js.c_str());
-        return true;
-    };
-    if (!value(0)) return false;
-    ws();
-    return i == js.size();
-}
-
-struct RunFigures {
-    double ate_rmse = 0, ate_mean = 0, ate_median = 0;
-    double rpe_t_rmse = 0, rpe_t_mean = 0, rpe_t_median = 0;
-    double rpe_r_rmse = 0, rpe_r_mean = 0, rpe_r_median = 0;
-    double fps_median = 0, fps_mean = 0, lost = 0;
-    // The run's masks against the renderer's person truth (NaN for real data)
-    double moving_recall = NAN, moving_area_recall = NAN, mask_precision = NAN, static_masked = NAN,
-           moving_instances = NAN, static_instances = NAN;
-    std::optional<std::uint64_t> seed;  ///< the render it ran on (synthetic, seeded)
-    fs::path dir;                       ///< its output folder
-    bool ok = false;
-    std::string unreadable;  ///< a run.json that is there but no whole JSON object: why
-};
-
-RunFigures readRun(const std::string& json_path) {
-    std::ifstream in(json_path);
-    RunFigures f;
-    if (!in) return f;
-    std::stringstream ss;
-    ss << in.rdbuf();
-    const std::string js = ss.str();
-    const auto first = js.find_first_not_of(" \t\r\n");
-    if (first == std::string::npos || js[first] != '{' || !wholeJson(js)) {
-        f.unreadable = json_path + " is not a whole JSON object (empty, cut short or garbage)";
-        return f;
-    }
-    const auto get = [&](const std::string& obj, const std::string& key) {
-        return jsonNumber(js, obj, key).value_or(std::numeric_limits<double>::quiet_NaN());
-    };
-    f.ate_rmse = get("ate", "rmse"), f.ate_mean = get("ate", "mean"),
-    f.ate_median = get("ate", "median");
-    // RPE over 1 s: translational then rotational summaries inside "rpe_1s".
-    const auto r = js.find("\"rpe_1s\":");
-    if (r != std::string::npos) {
-        const std::string sub = js.substr(r);
-        f.rpe_t_rmse = jsonNumber(sub, "trans", "rmse").value_or(NAN);
-        f.rpe_t_mean = jsonNumber(sub, "trans", "mean").value_or(NAN);
-        f.rpe_t_median = jsonNumber(sub, "trans", "median").value_or(NAN);
-        f.rpe_r_rmse = jsonNumber(sub, "rot_deg", "rmse").value_or(NAN);
-        f.rpe_r_mean = jsonNumber(sub, "rot_deg", "mean").value_or(NAN);
-        f.rpe_r_median = jsonNumber(sub, "rot_deg", "median").value_or(NAN);
-    } else {
-        f.rpe_t_rmse = f.rpe_t_mean = f.rpe_t_median = f.rpe_r_rmse = f.rpe_r_mean =
-            f.rpe_r_median = NAN;
-    }
-    f.fps_median = get("", "median_fps");
-    f.fps_mean = get("", "mean_fps");
-    f.lost = get("", "lost_frames");
-    f.moving_recall = get("mask_truth", "moving_recall");
-    f.moving_area_recall = get("mask_truth", "moving_area_recall");
-    f.mask_precision = get("mask_truth", "precision");
-    f.static_masked = get("mask_truth", "static_masked");
-    f.moving_instances = get("mask_truth", "moving_instances");
-    f.static_instances = get("mask_truth", "static_instances");
-    // devslam-run writes 0 for a fraction of no instances; here it is undefined.
-    if (f.moving_instances == 0) f.moving_recall = f.moving_area_recall = NAN;
-    if (f.static_instances == 0) f.static_masked = NAN;
-    // A run that stopped at a frame it could not read, or was interrupted, covers part of
-    // the input only.
-    const auto empty = [&](const std::string& key) {
-        return js.find("\"" + key + "\": \"") == std::string::npos ||
-               js.find("\"" + key + "\": \"\"") != std::string::npos;
-    };
-    f.ok = empty("read_error") && empty("interrupted");
-    return f;
 }
 
 std::string fmt(double v, int prec) {

@@ -2,6 +2,7 @@
 // two seeds and one without walkers, runs devslam-run in the three modes on the renders and
 // on the shipped TUM frames (plus the diagnostic truth mask on the synthetic ones), scores the
 // filter against the person truth, and writes the tables and the RESULTS section.
+#include "RunJson.h"
 #include "Targets.h"
 
 #include <gtest/gtest.h>
@@ -197,6 +198,70 @@ TEST(DevslamBench, TwoFrameSmokeRunOfTheWholeCommand) {
         << readFile(tmp / "RESULTS.md");
     EXPECT_NE(readFile(stopped).find(key), std::string::npos);
     fs::remove_all(tmp);
+}
+
+// run.json is read strictly: one whole JSON value, each scalar by its whole path, values in
+// arrays checked but not kept.
+TEST(RunJson, ScalarsAreFoundByTheirWholePath) {
+    using devslam::bench::jsonScalars;
+    const auto s = jsonScalars(
+        R"({"a": {"b": 1.5e-3, "c": "x\"y", "e": {}}, "l": [1, {"d": 2}, []], "t": true,
+            "n": null, "s": ""} )");
+    ASSERT_TRUE(s);
+    std::map<std::string, std::pair<bool, std::string>> got;
+    for (const auto& [k, v] : *s) got[k] = {v.string, v.text};
+    const std::map<std::string, std::pair<bool, std::string>> want{
+        {"a.b", {false, "1.5e-3"}}, {"a.c", {true, R"(x\"y)"}}, {"t", {false, "true"}},
+        {"n", {false, "null"}},     {"s", {true, ""}}};
+    EXPECT_EQ(got, want);
+    for (const char* bad : {"", " ", "{", R"({"a": 1} x)", R"({"a" 1})", R"({"a": "b})",
+                            R"({"a": [1,]})", R"({"a": 1,})", "{a: 1}", R"({"a": tru})"})
+        EXPECT_FALSE(jsonScalars(bad)) << bad;
+    EXPECT_TRUE(jsonScalars("3"));
+}
+
+// A figure the run has not is n/a, never the same key of another object: the ATE's median
+// used to be found by searching for the first "median" after "ate", which in a run.json without
+// one was the loop error's. A run.json without the keys devslam-run always writes is refused.
+TEST(RunJson, EachFigureComesFromItsOwnObject) {
+    using devslam::bench::readRun;
+    devslam::test::TempDir d("devslam_run_json_");
+    const std::string json = d.str("run.json");
+    const std::string always =
+        R"("median_fps": 41.5, "mean_fps": 40, "lost_frames": 2, "read_error": "",)";
+    std::ofstream(json) << "{" << always << R"( "interrupted": "",
+        "ate": {"rmse": 0.002}, "loop_error_m": {"mean": 9, "median": 9},
+        "rpe_1s": {"trans": {"rmse": 0.003, "mean": 0.002, "median": 0.001}},
+        "mask_truth": {"moving_recall": 0.9, "moving_instances": 0, "static_instances": 4,
+                       "static_masked": 0.25, "precision": 0.5}})";
+    auto f = readRun(json);
+    EXPECT_TRUE(f.ok) << f.unreadable;
+    EXPECT_EQ(f.ate_rmse, 0.002);
+    EXPECT_TRUE(std::isnan(f.ate_mean));
+    EXPECT_TRUE(std::isnan(f.ate_median));
+    EXPECT_EQ(f.rpe_t_median, 0.001);
+    EXPECT_TRUE(std::isnan(f.rpe_r_rmse));
+    EXPECT_EQ(f.fps_median, 41.5);
+    EXPECT_EQ(f.fps_mean, 40);
+    EXPECT_EQ(f.lost, 2);
+    EXPECT_TRUE(std::isnan(f.moving_recall));  // of no moving instance: undefined
+    EXPECT_EQ(f.static_masked, 0.25);
+    EXPECT_EQ(f.mask_precision, 0.5);
+
+    std::ofstream(json) << "{" << always << R"( "interrupted": "SIGINT at frame 3"})";
+    f = readRun(json);
+    EXPECT_FALSE(f.ok);
+    EXPECT_EQ(f.unreadable, "");  // a run that stopped, not a file that cannot be read
+
+    std::ofstream(json) << R"({"mean_fps": 40, "lost_frames": 2, "read_error": "",
+                             "interrupted": "", "ate": {"rmse": 0.002}})";
+    f = readRun(json);
+    EXPECT_FALSE(f.ok);
+    EXPECT_EQ(f.unreadable, json + R"( has no "median_fps" (not a devslam-run run.json?))");
+
+    f = readRun(d.str("nowhere.json"));
+    EXPECT_FALSE(f.ok);
+    EXPECT_EQ(f.unreadable, "");  // the run wrote nothing
 }
 
 // A target is checked on the medians over all renders, and counted render by render: a ratio
