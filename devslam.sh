@@ -3,6 +3,7 @@
 #   ./devslam.sh demo        set up, build, run the main job on the shipped TUM frames
 #   ./devslam.sh test        set up, build, run every test
 #   ./devslam.sh test-asan   the same with AddressSanitizer + UndefinedBehaviorSanitizer
+#   ./devslam.sh test-tsan   the same with ThreadSanitizer (OpenCV's loops serial, see cmake/)
 #   ./devslam.sh bench       regenerate docs/RESULTS.md (all benchmark commands)
 #   ./devslam.sh setup|build only those steps; packages: list the Debian packages
 # Environment: BUILD_DIR (default build), JOBS (default 2).
@@ -37,8 +38,8 @@ build() {  # build <dir> [cmake args...]
   cmake --build "$dir" -j"$JOBS"
 }
 
-run_tests() {  # run_tests <dir>
-  (cd "$1" && ctest --output-on-failure -j"$JOBS" --timeout 600)
+run_tests() {  # run_tests <dir> [command ctest runs under]
+  (cd "$1" && "${@:2}" ctest --output-on-failure -j"$JOBS" --timeout 600)
 }
 
 case "${1:-}" in
@@ -55,6 +56,13 @@ case "${1:-}" in
     build "$BUILD_DIR-asan" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDEVSLAM_SANITIZE=ON -DDEVSLAM_BUILD_BENCHMARKS=OFF
     ASAN_OPTIONS=detect_leaks=0:abort_on_error=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
       run_tests "$BUILD_DIR-asan" ;;
+  test-tsan)
+    setup
+    build "$BUILD_DIR-tsan" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDEVSLAM_SANITIZE_THREAD=ON -DDEVSLAM_BUILD_BENCHMARKS=OFF
+    # setarch -R: GCC 12's TSan runtime cannot map its shadow memory under the address-space
+    # randomisation of recent kernels (every program dies at start); the children inherit it.
+    TSAN_OPTIONS="halt_on_error=1 suppressions=$ROOT/tests/tsan.supp" \
+      run_tests "$BUILD_DIR-tsan" setarch "$(uname -m)" -R ;;
   bench)  # every section of docs/RESULTS.md, regenerated (long: see docs/bench.md)
     setup; build "$BUILD_DIR"
     B="$BUILD_DIR/bin"
@@ -66,5 +74,5 @@ case "${1:-}" in
     "$B/devslam-bench"                                          # section bench (Tables 1-3)
     "$B/devslam-nav-bench"                                      # section nav
     "$BUILD_DIR/benchmarks/bench_nav" ;;                        # Google Benchmark: A*, VFH+ step
-  *) sed -n '2,9p' "$0"; exit 2 ;;
+  *) sed -n '2,10p' "$0"; exit 2 ;;
 esac

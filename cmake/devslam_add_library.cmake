@@ -10,6 +10,20 @@ if(DEVSLAM_SANITIZE)
     -fsanitize=address,undefined -fno-omit-frame-pointer -fno-sanitize-recover=undefined)
   target_link_options(devslam_options INTERFACE -fsanitize=address,undefined)
 endif()
+if(DEVSLAM_SANITIZE_THREAD)
+  target_compile_options(devslam_options INTERFACE -fsanitize=thread -fno-omit-frame-pointer)
+  target_link_options(devslam_options INTERFACE -fsanitize=thread)
+endif()
+
+# Under ThreadSanitizer every program runs OpenCV's loops in the calling thread: OpenCV's own
+# thread pool synchronises in uninstrumented code, so TSan would report the loop bodies we
+# compile (FastConvolution's) as racing with the thread that started them.
+function(devslam_tsan_serial_opencv target)
+  if(DEVSLAM_SANITIZE_THREAD)
+    target_sources(${target} PRIVATE ${DEVSLAM_SOURCE_DIR}/cmake/TsanSerialOpenCV.cpp)
+    target_link_libraries(${target} PRIVATE opencv_core)
+  endif()
+endfunction()
 
 # devslam_add_library(<name> SOURCES a.cpp ... [DEPS target ...] [OBJECT])
 #   -> target devslam_<name>, alias devslam::<name>, public include dir libs/<name>/include
@@ -36,6 +50,7 @@ function(devslam_add_app name)
   target_link_libraries(${name} PRIVATE devslam_options ${ARG_DEPS})
   target_compile_definitions(${name} PRIVATE DEVSLAM_SOURCE_DIR="${DEVSLAM_SOURCE_DIR}")
   set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/bin)
+  devslam_tsan_serial_opencv(${name})
 endfunction()
 
 # devslam_add_test(<name> SOURCES t.cpp ... DEPS devslam::x ...)
@@ -46,12 +61,16 @@ function(devslam_add_test name)
   if(NOT ARG_TIMEOUT)
     set(ARG_TIMEOUT 120)
   endif()
+  if(DEVSLAM_SANITIZE_THREAD)  # 5-15x slower
+    math(EXPR ARG_TIMEOUT "${ARG_TIMEOUT} * 10")
+  endif()
   add_executable(${name} ${ARG_SOURCES})
   target_link_libraries(${name} PRIVATE devslam_options ${ARG_DEPS} GTest::gtest GTest::gtest_main)
   target_include_directories(${name} PRIVATE ${DEVSLAM_SOURCE_DIR}/tests/common)  # Scratch.h
   target_compile_definitions(${name} PRIVATE
     DEVSLAM_SOURCE_DIR="${DEVSLAM_SOURCE_DIR}" DEVSLAM_BIN_DIR="${CMAKE_BINARY_DIR}/bin")
   set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/tests)
+  devslam_tsan_serial_opencv(${name})
   include(GoogleTest)
   gtest_discover_tests(${name} WORKING_DIRECTORY ${CMAKE_BINARY_DIR}
     DISCOVERY_TIMEOUT 60 PROPERTIES TIMEOUT ${ARG_TIMEOUT})
