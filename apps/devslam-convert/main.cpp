@@ -4,6 +4,7 @@
 #include <devslam/core/Interrupt.h>
 #include <devslam/core/Parse.h>
 #include <devslam/core/Progress.h>
+#include <devslam/core/Results.h>
 #include <devslam/io/Rawlog.h>
 #include <devslam/io/RgbdReader.h>
 #include <devslam/io/TumWriter.h>
@@ -36,25 +37,19 @@ options:
                       what is intact, say what was left out
 )";
 
-bool endsWith(const std::string& s, const std::string& suffix) {
-    return s.size() >= suffix.size() &&
-           s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
 /// The writers open their output before the first frame is read: an output that is the
 /// input (or holds another sequence) would be emptied before it was read.
 void refuseOverwritingInput(const std::string& in, const std::string& out) {
     namespace fs = std::filesystem;
-    std::error_code ec;
-    if (fs::exists(out) && fs::equivalent(in, out, ec))
+    if (devslam::core::sameFile(in, out))
         throw std::invalid_argument("OUTPUT '" + out + "' is the input '" + in +
                                     "': writing it would destroy what is read; name another");
     // A conversion that fails midway (a frame that does not decode) leaves a partial rawlog:
     // it must not be written over one that was there.
-    if (endsWith(out, ".rawlog") && (fs::exists(out) || fs::is_symlink(out)))
+    if (devslam::core::endsWith(out, ".rawlog") && (fs::exists(out) || fs::is_symlink(out)))
         throw std::invalid_argument("OUTPUT '" + out +
                                     "' already exists; remove it or name another");
-    if (!endsWith(out, ".rawlog") && fs::exists(fs::path(out) / "rgb.txt"))
+    if (!devslam::core::endsWith(out, ".rawlog") && fs::exists(fs::path(out) / "rgb.txt"))
         throw std::invalid_argument("OUTPUT '" + out +
                                     "' already holds a TUM sequence (rgb.txt); remove it or name "
                                     "another folder");
@@ -150,7 +145,7 @@ struct Conversion {
     /// What was written and what was not; the exit code.
     int report(const devslam::io::RgbdReader& reader, const Args& args) const {
         std::cout << "wrote " << n << " frames to " << args.output << "\n";
-        if (endsWith(args.output, ".rawlog")) {  // one stamp per observation, no ground truth
+        if (devslam::core::endsWith(args.output, ".rawlog")) {  // one stamp per observation, no ground truth
             if (depth_gap > 0)
                 std::cout << "not kept: the depth images' own stamps (up to "
                           << std::lround(1e3 * depth_gap)
@@ -201,7 +196,7 @@ int convert(int argc, char** argv) {
         const std::size_t total = std::min(reader->size().value_or(0), args.max_frames);
         devslam::core::ProgressBar bar("converting", total);
         Conversion c;
-        if (endsWith(args.output, ".rawlog")) {
+        if (devslam::core::endsWith(args.output, ".rawlog")) {
             devslam::io::RawlogWriter out(args.output, args.wo);
             c.copy(*reader, out, args, bar);
             out.close();

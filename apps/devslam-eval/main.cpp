@@ -1,13 +1,13 @@
 // devslam-eval: ATE and RPE of an estimated trajectory against ground truth, computed as
 // the TUM RGB-D benchmark tools do (evaluate_ate.py, evaluate_rpe.py --fixed_delta).
 #include <devslam/core/Parse.h>
+#include <devslam/core/Results.h>
 #include <devslam/eval/Metrics.h>
 #include <devslam/eval/Report.h>
 #include <devslam/io/TrajectoryIO.h>
 
 #include <cstdio>
 #include <cstdlib>
-#include <filesystem>
 #include <iostream>
 #include <stdexcept>
 #include <string>
@@ -94,9 +94,7 @@ int main(int argc, char** argv) {
         // EST) replaced the estimate with the figures.
         for (const auto& [opt, out] : {std::pair{"--json", json}, {"--plot", plot}})
             for (const auto& in : pos) {
-                std::error_code ec;
-                if (!out.empty() && std::filesystem::exists(out) &&
-                    std::filesystem::equivalent(in, out, ec))
+                if (!out.empty() && devslam::core::sameFile(in, out))
                     throw std::invalid_argument(std::string(opt) + " '" + out +
                                                 "' is the input '" + in +
                                                 "': writing it would destroy it; name another");

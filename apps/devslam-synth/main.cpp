@@ -10,6 +10,7 @@
 #include <devslam/core/Interrupt.h>
 #include <devslam/core/Parse.h>
 #include <devslam/core/Progress.h>
+#include <devslam/core/Results.h>
 #include <devslam/render/PersonTexture.h>
 #include <devslam/render/Scenario.h>
 #include <devslam/render/SequenceRenderer.h>
@@ -81,8 +82,7 @@ int cutTexture(const std::vector<std::string>& a) {
     // the photo is not written over.
     if (!core::endsWithNoCase(a[3], ".png"))
         throw std::invalid_argument("--cut-texture OUT '" + a[3] + "': the name must end in .png");
-    std::error_code ec;
-    if (fs::exists(a[3]) && fs::equivalent(a[1], a[3], ec))
+    if (core::sameFile(a[1], a[3]))
         throw std::invalid_argument("--cut-texture OUT '" + a[3] + "' is the IMAGE '" + a[1] +
                                     "': writing it would destroy the photo; name another");
     const cv::Mat img = cv::imread(a[1], cv::IMREAD_COLOR);

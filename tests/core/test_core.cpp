@@ -270,6 +270,26 @@ TEST(Parse, ExtensionsInAnyCase) {
     EXPECT_TRUE(endsWithNoCase("b.png", ".png"));
     EXPECT_FALSE(endsWithNoCase("b.jpgx", ".png"));
     EXPECT_FALSE(endsWithNoCase("png", ".png"));
+    EXPECT_TRUE(endsWith("a/b.rawlog", ".rawlog"));
+    EXPECT_TRUE(endsWith(".rawlog", ".rawlog"));
+    EXPECT_FALSE(endsWith("b.RAWLOG", ".rawlog"));
+    EXPECT_FALSE(endsWith("rawlog", ".rawlog"));
+}
+
+// An output that is an input, under another spelling or through a link, is told apart from
+// a file of its own.
+TEST(Results, SameFileSeesThroughSpellingsAndLinks) {
+    devslam::test::TempDir d("devslam_core_");
+    namespace fs = std::filesystem;
+    std::ofstream(d.str("a.txt")) << "a";
+    std::ofstream(d.str("b.txt")) << "a";
+    fs::create_symlink("a.txt", d.str("link.txt"));
+    EXPECT_TRUE(devslam::core::sameFile(d.str("a.txt"), d.str("a.txt")));
+    EXPECT_TRUE(devslam::core::sameFile(d.str("a.txt"), d.str("./a.txt")));
+    EXPECT_TRUE(devslam::core::sameFile(d.str("a.txt"), d.str("link.txt")));
+    EXPECT_FALSE(devslam::core::sameFile(d.str("a.txt"), d.str("b.txt")));
+    EXPECT_FALSE(devslam::core::sameFile(d.str("a.txt"), d.str("new.txt")));  // not there yet
+    EXPECT_FALSE(devslam::core::sameFile(d.str("gone.txt"), d.str("a.txt")));
 }
 
 TEST(Parse, IntegersAreWholeAndInRange) {

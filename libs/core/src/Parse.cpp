@@ -130,6 +130,11 @@ bool endsWithNoCase(const std::string& text, const std::string& suffix) {
            lowercase(text.substr(text.size() - suffix.size())) == lowercase(suffix);
 }
 
+bool endsWith(const std::string& text, const std::string& suffix) {
+    return text.size() >= suffix.size() &&
+           text.compare(text.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
 namespace {
 bool anOption(const std::string& word) { return word.rfind("--", 0) == 0; }
 }  // namespace

@@ -160,6 +160,11 @@ void writeFileWhole(const std::string& link, const std::string& text) {
     }
 }
 
+bool sameFile(const std::string& in, const std::string& out) {
+    std::error_code ec;
+    return std::filesystem::exists(out) && std::filesystem::equivalent(in, out, ec);
+}
+
 std::string fileHash(const std::string& path) {
     std::ifstream in(path, std::ios::binary);
     if (!in) return "";

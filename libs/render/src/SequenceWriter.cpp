@@ -1,3 +1,5 @@
+#include <devslam/core/Parse.h>
+#include <devslam/core/Results.h>
 #include <devslam/core/Stats.h>
 #include <devslam/io/Rawlog.h>
 #include <devslam/io/TumWriter.h>
@@ -98,14 +100,12 @@ void checkOutputs(const Scenario& sc, const WriteOptions& o) {
     if (o.rawlog_path.empty()) return;
     const std::string ext = ".rawlog";
     const auto& r = o.rawlog_path;
-    if (r.size() <= ext.size() || r.compare(r.size() - ext.size(), ext.size(), ext) != 0)
+    if (r.size() <= ext.size() || !core::endsWith(r, ext))
         throw std::invalid_argument("rawlog '" + r + "': the name must end in .rawlog");
-    for (const auto& [what, file] : {std::pair{"scenario", sc.source}, {"room", sc.room.source}}) {
-        std::error_code ec;
-        if (!file.empty() && fs::exists(r) && fs::equivalent(r, file, ec))
+    for (const auto& [what, file] : {std::pair{"scenario", sc.source}, {"room", sc.room.source}})
+        if (!file.empty() && core::sameFile(file, r))
             throw std::invalid_argument("rawlog '" + r + "' is the " + what + " file '" + file +
                                         "': writing it would destroy it; name another");
-    }
 }
 
 WriteSummary writeSequence(const Scenario& sc, const WriteOptions& o,

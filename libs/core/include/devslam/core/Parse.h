@@ -48,6 +48,8 @@ namespace devslam::core {
 /// Whether `text` ends in `suffix`, letters compared in any case: a file name's extension
 /// (OpenCV picks an image's format by it, ".PNG" as ".png").
 [[nodiscard]] bool endsWithNoCase(const std::string& text, const std::string& suffix);
+/// Whether `text` ends in `suffix`, case counting (".rawlog", never ".RAWLOG").
+[[nodiscard]] bool endsWith(const std::string& text, const std::string& suffix);
 
 /// The value of the command-line option args[i], which is args[i + 1]; `i` moves onto it.
 /// Throws std::invalid_argument "<option> needs a value" when there is none or the next word

@@ -32,6 +32,10 @@ void writeFileWhole(const std::string& path, const std::string& text);
 /// whether a file's content changed (not a cryptographic hash).
 [[nodiscard]] std::string fileHash(const std::string& path);
 
+/// Whether the output `out` exists and is the file or folder `in` (another spelling, a link):
+/// writing it would destroy `in`. False when `in` cannot be compared (it does not exist).
+[[nodiscard]] bool sameFile(const std::string& in, const std::string& out);
+
 /// What replaceResultsSection would throw for `path` and `name`, found before a command's
 /// work (a bad name, broken markers, a folder, a missing parent folder); writes nothing.
 void checkResultsSection(const std::string& path, const std::string& name);
