@@ -69,14 +69,14 @@ void TumWriter::write(const core::Frame& f) {
         cf.close();  // flushed here: a full disk is found now
         if (!cf) throw std::runtime_error("cannot write '" + cam_path + "'");
     }
-    char stamp[32], depth_stamp[32];
-    std::snprintf(stamp, sizeof stamp, "%.6f", f.timestamp);
+    const std::string stamp = detail::stampText(f.timestamp);
     // A depth image with its own stamp (a TUM source) keeps it, as TUM names and lists it.
-    std::snprintf(depth_stamp, sizeof depth_stamp, "%.6f", f.depth_timestamp.value_or(f.timestamp));
+    const std::string depth_stamp = detail::stampText(f.depth_timestamp.value_or(f.timestamp));
     // Images are named by their stamp as written (microseconds): a stamp not after the
     // previous frame's would write over its images, or list them out of order, which
     // TumReader refuses.
-    const double t = std::strtod(stamp, nullptr), td = std::strtod(depth_stamp, nullptr);
+    const double t = std::strtod(stamp.c_str(), nullptr),
+                 td = std::strtod(depth_stamp.c_str(), nullptr);
     if (count_ > 0 && (!(t > last_t_) || !(td > last_depth_t_))) {
         const bool colour = !(t > last_t_);
         const double before = colour ? last_t_ : last_depth_t_;
@@ -87,14 +87,14 @@ void TumWriter::write(const core::Frame& f) {
             " (previous frame " + std::to_string(last_index_) + " at " +
             detail::stampText(before) + "): a TUM folder's stamps must increase");
     }
-    const std::string rgb = std::string("rgb/") + stamp + ".png";
-    const std::string depth = std::string("depth/") + depth_stamp + ".png";
+    const std::string rgb = "rgb/" + stamp + ".png";
+    const std::string depth = "depth/" + depth_stamp + ".png";
     if (!cv::imwrite(folder_ + "/" + rgb, f.bgr))
         throw std::runtime_error("cannot write '" + folder_ + "/" + rgb + "'");
     if (!cv::imwrite(folder_ + "/" + depth, f.rawDepth16(kTumScale)))
         throw std::runtime_error("cannot write '" + folder_ + "/" + depth + "'");
-    std::fprintf(rgb_list_.get(), "%s %s\n", stamp, rgb.c_str());
-    std::fprintf(depth_list_.get(), "%s %s\n", depth_stamp, depth.c_str());
+    std::fprintf(rgb_list_.get(), "%s %s\n", stamp.c_str(), rgb.c_str());
+    std::fprintf(depth_list_.get(), "%s %s\n", depth_stamp.c_str(), depth.c_str());
     last_t_ = t;
     last_depth_t_ = td;
     last_index_ = f.index;
