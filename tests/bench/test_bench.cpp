@@ -424,9 +424,8 @@ TEST(DevslamBench, CtrlCStopsTheBenchAndReuseRunsResumes) {
 // 1/1", no word): such a run is not kept but made again, with a warning naming the file.
 TEST(DevslamBench, ReuseRunsDoesNotKeepAnUnreadableRunJson) {
     const std::string root = DEVSLAM_SOURCE_DIR;
-    const fs::path tmp = devslam::test::scratchPath("devslam_bench_unreadable_run");
-    fs::remove_all(tmp);
-    fs::create_directories(tmp);
+    const devslam::test::TempDir d("devslam_");
+    const fs::path tmp = d.str();
     std::ofstream(tmp / "bench.ini")
         << "[bench]\nmodes = none\nrepeats = 1\nmax_frames = 3\n[sequence_tiny]\npath = "
         << root << "/data/tum/fr1_xyz_first37\nslam_config = " << root
@@ -454,7 +453,6 @@ TEST(DevslamBench, ReuseRunsDoesNotKeepAnUnreadableRunJson) {
     EXPECT_EQ(r.rc, 0) << r.out;
     EXPECT_EQ(r.out.find("WARNING"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("1 of 1 runs were kept"), std::string::npos) << r.out;
-    fs::remove_all(tmp);
 }
 
 TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {

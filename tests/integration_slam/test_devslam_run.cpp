@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <memory>
 #include <regex>
 #include <sstream>
@@ -222,9 +223,8 @@ TEST(DevslamConvert, SaysWhatARawlogDoesNotKeep) {
 
 // A conversion that stops midway leaves a partial rawlog: it must never replace a good one.
 TEST(DevslamConvert, RefusesToWriteOverAnExistingRawlog) {
-    const fs::path dir = devslam::test::scratchPath("devslam_convert_existing");
-    fs::remove_all(dir);
-    fs::create_directories(dir);
+    const devslam::test::TempDir d("devslam_");
+    const fs::path dir = d.str();
     const std::string tum = std::string(DEVSLAM_SOURCE_DIR) + "/data/tum/fr1_xyz_first37";
     const fs::path keep = dir / "keep.rawlog";
     auto c = devslam::test::runApp("devslam-convert",
@@ -252,14 +252,12 @@ TEST(DevslamConvert, RefusesToWriteOverAnExistingRawlog) {
     c = devslam::test::runApp("devslam-convert", keep.string() + " " + (dir / "x").string());
     EXPECT_EQ(c.rc, 0) << c.out;
     EXPECT_NE(c.out.find("wrote 5 frames"), std::string::npos) << c.out;
-    fs::remove_all(dir);
 }
 
 // --max-frames 0 wrote a rawlog of no frames, which no reader opens.
 TEST(DevslamConvert, MaxFramesMustBeAtLeastOne) {
-    const fs::path dir = devslam::test::scratchPath("devslam_convert_max_frames");
-    fs::remove_all(dir);
-    fs::create_directories(dir);
+    const devslam::test::TempDir d("devslam_");
+    const fs::path dir = d.str();
     const auto c = devslam::test::runApp(
         "devslam-convert", std::string(DEVSLAM_SOURCE_DIR) + "/data/tum/fr1_xyz_first37 " +
                                (dir / "x.rawlog").string() + " --max-frames 0");
@@ -267,35 +265,34 @@ TEST(DevslamConvert, MaxFramesMustBeAtLeastOne) {
     EXPECT_NE(c.out.find("--max-frames: expected an integer >= 1, got '0'"), std::string::npos)
         << c.out;
     EXPECT_FALSE(fs::exists(dir / "x.rawlog"));
-    fs::remove_all(dir);
 }
 
 // --allow-damaged with no frame that decodes: an empty output is a failure, not rc 0.
 TEST(DevslamConvert, NoFrameConvertedIsAFailure) {
-    const fs::path dir = devslam::test::scratchPath("devslam_convert_none");
-    fs::remove_all(dir);
+    const devslam::test::TempDir d("devslam_");
+    const fs::path dir = d.str();
     const fs::path src = std::string(DEVSLAM_SOURCE_DIR) + "/data/tum/fr1_xyz_first37";
-    fs::create_directories(dir / "in" / "rgb");
-    fs::create_directories(dir / "in" / "depth");
-    std::ifstream rgb_in(src / "rgb.txt"), depth_in(src / "depth.txt");
-    std::ofstream rgb_out(dir / "in" / "rgb.txt"), depth_out(dir / "in" / "depth.txt");
-    int n = 0;
-    for (std::string line; n < 2 && std::getline(rgb_in, line);) {
-        if (line.empty() || line[0] == '#') continue;
-        rgb_out << line << "\n";
-        std::ofstream(dir / "in" / line.substr(line.find(' ') + 1)) << "not a png";
-        ++n;
-    }
-    n = 0;
-    for (std::string line; n < 2 && std::getline(depth_in, line);) {
-        if (line.empty() || line[0] == '#') continue;
-        depth_out << line << "\n";
-        const std::string f = line.substr(line.find(' ') + 1);
-        fs::copy_file(src / f, dir / "in" / f);
-        ++n;
-    }
-    rgb_out.close();
-    depth_out.close();
+    // The first two frames, each listed image made by `make(from, to)`.
+    const auto firstTwo = [&](const std::string& list, const std::string& sub,
+                              const std::function<void(const fs::path&, const fs::path&)>& make) {
+        fs::create_directories(dir / "in" / sub);
+        std::ifstream in(src / list);
+        std::ofstream out(dir / "in" / list);
+        int n = 0;
+        for (std::string line; n < 2 && std::getline(in, line);) {
+            if (line.empty() || line[0] == '#') continue;
+            out << line << "\n";
+            const std::string f = line.substr(line.find(' ') + 1);
+            make(src / f, dir / "in" / f);
+            ++n;
+        }
+    };
+    firstTwo("rgb.txt", "rgb", [](const fs::path&, const fs::path& to) {
+        std::ofstream(to) << "not a png";
+    });
+    firstTwo("depth.txt", "depth", [](const fs::path& from, const fs::path& to) {
+        fs::copy_file(from, to);
+    });
     const auto c = devslam::test::runApp(
         "devslam-convert", (dir / "in").string() + " " + (dir / "out").string() +
                                " --allow-damaged --camera freiburg1");
@@ -304,7 +301,6 @@ TEST(DevslamConvert, NoFrameConvertedIsAFailure) {
     EXPECT_NE(c.out.find("no frame converted; " + (dir / "out").string() + " holds none"),
               std::string::npos)
         << c.out;
-    fs::remove_all(dir);
 }
 
 TEST(DevslamRun, TruncatedRawlogRunsOnItsIntactPartWhenAsked) {
