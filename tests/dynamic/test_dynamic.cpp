@@ -992,6 +992,43 @@ TEST(DynamicFilter, SilhouetteGrowsBeyondTheBoxOnlyThroughThePerson) {
     EXPECT_EQ(cv::countNonZero(grown), person.area()) << "nothing of the wall";
 }
 
+TEST(DynamicFilter, BorderSnapLetsTheSilhouetteReachTheBorder) {
+    // A person cut by the left border, 2 m away in front of a wall 4 m away, whose box stops
+    // 30 px short of the border; a bag at the person's depth lies by the border below them,
+    // not touching them. mask_border_snap = 40 extends the whole box to the border; with
+    // mask_silhouette the silhouette must reach it too, through the person's pixels only.
+    core::Frame f;
+    f.bgr = cv::Mat(480, 640, CV_8UC3, cv::Scalar(90, 120, 150));
+    f.depth = cv::Mat(480, 640, CV_32FC1, cv::Scalar(4.f));
+    const cv::Rect person(0, 60, 130, 340), strip(0, 60, 30, 340), bag(0, 420, 60, 50);
+    f.depth(person).setTo(2.f);
+    f.depth(bag).setTo(2.f);
+    f.K = core::CameraIntrinsics{};  // 525 px, 640x480
+    const cv::Rect2f box(30.f, 60.f, 100.f, 340.f);
+    auto masks = [&](int snap, bool silhouette) {
+        auto fo = testOptions();
+        fo.mode = MaskMode::AllPersons;
+        fo.mask_silhouette = silhouette;
+        fo.silhouette_depth_band = 0.1;
+        fo.mask_margin = 0;
+        fo.mask_border_snap = snap;
+        auto det = std::make_unique<ScriptedDetector>();
+        det->next = {{box, 0, "person", 0.9f}};
+        DynamicObjectFilter filter(fo, std::move(det));
+        return filter.step(f, std::nullopt).mask;
+    };
+    const auto frac = [](const cv::Mat& m, const cv::Rect& r) {
+        return cv::countNonZero(m(r)) / static_cast<double>(r.area());
+    };
+    EXPECT_EQ(frac(masks(0, false), strip), 0.0) << "no snap: the mask ends at the box";
+    EXPECT_EQ(frac(masks(40, false), strip), 1.0) << "the whole box snaps to the border";
+    const cv::Mat sil = masks(0, true), snapped = masks(40, true);
+    EXPECT_EQ(frac(sil, strip), 0.0);
+    EXPECT_EQ(frac(snapped, strip), 1.0) << "the silhouette snaps to the border as well";
+    EXPECT_EQ(frac(snapped, bag), 0.0) << "the bag is at the person's depth but apart";
+    EXPECT_EQ(cv::countNonZero(snapped), person.area()) << "nothing of the wall";
+}
+
 TEST(DynamicFilter, SlowWalkerIsCaughtByItsMeanResidualFlow) {
     // A person walking at 0.2 m/s 2.2 m away moves about 1.6 px a frame after ego-motion
     // compensation: under threshold1 (2 px) for nearly every point, so per-frame evidence

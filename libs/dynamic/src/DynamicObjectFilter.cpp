@@ -1030,10 +1030,11 @@ void DynamicObjectFilter::Impl::drawMask(const core::Frame& frame, bool have_pre
         const auto W = static_cast<float>(size.width), H = static_cast<float>(size.height);
         float x0 = t.tb.box.x - m, y0 = t.tb.box.y - m;
         float x1 = t.tb.box.br().x + m, y1 = t.tb.box.br().y + m;
-        if (x0 < snap) x0 = 0.f;
-        if (y0 < snap) y0 = 0.f;
-        if (x1 > W - snap) x1 = W;
-        if (y1 > H - snap) y1 = H;
+        const bool snap_l = x0<snap, snap_t = y0<snap, snap_r = x1> W - snap, snap_b = y1> H - snap;
+        if (snap_l) x0 = 0.f;
+        if (snap_t) y0 = 0.f;
+        if (snap_r) x1 = W;
+        if (snap_b) y1 = H;
         const cv::Rect r = cv::Rect(cv::Rect2f(x0, y0, x1 - x0, y1 - y0)) & cv::Rect({}, size);
         if (!o.mask_silhouette || !t.depth) {
             out.mask(r).setTo(255);
@@ -1053,9 +1054,15 @@ void DynamicObjectFilter::Impl::drawMask(const core::Frame& frame, bool have_pre
         // a desk at the person's depth beside it).
         const int gx = static_cast<int>(std::lround(o.silhouette_grow * t.tb.box.width));
         const int gy = static_cast<int>(std::lround(o.silhouette_grow * t.tb.box.height));
-        const cv::Rect outer =
+        cv::Rect outer =
             cv::Rect(inner.x - gx, inner.y - gy, inner.width + 2 * gx, inner.height + 2 * gy) &
             cv::Rect({}, size);
+        // mask_border_snap: on a side snapped to the border the silhouette may reach it, as
+        // the whole box does (still only through the person's pixels, like silhouette_grow).
+        if (snap_l) outer = cv::Rect(0, outer.y, outer.br().x, outer.height);
+        if (snap_t) outer = cv::Rect(outer.x, 0, outer.width, outer.br().y);
+        if (snap_r) outer.width = size.width - outer.x;
+        if (snap_b) outer.height = size.height - outer.y;
         cv::Mat sil, holes;
         cv::inRange(frame.depth(outer), zp - h, zp + h, sil);
         cv::compare(frame.depth(outer), 0.f, holes, cv::CMP_LE);

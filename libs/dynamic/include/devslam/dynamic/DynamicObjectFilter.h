@@ -210,7 +210,8 @@ class DynamicObjectFilter {
         bool mask_unknown_first_frame = false;
         /// [px] a masked box edge this close to the image border is extended to it: a
         /// person cut off by the border is detected with a box that stops short of it,
-        /// leaving a strip of the person unmasked.
+        /// leaving a strip of the person unmasked. With mask_silhouette the silhouette may
+        /// reach the border on that side, through the person's pixels.
         int mask_border_snap = 0;
         /// false: the whole (dilated) box is masked, as in the paper. true: only the box's
         /// pixels within the person's depth band (silhouette_depth_band, else fg_depth_band,
