@@ -244,3 +244,25 @@ TEST(SlamIntegration, ForwardBackwardClosesALoop) {
         std::cout << "confirm_keyframes " << confirm << ": " << r.loops << " loops\n";
     }
 }
+
+TEST(SlamIntegration, FramesHeldForRefinementStayBoundedWithoutLocalBa) {
+    // refine_frames keeps a frame's observations while its keyframe is in the local-BA
+    // window and releases them when it leaves: with local BA off too (they were kept to the
+    // end of the run then). A keyframe every 3 frames: 12 keyframes on the 37 frames, the
+    // window 5 of them, so about 15 frames may be held at a time.
+    const auto& seq = realSequence();
+    for (const bool ba : {true, false}) {
+        auto opts = options();
+        opts.keyframes.max_frames = 3;
+        opts.local_ba.enabled = ba;
+        slam::Slam* s = nullptr;
+        const auto r = runSlam(seq.frames, opts, {}, &s);
+        ASSERT_NE(s, nullptr);
+        EXPECT_TRUE(r.lost.empty()) << ba;
+        ASSERT_GE(r.keyframes, 10u) << ba;
+        const auto bound =
+            static_cast<std::size_t>(opts.local_ba.window * opts.keyframes.max_frames);
+        EXPECT_LE(s->framesHeldForRefinement(), bound) << "local BA " << ba;
+        EXPECT_GT(s->framesHeldForRefinement(), 0u) << "the newest frames are held";
+    }
+}

@@ -4,6 +4,7 @@
 
 #include <mrpt/config/CConfigFileBase.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -232,18 +233,20 @@ MappingResult Slam::mapStep(const core::Frame& frame, FrameFeatures features,
     }
     for (LandmarkId lid : cull) map_.removeLandmark(lid);
     out.culled_landmarks = static_cast<int>(cull.size());
-    if (opts_.local_ba.enabled) {
-        out.ba = localBundleAdjust(map_, id, frame.K, opts_.local_ba);
-        if (opts_.mapping.refine_frames)
-            refineFrames(map_.lastKeyframes(static_cast<std::size_t>(opts_.local_ba.window)),
-                         frame.K);
-    }
+    if (opts_.local_ba.enabled) out.ba = localBundleAdjust(map_, id, frame.K, opts_.local_ba);
+    // Without local BA nothing moved to refine against until finalize(), but the frames
+    // whose keyframe left the window are released all the same (else a long run keeps
+    // every frame's observations).
+    if (opts_.mapping.refine_frames)
+        refineFrames(map_.lastKeyframes(static_cast<std::size_t>(opts_.local_ba.window)), frame.K,
+                     opts_.local_ba.enabled);
     // The tracker continues from the (possibly adjusted) keyframe pose.
     tracker_.applyCorrection(map_.keyframe(id).T_wc * track.T_wc.inverse());
     return out;
 }
 
-void Slam::refineFrames(const std::vector<KeyframeId>& window, const core::CameraIntrinsics& K) {
+void Slam::refineFrames(const std::vector<KeyframeId>& window, const core::CameraIntrinsics& K,
+                        bool adjust) {
     if (window.empty()) return;
     const KeyframeId oldest = window.front();
     bool release = true;
@@ -260,7 +263,7 @@ void Slam::refineFrames(const std::vector<KeyframeId>& window, const core::Camer
             continue;
         }
         release = false;
-        if (r.is_keyframe || !r.valid || r.ref_kf == kNoId) continue;
+        if (!adjust || r.is_keyframe || !r.valid || r.ref_kf == kNoId) continue;
         std::vector<PoseObservation> obs;
         obs.reserve(r.obs.size());
         for (const auto& [lm, o] : r.obs) {
@@ -274,6 +277,11 @@ void Slam::refineFrames(const std::vector<KeyframeId>& window, const core::Camer
         const auto ref = refinePose(obs, T_wk * r.T_ref_c, K, opts_.tracker.refine);
         if (ref.n_inliers >= opts_.tracker.min_inliers) r.T_ref_c = T_wk.inverse() * ref.T_wc;
     }
+}
+
+std::size_t Slam::framesHeldForRefinement() const {
+    return static_cast<std::size_t>(std::count_if(
+        records_.begin(), records_.end(), [](const FrameRecord& r) { return !r.obs.empty(); }));
 }
 
 void Slam::finalize(const core::CameraIntrinsics& K) {

@@ -22,7 +22,9 @@ namespace devslam::slam {
 struct LoopOptions {
     bool enabled = true;
     int min_keyframe_gap = 20;   ///< candidates are at least this many keyframes older
-    int cooldown_keyframes = 5;  ///< no loop search for this many keyframes after a loop
+    /// after a loop closed at keyframe N, the next loop search is at keyframe N + this
+    /// (the keyframes in between are not searched; 0 and 1: no pause)
+    int cooldown_keyframes = 5;
     double max_distance = 1.0;   ///< [m] candidate keyframes within this of the current pose
     int max_candidates = 3;      ///< nearest candidates verified
     int max_hamming = 50;        ///< descriptor threshold

@@ -158,6 +158,9 @@ class Slam {
     /// Every loop closed so far, in closing order.
     [[nodiscard]] std::vector<ClosedLoop> closedLoops() const;
     [[nodiscard]] const SlamOptions& options() const { return opts_; }
+    /// Frames whose observations are still kept for refine_frames (those referencing a
+    /// keyframe in the local-BA window); bounded, whatever the sequence's length.
+    [[nodiscard]] std::size_t framesHeldForRefinement() const;
 
   private:
     struct FrameRecord {
@@ -172,8 +175,10 @@ class Slam {
     };
     void applyCorrections(const std::map<std::int64_t, Eigen::Isometry3d>& new_poses);
     /// Motion-only refinement of the non-keyframe frames whose reference keyframe is in
-    /// `window`, against the current landmark positions; releases older observations.
-    void refineFrames(const std::vector<KeyframeId>& window, const core::CameraIntrinsics& K);
+    /// `window`, against the current landmark positions (only when `adjust`); releases the
+    /// observations of older frames.
+    void refineFrames(const std::vector<KeyframeId>& window, const core::CameraIntrinsics& K,
+                      bool adjust = true);
     std::size_t first_record_with_obs_ = 0;
 
     SlamOptions opts_;
