@@ -401,6 +401,13 @@ TEST(Report, RefusesOverflowNonFiniteJsonAndOutputsThatAreInputs) {
         EXPECT_FALSE(std::filesystem::exists(d.str("p.png"))) << args;
     }
     EXPECT_EQ(text(e), est_text);
+    // A full disk: the JSON fits the stream's buffer, which goes out (and fails) only at the
+    // close; the app said nothing and returned 0.
+    if (std::filesystem::exists("/dev/full")) {
+        const auto r = devslam::test::runApp("devslam-eval", g + " " + e + " --json /dev/full");
+        EXPECT_EQ(r.rc, 1) << r.out;
+        EXPECT_NE(r.out.find("cannot write '/dev/full'"), std::string::npos) << r.out;
+    }
 }
 
 TEST(MaskScore, CountsWalkersStaticPeopleAndArea) {

@@ -96,6 +96,7 @@ void writeJson(const std::string& path, const AteResult* ate, const RpeResult* r
                const RpeOptions* ro) {
     std::ofstream out(path);
     out << toJson(ate, rpe, ro);
+    out.close();  // flushed here: a full disk is found now, not lost in the destructor
     if (!out) throw std::runtime_error("cannot write '" + path + "'");
 }
 

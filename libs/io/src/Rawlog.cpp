@@ -8,7 +8,6 @@
 #include <mrpt/core/aligned_allocator.h>
 #include <mrpt/img/CImage.h>
 #include <mrpt/io/CFileGZInputStream.h>
-#include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/obs/CActionCollection.h>
 #include <mrpt/obs/CActionRobotMovement2D.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
@@ -28,6 +27,9 @@
 #include <new>
 #include <stdexcept>
 #include <tuple>
+#include <utility>
+
+#include <zlib.h>
 
 namespace fs = std::filesystem;
 using mrpt::obs::CObservation3DRangeScan;
@@ -349,11 +351,55 @@ std::string RawlogReader::describe() const {
 }
 
 // ---------------------------------------------------------------------------------------
-struct RawlogWriter::Stream {
-    explicit Stream(const std::string& path, int level) {
-        if (!file.open(path, level)) throw std::runtime_error("cannot write rawlog '" + path + "'");
+// Written by hand instead of mrpt::io::CFileGZOutputStream, whose close() ignores what
+// gzclose() returns: the last compressed block and the gzip trailer leave zlib's buffers only
+// there, so a disk that fills at the end gave a cut rawlog without a word (found when read).
+// The same gzip stream otherwise (gzopen "wb<level>", as MRPT opens it).
+struct RawlogWriter::Stream : public mrpt::io::CStream {
+    Stream(const std::string& path, int level) : path_(path) {
+        gz_ = gzopen(path.c_str(), ("wb" + std::to_string(level)).c_str());
+        if (gz_ == nullptr) throw std::runtime_error("cannot write rawlog '" + path + "'");
     }
-    mrpt::io::CFileGZOutputStream file;
+    ~Stream() override {
+        if (gz_ != nullptr) gzclose(gz_);
+    }
+    Stream(const Stream&) = delete;
+    Stream& operator=(const Stream&) = delete;
+    size_t Read(void*, size_t) override {
+        throw std::logic_error("rawlog '" + path_ + "' is open for writing");
+    }
+    // Whole or nothing: MRPT's archive throws when fewer bytes than asked were written.
+    size_t Write(const void* buf, size_t count) override {
+        if (gz_ == nullptr) return 0;
+        const auto* p = static_cast<const char*>(buf);
+        size_t done = 0;
+        while (done < count) {
+            const auto chunk = static_cast<unsigned>(std::min<size_t>(count - done, 1u << 30));
+            const int n = gzwrite(gz_, p + done, chunk);
+            if (n <= 0) return done;
+            done += static_cast<size_t>(n);
+        }
+        written_ += done;
+        return done;
+    }
+    uint64_t Seek(int64_t, TSeekOrigin) override {
+        throw std::logic_error("rawlog '" + path_ + "': a gzip stream cannot seek");
+    }
+    uint64_t getTotalBytesCount() const override { return written_; }
+    uint64_t getPosition() const override { return written_; }
+    /// Flushes zlib's buffers and the trailer; throws if they could not be written.
+    void close() {
+        if (gz_ == nullptr) return;
+        const int rc = gzclose(std::exchange(gz_, nullptr));
+        if (rc != Z_OK)
+            throw std::runtime_error("error writing rawlog '" + path_ + "': its end was not " +
+                                     "written (disk full?), the file is cut short");
+    }
+
+  private:
+    std::string path_;
+    gzFile gz_ = nullptr;
+    uint64_t written_ = 0;
 };
 
 RawlogWriter::RawlogWriter(std::string path, RawlogWriterOptions opts)
@@ -401,11 +447,13 @@ void RawlogWriter::write(const core::Frame& f) {
     if (opts_.external_images) {
         const std::string base = "frame_" + std::to_string(count_);
         mrpt::img::CImage::setImagesPathBase(images_dir_);
-        obs->intensityImage.saveToFile(images_dir_ + "/" + base + "_rgb.png");
+        const std::string rgb_path = images_dir_ + "/" + base + "_rgb.png";
+        if (!obs->intensityImage.saveToFile(rgb_path))
+            throw std::runtime_error("cannot write '" + rgb_path + "'");
         obs->intensityImage.setExternalStorage(base + "_rgb.png");
         obs->rangeImage_convertToExternalStorage(base + "_depth.bin", images_dir_ + "/");
     }
-    auto arch = mrpt::serialization::archiveFrom(stream_->file);
+    auto arch = mrpt::serialization::archiveFrom(static_cast<mrpt::io::CStream&>(*stream_));
     if (opts_.sensory_frames) {
         mrpt::obs::CActionCollection acts;  // no odometry: an empty action keeps the layout
         mrpt::obs::CSensoryFrame sf;
@@ -419,8 +467,8 @@ void RawlogWriter::write(const core::Frame& f) {
 
 void RawlogWriter::close() {
     if (!stream_) return;
-    stream_->file.close();
-    stream_.reset();
+    const auto stream = std::move(stream_);  // closed once, even when it throws
+    stream->close();
 }
 
 }  // namespace devslam::io

@@ -41,6 +41,7 @@ void writePly(const std::string& path, const Map& map) {
                       l.p_w.z(), l.color[2], l.color[1], l.color[0]);
         out << line;
     }
+    out.close();  // flushed here: a full disk is found now, not lost in the destructor
     if (!out) throw std::runtime_error("error writing PLY '" + path + "'");
 }
 
