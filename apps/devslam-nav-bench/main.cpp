@@ -285,7 +285,9 @@ void count(Tally& t, const devslam::sim::WorldSpec& world, const devslam::sim::E
     t.static_collision += r.static_collisions > 0 ? 1 : 0;
     t.person_collision += r.person_collisions > 0 ? 1 : 0;
     t.score.push_back(score);
-    if (!world.pedestrians.empty()) t.people_clearance.push_back(r.min_clearance_people);
+    // (A run that never started has no closest approach: its 1e9 m would count as one.)
+    if (!world.pedestrians.empty() && r.outcome != devslam::sim::Outcome::NoPath)
+        t.people_clearance.push_back(r.min_clearance_people);
 }
 
 /// Every method on the same seeded worlds of every category, with a progress bar; Ctrl-C

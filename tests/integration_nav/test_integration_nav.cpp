@@ -121,6 +121,84 @@ TEST(IntegrationNav, AStarPlusVfhOnMrptKinematicSimulator) {
     EXPECT_GT(min_wall, 0.25);  // never touched the wall (robot radius 0.25)
 }
 
+// A person stands on the route, 1.5 m ahead, where the map shows nothing: the replanned
+// route goes round them, and so must the straight legs between its waypoints. They were
+// shortened against the static map alone, and cut through the person again.
+TEST(IntegrationNav, ReplannedWaypointsKeepClearOfWhatWasSensed) {
+    devslam::nav::registerNavClasses();
+    // A corridor 2.4 m wide, along x: the route round a person in it keeps close to them.
+    mrpt::maps::COccupancyGridMap2D grid;
+    grid.setSize(0, 12, 0, 8, 0.05f, 1.0f);
+    for (double y = 2.7; y <= 2.8; y += 0.025)
+        for (double x = 0; x <= 12; x += 0.025) grid.setPos(x, y, 0.0f);
+    for (double y = 5.2; y <= 5.3; y += 0.025)
+        for (double x = 0; x <= 12; x += 0.025) grid.setPos(x, y, 0.0f);
+    // The person as a laser sees them: the near half of a 0.22 m circle.
+    struct PersonRobot : KinematicRobot {
+        using KinematicRobot::KinematicRobot;
+        mrpt::math::TPoint2D at;
+        bool senseObstacles(mrpt::maps::CSimplePointsMap& obstacles,
+                            mrpt::system::TTimeStamp& ts) override {
+            obstacles.clear();
+            for (int k = 0; k <= 12; ++k) {
+                const double a = M_PI / 2 + M_PI * k / 12;  // the side facing the robot
+                obstacles.insertPoint(static_cast<float>(at.x + 0.22 * std::cos(a) - 1.5),
+                                      static_cast<float>(at.y + 0.22 * std::sin(a) - 4.0), 0);
+            }
+            ts = mrpt::Clock::now();
+            return true;
+        }
+    };
+    struct ClockGuard {
+        mrpt::Clock::Source prev = mrpt::Clock::getActiveClock();
+        ~ClockGuard() { mrpt::Clock::setActiveClock(prev); }
+    } clock_guard;
+    mrpt::Clock::setActiveClock(mrpt::Clock::Simulated);
+    const auto ini = devslam::core::loadIni(kIni);
+    auto opts = devslam::nav::NavigatorOptions::fromConfig(*ini, kIni);
+    opts.robot_radius = 0.25;
+    opts.planner.robot_radius = 0.25;
+    opts.planner.waypoint_spacing = 3.0;  // as long as the PTGs allow (0.9 x ref_distance)
+    // The person 1 to 2 m ahead (within the blocked-path look-ahead), on the route or beside it.
+    for (int tenths = 10; tenths <= 20; ++tenths) {
+        for (double side : {-0.2, 0.0, 0.2}) {
+            const double ahead = tenths / 10.0;
+            const mrpt::math::TPoint2D person{1.5 + ahead, 4.0 + side};
+            mrpt::kinematics::CVehicleSimul_DiffDriven sim;
+            sim.setCurrentGTPose({1.5, 4.0, 0.0});
+            PersonRobot robot(sim, grid);
+            robot.at = person;
+            mrpt::Clock::setSimulatedTime(mrpt::Clock::fromDouble(1.7e9));
+            devslam::nav::Navigator nav(robot, *ini, opts);
+            ASSERT_TRUE(nav.start(grid, {1.5, 4.0, 0.0}, {10.5, 4.0}, 0.3));
+            // The robot stands still; once replanning is allowed, the blocked path is replanned.
+            for (double t = 0.1; t < 3.0 && nav.replanCount() == 0; t += 0.1) {
+                mrpt::Clock::setSimulatedTime(mrpt::Clock::fromDouble(1.7e9 + t));
+                (void)nav.step(t);
+            }
+            ASSERT_EQ(nav.replanCount(), 1)
+                << "person " << ahead << " m ahead, " << side << " aside";
+            std::vector<mrpt::math::TPoint2D> legs{{1.5, 4.0}};
+            for (const auto& w : nav.waypoints()) legs.push_back(w);
+            double closest = 1e9;
+            for (std::size_t i = 0; i + 1 < legs.size(); ++i) {
+                const auto &a = legs[i], &b = legs[i + 1];
+                const double vx = b.x - a.x, vy = b.y - a.y;
+                const double u = std::clamp(
+                    ((person.x - a.x) * vx + (person.y - a.y) * vy) / (vx * vx + vy * vy), 0.0,
+                    1.0);
+                closest =
+                    std::min(closest, std::hypot(person.x - a.x - u * vx, person.y - a.y - u * vy));
+            }
+            std::printf(
+                "person %.2f m ahead, %.1f m aside: the legs pass %.3f m from their centre\n",
+                ahead, side, closest);
+            EXPECT_GT(closest, 0.22 + 0.25)
+                << "person " << ahead << " m ahead, " << side << " aside";
+        }
+    }
+}
+
 TEST(IntegrationNav, AStarPlusVfhInBulletWorld) {
     devslam::nav::registerNavClasses();
     const auto world = devslam::sim::loadWorld(kSrc + "/sim_worlds/obstacle_near_goal.ini");

@@ -197,6 +197,16 @@ TEST(World, AbsurdValuesAreErrorsNamingTheKey) {
     EXPECT_EQ(errorOf(head + goal + "[pedestrians]\np = random 0.5 0.2 1e300 3 1\n"),
               "w.ini [pedestrians] p: delay must be at most the world's timeout (60 s)");
     EXPECT_EQ(errorOf(head + goal + "[pedestrians]\np = random 5 0.2 60 3 1\n"), "");
+    // Contacts are tested at the physics steps only: a person and the robot may not close
+    // in by more than the smaller radius in one step.
+    EXPECT_EQ(errorOf(world + "time_step = 0.1\n[robot]\nstart_x=1\nstart_y=1\n" + goal +
+                      "[pedestrians]\np = random 5 0.2 0 3 1\n"),
+              "w.ini [pedestrians] p: speed 5 m/s and the robot's max_v 0.6 m/s close 0.56 m in "
+              "one time_step of 0.1 s, more than the smaller radius (0.2 m): a contact could be "
+              "missed; lower [world] time_step");
+    EXPECT_EQ(errorOf(world + "time_step = 0.02\n[robot]\nstart_x=1\nstart_y=1\n" + goal +
+                      "[pedestrians]\np = random 5 0.2 0 3 1\n"),
+              "");
 }
 
 TEST(World, DistanceToRotatedBox) {
@@ -250,6 +260,43 @@ TEST(Simulator, AccelerationLimitsAndDriving) {
     sim.setCommand(0.0, 10.0);  // clamped to max_w
     for (int i = 0; i < 200; i++) sim.step();
     EXPECT_NEAR(sim.angularVelocity(), w.robot.max_w, 1e-9);
+}
+
+TEST(Simulator, ThePoseIsTheBodysNotOneStepOld) {
+    // Turning in place: the yaw is the sum of each step's angular velocity x dt. Bullet's
+    // motion state (read until now) lags one fixed step behind the body.
+    auto w = room();
+    Simulator sim(w);
+    sim.setCommand(0.0, 1.0);
+    double yaw = 0;
+    for (int i = 0; i < 100; i++) {
+        sim.step();
+        yaw += sim.angularVelocity() * w.time_step;
+    }
+    EXPECT_NEAR(sim.robotPose().phi, yaw, 1e-4) << "one step's turn is " << 1.0 * w.time_step;
+}
+
+TEST(Simulator, ARandomWalkerWhoStartsCloseToAWallWalksAway) {
+    // 0.25 m from the south wall's face: closer than its radius + 5 cm. Every step was
+    // refused, away from the wall too, and the walker stood there for the whole run.
+    auto w = room();
+    w.pedestrians_yield = false;
+    Pedestrian p;
+    p.name = "p";
+    p.mode = Pedestrian::Mode::RandomWalk;
+    p.speed = 0.5;
+    p.radius = 0.22;
+    p.path = {{5.0, 0.35}};
+    w.pedestrians.push_back(p);
+    Simulator sim(w);
+    double moved = 0;
+    for (int i = 0; i < 2000; i++) {  // 20 s
+        sim.step();
+        const auto q = sim.pedestrianPositions().at(0);
+        moved = std::max(moved, std::hypot(q.x - 5.0, q.y - 0.35));
+        EXPECT_GE(q.y, 0.1 + 0.22 - 1e-9) << "inside the wall at step " << i;
+    }
+    EXPECT_GT(moved, 1.0);
 }
 
 TEST(Simulator, CollisionWithWallIsCountedOnce) {

@@ -209,19 +209,26 @@ bool Navigator::start(const mrpt::maps::COccupancyGridMap2D& map, const mrpt::ma
         return false;
     }
     first_path_ = *p;
-    path_ = *p;
+    setPath(*p);
     replans_ = 0;
     trigger_.reset(0.0);
-    sendWaypoints();
+    sendWaypoints(0);
     active_ = true;
     return true;
 }
 
-void Navigator::sendWaypoints() {
+void Navigator::setPath(const GridPath& p) {
+    path_ = p;
+    // planner_ holds the map the path was planned on: a replanned path's shortcuts are checked
+    // against the sensed obstacles it went round, not only the static map's walls.
     const double spacing = std::min(opts_.planner.waypoint_spacing, 0.9 * ref_distance_);
     waypoints_ = decimateWaypoints(planner_, path_, spacing);
+}
+
+void Navigator::sendWaypoints(std::size_t first) {
+    if (waypoints_.empty()) return;  // decimateWaypoints keeps at least the goal
     mrpt::nav::TWaypointSequence seq;
-    for (size_t i = 0; i < waypoints_.size(); i++) {
+    for (size_t i = std::min(first, waypoints_.size() - 1); i < waypoints_.size(); i++) {
         const bool last = i + 1 == waypoints_.size();
         seq.waypoints.emplace_back(waypoints_[i].x, waypoints_[i].y,
                                    last ? goal_tolerance_ : opts_.waypoint_allowed_distance, !last);
@@ -243,13 +250,15 @@ bool Navigator::replan(const mrpt::math::TPose2D& pose,
             last_error_ = e.what();
             p.reset();
         }
-        if (p) break;
+        if (p) {
+            setPath(*p);
+            break;
+        }
     }
     planner_.setMap(static_map_);
     if (!p) return false;
-    path_ = *p;
     replans_++;
-    sendWaypoints();
+    sendWaypoints(0);
     return true;
 }
 
@@ -269,7 +278,9 @@ NavState Navigator::step(double t) {
 
     const double goal_dist = std::hypot(pose.x - goal_.x, pose.y - goal_.y);
     const auto st = nav_->getCurrentState();
-    if (st == mrpt::nav::CAbstractNavigator::IDLE && goal_dist <= goal_tolerance_ + 0.05) {
+    // Within the tolerance the run counts as arrived (sim::runEpisode): idle short of it,
+    // MRPT is sent on again below.
+    if (st == mrpt::nav::CAbstractNavigator::IDLE && goal_dist <= goal_tolerance_) {
         active_ = false;
         return NavState::GoalReached;
     }
@@ -293,8 +304,14 @@ NavState Navigator::step(double t) {
         if (st == mrpt::nav::CAbstractNavigator::NAV_ERROR) nav_->resetNavError();
         trigger_.reset(t);
         if (!replan(pose, sensed)) {
-            // keep trying with the previous path
-            sendWaypoints();
+            // Keep trying with the previous path, from its waypoint nearest the robot: from
+            // its first, MRPT would drive back to where the path began.
+            std::size_t nearest = 0;
+            for (std::size_t i = 1; i < waypoints_.size(); ++i)
+                if (std::hypot(waypoints_[i].x - pose.x, waypoints_[i].y - pose.y) <
+                    std::hypot(waypoints_[nearest].x - pose.x, waypoints_[nearest].y - pose.y))
+                    nearest = i;
+            sendWaypoints(nearest);
         }
         return NavState::Navigating;
     }

@@ -200,7 +200,6 @@ WorldSpec obstacleNearGoal(Rng& g) {
 
 WorldSpec randomWorld(Category c, uint32_t seed, const nav::GridPlannerOptions& planner) {
     Rng g(seed * 7919u + static_cast<uint32_t>(c) * 104729u + 17u);
-    nav::GridPlanner pl(planner);
     for (int attempt = 0; attempt < 200; attempt++) {
         WorldSpec w;
         switch (c) {
@@ -225,6 +224,10 @@ WorldSpec randomWorld(Category c, uint32_t seed, const nav::GridPlannerOptions& 
         } catch (const std::invalid_argument&) {
             continue;
         }
+        // Planned as sim::runEpisode will: with the world's robot radius, not the INI's.
+        auto po = planner;
+        po.robot_radius = w.robot.radius;
+        nav::GridPlanner pl(po);
         pl.setMap(rasterize(w));
         try {
             if (pl.plan({w.robot.start.x, w.robot.start.y}, w.goal)) return w;

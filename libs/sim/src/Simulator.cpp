@@ -118,20 +118,23 @@ struct Simulator::Impl {
     }
 
     [[nodiscard]] mrpt::math::TPose2D pose() const {
-        btTransform tf;
-        robot->getMotionState()->getWorldTransform(tf);
+        // The body's own transform: its motion state is, by Bullet's default latency
+        // interpolation (meant for rendering), extrapolated one fixed step back.
+        const btTransform& tf = robot->getWorldTransform();
         btScalar yaw, pitch, roll;
         tf.getBasis().getEulerZYX(yaw, pitch, roll);
         return {tf.getOrigin().x(), tf.getOrigin().y(), static_cast<double>(yaw)};
     }
 
-    [[nodiscard]] bool blockedForPerson(const mrpt::math::TPoint2D& p, double radius) const {
-        if (p.x - radius < world.x_min || p.x + radius > world.x_max ||
-            p.y - radius < world.y_min || p.y + radius > world.y_max)
-            return true;
+    /// [m] how much room a walker of this radius at p has: < 0 when it is closer than its
+    /// radius to the bounds, or than its radius + 5 cm to an obstacle.
+    [[nodiscard]] double walkerRoom(const mrpt::math::TPoint2D& p, double radius) const {
+        double room =
+            std::min({p.x - world.x_min, world.x_max - p.x, p.y - world.y_min, world.y_max - p.y}) -
+            radius;
         for (const auto& o : statics)
-            if (distanceToObstacle(o, p) < radius + 0.05) return true;
-        return false;
+            room = std::min(room, distanceToObstacle(o, p) - radius - 0.05);
+        return room;
     }
 
     void movePedestrians(double dt) {
@@ -161,7 +164,11 @@ struct Simulator::Impl {
                 std::normal_distribution<double> turn(0.0, 0.8 * std::sqrt(dt));
                 s.heading += turn(rng);
                 next = {s.pos.x + step * std::cos(s.heading), s.pos.y + step * std::sin(s.heading)};
-                if (blockedForPerson(next, spec.radius)) {
+                // A step into too little room is refused, unless it leaves more room than
+                // there was: a walker who starts that close to a wall walks away from it
+                // (refusing every step froze them there for the whole run).
+                const double there = walkerRoom(next, spec.radius);
+                if (there < 0 && there <= walkerRoom(s.pos, spec.radius)) {
                     s.heading = std::uniform_real_distribution<double>(-M_PI, M_PI)(rng);
                     next = s.pos;
                 }

@@ -362,6 +362,18 @@ void validatePedestrians(const WorldSpec& w, const std::vector<Obstacle>& static
     for (const auto& p : w.pedestrians) {
         if (p.path.empty()) fail(src, "pedestrians", p.name, "no position given");
         if (p.speed > 5) fail(src, "pedestrians", p.name, "speed must be at most 5 m/s");
+        // Bullet tests contacts at the steps only (no continuous detection): a person and
+        // the robot closing in by more than the smaller radius in one step could pass
+        // through each other unseen.
+        if (const double closing = (p.speed + w.robot.max_v) * w.time_step;
+            closing > std::min(p.radius, w.robot.radius)) {
+            std::ostringstream m;
+            m << "speed " << p.speed << " m/s and the robot's max_v " << w.robot.max_v
+              << " m/s close " << closing << " m in one time_step of " << w.time_step
+              << " s, more than the smaller radius (" << std::min(p.radius, w.robot.radius)
+              << " m): a contact could be missed; lower [world] time_step";
+            fail(src, "pedestrians", p.name, m.str());
+        }
         if (p.start_delay > w.timeout) {
             std::ostringstream m;
             m << "delay must be at most the world's timeout (" << w.timeout << " s)";

@@ -86,7 +86,10 @@ class Navigator {
 
   private:
     bool replan(const mrpt::math::TPose2D& pose, const std::vector<mrpt::math::TPoint2D>& sensed);
-    void sendWaypoints();
+    /// The current path and its waypoints, decimated on the map planner_ holds.
+    void setPath(const GridPath& p);
+    /// Sends waypoints_ from index `first` on (the last one at least) to MRPT.
+    void sendWaypoints(std::size_t first);
     mrpt::nav::CRobot2NavInterface& robot_;
     NavigatorOptions opts_;
     std::unique_ptr<mrpt::nav::CReactiveNavigationSystem> nav_;

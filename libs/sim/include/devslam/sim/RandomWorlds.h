@@ -1,7 +1,8 @@
 #pragma once
 /// Seeded random worlds for the navigation benchmark, one generator per category. Every
 /// world returned is valid (validateWorld) and has an A* path from start to goal for the
-/// given planner options; the same (category, seed) always gives the same world.
+/// given planner options with the world's robot radius (as sim::runEpisode plans); the
+/// same (category, seed) always gives the same world.
 ///
 /// Usage:
 ///   auto w = devslam::sim::randomWorld(devslam::sim::Category::Office, 7, plannerOpts);
