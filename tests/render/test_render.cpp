@@ -419,6 +419,24 @@ TEST(RenderSequence, StopEndsTheRenderWithTheFramesBeforeItWritten) {
     EXPECT_EQ(readFile(o.out_dir + "/rgb.txt"), list);
 }
 
+// A render that dies half-way (killed, a write error) leaves no ground truth: the earlier
+// render's groundtruth.txt stayed beside the new frames, and passed for theirs.
+TEST(RenderSequence, ARenderThatDiesHalfWayLeavesNoOldGroundTruth) {
+    TempDir tmp;
+    const Scenario sc = smallShort();
+    WriteOptions o;
+    o.out_dir = tmp.str("seq");
+    o.max_frames = 4;
+    (void)writeSequence(sc, o);
+    ASSERT_TRUE(fs::exists(o.out_dir + "/groundtruth.txt"));
+    const auto dies = [](std::size_t done, std::size_t) {
+        if (done == 2) throw std::runtime_error("killed");
+    };
+    EXPECT_THROW((void)writeSequence(sc, o, dies), std::runtime_error);
+    EXPECT_FALSE(fs::exists(o.out_dir + "/render.txt"));
+    EXPECT_FALSE(fs::exists(o.out_dir + "/groundtruth.txt"));
+}
+
 // A real TUM folder (rgb.txt, no render.txt or persons.txt) is not written over, and a
 // rawlog that is not named .rawlog, or is the scenario file, is refused (fuzz: both were
 // overwritten with rc 0); a render's own folder, whole or stopped, is rendered again.

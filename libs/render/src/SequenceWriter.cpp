@@ -113,15 +113,22 @@ WriteSummary writeSequence(const Scenario& sc, const WriteOptions& o,
     if (o.out_dir.empty()) throw std::invalid_argument("writeSequence: empty output folder");
     checkOutputs(sc, o);
     const std::string signature = renderSignature(sc, o);
+    // Made before any output is touched: it takes a while (photos, blurred panels, the EGL
+    // context), and a stop asked meanwhile, or its failure, leaves the folder as it was.
+    SequenceRenderer renderer(sc);
     // Stopped before it began: the folder (perhaps a whole earlier render) is left as it was.
     if (o.stop && o.stop()) {
         WriteSummary none;
         none.stopped = true;
         return none;
     }
-    // Until the last frame is written the folder is not a current render.
+    // Until the last frame is written the folder is not a current render; an earlier
+    // render's ground truth and intrinsics go too, so that a run killed half-way leaves no
+    // old trajectory beside the new frames (written again at the end, or at a stop).
     std::error_code ec;
     fs::remove(signaturePath(o), ec);
+    fs::remove(fs::path(o.out_dir) / "groundtruth.txt", ec);
+    fs::remove(fs::path(o.out_dir) / "camera.ini", ec);
     const std::size_t n = o.max_frames > 0 ? std::min(o.max_frames, sc.n_frames) : sc.n_frames;
     // persons.txt before rgb.txt: a folder with rgb.txt and neither it nor render.txt is
     // no render of ours (checkOutputs), even when a run ended between the two.
@@ -139,7 +146,6 @@ WriteSummary writeSequence(const Scenario& sc, const WriteOptions& o,
     fs::remove_all(fs::path(o.out_dir) / "labels");
     if (o.write_labels) fs::create_directories(fs::path(o.out_dir) / "labels");
 
-    SequenceRenderer renderer(sc);
     core::Trajectory gt;
     WriteSummary sum;
     std::vector<double> ms;
