@@ -330,13 +330,19 @@ int stopAfter(int status) {
 
 /// What a run is made from, as its command.txt records it: the command line, then the
 /// content hash (core::fileHash) and path of each file it reads that the bench knows of.
-/// `hash` caches the hashes (a rawlog or the program is read once per bench).
+/// `hash` caches the hashes (a rawlog or the program is read once per bench), by path, size
+/// and modification time: a file edited or rebuilt while the bench runs is hashed again, so a
+/// later run's command.txt names what that run read.
 std::string provenance(const std::string& cmd, const std::vector<std::string>& files,
                        std::map<std::string, std::string>& hash) {
     std::string text = cmd + "\n";
     for (const auto& f : files) {
-        auto it = hash.find(f);
-        if (it == hash.end()) it = hash.emplace(f, core::fileHash(f)).first;
+        std::error_code ec;
+        const auto size = fs::file_size(f, ec);
+        const auto when = fs::last_write_time(f, ec).time_since_epoch().count();
+        const std::string key = f + "\n" + std::to_string(size) + " " + std::to_string(when);
+        auto it = hash.find(key);
+        if (it == hash.end()) it = hash.emplace(key, core::fileHash(f)).first;
         text += (it->second.empty() ? "unreadable" : it->second) + " " + f + "\n";
     }
     return text;
