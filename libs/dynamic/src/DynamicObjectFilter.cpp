@@ -1030,7 +1030,10 @@ void DynamicObjectFilter::Impl::drawMask(const core::Frame& frame, bool have_pre
         const auto W = static_cast<float>(size.width), H = static_cast<float>(size.height);
         float x0 = t.tb.box.x - m, y0 = t.tb.box.y - m;
         float x1 = t.tb.box.br().x + m, y1 = t.tb.box.br().y + m;
-        const bool snap_l = x0<snap, snap_t = y0<snap, snap_r = x1> W - snap, snap_b = y1> H - snap;
+        const bool snap_l = x0 < snap;
+        const bool snap_t = y0 < snap;
+        const bool snap_r = x1 > W - snap;
+        const bool snap_b = y1 > H - snap;
         if (snap_l) x0 = 0.f;
         if (snap_t) y0 = 0.f;
         if (snap_r) x1 = W;
