@@ -956,39 +956,54 @@ TEST(DynamicFilter, NarrowSilhouetteBandKeepsTheWallRightBehindAPerson) {
     EXPECT_LT(masked_narrow, 0.6) << "and leaves the wall in the box";
 }
 
+namespace {
+/// A 640x480 frame of a grey wall 4 m away with `near` regions 2 m away (525 px focal).
+core::Frame wallWithNearRegions(std::initializer_list<cv::Rect> near) {
+    core::Frame f;
+    f.bgr = cv::Mat(480, 640, CV_8UC3, cv::Scalar(90, 120, 150));
+    f.depth = cv::Mat(480, 640, CV_32FC1, cv::Scalar(4.f));
+    for (const auto& r : near) f.depth(r).setTo(2.f);
+    f.K = core::CameraIntrinsics{};
+    return f;
+}
+
+/// The mask of one person box in mode all_persons, as a silhouette of the SLAM INIs' band
+/// (0.1 m) without margin, after `tweak`.
+cv::Mat silhouetteMask(const core::Frame& f, const cv::Rect2f& box,
+                       const std::function<void(DynamicObjectFilter::Options&)>& tweak) {
+    auto fo = testOptions();
+    fo.mode = MaskMode::AllPersons;
+    fo.mask_silhouette = true;
+    fo.silhouette_depth_band = 0.1;
+    fo.mask_margin = 0;
+    tweak(fo);
+    auto det = std::make_unique<ScriptedDetector>();
+    det->next = {{box, 0, "person", 0.9f}};
+    DynamicObjectFilter filter(fo, std::move(det));
+    return filter.step(f, std::nullopt).mask;
+}
+
+double maskedFraction(const cv::Mat& m, const cv::Rect& r) {
+    return cv::countNonZero(m(r)) / static_cast<double>(r.area());
+}
+}  // namespace
+
 TEST(DynamicFilter, SilhouetteGrowsBeyondTheBoxOnlyThroughThePerson) {
     // A person 2 m away in front of a wall 4 m away; the detector's box stops 60 px short of
     // the head. A desk at the person's depth starts 10 px to the right of the person, not
     // touching them. With silhouette_grow the head above the box is masked (it is connected
     // to the silhouette inside the box), the desk is not.
-    core::Frame f;
-    f.bgr = cv::Mat(480, 640, CV_8UC3, cv::Scalar(90, 120, 150));
-    f.depth = cv::Mat(480, 640, CV_32FC1, cv::Scalar(4.f));
     const cv::Rect person(200, 40, 100, 360), head(200, 40, 100, 60), desk(310, 300, 110, 100);
-    f.depth(person).setTo(2.f);
-    f.depth(desk).setTo(2.f);
-    f.K = core::CameraIntrinsics{};  // 525 px, 640x480
+    const core::Frame f = wallWithNearRegions({person, desk});
     const cv::Rect2f box(200.f, 100.f, 100.f, 300.f);
-    auto masks = [&](double grow) {
-        auto fo = testOptions();
-        fo.mode = MaskMode::AllPersons;
-        fo.mask_silhouette = true;
-        fo.silhouette_depth_band = 0.1;
-        fo.mask_margin = 0;
-        fo.silhouette_grow = grow;
-        auto det = std::make_unique<ScriptedDetector>();
-        det->next = {{box, 0, "person", 0.9f}};
-        DynamicObjectFilter filter(fo, std::move(det));
-        return filter.step(f, std::nullopt).mask;
+    const auto masks = [&](double grow) {
+        return silhouetteMask(f, box, [&](auto& fo) { fo.silhouette_grow = grow; });
     };
     const cv::Mat in_box = masks(0.0), grown = masks(0.25);
-    const auto frac = [](const cv::Mat& m, const cv::Rect& r) {
-        return cv::countNonZero(m(r)) / static_cast<double>(r.area());
-    };
-    EXPECT_EQ(frac(in_box, cv::Rect(box)), 1.0);
-    EXPECT_EQ(frac(in_box, head), 0.0) << "without growing, the mask ends at the box";
-    EXPECT_EQ(frac(grown, head), 1.0) << "the head is connected to the silhouette";
-    EXPECT_EQ(frac(grown, desk), 0.0) << "the desk is at the person's depth but apart";
+    EXPECT_EQ(maskedFraction(in_box, cv::Rect(box)), 1.0);
+    EXPECT_EQ(maskedFraction(in_box, head), 0.0) << "without growing, the mask ends at the box";
+    EXPECT_EQ(maskedFraction(grown, head), 1.0) << "the head is connected to the silhouette";
+    EXPECT_EQ(maskedFraction(grown, desk), 0.0) << "the desk is at the person's depth but apart";
     EXPECT_EQ(cv::countNonZero(grown), person.area()) << "nothing of the wall";
 }
 
@@ -997,35 +1012,21 @@ TEST(DynamicFilter, BorderSnapLetsTheSilhouetteReachTheBorder) {
     // 30 px short of the border; a bag at the person's depth lies by the border below them,
     // not touching them. mask_border_snap = 40 extends the whole box to the border; with
     // mask_silhouette the silhouette must reach it too, through the person's pixels only.
-    core::Frame f;
-    f.bgr = cv::Mat(480, 640, CV_8UC3, cv::Scalar(90, 120, 150));
-    f.depth = cv::Mat(480, 640, CV_32FC1, cv::Scalar(4.f));
     const cv::Rect person(0, 60, 130, 340), strip(0, 60, 30, 340), bag(0, 420, 60, 50);
-    f.depth(person).setTo(2.f);
-    f.depth(bag).setTo(2.f);
-    f.K = core::CameraIntrinsics{};  // 525 px, 640x480
+    const core::Frame f = wallWithNearRegions({person, bag});
     const cv::Rect2f box(30.f, 60.f, 100.f, 340.f);
-    auto masks = [&](int snap, bool silhouette) {
-        auto fo = testOptions();
-        fo.mode = MaskMode::AllPersons;
-        fo.mask_silhouette = silhouette;
-        fo.silhouette_depth_band = 0.1;
-        fo.mask_margin = 0;
-        fo.mask_border_snap = snap;
-        auto det = std::make_unique<ScriptedDetector>();
-        det->next = {{box, 0, "person", 0.9f}};
-        DynamicObjectFilter filter(fo, std::move(det));
-        return filter.step(f, std::nullopt).mask;
+    const auto masks = [&](int snap, bool silhouette) {
+        return silhouetteMask(f, box, [&](auto& fo) {
+            fo.mask_silhouette = silhouette;
+            fo.mask_border_snap = snap;
+        });
     };
-    const auto frac = [](const cv::Mat& m, const cv::Rect& r) {
-        return cv::countNonZero(m(r)) / static_cast<double>(r.area());
-    };
-    EXPECT_EQ(frac(masks(0, false), strip), 0.0) << "no snap: the mask ends at the box";
-    EXPECT_EQ(frac(masks(40, false), strip), 1.0) << "the whole box snaps to the border";
+    EXPECT_EQ(maskedFraction(masks(0, false), strip), 0.0) << "no snap: the mask ends at the box";
+    EXPECT_EQ(maskedFraction(masks(40, false), strip), 1.0) << "the whole box snaps to the border";
     const cv::Mat sil = masks(0, true), snapped = masks(40, true);
-    EXPECT_EQ(frac(sil, strip), 0.0);
-    EXPECT_EQ(frac(snapped, strip), 1.0) << "the silhouette snaps to the border as well";
-    EXPECT_EQ(frac(snapped, bag), 0.0) << "the bag is at the person's depth but apart";
+    EXPECT_EQ(maskedFraction(sil, strip), 0.0);
+    EXPECT_EQ(maskedFraction(snapped, strip), 1.0) << "the silhouette snaps to the border as well";
+    EXPECT_EQ(maskedFraction(snapped, bag), 0.0) << "the bag is at the person's depth but apart";
     EXPECT_EQ(cv::countNonZero(snapped), person.area()) << "nothing of the wall";
 }
 

@@ -65,6 +65,24 @@ class KinematicRobot : public mrpt::nav::CRobot2NavInterfaceForSimulator_DiffDri
     mrpt::kinematics::CVehicleSimul_DiffDriven& sim_;
     const mrpt::maps::COccupancyGridMap2D& grid_;
 };
+
+/// MRPT's clock is process-wide: simulated while this lives, set back however the test ends
+/// (a failed ASSERT returns early, and later tests in this binary would run on it).
+struct SimulatedClock {
+    mrpt::Clock::Source prev = mrpt::Clock::getActiveClock();
+    SimulatedClock() { mrpt::Clock::setActiveClock(mrpt::Clock::Simulated); }
+    ~SimulatedClock() { mrpt::Clock::setActiveClock(prev); }
+    SimulatedClock(const SimulatedClock&) = delete;
+    SimulatedClock& operator=(const SimulatedClock&) = delete;
+};
+
+/// The shipped INI's navigator options for a robot of radius 0.25 m.
+devslam::nav::NavigatorOptions navOptions(const mrpt::config::CConfigFileBase& ini) {
+    auto opts = devslam::nav::NavigatorOptions::fromConfig(ini, kIni);
+    opts.robot_radius = 0.25;
+    opts.planner.robot_radius = 0.25;
+    return opts;
+}
 }  // namespace
 
 TEST(IntegrationNav, AStarPlusVfhOnMrptKinematicSimulator) {
@@ -86,18 +104,9 @@ TEST(IntegrationNav, AStarPlusVfhOnMrptKinematicSimulator) {
     KinematicRobot robot(sim, grid);
 
     mrpt::Clock::setSimulatedTime(mrpt::Clock::fromDouble(1.7e9));
-    // MRPT's clock is process-wide: set back however the test ends (a failed ASSERT returns
-    // early, and later tests in this binary would run on the simulated clock).
-    struct ClockGuard {
-        mrpt::Clock::Source prev = mrpt::Clock::getActiveClock();
-        ~ClockGuard() { mrpt::Clock::setActiveClock(prev); }
-    } clock_guard;
-    mrpt::Clock::setActiveClock(mrpt::Clock::Simulated);
+    const SimulatedClock simulated_clock;
     const auto ini = devslam::core::loadIni(kIni);
-    auto opts = devslam::nav::NavigatorOptions::fromConfig(*ini, kIni);
-    opts.robot_radius = 0.25;
-    opts.planner.robot_radius = 0.25;
-    devslam::nav::Navigator nav(robot, *ini, opts);
+    devslam::nav::Navigator nav(robot, *ini, navOptions(*ini));
     ASSERT_TRUE(nav.start(grid, {1.5, 2.0, 0.0}, {10.5, 2.0}, 0.3));
     EXPECT_GT(nav.globalPath().length, 10.5);  // straight line 9 m: must detour via the gap
     double min_wall = 1e9;
@@ -149,15 +158,9 @@ TEST(IntegrationNav, ReplannedWaypointsKeepClearOfWhatWasSensed) {
             return true;
         }
     };
-    struct ClockGuard {
-        mrpt::Clock::Source prev = mrpt::Clock::getActiveClock();
-        ~ClockGuard() { mrpt::Clock::setActiveClock(prev); }
-    } clock_guard;
-    mrpt::Clock::setActiveClock(mrpt::Clock::Simulated);
+    const SimulatedClock simulated_clock;
     const auto ini = devslam::core::loadIni(kIni);
-    auto opts = devslam::nav::NavigatorOptions::fromConfig(*ini, kIni);
-    opts.robot_radius = 0.25;
-    opts.planner.robot_radius = 0.25;
+    auto opts = navOptions(*ini);
     opts.planner.waypoint_spacing = 3.0;  // as long as the PTGs allow (0.9 x ref_distance)
     // The person 1 to 2 m ahead (within the blocked-path look-ahead), on the route or beside it.
     for (int tenths = 10; tenths <= 20; ++tenths) {
