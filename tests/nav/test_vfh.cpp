@@ -48,6 +48,20 @@ TEST(VfhPlus, FreeSpaceGoesToTarget) {
     }
 }
 
+TEST(VfhPlus, ATargetNearPlusOrMinusPiIsReachable) {
+    // The histogram's ends are no obstacle: in free space a target 3 sectors from -pi (or +pi)
+    // is the direction taken. Keeping wide_valley_sectors / 2 off the ends, VFH+ chose a
+    // sector 8 off, and MRPT then found no way to a goal the robot had just passed.
+    for (const double a : {-M_PI + 3.5 * kSector, M_PI - 3.5 * kSector}) {
+        auto in = field();
+        setTarget(in, a, 0.17);
+        const auto out = vfhPlusStep(in, {}, {});
+        ASSERT_GE(out.sector, 0);
+        EXPECT_EQ(out.sector, out.target_sector) << "target at " << a;
+        EXPECT_NEAR(out.direction, a, kSector) << "target at " << a;
+    }
+}
+
 TEST(VfhPlus, WallWithGapPicksTheGap) {
     // a wall at 0.25 (norm) everywhere ahead except a gap centred at +0.6 rad
     auto in = field();

@@ -172,7 +172,12 @@ VfhOutput vfhPlusStep(const VfhInput& in, const VfhState& state, const VfhPlusOp
         const int k_l = k - 1;
         const int len = k_l - k_r + 1;
         if (len > s_max) {
-            const int c_r = k_r + s_max / 2, c_l = k_l - s_max / 2;
+            // A valley's side at the histogram's end (+-pi) is no obstacle: the TP-space
+            // directions do not wrap there (MRPT's C PTGs' paths at +-pi differ), and keeping
+            // s_max/2 off it left a target near +-pi out of reach (the robot stopped 0.33 m
+            // from a goal it had passed, the target at sector 4 of 121, every candidate >= 8).
+            const int c_r = k_r == 0 ? 0 : k_r + s_max / 2;
+            const int c_l = k_l == n - 1 ? n - 1 : k_l - s_max / 2;
             out.candidates.push_back(c_r);
             out.candidates.push_back(c_l);
             if (out.target_sector > c_r && out.target_sector < c_l)
