@@ -37,6 +37,9 @@ options:
                       what is intact, say what was left out
 )";
 
+/// Whether the output is a rawlog (else a TUM folder), by its name as given.
+bool isRawlog(const std::string& out) { return devslam::core::endsWith(out, ".rawlog"); }
+
 /// The writers open their output before the first frame is read: an output that is the
 /// input (or holds another sequence) would be emptied before it was read.
 void refuseOverwritingInput(const std::string& in, const std::string& out) {
@@ -46,10 +49,10 @@ void refuseOverwritingInput(const std::string& in, const std::string& out) {
                                     "': writing it would destroy what is read; name another");
     // A conversion that fails midway (a frame that does not decode) leaves a partial rawlog:
     // it must not be written over one that was there.
-    if (devslam::core::endsWith(out, ".rawlog") && (fs::exists(out) || fs::is_symlink(out)))
+    if (isRawlog(out) && (fs::exists(out) || fs::is_symlink(out)))
         throw std::invalid_argument("OUTPUT '" + out +
                                     "' already exists; remove it or name another");
-    if (!devslam::core::endsWith(out, ".rawlog") && fs::exists(fs::path(out) / "rgb.txt"))
+    if (!isRawlog(out) && fs::exists(fs::path(out) / "rgb.txt"))
         throw std::invalid_argument("OUTPUT '" + out +
                                     "' already holds a TUM sequence (rgb.txt); remove it or name "
                                     "another folder");
@@ -145,7 +148,7 @@ struct Conversion {
     /// What was written and what was not; the exit code.
     int report(const devslam::io::RgbdReader& reader, const Args& args) const {
         std::cout << "wrote " << n << " frames to " << args.output << "\n";
-        if (devslam::core::endsWith(args.output, ".rawlog")) {  // one stamp per observation, no ground truth
+        if (isRawlog(args.output)) {  // one stamp per observation, no ground truth
             if (depth_gap > 0)
                 std::cout << "not kept: the depth images' own stamps (up to "
                           << std::lround(1e3 * depth_gap)
@@ -196,7 +199,7 @@ int convert(int argc, char** argv) {
         const std::size_t total = std::min(reader->size().value_or(0), args.max_frames);
         devslam::core::ProgressBar bar("converting", total);
         Conversion c;
-        if (devslam::core::endsWith(args.output, ".rawlog")) {
+        if (isRawlog(args.output)) {
             devslam::io::RawlogWriter out(args.output, args.wo);
             c.copy(*reader, out, args, bar);
             out.close();

@@ -9,6 +9,7 @@
 #include <mrpt/poses/CPose2D.h>
 #include <mrpt/system/filesystem.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <ctime>
@@ -306,12 +307,13 @@ NavState Navigator::step(double t) {
         if (!replan(pose, sensed)) {
             // Keep trying with the previous path, from its waypoint nearest the robot: from
             // its first, MRPT would drive back to where the path began.
-            std::size_t nearest = 0;
-            for (std::size_t i = 1; i < waypoints_.size(); ++i)
-                if (std::hypot(waypoints_[i].x - pose.x, waypoints_[i].y - pose.y) <
-                    std::hypot(waypoints_[nearest].x - pose.x, waypoints_[nearest].y - pose.y))
-                    nearest = i;
-            sendWaypoints(nearest);
+            const auto away = [&](const mrpt::math::TPoint2D& w) {
+                return std::hypot(w.x - pose.x, w.y - pose.y);
+            };
+            const auto nearest = std::min_element(
+                waypoints_.begin(), waypoints_.end(),
+                [&](const auto& a, const auto& b) { return away(a) < away(b); });
+            sendWaypoints(static_cast<std::size_t>(nearest - waypoints_.begin()));
         }
         return NavState::Navigating;
     }
