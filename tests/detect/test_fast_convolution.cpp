@@ -29,7 +29,9 @@ std::string describe(const ConvCase& c) {
 }
 
 // convolution [-> batch norm] [-> ReLU], weights drawn from a fixed seed.
-cv::dnn::Net makeNet(const ConvCase& c) {
+// `bias_term`: whether the parameters say so beside the bias blob (OpenCV's ONNX importer
+// pushes the blob and leaves the key out).
+cv::dnn::Net makeNet(const ConvCase& c, bool bias_term_key = true) {
     cv::RNG rng(1234);
     cv::dnn::Net net;
     cv::dnn::LayerParams conv;
@@ -38,7 +40,7 @@ cv::dnn::Net makeNet(const ConvCase& c) {
     conv.set("pad", c.pad);
     conv.set("num_output", c.cout);
     conv.set("group", c.group);
-    conv.set("bias_term", c.bias);
+    if (bias_term_key) conv.set("bias_term", c.bias);
     cv::Mat w(std::vector<int>{c.cout, c.cin / c.group, c.k, c.k}, CV_32F);
     rng.fill(w, cv::RNG::UNIFORM, -1.0, 1.0);
     conv.blobs.push_back(w);
@@ -123,6 +125,24 @@ TEST_F(FastConvolution, DepthwiseAndPointwiseMatchOpenCv) {
         const double scale = 1.0 + cv::norm(a, cv::NORM_INF);
         EXPECT_LE(cv::norm(a, b, cv::NORM_INF), 1e-5 * scale)
             << "largest output " << scale - 1.0;
+    }
+}
+
+// The ONNX importer's convolutions: a bias blob and no "bias_term" key. OpenCV's layer
+// adds the blob (hasBias() is blobs.size() >= 2); so must ours (it dropped the bias).
+TEST_F(FastConvolution, ABiasBlobWithoutTheBiasTermKeyIsAdded) {
+    const std::vector<ConvCase> cases{{12, 12, 3, 1, 1, 12, 20, 20, true, false, -1.f},
+                                      {17, 5, 1, 1, 0, 1, 10, 10, true, false, -1.f}};
+    for (const auto& c : cases) {
+        SCOPED_TRACE(describe(c));
+        cv::dnn::Net reference = makeNet(c, false);
+        cv::dnn::Net fast = detect::withFastConvolutions([&] { return makeNet(c, false); });
+        ASSERT_TRUE(detect::isFastConvolution(fast.getLayer("conv")));
+        const cv::Mat x = randomInput(c);
+        const cv::Mat a = run(reference, x);
+        const cv::Mat b = run(fast, x);
+        ASSERT_EQ(a.size, b.size);
+        EXPECT_LE(cv::norm(a, b, cv::NORM_INF), 1e-5 * (1.0 + cv::norm(a, cv::NORM_INF)));
     }
 }
 

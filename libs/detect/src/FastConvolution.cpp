@@ -31,6 +31,7 @@ struct Shape {
     int pad = 0;     // same on every side
     int cin = 0;
     int cout = 0;
+    bool bias = false;  // a second blob holds it
 };
 
 // `key` as one int, also when given as a list of equal values (some importers write
@@ -60,15 +61,17 @@ bool handledShape(const LayerParams& p, Shape& s) {
         !uniformInt(p, "pad", 0, s.pad) || !uniformInt(p, "dilation", 1, dilation) ||
         !uniformInt(p, "group", 1, group) || !uniformInt(p, "num_output", 0, s.cout))
         return false;
-    if (p.blobs.empty() || dilation != 1 || s.cout <= 0) return false;
+    if (p.blobs.empty() || p.blobs.size() > 2 || dilation != 1 || s.cout <= 0) return false;
     const cv::Mat& w = p.blobs[0];
     if (w.type() != CV_32F || w.dims != 4 || w.size[0] != s.cout || w.size[2] != s.k ||
         w.size[3] != s.k || !w.isContinuous())
         return false;
-    const bool bias = p.get<bool>("bias_term", false);
-    if (bias && (p.blobs.size() < 2 || p.blobs[1].type() != CV_32F ||
-                 static_cast<int>(p.blobs[1].total()) != s.cout))
+    // A bias is there when its blob is, as OpenCV's own layer decides (hasBias()): the
+    // ONNX importer pushes it without setting "bias_term", the darknet one sets both.
+    s.bias = p.blobs.size() >= 2;
+    if (s.bias && (p.blobs[1].type() != CV_32F || static_cast<int>(p.blobs[1].total()) != s.cout))
         return false;
+    if (!s.bias && p.get<bool>("bias_term", false)) return false;  // promised, not given
     if (group == s.cout && w.size[1] == 1 && s.k % 2 == 1 && s.k <= 7 &&
         (s.stride == 1 || s.stride == 2) && s.pad >= 0 && s.pad < s.k) {
         s.kind = Shape::Depthwise;
@@ -311,7 +314,7 @@ class FastConvolutionLayer final : public cv::dnn::Layer {
         const cv::Mat& w = params.blobs[0];
         weights_.assign(w.ptr<float>(), w.ptr<float>() + w.total());
         bias_.assign(static_cast<std::size_t>(shape_.cout), 0.f);
-        if (params.get<bool>("bias_term", false))
+        if (shape_.bias)
             std::copy_n(params.blobs[1].ptr<float>(), shape_.cout, bias_.begin());
         pack();
     }
