@@ -153,6 +153,33 @@ TEST(FrameFeatures, WeightWhereARegionIsSetScalesTheInformation) {
     EXPECT_THROW(f.weighWhere(cv::Mat::zeros(80, 100, CV_32FC1), 0.5f), std::invalid_argument);
 }
 
+// A distorted camera's keypoints move when undistorted (fr1: pixels near the corners); the
+// filter's regions are the image's, so the weights follow the image's pixels.
+TEST(FrameFeatures, WeightsOfADistortedCameraFollowTheImagesPixels) {
+    const auto K = core::CameraIntrinsics::fromPreset("fr1");
+    ASSERT_TRUE(K.distorted());
+    FrameFeatures f;
+    f.keypoints = {cv::KeyPoint(20, 20, 31), cv::KeyPoint(320, 240, 31)};
+    f.depth = {1.5f, 0.f};
+    f.points_c = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+    slam::undistortKeypoints(f, K);
+    ASSERT_EQ(f.image_pt.size(), 2u);
+    EXPECT_EQ(f.image_pt[0], cv::Point2f(20, 20));
+    EXPECT_GT(cv::norm(f.keypoints[0].pt - f.image_pt[0]), 3.0);  // moved by the undistortion
+    cv::Mat where = cv::Mat::zeros(K.height, K.width, CV_8UC1);
+    where(cv::Rect(15, 15, 10, 10)).setTo(255);  // around the keypoint in the image
+    f.weighWhere(where, 0.5f);
+    EXPECT_EQ(f.weight[0], 0.5f);
+    EXPECT_EQ(f.weight[1], 1.f);
+    // The undistorted pixel is outside the region: the weight is not looked up there.
+    cv::Mat at_undistorted = cv::Mat::zeros(K.height, K.width, CV_8UC1);
+    at_undistorted.at<uchar>(cvFloor(f.keypoints[0].pt.y), cvFloor(f.keypoints[0].pt.x)) = 255;
+    FrameFeatures g = f;
+    g.weight.clear();
+    g.weighWhere(at_undistorted, 0.5f);
+    EXPECT_EQ(g.weight[0], 1.f);
+}
+
 // A person who moved 2 px since the map saw them pulls the pose; weighed down, less.
 TEST(PoseSolver, LowWeightReducesTheBiasOfAShiftedGroup) {
     const auto K = fr1NoDist();

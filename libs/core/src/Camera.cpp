@@ -4,7 +4,9 @@
 
 #include <mrpt/config/CConfigFileBase.h>
 #include <mrpt/img/TCamera.h>
+#include <opencv2/calib3d.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <sstream>
@@ -160,6 +162,20 @@ CameraIntrinsics CameraIntrinsics::scaled(double s) const {
     o.width = static_cast<int>(std::lround(width * s));
     o.height = static_cast<int>(std::lround(height * s));
     return o;
+}
+
+bool CameraIntrinsics::distorted() const {
+    return std::any_of(dist.begin(), dist.end(), [](double d) { return d != 0.0; });
+}
+
+std::vector<cv::Point2f> undistortPixels(const std::vector<cv::Point2f>& px,
+                                         const CameraIntrinsics& K) {
+    if (!K.distorted() || px.empty()) return px;
+    const cv::Mat Kc = (cv::Mat_<double>(3, 3) << K.fx, 0, K.cx, 0, K.fy, K.cy, 0, 0, 1);
+    const cv::Mat D(1, 5, CV_64F, const_cast<double*>(K.dist.data()));
+    std::vector<cv::Point2f> out;
+    cv::undistortPoints(px, out, Kc, D, cv::noArray(), Kc);
+    return out;
 }
 
 bool CameraIntrinsics::operator==(const CameraIntrinsics& o) const {

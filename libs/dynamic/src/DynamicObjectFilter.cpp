@@ -350,7 +350,12 @@ using Options = DynamicObjectFilter::Options;
 /// (p1), in full-resolution pixels; only points that pass the forward-backward check and
 /// land in the image.
 struct PointFlow {
-    std::vector<cv::Point2f> p0, p1;
+    std::vector<cv::Point2f> p0, p1;  ///< in the previous / current image [px]
+    /// p0, p1 undistorted (core::undistortPixels with the previous / current intrinsics):
+    /// for the geometry (back-projection, PnP, predicted flow); the images, boxes and depth
+    /// are the camera's own, so p0 and p1 serve the rest. Copies of p0, p1 for a camera
+    /// without distortion (the renders).
+    std::vector<cv::Point2f> u0, u1;
 };
 
 /// What ego-motion compensation says about each point of a PointFlow.
@@ -510,7 +515,11 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
     const bool have_prev = im.prepareImages(frame, opts_);
     lap(times.images);
     PointFlow flow;
-    if (have_prev) flow = im.trackCorners(opts_, image, times);
+    if (have_prev) {
+        flow = im.trackCorners(opts_, image, times);
+        flow.u0 = core::undistortPixels(flow.p0, im.prev_K);
+        flow.u1 = core::undistortPixels(flow.p1, frame.K);
+    }
     t_stage = Clock::now();
     im.carryBoxes(flow, image);
     if (im.frame_count % opts_.detect_every == 0) {
@@ -742,12 +751,12 @@ Eigen::Isometry3d DynamicObjectFilter::Impl::egoMotion(
     for (std::size_t i = 0; i < p0.size(); ++i) {
         const auto z = stableDepth(prev_depth, p0[i], o.max_depth);
         if (!z) continue;
-        r.X[i] = core::backproject(p0[i].x, p0[i].y, *z, prev_K);
+        r.X[i] = core::backproject(f.u0[i].x, f.u0[i].y, *z, prev_K);
         r.background[i] = !nearAnyBox(p0[i], p1[i], o);
         if (r.background[i]) {
             bg_obj.emplace_back(static_cast<float>(r.X[i]->x()), static_cast<float>(r.X[i]->y()),
                                 static_cast<float>(r.X[i]->z()));
-            bg_img.push_back(p1[i]);
+            bg_img.push_back(f.u1[i]);  // the PnP's pinhole K: undistorted pixels
         }
     }
     Eigen::Isometry3d T_prev_cur = prior.value_or(Eigen::Isometry3d::Identity());
@@ -806,8 +815,8 @@ void DynamicObjectFilter::Impl::residualFlow(const core::Frame& frame, const Poi
         if (r.X[i]) {
             const Eigen::Vector3d Xc = T_cur_prev * *r.X[i];
             if (const auto uv = core::project(Xc, Kc)) {
-                r.vec[i] = {p1[i].x - static_cast<float>(uv->x()),
-                            p1[i].y - static_cast<float>(uv->y())};
+                r.vec[i] = {f.u1[i].x - static_cast<float>(uv->x()),
+                            f.u1[i].y - static_cast<float>(uv->y())};
                 fp.residual = static_cast<float>(std::hypot(r.vec[i].x, r.vec[i].y));
                 if (want_z)
                     if (const auto z = stableDepth(frame.depth, p1[i], o.max_depth))

@@ -2,7 +2,6 @@
 #include <devslam/slam/OrbExtractor.h>
 
 #include <mrpt/config/CConfigFileBase.h>
-#include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
@@ -135,14 +134,11 @@ static bool onDepthEdge(const cv::Mat& depth, int u, int v, double threshold) {
 }
 
 void undistortKeypoints(FrameFeatures& f, const core::CameraIntrinsics& K) {
-    const bool distorted =
-        std::any_of(K.dist.begin(), K.dist.end(), [](double d) { return d != 0.0; });
-    if (!distorted || f.keypoints.empty()) return;
-    std::vector<cv::Point2f> in(f.keypoints.size()), out;
+    if (!K.distorted() || f.keypoints.empty()) return;
+    std::vector<cv::Point2f> in(f.keypoints.size());
     for (std::size_t i = 0; i < in.size(); ++i) in[i] = f.keypoints[i].pt;
-    const cv::Mat Kc = (cv::Mat_<double>(3, 3) << K.fx, 0, K.cx, 0, K.fy, K.cy, 0, 0, 1);
-    const cv::Mat D(1, 5, CV_64F, const_cast<double*>(K.dist.data()));
-    cv::undistortPoints(in, out, Kc, D, cv::noArray(), Kc);
+    const std::vector<cv::Point2f> out = core::undistortPixels(in, K);
+    f.image_pt = in;
     for (std::size_t i = 0; i < in.size(); ++i) {
         f.keypoints[i].pt = out[i];
         if (f.depth[i] > 0) f.points_c[i] = core::backproject(out[i].x, out[i].y, f.depth[i], K);

@@ -7,6 +7,7 @@
 ///   auto uv = devslam::core::project(p, K);   // std::nullopt behind the camera
 
 #include <Eigen/Core>
+#include <opencv2/core/types.hpp>
 
 #include <array>
 #include <optional>
@@ -62,8 +63,17 @@ struct CameraIntrinsics {
     /// forever), a principal point finite and inside the image, a finite distortion.
     [[nodiscard]] std::string problem() const;
 
+    /// True when a distortion coefficient is not zero.
+    [[nodiscard]] bool distorted() const;
+
     bool operator==(const CameraIntrinsics& o) const;
 };
+
+/// Pixels of this camera to the pixels an undistorted camera with the same fx fy cx cy
+/// would have seen them at (OpenCV's model, cv::undistortPoints): the pixels the pinhole
+/// backproject() and project() are exact for. The input itself when !K.distorted().
+[[nodiscard]] std::vector<cv::Point2f> undistortPixels(const std::vector<cv::Point2f>& px,
+                                                       const CameraIntrinsics& K);
 
 /// Pixel (u, v) with depth z [m] to a point in the optical frame (x right, y down, z forward).
 [[nodiscard]] inline Eigen::Vector3d backproject(double u, double v, double z,

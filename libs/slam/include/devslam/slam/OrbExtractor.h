@@ -69,7 +69,8 @@ class OrbExtractor {
 
 /// Replaces keypoint positions by their undistorted pixels (K.dist, OpenCV model) and
 /// re-back-projects the points with depth; no-op for an undistorted camera. Depth and
-/// colour are looked up at the raw (distorted) pixel, where the registered depth lies.
+/// colour are looked up at the raw (distorted) pixel, where the registered depth lies; the
+/// raw pixels are kept in `f.image_pt`.
 void undistortKeypoints(FrameFeatures& f, const core::CameraIntrinsics& K);
 
 /// Keeps at most `n` keypoints spread over a cols x rows grid: each cell first keeps its

@@ -25,6 +25,10 @@ struct FrameFeatures {
     std::vector<float> depth;               ///< [m] per keypoint, 0 = none (missing/out of range)
     std::vector<Eigen::Vector3d> points_c;  ///< back-projected point [m] (valid iff depth > 0)
     std::vector<cv::Vec3b> colors;          ///< BGR at the keypoint
+    /// [px] each keypoint where the image shows it, when undistortKeypoints moved the
+    /// keypoints (a camera with distortion); empty: keypoints[i].pt. Image regions (the
+    /// filter's, in weighWhere) are looked up here.
+    std::vector<cv::Point2f> image_pt;
     int n_masked = 0;            ///< keypoints dropped because they fell in the dynamic mask
     double masked_fraction = 0;  ///< fraction of the image covered by the dynamic mask
     /// Per keypoint, multiplies its information (1/sigma^2) in the optimisations of tracking,
@@ -41,14 +45,15 @@ struct FrameFeatures {
     /// Lowers the weight of the keypoints where `where` (CV_8UC1, the frame's size) is set
     /// to `w` (a lower weight already there is kept); the first call sets every other
     /// weight to 1. Throws std::invalid_argument for another type; a keypoint outside
-    /// `where` keeps its weight.
+    /// `where` keeps its weight. `where` is in the image's pixels (image_pt).
     void weighWhere(const cv::Mat& where, float w) {
         if (where.type() != CV_8UC1)
             throw std::invalid_argument("FrameFeatures::weighWhere: the region must be CV_8UC1");
         if (weight.empty()) weight.assign(keypoints.size(), 1.f);
         for (std::size_t i = 0; i < keypoints.size(); ++i) {
-            const int x = static_cast<int>(keypoints[i].pt.x);
-            const int y = static_cast<int>(keypoints[i].pt.y);
+            const cv::Point2f& pt = image_pt.empty() ? keypoints[i].pt : image_pt[i];
+            const int x = static_cast<int>(pt.x);
+            const int y = static_cast<int>(pt.y);
             if (x >= 0 && y >= 0 && x < where.cols && y < where.rows &&
                 where.at<unsigned char>(y, x) != 0)
                 weight[i] = std::min(weight[i], w);
