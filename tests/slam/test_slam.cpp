@@ -803,7 +803,9 @@ TEST(Config, EveryShippedSlamIniLoadsAndUnknownKeysAreRejected) {
              {"[tracker]\nmax_depth = 0\n", "[tracker] max_depth: must be > 0"},
              {"[tracker]\nfine_radius = 0\n", "[tracker] fine_radius: must be > 0"},
              {"[loop_closure]\nsigma_r_deg = 0\n", "[loop_closure] sigma_r_deg: must be > 0"},
-             {"[local_ba]\nchi2_mono = -1\n", "[local_ba] chi2_mono: must be > 0"}}) {
+             {"[local_ba]\nchi2_mono = -1\n", "[local_ba] chi2_mono: must be > 0"},
+             // (a window of 1 was accepted and adjusted nothing, silently)
+             {"[local_ba]\nwindow = 1\n", "[local_ba] window: must be in [2, 30]"}}) {
         mrpt::config::CConfigFileMemory c(text);
         try {
             (void)SlamOptions::fromConfig(c);

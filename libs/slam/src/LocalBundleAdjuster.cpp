@@ -27,7 +27,9 @@ void LocalBaOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, cons
     bf = core::readDouble(c, s, "bf", bf);
     chi2_mono = core::readDouble(c, s, "chi2_mono", chi2_mono);
     chi2_stereo = core::readDouble(c, s, "chi2_stereo", chi2_stereo);
-    core::requireValue(window >= 1 && window <= 30, s, "window", "must be in [1, 30]");
+    // One keyframe is no window: the adjustment needs two (enabled = false turns it off).
+    core::requireValue(window >= 2 && window <= 30, s, "window",
+                       "must be in [2, 30] (a window of 1 adjusts nothing: enabled = false)");
     core::requireValue(iterations >= 0 && iterations <= 1000, s, "iterations",
                        "must be in [0, 1000]");
     core::requireValue(bf > 0, s, "bf", "must be > 0");

@@ -149,6 +149,9 @@ std::optional<mrpt::maps::COccupancyGridMap2D> buildOccupancyGrid(const Map& map
             const Landmark* l = map.landmark(lid);
             if (!l) continue;
             const auto p = opticalToNav(l->p_w);
+            // (A NaN passes the tests below, and its cell index is no number: Bresenham's
+            // walk to it went on for some 2^31 steps.)
+            if (!p.allFinite()) continue;
             if (p.z() < opts.min_height || p.z() > opts.max_height) continue;
             if ((p.head<2>() - c.head<2>()).norm() > opts.max_range) continue;
             const int px = grid.x2idx(static_cast<float>(p.x())),

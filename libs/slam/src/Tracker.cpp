@@ -275,7 +275,11 @@ TrackResult Tracker::track(const TrackInput& in, Map& map, const core::CameraInt
         res.reason = "not initialized";
         return res;
     }
-    const auto prev_cur = in.T_prev_cur_prior ? in.T_prev_cur_prior : predictPrevCur(in.timestamp);
+    // While lost, the last tracked pose is frames old and a one-frame prior says nothing
+    // of how far the camera went since: the frame keeps that pose, as without a prior.
+    const auto prev_cur = in.T_prev_cur_prior && state_ != TrackingState::Lost
+                              ? in.T_prev_cur_prior
+                              : predictPrevCur(in.timestamp);
     const Eigen::Isometry3d pred = last_T_wc_ * prev_cur.value_or(Eigen::Isometry3d::Identity());
     res.T_wc = pred;
     const auto local = map.landmarksOf(map.lastKeyframes(opts_.local_keyframes));

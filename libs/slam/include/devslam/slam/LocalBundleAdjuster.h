@@ -21,7 +21,7 @@ namespace devslam::slam {
 
 struct LocalBaOptions {
     bool enabled = true;
-    int window = 5;      ///< keyframes optimised (newest ones)
+    int window = 5;      ///< keyframes optimised (newest ones), 2..30
     int iterations = 8;  ///< LM iterations (per round)
     /// rounds after the first, each without the observations the previous round left
     /// outside chi2 (ORB-SLAM2 local BA: 1)

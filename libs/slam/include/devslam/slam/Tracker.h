@@ -63,7 +63,9 @@ struct TrackInput {
     const FrameFeatures* features = nullptr;
     double timestamp = 0.0;  ///< [s]
     /// Pose of this camera in the previous one (p_prev = T * p_cur) from elsewhere (e.g. the
-    /// dynamic filter's refined ego-motion); replaces the velocity model when set.
+    /// dynamic filter's refined ego-motion); replaces the velocity model when set. Not used
+    /// while the tracker is lost (the last tracked pose is then frames old; relocalisation
+    /// needs no prior).
     std::optional<Eigen::Isometry3d> T_prev_cur_prior;
 };
 
