@@ -571,6 +571,22 @@ TEST(Rawlog, RejectsFramesThatCannotBeWritten) {
     EXPECT_THROW(io::RawlogWriter(d.str("y.rawlog"), bad), std::invalid_argument);
 }
 
+// 16-bit depth at 5000 units per metre ends at 13.1 m: a farther reading was saturated to a
+// wall at 13.1 m in a rawlog (a TUM folder already refused it). Both refuse it now.
+TEST(Rawlog, DepthBeyondSixteenBitsIsRefusedNotClipped) {
+    TempDir d;
+    core::Frame f = io::TumReader(kTum).read(0);
+    f.depth.at<float>(10, 20) = 15.0f;
+    io::RawlogWriter w(d.str("far.rawlog"), {});
+    expectError([&] { w.write(f); },
+                "depth 15.0+ m does not fit a rawlog's range image \\(16 bits at 5000 per "
+                "metre: at most 13.1 m\\)");
+    io::TumWriter t(d.str("far_tum"));
+    expectError([&] { t.write(f); }, "frame 0: depth 15.0+ m does not fit a TUM depth PNG");
+    f.depth.at<float>(10, 20) = 13.1f;  // the farthest depth that fits
+    EXPECT_NO_THROW(w.write(f));
+}
+
 // A full disk at the end: a frame of one colour fits zlib's buffers, which go out (and fail)
 // only at the close. MRPT's gz stream ignored that, and the cut rawlog passed for written.
 TEST(Rawlog, AFullDiskAtTheCloseIsAnError) {

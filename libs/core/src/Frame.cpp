@@ -3,6 +3,7 @@
 #include <opencv2/core.hpp>
 
 #include <cmath>
+#include <cstdio>
 #include <stdexcept>
 
 namespace devslam::core {
@@ -34,6 +35,18 @@ void validateFrame(const Frame& f, const std::string& what) {
     // inf: a rawlog's rangeUnits of 0 (every depth 0 m without a word before)
     if (!(f.depth_scale > 0 && std::isfinite(f.depth_scale)))
         fail("depth_scale must be finite and > 0 (a depth unit of 0 m?)");
+}
+
+void requireDepthFits16(const Frame& f, double units_per_metre, const std::string& what,
+                        const std::string& format) {
+    double max_depth = 0;
+    cv::minMaxLoc(f.depth, nullptr, &max_depth);
+    if (max_depth * units_per_metre <= 65535.5) return;  // (rounds to 65535 at most)
+    char scale[96];
+    std::snprintf(scale, sizeof scale, "16 bits at %g per metre: at most %.1f m", units_per_metre,
+                  65535.0 / units_per_metre);
+    throw std::runtime_error(what + ": depth " + std::to_string(max_depth) + " m does not fit " +
+                             format + " (" + scale + ")");
 }
 
 }  // namespace devslam::core

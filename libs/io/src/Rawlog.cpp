@@ -424,7 +424,10 @@ RawlogWriter::~RawlogWriter() {
 
 void RawlogWriter::write(const core::Frame& f) {
     if (!stream_) throw std::logic_error("RawlogWriter::write after close: " + path_);
-    core::validateFrame(f, f.rgb_source.empty() ? "frame" : f.rgb_source);
+    const std::string what = f.rgb_source.empty() ? "frame" : f.rgb_source;
+    core::validateFrame(f, what);
+    // (rawDepth16 saturates: a 15 m reading at 5000 units per metre was stored as 13.1 m)
+    core::requireDepthFits16(f, f.depth_scale, what, "a rawlog's range image");
     auto obs = CObservation3DRangeScan::Create();
     obs->sensorLabel = opts_.sensor_label;
     obs->timestamp = mrpt::Clock::fromDouble(f.timestamp);

@@ -50,13 +50,7 @@ void TumWriter::write(const core::Frame& f) {
     // rawlog's millimetres become 5 units each, exactly); a reader of the folder, ours or the
     // TUM tools, knows no other scale.
     constexpr double kTumScale = 5000.0;
-    double max_depth = 0;
-    cv::minMaxLoc(f.depth, nullptr, &max_depth);
-    if (max_depth * kTumScale > 65535.5)
-        throw std::runtime_error("frame " + std::to_string(f.index) + ": depth " +
-                                 std::to_string(max_depth) +
-                                 " m does not fit a TUM depth PNG (16 bits at 5000 per metre: "
-                                 "at most 13.1 m)");
+    core::requireDepthFits16(f, kTumScale, "frame " + std::to_string(f.index), "a TUM depth PNG");
     if (count_ == 0) {
         // Intrinsics travel with the folder (TumReader reads camera.ini before guessing).
         mrpt::config::CConfigFileMemory cam;

@@ -44,4 +44,10 @@ struct Frame {
 /// std::runtime_error naming `what` (a file or frame) and the violated invariant.
 void validateFrame(const Frame& f, const std::string& what);
 
+/// Throws std::runtime_error naming `what` when a depth of `f` is beyond 16 bits at
+/// `units_per_metre` (rawDepth16 would store it as 65535 units: a wall that is not there),
+/// `format` naming what the depth goes into ("a TUM depth PNG").
+void requireDepthFits16(const Frame& f, double units_per_metre, const std::string& what,
+                        const std::string& format);
+
 }  // namespace devslam::core
