@@ -195,6 +195,29 @@ TEST(Rpe, ReproducesEvaluateRpeQuirks) {
     EXPECT_THROW((void)eval::computeRpe(line, rotated, o), std::invalid_argument);
 }
 
+// evaluate_rpe.py refuses trajectories that overlap at one estimate pose ("Number of overlap
+// in the timestamps is too small"): ground truth at 0 and 100 s, the estimate at 0..10 s,
+// every estimate stamp meets the ground truth at 0 s, whose nearest estimate stamp is 0 s.
+// Our RPE gave 9 pairs, all against the ground-truth pose at 0 s.
+TEST(Rpe, TrajectoriesThatHardlyOverlapAreRefusedAsByTheScript) {
+    core::Trajectory gt{{0.0, CPose3D()}, {100.0, CPose3D(1, 0, 0, 0, 0, 0)}}, est;
+    for (int i = 0; i <= 10; ++i) est.push_back({double(i), CPose3D(0.1 * i, 0, 0, 0, 0, 0)});
+    eval::RpeOptions o;
+    o.delta = 1;
+    try {
+        (void)eval::computeRpe(gt, est, o);
+        ADD_FAILURE() << "accepted";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_NE(std::string(e.what()).find("Number of overlap in the timestamps is too small"),
+                  std::string::npos)
+            << e.what();
+    }
+    // Ground truth over the whole estimate: two poses come back, and it is evaluated.
+    core::Trajectory gt2;
+    for (int i = 0; i <= 10; ++i) gt2.push_back({double(i), CPose3D(0.1 * i, 0, 0, 0, 0, 0)});
+    EXPECT_EQ(eval::computeRpe(gt2, est, o).n_pairs, 9u);
+}
+
 // evaluate_rpe.py's error is A B^-1 (A, B: the estimate's and the ground truth's relative
 // motions), not the TUM paper's B^-1 A: with a rotation error its translation differs.
 // Ground truth: 1 m steps along x. Estimate: the same positions, turned 10 deg more about z

@@ -117,6 +117,25 @@ RpeResult computeRpe(const core::Trajectory& gt, const core::Trajectory& est,
     for (std::size_t i = 0; i < se.size(); ++i)
         index[i] = opts.delta_in_frames ? static_cast<double>(i) : se[i];
 
+    // evaluate_rpe.py's overlap check: from each estimate stamp to its nearest ground truth
+    // and back to the nearest estimate stamp; fewer than two of those come back when the two
+    // trajectories hardly overlap in time, and their pairs would all meet the same
+    // ground-truth pose (the figures then the estimate's own motion).
+    std::size_t first_back = 0, n_back = 0;
+    for (std::size_t i = 0; i < se.size() && n_back < 2; ++i) {
+        const std::size_t g = findClosestIndex(sg, se[i] + opts.offset);
+        const std::size_t b = findClosestIndex(se, sg[g] - opts.offset);
+        if (n_back == 0 || b != first_back) {
+            if (n_back == 0) first_back = b;
+            ++n_back;
+        }
+    }
+    if (n_back < 2)
+        throw std::invalid_argument(
+            "RPE: the trajectories overlap in time at one estimate pose only (evaluate_rpe.py: "
+            "'Number of overlap in the timestamps is too small'): the right files, the right "
+            "offset?");
+
     std::vector<double> intervals;
     for (std::size_t i = 1; i < sg.size(); ++i) intervals.push_back(sg[i] - sg[i - 1]);
     const double gt_max_dt = 2.0 * core::median(intervals);
