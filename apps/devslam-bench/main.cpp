@@ -40,6 +40,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <functional>
 #include <iostream>
 #include <map>
@@ -328,14 +329,18 @@ int stopAfter(int status) {
     return core::stopSignalOf(status);
 }
 
-/// What a run is made from, as its command.txt records it: the command line, then the
-/// content hash (core::fileHash) and path of each file it reads that the bench knows of.
+/// What a run is made from, as its command.txt records it: the command line, the machine
+/// (core::hostLine: runs on another CPU or SIMD level give other trajectories and speeds,
+/// docs/bench.md), then the content hash (core::fileHash) and path of each file it reads
+/// that the bench knows of.
 /// `hash` caches the hashes (a rawlog or the program is read once per bench), by path, size
 /// and modification time: a file edited or rebuilt while the bench runs is hashed again, so a
 /// later run's command.txt names what that run read.
+constexpr const char* kMachine = "machine: ";  // command.txt's second line
+
 std::string provenance(const std::string& cmd, const std::vector<std::string>& files,
                        std::map<std::string, std::string>& hash) {
-    std::string text = cmd + "\n";
+    std::string text = cmd + "\n" + kMachine + core::hostLine() + "\n";
     for (const auto& f : files) {
         std::error_code ec;
         const auto size = fs::file_size(f, ec);
@@ -376,20 +381,26 @@ std::string staleRun(const fs::path& dir, const std::string& made_from) {
     ss << in.rdbuf();
     const std::string had = ss.str();
     if (had == made_from) return "";
-    // Line 1: the command; then "HASH PATH" lines, compared by path (one file more or less
-    // shifts the lines).
-    const auto parse = [](const std::string& text, std::string& cmd) {
+    // Line 1: the command; line 2 the machine; then "HASH PATH" lines, compared by path
+    // (one file more or less shifts the lines).
+    const auto parse = [](const std::string& text, std::string& cmd, std::string& machine) {
         std::map<std::string, std::string> files;
         std::istringstream lines(text);
         std::getline(lines, cmd);
         for (std::string l; std::getline(lines, l);)
-            if (const auto sp = l.find(' '); sp != std::string::npos)
+            if (l.rfind(kMachine, 0) == 0)
+                machine = l.substr(std::string(kMachine).size());
+            else if (const auto sp = l.find(' '); sp != std::string::npos)
                 files[l.substr(sp + 1)] = l.substr(0, sp);
         return files;
     };
-    std::string had_cmd, now_cmd;
-    const auto had_files = parse(had, had_cmd), now_files = parse(made_from, now_cmd);
+    std::string had_cmd, now_cmd, had_machine, now_machine;
+    const auto had_files = parse(had, had_cmd, had_machine),
+               now_files = parse(made_from, now_cmd, now_machine);
     if (had_cmd != now_cmd) return "made by another command (command.txt)";
+    if (had_machine != now_machine)
+        return had_machine.empty() ? "made where its machine was not recorded (command.txt)"
+                                   : "made on another machine (" + had_machine + ")";
     for (const auto& [path, hash] : now_files) {
         const auto it = had_files.find(path);
         if (it == had_files.end()) return "made without " + path;
@@ -1051,9 +1062,14 @@ int run(int argc, char** argv) {
     }
     if (!a.results.empty()) {
         // The plots it shows with it (a bench with failed runs changed neither).
+        // Each whole or not at all (writeFileWhole): a bench stopped while copying leaves
+        // every plot either the old one or the new one, never a cut file.
         for (const auto& [src, dst] : t.results_images) {
             fs::create_directories(dst.parent_path());
-            fs::copy_file(src, dst, fs::copy_options::overwrite_existing);
+            std::ifstream in(src, std::ios::binary);
+            const std::string png{std::istreambuf_iterator<char>(in), {}};
+            if (!in && !in.eof()) throw std::runtime_error("cannot read '" + src.string() + "'");
+            core::writeFileWhole(dst.string(), png);
         }
         core::replaceResultsSection(a.results, "bench", md);
     }

@@ -416,6 +416,25 @@ TEST(DevslamBench, CtrlCStopsTheBenchAndReuseRunsResumes) {
               std::string::npos)
         << changed.out;
     EXPECT_EQ(readFile(tmp / "RESULTS.md").find("runs were kept"), std::string::npos);
+
+    // A run made on another machine (an out/ folder carried over): other kernels, other
+    // trajectories and speeds; not kept (it was, and its figures passed for this machine's).
+    const fs::path cmd_txt = tmp / "out/runs/fr1/none/r0/command.txt";
+    std::string made = readFile(cmd_txt);
+    const auto at = made.find("\nmachine: ");
+    ASSERT_NE(at, std::string::npos) << made;
+    made.replace(at + 1, made.find('\n', at + 1) - at - 1,
+                 "machine: 2 hardware threads, Imaginary CPU (family 0 model 0), OpenCV SIMD AVX2");
+    std::ofstream(cmd_txt, std::ios::trunc) << made;
+    const auto moved = devslam::test::runApp("devslam-bench", other);
+    EXPECT_EQ(moved.rc, 0) << moved.out;
+    EXPECT_NE(moved.out.find("not kept: its run.json was made on another machine (2 hardware "
+                             "threads, Imaginary CPU (family 0 model 0), OpenCV SIMD AVX2)"),
+              std::string::npos)
+        << moved.out;
+    EXPECT_NE(readFile(tmp / "RESULTS.md").find("7 of 8 runs were kept from an earlier"),
+              std::string::npos)
+        << readFile(tmp / "RESULTS.md");
     fs::remove_all(tmp);
 }
 

@@ -19,6 +19,7 @@
 #include <atomic>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <thread>
 #include <typeinfo>
@@ -553,6 +554,43 @@ TEST(Results, SectionsAreReplacedInPlaceAndBrokenMarkersRefused) {
                  std::runtime_error);
     EXPECT_EQ(read(), broken);
     std::filesystem::remove(path);
+}
+
+// A results file that is there but cannot be read was taken for a new one: the section was
+// written alone, and the file's other sections were lost. Root reads any file, so the write
+// runs in a child as nobody when the test runs as root.
+TEST(Results, AFileThatCannotBeReadIsNotWrittenOver) {
+    devslam::test::TempDir d("devslam_");
+    const std::string path = d.str("RESULTS.md");
+    const std::string text =
+        "# R\n<!-- BEGIN a -->\nold\n<!-- END a -->\n<!-- BEGIN b -->\nkept\n<!-- END b -->\n";
+    std::ofstream(path) << text;
+    namespace fs = std::filesystem;
+    fs::permissions(d.str(), fs::perms::all);  // the child may write beside it
+    fs::permissions(path, fs::perms::owner_write | fs::perms::group_write | fs::perms::others_write);
+    const pid_t pid = fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+        if (geteuid() == 0 && (setgid(65534) != 0 || setuid(65534) != 0)) _exit(3);
+        try {
+            replaceResultsSection(path, "a", "new");
+            _exit(0);
+        } catch (const std::runtime_error& e) {
+            _exit(std::string(e.what()).find(path + "' is there but cannot be read") !=
+                          std::string::npos
+                      ? 1
+                      : 2);
+        } catch (...) {
+            _exit(4);
+        }
+    }
+    int status = 0;
+    ASSERT_EQ(waitpid(pid, &status, 0), pid);
+    ASSERT_TRUE(WIFEXITED(status));
+    EXPECT_EQ(WEXITSTATUS(status), 1) << "0: written over; 2: another error; 3: no setuid";
+    fs::permissions(path, fs::perms::owner_read | fs::perms::owner_write);
+    std::ifstream in(path);
+    EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), text);
 }
 
 // Two commands regenerating their sections at once (say devslam-bench and devslam-nav-bench,

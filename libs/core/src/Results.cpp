@@ -33,10 +33,21 @@ std::string withSection(const std::string& path, const std::string& name,
         throw std::runtime_error("results file '" + path + "' is a folder");
     std::string text;
     {
+        // A file that is there but cannot be read is no new file: taken for one, it was
+        // written over with this section alone, and every other section was lost.
+        std::error_code ec;
+        const bool exists = std::filesystem::exists(path, ec) ||
+                            (ec && ec != std::errc::no_such_file_or_directory);  // a link loop
         std::ifstream in(path);
+        if (exists && !in)
+            throw std::runtime_error("results file '" + path +
+                                     "' is there but cannot be read; nothing was written");
         if (in) {
             std::stringstream ss;
             ss << in.rdbuf();
+            if (in.bad() || ss.bad())
+                throw std::runtime_error("results file '" + path +
+                                         "': error reading it; nothing was written");
             text = ss.str();
         } else {
             text =
@@ -191,8 +202,11 @@ std::string utcMinute(std::time_t t) {
 }
 
 std::string measuredOnLine() {
-    const std::string date =
-        utcMinute(std::chrono::system_clock::to_time_t(std::chrono::system_clock::now()));
+    return utcMinute(std::chrono::system_clock::to_time_t(std::chrono::system_clock::now())) +
+           ", " + hostLine();
+}
+
+std::string hostLine() {
     std::string cpu = "unknown CPU", family, model;
     std::ifstream info("/proc/cpuinfo");
     const auto value = [](const std::string& line) {
@@ -210,8 +224,8 @@ std::string measuredOnLine() {
     const char* simd = cv::checkHardwareSupport(CV_CPU_AVX512_SKX) ? "AVX-512"
                        : cv::checkHardwareSupport(CV_CPU_AVX2)     ? "AVX2"
                                                                    : "SSE/AVX";
-    return std::string(date) + ", " + std::to_string(std::thread::hardware_concurrency()) +
-           " hardware threads, " + cpu + ", OpenCV SIMD " + simd;
+    return std::to_string(std::thread::hardware_concurrency()) + " hardware threads, " + cpu +
+           ", OpenCV SIMD " + simd;
 }
 
 std::string shownPath(const std::string& path, const std::string& root) {

@@ -49,6 +49,9 @@ void checkResultsSection(const std::string& path, const std::string& name);
 /// table. The SIMD level matters: OpenCV picks its kernels by it at run time, and the same
 /// code gives other trajectories with other kernels (docs/bench.md, "Limits").
 [[nodiscard]] std::string measuredOnLine();
+/// measuredOnLine() without its date: "2 hardware threads, AMD EPYC (family 25 model 1),
+/// OpenCV SIMD AVX2" (what decides a run's figures besides its inputs).
+[[nodiscard]] std::string hostLine();
 
 /// `t` as "2026-11-27 10:32 UTC", the form measuredOnLine() gives its date in.
 [[nodiscard]] std::string utcMinute(std::time_t t);
