@@ -170,16 +170,15 @@ int run(int argc, char** argv) {
         return 0;
     }
     const std::size_t n = frames > 0 ? std::min(frames, sc.n_frames) : sc.n_frames;
-    // A picture of the middle frame, for people; made first, as writeSequence writes
-    // render.txt last (a render stopped before it is made again by --if-changed).
+    // A picture of the middle frame, for people, written as the render passes it (before
+    // render.txt, which comes last), from the frame the render made: a second renderer for
+    // it cost two seconds. An earlier render's picture goes with the first frame.
     const std::string prev = (fs::path(out_dir) / "preview.png").string();
-    {
-        render::SequenceRenderer r(sc);
-        const auto mid = r.render(n / 2);
-        fs::create_directories(out_dir);
-        if (!cv::imwrite(prev, preview(mid)))
+    o.on_frame = [&](std::size_t i, const render::RenderedFrame& f) {
+        if (i == 0) fs::remove(prev);
+        if (i == n / 2 && !cv::imwrite(prev, preview(f)))
             throw std::runtime_error("cannot write '" + prev + "'");
-    }
+    };
     core::ProgressBar bar("render " + sc.name, n);
     o.stop = [] { return core::stopSignal() != 0; };
     const auto sum =

@@ -89,8 +89,15 @@ void addRgbNoise(cv::Mat& bgr, double sigma, std::uint64_t seed) {
     cv::Mat noise(bgr.size(), CV_32FC3);
     std::mt19937_64 rng(seed);
     std::normal_distribution<float> g(0.f, float(sigma));
-    for (auto it = noise.begin<cv::Vec3f>(); it != noise.end<cv::Vec3f>(); ++it)
-        *it = cv::Vec3f(g(rng), g(rng), g(rng));
+    for (auto it = noise.begin<cv::Vec3f>(); it != noise.end<cv::Vec3f>(); ++it) {
+        // Drawn in a stated order (a call's arguments have none, and another compiler gave
+        // other renders): last channel first, as GCC evaluated Vec3f(g(rng), g(rng), g(rng))
+        // for every render so far.
+        const float c2 = g(rng);
+        const float c1 = g(rng);
+        const float c0 = g(rng);
+        *it = cv::Vec3f(c0, c1, c2);
+    }
     cv::Mat f;
     bgr.convertTo(f, CV_32FC3);
     f += noise;

@@ -179,6 +179,7 @@ WriteSummary writeSequence(const Scenario& sc, const WriteOptions& o,
                 (fs::path(o.out_dir) / "labels" / (std::string(stamp) + ".png")).string();
             if (!cv::imwrite(lp, rf.labels)) throw std::runtime_error("cannot write '" + lp + "'");
         }
+        if (o.on_frame) o.on_frame(i, rf);
         if (progress) progress(i + 1, n);
     }
     persons.close();

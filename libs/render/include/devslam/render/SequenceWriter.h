@@ -15,6 +15,8 @@
 
 namespace devslam::render {
 
+struct RenderedFrame;
+
 struct WriteOptions {
     std::string out_dir;         ///< created if missing; existing files are overwritten
     std::string rawlog_path;     ///< empty = no rawlog
@@ -25,6 +27,10 @@ struct WriteOptions {
     /// render.txt, so the folder is not a current render (isRenderCurrent). True before the
     /// first frame: nothing is written, the folder is left as it was.
     std::function<bool()> stop;
+    /// Called with each frame (its index and the frame) once it is written, before the next
+    /// is rendered: what a caller wants of the frames besides the files (devslam-synth's
+    /// preview.png), without rendering them again. An exception from it ends the render.
+    std::function<void(std::size_t, const RenderedFrame&)> on_frame;
 };
 
 struct WriteSummary {
