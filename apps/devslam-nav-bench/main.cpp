@@ -77,6 +77,7 @@ void usage() {
 
 struct Tally {
     int n = 0, success = 0, collision = 0, static_collision = 0, person_collision = 0, timeout = 0;
+    int no_run = 0;  ///< no path at the start, or a navigator error (not timeouts)
     std::vector<double> success_time, ratio, score;
     std::vector<double> people_clearance;  ///< [m] each run's minimum, runs with people
 };
@@ -278,8 +279,12 @@ void count(Tally& t, const devslam::sim::WorldSpec& world, const devslam::sim::E
         case devslam::sim::Outcome::Collision:
             t.collision++;
             break;
-        default:
+        case devslam::sim::Outcome::Timeout:
             t.timeout++;
+            break;
+        case devslam::sim::Outcome::NoPath:
+        case devslam::sim::Outcome::Error:
+            t.no_run++;
             break;
     }
     t.static_collision += r.static_collisions > 0 ? 1 : 0;
@@ -376,7 +381,9 @@ std::string categoryTables(const Args& a, const std::vector<devslam::sim::Catego
             const auto sc = devslam::core::summarize(t.score);
             md << "| " << shortName(m) << " | " << pct(t.success, t.n) << " (" << t.success << "/"
                << t.n << ") | " << pct(t.collision, t.n) << " (" << t.static_collision << " / "
-               << t.person_collision << ") | " << pct(t.timeout, t.n) << " | "
+               << t.person_collision << ") | " << pct(t.timeout, t.n)
+               << (t.no_run > 0 ? " (+" + std::to_string(t.no_run) + " no path or error)" : "")
+               << " | "
                << (t.success_time.empty() ? "-" : num(st.mean, 1)) << " | "
                << (t.ratio.empty() ? "-" : num(rt.mean, 2)) << " | " << num(sc.mean, 3) << " |";
             if (people && !t.people_clearance.empty()) {

@@ -123,6 +123,32 @@ TEST(GridPlanner, InvalidEndpointsThrowClearErrors) {
     ASSERT_TRUE(near);
 }
 
+// A robot whose edge is 3 cm off a wall stands in a cell the 5 cm grid calls too close (its
+// clearances are up to a cell and a half short): it is planned from the nearest cell it may
+// stand in, which is a few centimetres away, not refused (the navigator's replan failed
+// every time there, and the robot waited for the timeout).
+TEST(GridPlanner, NearestTraversableCellOfARobotPressedAgainstAWall) {
+    auto g = emptyGrid(6, 4, 0.05);
+    // A wall whose face is at y = 1.01, in the cells it touches: its face on the grid is
+    // at y = 1.05.
+    fillRect(g, 0, 0.9, 6.0, 1.03);
+    GridPlannerOptions o;
+    o.robot_radius = 0.25;
+    GridPlanner p(o);
+    p.setMap(g);
+    const TPoint2D robot{3.0, 1.29};  // its edge 3 cm off the wall
+    ASSERT_EQ(p.checkEndpoint(robot), EndpointStatus::TooCloseToObstacle);
+    EXPECT_THROW((void)p.plan(robot, {3.0, 3.5}), PlanningError);
+    const auto s = p.nearestTraversable(robot, o.robot_radius);
+    ASSERT_TRUE(s);
+    EXPECT_EQ(p.checkEndpoint(*s), EndpointStatus::Ok);
+    EXPECT_LE(std::hypot(s->x - robot.x, s->y - robot.y), 0.1);
+    EXPECT_TRUE(p.plan(*s, {3.0, 3.5}));
+    // A cell that is fine is its own answer; none within reach: nullopt.
+    EXPECT_EQ(p.nearestTraversable({3.0, 2.5}, 0.25)->y, 2.5);
+    EXPECT_FALSE(p.nearestTraversable({3.0, 0.95}, 0.1));
+}
+
 TEST(GridPlanner, InflationAndClearanceKeepAwayFromWalls) {
     auto g = emptyGrid(10, 6, 0.05);
     fillRect(g, 0, 2.9, 6.0, 3.1);  // a wall just above a straight line

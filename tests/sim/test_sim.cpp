@@ -176,6 +176,13 @@ TEST(World, AbsurdValuesAreErrorsNamingTheKey) {
               "w.ini [robot] max_acc: must be at most 20 m/s^2");
     EXPECT_EQ(errorOf(head + "max_ang_acc_deg = 1e9\n" + goal),
               "w.ini [robot] max_ang_acc_deg: must be at most 3600 deg/s^2");
+    // A scan plane above the 0.4 m blocks (30 for 0.30, centimetres for metres) saw none.
+    for (const char* h : {"30", "0.5", "0", "-1"})
+        EXPECT_EQ(errorOf(head + goal + "[laser]\nheight = " + h + "\n"),
+                  "w.ini [laser] height: must be in (0, 0.4) m, below the top of the lowest "
+                  "obstacle")
+            << h;
+    EXPECT_EQ(errorOf(head + goal + "[laser]\nheight = 0.39\n"), "");
     EXPECT_EQ(errorOf(head + goal + "[obstacles]\nhuge = box 2 2 1e300 1\n"),
               "w.ini [obstacles] huge: sizes must be in (0, 1000] m");
     EXPECT_EQ(errorOf(head + goal + "[obstacles]\nhuge = cylinder 2 2 1e300\n"),

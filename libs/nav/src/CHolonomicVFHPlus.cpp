@@ -54,6 +54,7 @@ void CHolonomicVFHPlus::navigate(const NavInput& ni, NavOutput& no) {
 
     last_ = vfhPlusStep(in, state_, options);
     state_ = last_.next;
+    ++steps_;
 
     auto log = std::make_shared<CLogFileRecord_VFHPlus>();
     log->selected_sector = last_.sector;

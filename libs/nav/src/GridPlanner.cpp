@@ -117,6 +117,29 @@ double GridPlanner::clearance(const mrpt::math::TPoint2D& p) const {
     return clearance_[x + y * w_];
 }
 
+std::optional<mrpt::math::TPoint2D> GridPlanner::nearestTraversable(
+    const mrpt::math::TPoint2D& p, double max_dist) const {
+    if (w_ == 0) throw std::logic_error("GridPlanner: setMap() was not called");
+    const int px = grid_.x2idx(p.x), py = grid_.y2idx(p.y);
+    if (px < 0 || py < 0 || px >= w_ || py >= h_) return std::nullopt;
+    if (clearance_[px + py * w_] >= opts_.robot_radius) return p;
+    const double res = grid_.getResolution();
+    const int r = static_cast<int>(std::ceil(max_dist / res));
+    std::optional<mrpt::math::TPoint2D> best;
+    double best_d = max_dist;
+    for (int y = std::max(0, py - r); y <= std::min(h_ - 1, py + r); y++)
+        for (int x = std::max(0, px - r); x <= std::min(w_ - 1, px + r); x++) {
+            if (clearance_[x + y * w_] < opts_.robot_radius) continue;
+            const mrpt::math::TPoint2D c{grid_.idx2x(x), grid_.idx2y(y)};
+            const double d = std::hypot(c.x - p.x, c.y - p.y);
+            if (d <= best_d) {
+                best_d = d;
+                best = c;
+            }
+        }
+    return best;
+}
+
 EndpointStatus GridPlanner::checkEndpoint(const mrpt::math::TPoint2D& p) const {
     if (w_ == 0) throw std::logic_error("GridPlanner: setMap() was not called");
     if (p.x < grid_.getXMin() || p.x >= grid_.getXMax() || p.y < grid_.getYMin() ||

@@ -36,14 +36,27 @@ class ReactiveNav : public mrpt::nav::CReactiveNavigationSystem {
         : CReactiveNavigationSystem(r, false, false, dir) {
         m_timlog_delays.enable(false);
     }
-    /// Lowest VFH+ target density over the PTGs (-1 if no VFH+ instance).
+    /// Notes how many steps each VFH+ instance has made, before a navigationStep().
+    void markVfhSteps() {
+        vfh_steps_.clear();
+        for (const auto& h : m_holonomicMethod) {
+            const auto* v = dynamic_cast<const CHolonomicVFHPlus*>(h.get());
+            vfh_steps_.push_back(v ? v->steps() : 0);
+        }
+    }
+    /// Lowest VFH+ target density over the PTGs whose VFH+ ran since markVfhSteps() (-1 if
+    /// none did). MRPT runs a PTG's method only when the target is in that PTG's domain: the
+    /// others' outputs are older steps', and a backward PTG's density 0 from the one step
+    /// the target was behind the robot held the minimum at 0 for the rest of the run.
     double vfhTargetDensity() const {
         double d = -1;
-        for (const auto& h : m_holonomicMethod)
-            if (const auto* v = dynamic_cast<const CHolonomicVFHPlus*>(h.get()))
-                if (!v->lastOutput().primary.empty())
-                    d = d < 0 ? v->lastOutput().target_density
-                              : std::min(d, v->lastOutput().target_density);
+        for (std::size_t i = 0; i < m_holonomicMethod.size(); ++i) {
+            const auto* v = dynamic_cast<const CHolonomicVFHPlus*>(m_holonomicMethod[i].get());
+            if (!v || v->lastOutput().primary.empty()) continue;
+            if (i < vfh_steps_.size() && v->steps() == vfh_steps_[i]) continue;  // not run
+            d = d < 0 ? v->lastOutput().target_density
+                      : std::min(d, v->lastOutput().target_density);
+        }
         return d;
     }
     /// As the INI names it: "mrpt::nav::CHolonomicND" -> "CHolonomicND".
@@ -53,6 +66,9 @@ class ReactiveNav : public mrpt::nav::CReactiveNavigationSystem {
         const auto colon = name.rfind("::");
         return colon == std::string::npos ? name : name.substr(colon + 2);
     }
+
+  private:
+    std::vector<std::uint64_t> vfh_steps_;  // per PTG, at markVfhSteps()
 };
 
 void copyConfig(const mrpt::config::CConfigFileBase& from, mrpt::config::CConfigFileMemory& to) {
@@ -245,8 +261,13 @@ bool Navigator::replan(const mrpt::math::TPose2D& pose,
     std::optional<GridPath> p;
     for (const auto* mp : {&m, &static_map_}) {
         planner_.setMap(*mp);
+        // A robot pressed against a wall (when MRPT gives up) stands in a cell the grid
+        // calls too close: planning from there failed every time, and it waited for the
+        // timeout. It plans from the nearest cell it may stand in, a robot radius away at most.
+        const auto start = planner_.nearestTraversable({pose.x, pose.y}, opts_.planner.robot_radius)
+                               .value_or(mrpt::math::TPoint2D{pose.x, pose.y});
         try {
-            p = planner_.plan({pose.x, pose.y}, goal_);
+            p = planner_.plan(start, goal_);
         } catch (const PlanningError& e) {
             last_error_ = e.what();
             p.reset();
@@ -273,6 +294,8 @@ NavState Navigator::step(double t) {
         last_error_ = "robot did not report its pose";
         return NavState::Error;
     }
+    auto& reactive = static_cast<ReactiveNav&>(*nav_);
+    reactive.markVfhSteps();
     const double t0 = threadCpuSeconds();
     nav_->navigationStep();
     last_step_s_ = threadCpuSeconds() - t0;
@@ -326,7 +349,7 @@ NavState Navigator::step(double t) {
     const double radius = opts_.planner.robot_radius + opts_.replan.blocked_margin;
     const bool blocked = pathBlocked(path_.points, {pose.x, pose.y}, unmapped, radius,
                                      opts_.replan.blocked_lookahead);
-    const double density = static_cast<const ReactiveNav&>(*nav_).vfhTargetDensity();
+    const double density = reactive.vfhTargetDensity();
     const ReplanReason why = trigger_.update({t, blocked, std::max(0.0, density)});
     if (why != ReplanReason::None) (void)replan(pose, sensed);
     return NavState::Navigating;

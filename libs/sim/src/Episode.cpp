@@ -44,6 +44,8 @@ const char* toString(Outcome o) {
             return "timeout";
         case Outcome::NoPath:
             return "no_path";
+        case Outcome::Error:
+            return "error";
     }
     return "?";
 }
@@ -122,7 +124,7 @@ EpisodeResult runEpisode(const WorldSpec& world, const mrpt::config::CConfigFile
             res.step_seconds.push_back(navigator.lastStepSeconds());
             next_nav += nav_opts.nav_period;
             if (st == nav::NavState::Error) {
-                res.outcome = Outcome::Timeout;
+                res.outcome = Outcome::Error;  // (was counted as a timeout)
                 res.reason = "navigator error: " + navigator.lastError();
                 break;
             }

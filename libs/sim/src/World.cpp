@@ -260,6 +260,10 @@ void validateRobotAndLaser(const WorldSpec& w) {
     if (w.laser.rays < 2 || w.laser.rays > 100000)
         fail(src, "laser", "rays", "must be in [2, 100000]");
     if (!(w.laser.rate > 0)) fail(src, "laser", "rate_hz", "must be > 0");
+    // The scan plane must cut every obstacle: above the 0.4 m blocks (or at 0 or below) the
+    // robot was blind to them while its planner steered round them.
+    if (!(w.laser.height > 0 && w.laser.height < 0.4))
+        fail(src, "laser", "height", "must be in (0, 0.4) m, below the top of the lowest obstacle");
     if (!(w.laser.noise_std >= 0)) fail(src, "laser", "noise_std", "must be >= 0 m");
     if (!(w.laser.fov > 0) || w.laser.fov > 2 * M_PI + 1e-9)
         fail(src, "laser", "fov_deg", "must be in (0, 360]");

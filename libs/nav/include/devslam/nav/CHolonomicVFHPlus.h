@@ -51,10 +51,14 @@ class CHolonomicVFHPlus : public mrpt::nav::CAbstractHolonomicReactiveMethod {
     VfhPlusOptions options;
     /// The last step's full output (for tests and the replanning trigger).
     [[nodiscard]] const VfhOutput& lastOutput() const { return last_; }
+    /// How many times navigate() has run: MRPT runs a PTG's method only on the steps where
+    /// the target is in that PTG's domain, so lastOutput() may be an older step's.
+    [[nodiscard]] std::uint64_t steps() const { return steps_; }
 
   private:
     VfhState state_;
     VfhOutput last_;
+    std::uint64_t steps_ = 0;
 };
 
 /// Registers CHolonomicVFHPlus and its log record in MRPT's class registry. Idempotent;

@@ -84,6 +84,12 @@ class GridPlanner {
     /// [m] distance from p to the nearest obstacle edge (0 inside an obstacle; a large
     /// value if the map has no obstacle); p must be inside the map.
     [[nodiscard]] double clearance(const mrpt::math::TPoint2D& p) const;
+    /// The centre of the cell nearest to p (within `max_dist` [m] of it) that the robot may
+    /// stand in (clearance >= robot_radius): where to plan from when the robot's own cell is
+    /// too close to an obstacle on the grid, whose clearances are up to a cell and a half
+    /// short of the true distance. p itself when its cell is fine; nullopt when none is near.
+    [[nodiscard]] std::optional<mrpt::math::TPoint2D> nearestTraversable(
+        const mrpt::math::TPoint2D& p, double max_dist) const;
     /// True when every cell on the segment a-b has at least `min_clearance` [m].
     [[nodiscard]] bool segmentClear(const mrpt::math::TPoint2D& a, const mrpt::math::TPoint2D& b,
                                     double min_clearance) const;

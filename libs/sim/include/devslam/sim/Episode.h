@@ -25,7 +25,9 @@ struct EpisodeOptions {
     double record_period = 0.1;  ///< [s] trajectory / tracks sampling
 };
 
-enum class Outcome { Success, Collision, Timeout, NoPath };
+/// NoPath: no global route at the start; Error: the navigator stopped on an error (the
+/// robot did not report its pose).
+enum class Outcome { Success, Collision, Timeout, NoPath, Error };
 [[nodiscard]] const char* toString(Outcome o);
 
 struct EpisodeResult {
