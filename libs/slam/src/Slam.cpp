@@ -15,7 +15,7 @@ void MappingOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, cons
     core::requireKnownKeys(
         c, s,
         {"min_init_points", "cull_min_found_ratio", "cull_min_visible", "cull_keyframe_age",
-         "odometry_sigma_t", "odometry_sigma_r_deg", "depth_time_compensation", "refine_frames"});
+         "cull_ratio_keyframes", "odometry_sigma_t", "odometry_sigma_r_deg", "depth_time_compensation", "refine_frames"});
     depth_time_compensation =
         core::readBool(c, s, "depth_time_compensation", depth_time_compensation);
     refine_frames = core::readBool(c, s, "refine_frames", refine_frames);
@@ -23,6 +23,7 @@ void MappingOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, cons
     cull_min_found_ratio = core::readDouble(c, s, "cull_min_found_ratio", cull_min_found_ratio);
     cull_min_visible = core::readInt(c, s, "cull_min_visible", cull_min_visible);
     cull_keyframe_age = core::readInt(c, s, "cull_keyframe_age", cull_keyframe_age);
+    cull_ratio_keyframes = core::readInt(c, s, "cull_ratio_keyframes", cull_ratio_keyframes);
     odometry_sigma_t = core::readDouble(c, s, "odometry_sigma_t", odometry_sigma_t);
     odometry_sigma_r_deg = core::readDouble(c, s, "odometry_sigma_r_deg", odometry_sigma_r_deg);
     core::requireValue(min_init_points >= 10, s, "min_init_points", "must be >= 10");
@@ -31,6 +32,8 @@ void MappingOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, cons
     core::requireValue(cull_min_visible >= 0, s, "cull_min_visible", "must be >= 0");
     core::requireValue(cull_keyframe_age >= 1, s, "cull_keyframe_age",
                        "must be >= 1 (0 culled every new landmark at once)");
+    core::requireValue(cull_ratio_keyframes >= 0, s, "cull_ratio_keyframes",
+                       "must be >= 0 (0: at any age)");
     core::requireValue(odometry_sigma_t > 0, s, "odometry_sigma_t", "must be > 0 [m]");
     core::requireValue(odometry_sigma_r_deg > 0, s, "odometry_sigma_r_deg", "must be > 0");
 }
@@ -40,6 +43,7 @@ void MappingOptions::saveToConfig(mrpt::config::CConfigFileBase& c, const std::s
     core::writeKey(c, s, "cull_min_found_ratio", cull_min_found_ratio);
     core::writeKey(c, s, "cull_min_visible", cull_min_visible);
     core::writeKey(c, s, "cull_keyframe_age", cull_keyframe_age);
+    core::writeKey(c, s, "cull_ratio_keyframes", cull_ratio_keyframes);
     core::writeKey(c, s, "odometry_sigma_t", odometry_sigma_t);
     core::writeKey(c, s, "odometry_sigma_r_deg", odometry_sigma_r_deg);
     core::writeKey(c, s, "depth_time_compensation", depth_time_compensation);
@@ -225,7 +229,11 @@ MappingResult Slam::mapStep(const core::Frame& frame, FrameFeatures features,
     // keyframe confirmed.
     std::vector<LandmarkId> cull;
     for (const auto& [lid, lm] : map_.landmarks()) {
-        const bool rarely_found = lm.n_visible >= opts_.mapping.cull_min_visible &&
+        // (A landmark behind a person, masked or not, is counted visible and not found: at
+        // any age the test wears away the structure where people stand or sit.)
+        const bool young = opts_.mapping.cull_ratio_keyframes == 0 ||
+                           lm.ref_kf >= id - opts_.mapping.cull_ratio_keyframes;
+        const bool rarely_found = young && lm.n_visible >= opts_.mapping.cull_min_visible &&
                                   lm.n_found < opts_.mapping.cull_min_found_ratio * lm.n_visible;
         const bool unconfirmed =
             lm.ref_kf == id - opts_.mapping.cull_keyframe_age && lm.observations.size() < 2;

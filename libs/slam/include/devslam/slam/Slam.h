@@ -39,6 +39,9 @@ struct MappingOptions {
         0.25;                   ///< found/visible below this (after cull_min_visible) -> removed
     int cull_min_visible = 6;   ///< visible count before the ratio test applies
     int cull_keyframe_age = 3;  ///< landmarks this many keyframes old need >= 2 observations
+    /// The found/visible test applies to landmarks created in the last this many keyframes
+    /// (ORB-SLAM2: about 3); 0: at any age
+    int cull_ratio_keyframes = 0;
     double odometry_sigma_t = 0.01;     ///< [m] consecutive-keyframe edge std in the pose graph
     double odometry_sigma_r_deg = 0.5;  ///< [deg]
     /// Move depth points to the colour image's time with the constant-velocity model when
