@@ -204,6 +204,15 @@ TEST(DetectYolo, BadOptionsAreRejected) {
         EXPECT_EQ(std::string(e.what()),
                   "[detector] classes: 'unicorn' is not in 'models/yolo-fastest-1.1/coco.names'");
     }
+    // Listed twice, every person came out twice (two tracks each): refused.
+    mrpt::config::CConfigFileMemory cfg4;
+    cfg4.write("detector", "classes", std::string("person, person"));
+    try {
+        (void)detect::makeDetector(cfg4);
+        ADD_FAILURE() << "no error";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_EQ(std::string(e.what()), "[detector] classes: 'person' is listed twice");
+    }
 }
 
 // OpenCV zeroes the class scores at or under a [yolo] layer's `thresh` (0.2 where the cfg

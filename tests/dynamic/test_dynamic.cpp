@@ -441,6 +441,7 @@ TEST(DynamicFilter, FrameOfAnotherSizeStartsAfresh) {
     auto det = std::make_unique<ScriptedDetector>();
     ScriptedDetector* script = det.get();
     DynamicObjectFilter filter(testOptions(), std::move(det));
+    int walker_id = -1;
     for (std::size_t i = 0; i < 6; ++i) {
         core::Frame f = seq[i].frame;
         ASSERT_TRUE(seq[i].person_box.has_value()) << "frame " << i;
@@ -458,10 +459,12 @@ TEST(DynamicFilter, FrameOfAnotherSizeStartsAfresh) {
         if (i == 2) {
             ASSERT_EQ(out.boxes.size(), 1u);
             EXPECT_EQ(out.boxes[0].state, BoxState::Moving) << "the walker, before the switch";
+            walker_id = out.boxes[0].id;
         }
         if (i == 3) {  // one track, the new detection's, with no evidence yet
             ASSERT_EQ(out.boxes.size(), 1u);
             EXPECT_EQ(out.boxes[0].state, BoxState::Unknown);
+            EXPECT_GT(out.boxes[0].id, walker_id) << "a new track, with an id of its own";
             EXPECT_GT(detect::iou(out.boxes[0].box, box), 0.99f);
         }
         for (const auto& fp : out.flow)

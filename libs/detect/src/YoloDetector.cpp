@@ -160,7 +160,11 @@ YoloDetector::YoloDetector(const Options& opts) : opts_(opts) {
         const auto it = std::find(names_.begin(), names_.end(), c);
         if (it == names_.end())
             throw UnknownClass("classes: '" + c + "' is not in '" + opts_.names + "'");
-        wanted_.push_back(static_cast<int>(it - names_.begin()));
+        const int k = static_cast<int>(it - names_.begin());
+        // Listed twice, each of its boxes was reported twice (two tracks per person).
+        if (std::find(wanted_.begin(), wanted_.end(), k) != wanted_.end())
+            throw std::invalid_argument("classes: '" + c + "' is listed twice");
+        wanted_.push_back(k);
     }
     std::string weights;
     const auto read = [&](const std::function<cv::dnn::Net()>& reader) {

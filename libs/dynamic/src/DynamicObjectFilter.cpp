@@ -470,7 +470,11 @@ DynamicObjectFilter::DynamicObjectFilter(const Options& opts,
 DynamicObjectFilter::~DynamicObjectFilter() = default;
 
 void DynamicObjectFilter::reset() {
+    // Track ids go on from where they were: a box after the reset is another track, and
+    // its id must not be an old one's (a consumer keying on ids would join the two).
+    const int next_id = impl_->next_id;
     impl_ = std::make_unique<Impl>();
+    impl_->next_id = next_id;
 }
 
 FilterOutput DynamicObjectFilter::step(const core::Frame& frame,

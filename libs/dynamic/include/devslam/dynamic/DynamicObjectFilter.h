@@ -267,7 +267,8 @@ class DynamicObjectFilter {
                                     const std::optional<Eigen::Isometry3d>& T_prev_cur_prior);
 
     [[nodiscard]] const Options& options() const { return opts_; }
-    /// Forgets all tracks and the previous frame (e.g. after tracking is lost).
+    /// Forgets all tracks and the previous frame (e.g. after tracking is lost); later tracks
+    /// get new ids, never an earlier track's.
     void reset();
 
   private:
