@@ -567,7 +567,8 @@ TEST(Results, AFileThatCannotBeReadIsNotWrittenOver) {
     std::ofstream(path) << text;
     namespace fs = std::filesystem;
     fs::permissions(d.str(), fs::perms::all);  // the child may write beside it
-    fs::permissions(path, fs::perms::owner_write | fs::perms::group_write | fs::perms::others_write);
+    fs::permissions(path,
+                    fs::perms::owner_write | fs::perms::group_write | fs::perms::others_write);
     const pid_t pid = fork();
     ASSERT_GE(pid, 0);
     if (pid == 0) {

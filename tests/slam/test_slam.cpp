@@ -788,7 +788,8 @@ TEST(Config, EveryShippedSlamIniLoadsAndUnknownKeysAreRejected) {
              {"[loop_closure]\nmax_candidates = -1\n", "[loop_closure] max_candidates: must be"},
              {"[tracker]\npnp_confidence = 1\n", "[tracker] pnp_confidence: must be in (0, 1)"},
              {"[mapping]\ncull_keyframe_age = 0\n", "[mapping] cull_keyframe_age: must be >= 1"},
-             {"[mapping]\ncull_ratio_keyframes = -1\n", "[mapping] cull_ratio_keyframes: must be >= 0"},
+             {"[mapping]\ncull_ratio_keyframes = -1\n",
+              "[mapping] cull_ratio_keyframes: must be >= 0"},
              {"[tracker]\nrefine_rounds = 0\n", "[tracker] refine_rounds: must be in [1, 10]"},
              // Values so large that a run crashed (grid_cols), ran out of memory or ran for
              // good (refine_rounds, n_levels) before saying which key was wrong.

@@ -121,16 +121,13 @@ RpeResult computeRpe(const core::Trajectory& gt, const core::Trajectory& est,
     // and back to the nearest estimate stamp; fewer than two of those come back when the two
     // trajectories hardly overlap in time, and their pairs would all meet the same
     // ground-truth pose (the figures then the estimate's own motion).
-    std::size_t first_back = 0, n_back = 0;
-    for (std::size_t i = 0; i < se.size() && n_back < 2; ++i) {
-        const std::size_t g = findClosestIndex(sg, se[i] + opts.offset);
-        const std::size_t b = findClosestIndex(se, sg[g] - opts.offset);
-        if (n_back == 0 || b != first_back) {
-            if (n_back == 0) first_back = b;
-            ++n_back;
-        }
-    }
-    if (n_back < 2)
+    const auto back = [&](std::size_t i) {
+        return findClosestIndex(se, sg[findClosestIndex(sg, se[i] + opts.offset)] - opts.offset);
+    };
+    const std::size_t first = back(0);
+    bool two_back = false;
+    for (std::size_t i = 1; i < se.size() && !two_back; ++i) two_back = back(i) != first;
+    if (!two_back)
         throw std::invalid_argument(
             "RPE: the trajectories overlap in time at one estimate pose only (evaluate_rpe.py: "
             "'Number of overlap in the timestamps is too small'): the right files, the right "

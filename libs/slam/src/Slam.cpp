@@ -15,7 +15,8 @@ void MappingOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, cons
     core::requireKnownKeys(
         c, s,
         {"min_init_points", "cull_min_found_ratio", "cull_min_visible", "cull_keyframe_age",
-         "cull_ratio_keyframes", "odometry_sigma_t", "odometry_sigma_r_deg", "depth_time_compensation", "refine_frames"});
+         "cull_ratio_keyframes", "odometry_sigma_t", "odometry_sigma_r_deg",
+         "depth_time_compensation", "refine_frames"});
     depth_time_compensation =
         core::readBool(c, s, "depth_time_compensation", depth_time_compensation);
     refine_frames = core::readBool(c, s, "refine_frames", refine_frames);
