@@ -18,6 +18,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <algorithm>
@@ -27,6 +28,8 @@
 #include <regex>
 #include <tuple>
 #include <vector>
+
+#include <sys/resource.h>
 
 
 namespace fs = std::filesystem;
@@ -598,6 +601,76 @@ TEST(Rawlog, AFullDiskAtTheCloseIsAnError) {
     w.write(f);
     expectError([&] { w.close(); }, "error writing rawlog '/dev/full'");
     w.close();  // closed once: nothing more to report
+}
+
+// A file-size limit (RLIMIT_FSIZE, with SIGXFSZ ignored) for a scope: each file is cut at
+// the limit as on a disk that fills there, and writes past it fail (EFBIG).
+class FileSizeLimit {
+  public:
+    explicit FileSizeLimit(rlim_t bytes) : old_signal_(std::signal(SIGXFSZ, SIG_IGN)) {
+        getrlimit(RLIMIT_FSIZE, &old_);
+        rlimit l = old_;
+        l.rlim_cur = bytes;
+        EXPECT_EQ(setrlimit(RLIMIT_FSIZE, &l), 0);
+    }
+    ~FileSizeLimit() {
+        setrlimit(RLIMIT_FSIZE, &old_);
+        std::signal(SIGXFSZ, old_signal_);
+    }
+    FileSizeLimit(const FileSizeLimit&) = delete;
+    FileSizeLimit& operator=(const FileSizeLimit&) = delete;
+
+  private:
+    rlimit old_{};
+    void (*old_signal_)(int);
+};
+
+// A disk that fills during an image file's last buffer: OpenCV's PNG encoder does not check
+// fclose(), nor MRPT's gz stream gzclose(), so the cut file passed for written. Each writer
+// writes the frame once to learn the file's size, then again with the limit one byte below.
+TEST(Writers, AnImageFileCutAtItsEndIsAnError) {
+    const core::Frame f = io::TumReader(kTum).read(0);
+    TempDir d;
+    {
+        io::TumWriter ok(d.str("ok"));
+        ok.write(f);
+    }
+    std::uintmax_t rgb_size = 0;
+    for (const auto& e : fs::directory_iterator(d.str("ok/rgb")))
+        rgb_size = fs::file_size(e.path());
+    ASSERT_GT(rgb_size, 1000u);
+    {
+        io::TumWriter cut(d.str("cut"));
+        FileSizeLimit limit(rgb_size - 1);
+        expectError([&] { cut.write(f); },
+                    "cannot write '.*cut/rgb/[0-9.]+\\.png': the file is cut short");
+    }
+
+    // A rawlog with external images: a black colour image (a small PNG), then the depth.
+    core::Frame b = f;
+    b.bgr = cv::Mat(f.bgr.size(), CV_8UC3, cv::Scalar(0, 0, 0));
+    io::RawlogWriterOptions wo;
+    wo.external_images = true;
+    {
+        io::RawlogWriter ok(d.str("ok.rawlog"), wo);
+        ok.write(b);
+        ok.close();
+    }
+    const auto depth_size = fs::file_size(d.str("ok_Images/frame_0_depth.bin"));
+    ASSERT_GT(depth_size, fs::file_size(d.str("ok_Images/frame_0_rgb.png")));
+    {
+        io::RawlogWriter cut(d.str("cut.rawlog"), wo);
+        FileSizeLimit limit(depth_size - 1);
+        expectError([&] { cut.write(b); },
+                    "cannot write '.*cut_Images/frame_0_depth\\.bin': .*\\(disk full\\?\\)");
+    }
+    {
+        // And the colour image, when the limit cuts it.
+        io::RawlogWriter cut(d.str("cut2.rawlog"), wo);
+        FileSizeLimit limit(fs::file_size(d.str("ok_Images/frame_0_rgb.png")) - 1);
+        expectError([&] { cut.write(b); },
+                    "cannot write '.*cut2_Images/frame_0_rgb\\.png': the file is cut short");
+    }
 }
 
 // Binary garbage read as an object's class name was echoed to the terminal in the error.

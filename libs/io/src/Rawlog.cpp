@@ -453,8 +453,14 @@ void RawlogWriter::write(const core::Frame& f) {
         const std::string rgb_path = images_dir_ + "/" + base + "_rgb.png";
         if (!obs->intensityImage.saveToFile(rgb_path))
             throw std::runtime_error("cannot write '" + rgb_path + "'");
+        detail::requireWholePng(rgb_path);
         obs->intensityImage.setExternalStorage(base + "_rgb.png");
         obs->rangeImage_convertToExternalStorage(base + "_depth.bin", images_dir_ + "/");
+        // MRPT writes it through a gz stream that ignores what gzclose() returns (the end of
+        // the file leaves zlib's buffers there; see RawlogWriter::Stream): read back whole.
+        const std::string depth_path = images_dir_ + "/" + base + "_depth.bin";
+        if (const std::string d = core::gzipDamage(depth_path); !d.empty())
+            throw std::runtime_error("cannot write '" + depth_path + "': " + d + " (disk full?)");
     }
     auto arch = mrpt::serialization::archiveFrom(static_cast<mrpt::io::CStream&>(*stream_));
     if (opts_.sensory_frames) {

@@ -1,5 +1,8 @@
 #include "TextFile.h"
 
+#include <opencv2/imgcodecs.hpp>
+
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -64,6 +67,23 @@ WrittenFile openForWriting(const std::string& path) {
 void closeWritten(WrittenFile& f, const std::string& error) {
     const bool failed = std::ferror(f.get()) != 0;
     if (std::fclose(f.release()) != 0 || failed) throw std::runtime_error(error);
+}
+
+void writePng(const std::string& path, const cv::Mat& image) {
+    if (!cv::imwrite(path, image)) throw std::runtime_error("cannot write '" + path + "'");
+    requireWholePng(path);
+}
+
+void requireWholePng(const std::string& path) {
+    // The IEND chunk: length 0, type "IEND", CRC AE 42 60 82.
+    static const char kEnd[12] = {0, 0, 0, 0, 'I', 'E', 'N', 'D', '\xAE', '\x42', '\x60', '\x82'};
+    std::ifstream in(path, std::ios::binary | std::ios::ate);
+    char tail[12] = {};
+    const bool whole = in && in.tellg() >= 12 && in.seekg(-12, std::ios::end) &&
+                       in.read(tail, 12) && std::equal(tail, tail + 12, kEnd);
+    if (!whole)
+        throw std::runtime_error("cannot write '" + path +
+                                 "': the file is cut short (disk full?)");
 }
 
 }  // namespace devslam::io::detail

@@ -2,6 +2,8 @@
 // Private helpers: iterate over the data lines of a whitespace-separated text file with
 // '#' comments (the TUM list and trajectory formats), and write one whole.
 
+#include <opencv2/core/mat.hpp>
+
 #include <cstdio>
 #include <functional>
 #include <memory>
@@ -40,5 +42,15 @@ using WrittenFile = std::unique_ptr<std::FILE, int (*)(std::FILE*)>;
 /// failed: the last buffer goes out at fclose, so a full disk is found there, not by ferror
 /// before.
 void closeWritten(WrittenFile& f, const std::string& error);
+
+/// Writes an image with cv::imwrite and checks that the whole file reached the disk;
+/// throws std::runtime_error "cannot write '<path>'" (and why, when known). OpenCV's PNG
+/// encoder does not check fclose(), where stdio's last buffer goes out: a disk that filled
+/// there left a cut PNG behind a success. (PNG only: its last chunk, IEND, is checked.)
+void writePng(const std::string& path, const cv::Mat& image);
+
+/// Throws std::runtime_error "cannot write '<path>': ..." unless the file ends with a PNG's
+/// IEND chunk (an image cut short, e.g. by a full disk, does not).
+void requireWholePng(const std::string& path);
 
 }  // namespace devslam::io::detail

@@ -5,13 +5,10 @@
 
 #include <mrpt/config/CConfigFileMemory.h>
 
-#include <opencv2/imgcodecs.hpp>
-
-#include <fstream>
-
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <stdexcept>
 
 namespace fs = std::filesystem;
@@ -83,10 +80,8 @@ void TumWriter::write(const core::Frame& f) {
     }
     const std::string rgb = "rgb/" + stamp + ".png";
     const std::string depth = "depth/" + depth_stamp + ".png";
-    if (!cv::imwrite(folder_ + "/" + rgb, f.bgr))
-        throw std::runtime_error("cannot write '" + folder_ + "/" + rgb + "'");
-    if (!cv::imwrite(folder_ + "/" + depth, f.rawDepth16(kTumScale)))
-        throw std::runtime_error("cannot write '" + folder_ + "/" + depth + "'");
+    detail::writePng(folder_ + "/" + rgb, f.bgr);
+    detail::writePng(folder_ + "/" + depth, f.rawDepth16(kTumScale));
     std::fprintf(rgb_list_.get(), "%s %s\n", stamp.c_str(), rgb.c_str());
     std::fprintf(depth_list_.get(), "%s %s\n", depth_stamp.c_str(), depth.c_str());
     last_t_ = t;
