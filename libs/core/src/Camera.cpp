@@ -132,6 +132,10 @@ Eigen::Matrix3d CameraIntrinsics::matrix() const {
     return M;
 }
 
+cv::Matx33d CameraIntrinsics::cvMatrix() const {
+    return {fx, 0, cx, 0, fy, cy, 0, 0, 1};
+}
+
 mrpt::img::TCamera CameraIntrinsics::toMrpt() const {
     mrpt::img::TCamera cam;
     cam.ncols = static_cast<uint32_t>(width);
@@ -171,7 +175,7 @@ bool CameraIntrinsics::distorted() const {
 std::vector<cv::Point2f> undistortPixels(const std::vector<cv::Point2f>& px,
                                          const CameraIntrinsics& K) {
     if (!K.distorted() || px.empty()) return px;
-    const cv::Mat Kc = (cv::Mat_<double>(3, 3) << K.fx, 0, K.cx, 0, K.fy, K.cy, 0, 0, 1);
+    const cv::Matx33d Kc = K.cvMatrix();
     const cv::Mat D(1, 5, CV_64F, const_cast<double*>(K.dist.data()));
     std::vector<cv::Point2f> out;
     cv::undistortPoints(px, out, Kc, D, cv::noArray(), Kc);

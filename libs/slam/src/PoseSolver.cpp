@@ -31,7 +31,7 @@ std::optional<PnpResult> solvePnpRansac(const std::vector<PoseObservation>& obs,
                          static_cast<float>(o.p_w.z()));
         img.emplace_back(static_cast<float>(o.uv.x()), static_cast<float>(o.uv.y()));
     }
-    cv::Mat Kc = (cv::Mat_<double>(3, 3) << K.fx, 0, K.cx, 0, K.fy, K.cy, 0, 0, 1);
+    const cv::Matx33d Kc = K.cvMatrix();
     cv::Mat rvec, tvec;
     bool use_guess = false;
     if (guess_T_wc) {

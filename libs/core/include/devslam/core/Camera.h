@@ -54,6 +54,8 @@ struct CameraIntrinsics {
 
     /// The 3x3 camera matrix.
     [[nodiscard]] Eigen::Matrix3d matrix() const;
+    /// The same, for OpenCV's calib3d functions.
+    [[nodiscard]] cv::Matx33d cvMatrix() const;
     /// As an MRPT camera model (for CObservation3DRangeScan).
     [[nodiscard]] mrpt::img::TCamera toMrpt() const;
     [[nodiscard]] static CameraIntrinsics fromMrpt(const mrpt::img::TCamera& cam);
