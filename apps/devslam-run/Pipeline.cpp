@@ -226,6 +226,7 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
         fl.keyframe = mr.keyframe_inserted;
         fl.ba_rejected = mr.ba.rejected;
         if (mr.ba.n_keyframes > 0) ++rep.ba_runs;
+        rep.keyframes_culled += static_cast<std::size_t>(mr.culled_keyframes);
         if (mr.ba.rejected) ++rep.ba_rejected;
         fl.keyframe_reason = slam::toString(mr.reason);
         fl.loop = br.loop_closed;
@@ -418,6 +419,7 @@ std::string formatSummary(const RunReport& r) {
       << (r.async_filter ? ", filter one frame ahead in a second thread" : "") << ")\n"
       << "camera     : " << r.camera << "\n"
       << "frames     : " << r.frames << "   keyframes: " << r.keyframes
+      << (r.keyframes_culled ? " (" + std::to_string(r.keyframes_culled) + " culled)" : "")
       << "   landmarks: " << r.landmarks << "   loops closed: " << r.loops << "\n";
     if (const auto e = loopErrors(r.loop_reports); !e.empty()) {
         const auto s = core::summarize(e);
@@ -532,7 +534,9 @@ std::string toJson(const RunReport& r) {
       << esc(r.input_damage) << "\",\n  \"read_error\": \"" << esc(r.read_error)
       << "\",\n  \"interrupted\": \"" << r.interrupted << "\",\n  \"mode\": \"" << r.mode
       << "\",\n  \"mask_source\": \"" << esc(r.mask_source) << "\",\n  \"frames\": " << r.frames
-      << ",\n  \"keyframes\": " << r.keyframes << ",\n  \"landmarks\": " << r.landmarks
+      << ",\n  \"keyframes\": " << r.keyframes
+      << ",\n  \"keyframes_culled\": " << r.keyframes_culled
+      << ",\n  \"landmarks\": " << r.landmarks
       << ",\n  \"local_ba_runs\": " << r.ba_runs << ",\n  \"local_ba_rejected\": " << r.ba_rejected
       << ",\n  \"loops_closed\": " << r.loops << ",\n  \"lost_frames\": " << r.lost.size()
       << ",\n  \"lost_frame_indices\": [";

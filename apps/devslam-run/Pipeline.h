@@ -79,6 +79,7 @@ struct RunReport {
     std::string interrupted;
     bool async_filter = false;
     std::size_t frames = 0, keyframes = 0, landmarks = 0, loops = 0;
+    std::size_t keyframes_culled = 0;  ///< redundant keyframes removed ([mapping])
     std::vector<std::size_t> lost;  ///< frame indices without a tracked pose
     std::size_t ba_runs = 0, ba_rejected = 0;  ///< local BAs, and those not applied
     double ba_max_shift = 0;  ///< [m] [local_ba] max_keyframe_shift (0 = off)

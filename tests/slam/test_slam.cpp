@@ -621,6 +621,45 @@ TEST(Map, ObservationsAndRemovalStayConsistent) {
     EXPECT_THROW((void)map.keyframe(42), std::out_of_range);
 }
 
+TEST(Map, RedundancyAndKeyframeRemoval) {
+    // Keyframes 0..3; landmark a seen by all four, b by 0 and 1 (created by 1), c by 1 only.
+    Map map;
+    Keyframe kf;
+    kf.features.keypoints.resize(3);
+    kf.features.descriptors = cv::Mat(3, 32, CV_8U, cv::Scalar(1));
+    std::vector<KeyframeId> k;
+    for (int i = 0; i < 4; ++i) k.push_back(map.addKeyframe(kf));
+    const auto d = kf.features.descriptors.row(0);
+    const LandmarkId a = map.addLandmark({0, 0, 1}, d, {}, k[0], 0);
+    for (int i = 1; i < 4; ++i) map.addObservation(a, k[i], 0);
+    const LandmarkId b = map.addLandmark({0, 1, 1}, d, {}, k[1], 1);
+    map.addObservation(b, k[0], 1);
+    const LandmarkId c = map.addLandmark({1, 0, 1}, d, {}, k[1], 2);
+    // Keyframe 1: a has 3 other observers, b 1, c none.
+    EXPECT_DOUBLE_EQ(map.redundantFraction(k[1], 3), 1.0 / 3.0);
+    EXPECT_DOUBLE_EQ(map.redundantFraction(k[1], 1), 2.0 / 3.0);
+    EXPECT_DOUBLE_EQ(map.redundantFraction(k[3], 3), 1.0);
+    // An observer at a coarser level than one above counts for nothing.
+    map.keyframe(k[2]).features.keypoints[0].octave = 2;
+    EXPECT_DOUBLE_EQ(map.redundantFraction(k[3], 3), 0.0);
+    EXPECT_DOUBLE_EQ(map.redundantFraction(k[3], 2), 1.0);
+    map.keyframe(k[2]).features.keypoints[0].octave = 0;
+
+    // Removing keyframe 1: c goes with it, b is re-anchored to keyframe 0 (its creation
+    // stays keyframe 1), a keeps its three other observations.
+    EXPECT_EQ(map.removeKeyframe(k[1]), 1);
+    EXPECT_EQ(map.keyframes().count(k[1]), 0u);
+    EXPECT_EQ(map.landmark(c), nullptr);
+    ASSERT_NE(map.landmark(b), nullptr);
+    EXPECT_EQ(map.landmark(b)->ref_kf, k[0]);
+    EXPECT_EQ(map.landmark(b)->created_kf, k[1]);
+    EXPECT_EQ(map.landmark(b)->observations.size(), 1u);
+    EXPECT_EQ(map.landmark(a)->observations.size(), 3u);
+    EXPECT_EQ(map.landmark(a)->ref_kf, k[0]);
+    EXPECT_EQ(map.landmarksOf({k[0], k[2], k[3]}), (std::vector<LandmarkId>{a, b}));
+    EXPECT_THROW((void)map.removeKeyframe(k[1]), std::out_of_range);
+}
+
 /// 4 keyframes looking at 300 points (noise-free keypoints and depths); keyframes 1..3
 /// start 1-2 cm off their true pose (keyframe 3 also by `extra_3`), and the points by 1 cm
 /// noise. Keyframe 0 is the gauge.

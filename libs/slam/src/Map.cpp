@@ -23,6 +23,7 @@ LandmarkId Map::addLandmark(const Eigen::Vector3d& p_w, const cv::Mat& descripto
     lm.descriptor = descriptor.clone();
     lm.color = color;
     lm.ref_kf = kf;
+    lm.created_kf = kf;
     const LandmarkId id = lm.id;
     landmarks_.emplace(id, std::move(lm));
     addObservation(id, kf, kp);
@@ -62,6 +63,48 @@ void Map::removeLandmark(LandmarkId lm) {
             k->second.landmark_of_kp[kp] = kNoId;
     }
     landmarks_.erase(it);
+}
+
+int Map::removeKeyframe(KeyframeId id) {
+    const Keyframe& k = keyframe(id);
+    int orphans = 0;
+    for (std::size_t kp = 0; kp < k.landmark_of_kp.size(); ++kp) {
+        auto it = landmarks_.find(k.landmark_of_kp[kp]);
+        if (it == landmarks_.end()) continue;
+        auto& obs = it->second.observations;
+        obs.erase(std::remove(obs.begin(), obs.end(), std::make_pair(id, static_cast<int>(kp))),
+                  obs.end());
+        if (obs.empty()) {
+            landmarks_.erase(it);
+            ++orphans;
+        } else if (it->second.ref_kf == id) {
+            it->second.ref_kf =
+                std::min_element(obs.begin(), obs.end())->first;  // the oldest observer
+        }
+    }
+    keyframes_.erase(id);
+    return orphans;
+}
+
+double Map::redundantFraction(KeyframeId id, int min_observers) const {
+    const Keyframe& k = keyframe(id);
+    int n = 0, redundant = 0;
+    for (std::size_t kp = 0; kp < k.landmark_of_kp.size(); ++kp) {
+        const Landmark* l = landmark(k.landmark_of_kp[kp]);
+        if (!l) continue;
+        ++n;
+        // Seen as sharply elsewhere: at the same pyramid level, one coarser, or finer.
+        const int level = k.features.keypoints[kp].octave;
+        int others = 0;
+        for (const auto& [kf, okp] : l->observations) {
+            if (kf == id) continue;
+            if (keyframe(kf).features.keypoints[static_cast<std::size_t>(okp)].octave <= level + 1)
+                ++others;
+            if (others >= min_observers) break;
+        }
+        if (others >= min_observers) ++redundant;
+    }
+    return n > 0 ? static_cast<double>(redundant) / n : 0.0;
 }
 
 Keyframe& Map::keyframe(KeyframeId id) {

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <iterator>
 
 namespace devslam::slam {
 
@@ -15,8 +16,9 @@ void MappingOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, cons
     core::requireKnownKeys(
         c, s,
         {"min_init_points", "cull_min_found_ratio", "cull_min_visible", "cull_keyframe_age",
-         "cull_ratio_keyframes", "odometry_sigma_t", "odometry_sigma_r_deg",
-         "depth_time_compensation", "refine_frames"});
+         "cull_ratio_keyframes", "redundant_keyframe_ratio", "redundant_keyframe_observers",
+         "odometry_sigma_t", "odometry_sigma_r_deg", "depth_time_compensation",
+         "refine_frames"});
     depth_time_compensation =
         core::readBool(c, s, "depth_time_compensation", depth_time_compensation);
     refine_frames = core::readBool(c, s, "refine_frames", refine_frames);
@@ -25,6 +27,10 @@ void MappingOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, cons
     cull_min_visible = core::readInt(c, s, "cull_min_visible", cull_min_visible);
     cull_keyframe_age = core::readInt(c, s, "cull_keyframe_age", cull_keyframe_age);
     cull_ratio_keyframes = core::readInt(c, s, "cull_ratio_keyframes", cull_ratio_keyframes);
+    redundant_keyframe_ratio =
+        core::readDouble(c, s, "redundant_keyframe_ratio", redundant_keyframe_ratio);
+    redundant_keyframe_observers =
+        core::readInt(c, s, "redundant_keyframe_observers", redundant_keyframe_observers);
     odometry_sigma_t = core::readDouble(c, s, "odometry_sigma_t", odometry_sigma_t);
     odometry_sigma_r_deg = core::readDouble(c, s, "odometry_sigma_r_deg", odometry_sigma_r_deg);
     core::requireValue(min_init_points >= 10, s, "min_init_points", "must be >= 10");
@@ -35,6 +41,10 @@ void MappingOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, cons
                        "must be >= 1 (0 culled every new landmark at once)");
     core::requireValue(cull_ratio_keyframes >= 0, s, "cull_ratio_keyframes",
                        "must be >= 0 (0: at any age)");
+    core::requireValue(redundant_keyframe_ratio >= 0 && redundant_keyframe_ratio <= 1, s,
+                       "redundant_keyframe_ratio", "must be in [0, 1] (0: no keyframe culling)");
+    core::requireValue(redundant_keyframe_observers >= 1, s, "redundant_keyframe_observers",
+                       "must be >= 1");
     core::requireValue(odometry_sigma_t > 0, s, "odometry_sigma_t", "must be > 0 [m]");
     core::requireValue(odometry_sigma_r_deg > 0, s, "odometry_sigma_r_deg", "must be > 0");
 }
@@ -45,6 +55,8 @@ void MappingOptions::saveToConfig(mrpt::config::CConfigFileBase& c, const std::s
     core::writeKey(c, s, "cull_min_visible", cull_min_visible);
     core::writeKey(c, s, "cull_keyframe_age", cull_keyframe_age);
     core::writeKey(c, s, "cull_ratio_keyframes", cull_ratio_keyframes);
+    core::writeKey(c, s, "redundant_keyframe_ratio", redundant_keyframe_ratio);
+    core::writeKey(c, s, "redundant_keyframe_observers", redundant_keyframe_observers);
     core::writeKey(c, s, "odometry_sigma_t", odometry_sigma_t);
     core::writeKey(c, s, "odometry_sigma_r_deg", odometry_sigma_r_deg);
     core::writeKey(c, s, "depth_time_compensation", depth_time_compensation);
@@ -233,16 +245,17 @@ MappingResult Slam::mapStep(const core::Frame& frame, FrameFeatures features,
         // (A landmark behind a person, masked or not, is counted visible and not found: at
         // any age the test wears away the structure where people stand or sit.)
         const bool young = opts_.mapping.cull_ratio_keyframes == 0 ||
-                           lm.ref_kf >= id - opts_.mapping.cull_ratio_keyframes;
+                           lm.created_kf >= id - opts_.mapping.cull_ratio_keyframes;
         const bool rarely_found = young && lm.n_visible >= opts_.mapping.cull_min_visible &&
                                   lm.n_found < opts_.mapping.cull_min_found_ratio * lm.n_visible;
         const bool unconfirmed =
-            lm.ref_kf == id - opts_.mapping.cull_keyframe_age && lm.observations.size() < 2;
+            lm.created_kf == id - opts_.mapping.cull_keyframe_age && lm.observations.size() < 2;
         if (rarely_found || unconfirmed) cull.push_back(lid);
     }
     for (LandmarkId lid : cull) map_.removeLandmark(lid);
     out.culled_landmarks = static_cast<int>(cull.size());
     if (opts_.local_ba.enabled) out.ba = localBundleAdjust(map_, id, frame.K, opts_.local_ba);
+    out.culled_keyframes = cullKeyframes(id);
     // Without local BA nothing moved to refine against until finalize(), but the frames
     // whose keyframe left the window are released all the same (else a long run keeps
     // every frame's observations).
@@ -252,6 +265,37 @@ MappingResult Slam::mapStep(const core::Frame& frame, FrameFeatures features,
     // The tracker continues from the (possibly adjusted) keyframe pose.
     tracker_.applyCorrection(map_.keyframe(id).T_wc * track.T_wc.inverse());
     return out;
+}
+
+int Slam::cullKeyframes(KeyframeId newest) {
+    if (opts_.mapping.redundant_keyframe_ratio <= 0) return 0;
+    // Kept: the first keyframe (the world frame and the pose graph's gauge), the newest,
+    // and the keyframes of closed or pending loops (the graph's loop edges).
+    std::vector<KeyframeId> keep{map_.keyframes().begin()->first, newest};
+    for (const auto& l : loops_) keep.insert(keep.end(), {l.old_kf, l.new_kf});
+    if (pending_loop_) keep.insert(keep.end(), {pending_loop_->old_kf, pending_loop_->new_kf});
+    int culled = 0;
+    // Oldest first: a keyframe removed no longer counts as an observer of the next ones.
+    for (KeyframeId k : map_.lastKeyframes(static_cast<std::size_t>(opts_.local_ba.window))) {
+        if (std::find(keep.begin(), keep.end(), k) != keep.end()) continue;
+        if (map_.redundantFraction(k, opts_.mapping.redundant_keyframe_observers) <
+            opts_.mapping.redundant_keyframe_ratio)
+            continue;
+        // Its frames (a contiguous run: records_ is in time order and each frame references
+        // the newest keyframe when it was tracked) keep their poses, relative to the
+        // keyframe before it.
+        const KeyframeId p = std::prev(map_.keyframes().find(k))->first;  // exists: the first keyframe is kept
+        const Eigen::Isometry3d T_p_k = map_.keyframe(p).T_wc.inverse() * map_.keyframe(k).T_wc;
+        for (auto r = records_.rbegin(); r != records_.rend() && r->ref_kf >= k; ++r) {
+            if (r->ref_kf != k) continue;
+            r->ref_kf = p;
+            r->T_ref_c = T_p_k * r->T_ref_c;
+            r->is_keyframe = false;
+        }
+        (void)map_.removeKeyframe(k);
+        ++culled;
+    }
+    return culled;
 }
 
 void Slam::refineFrames(const std::vector<KeyframeId>& window, const core::CameraIntrinsics& K,

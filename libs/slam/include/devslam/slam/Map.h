@@ -26,6 +26,14 @@ class Map {
     void removeLandmark(LandmarkId lm);
     /// Removes one observation (keyframe kf, keypoint kp), if present.
     void removeObservation(LandmarkId lm, KeyframeId kf, int kp);
+    /// Removes a keyframe (which must exist) and its observations. A landmark no other
+    /// keyframe observes goes with it; one it anchored (ref_kf) is anchored to its oldest
+    /// remaining observer. Returns the number of landmarks removed.
+    int removeKeyframe(KeyframeId id);
+    /// Fraction of the landmarks keyframe `id` observes that at least `min_observers` other
+    /// keyframes observe at the same pyramid level, one coarser, or finer (ORB-SLAM2's
+    /// redundancy test); 0 for a keyframe without landmarks.
+    [[nodiscard]] double redundantFraction(KeyframeId id, int min_observers) const;
 
     [[nodiscard]] const std::map<KeyframeId, Keyframe>& keyframes() const { return keyframes_; }
     [[nodiscard]] std::map<KeyframeId, Keyframe>& keyframes() { return keyframes_; }

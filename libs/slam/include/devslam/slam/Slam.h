@@ -42,6 +42,13 @@ struct MappingOptions {
     /// The found/visible test applies to landmarks created in the last this many keyframes
     /// (ORB-SLAM2: about 3); 0: at any age
     int cull_ratio_keyframes = 0;
+    /// A keyframe of the local-BA window (not the newest, the first or a loop's) is removed
+    /// when at least this fraction of its landmarks is observed by
+    /// `redundant_keyframe_observers` other keyframes at the same or a finer scale
+    /// (ORB-SLAM2's keyframe culling, 0.9 there); 0: keyframes are never removed. Bounds the
+    /// map of a camera that stands still (a robot waiting adds a keyframe every max_frames).
+    double redundant_keyframe_ratio = 0.0;
+    int redundant_keyframe_observers = 3;
     double odometry_sigma_t = 0.01;     ///< [m] consecutive-keyframe edge std in the pose graph
     double odometry_sigma_r_deg = 0.5;  ///< [deg]
     /// Move depth points to the colour image's time with the constant-velocity model when
@@ -92,6 +99,7 @@ struct MappingResult {
     KeyframeId keyframe = kNoId;
     int new_landmarks = 0;
     int culled_landmarks = 0;
+    int culled_keyframes = 0;  ///< redundant keyframes removed (redundant_keyframe_ratio)
     LocalBaResult ba;
 };
 
@@ -182,6 +190,9 @@ class Slam {
     /// observations of older frames.
     void refineFrames(const std::vector<KeyframeId>& window, const core::CameraIntrinsics& K,
                       bool adjust = true);
+    /// Removes the redundant keyframes of the local window before `newest` (see
+    /// MappingOptions::redundant_keyframe_ratio); their frames move to the keyframe before.
+    int cullKeyframes(KeyframeId newest);
     std::size_t first_record_with_obs_ = 0;
 
     SlamOptions opts_;

@@ -91,7 +91,10 @@ struct Landmark {
     Eigen::Vector3d p_w = Eigen::Vector3d::Zero();  ///< [m] world
     cv::Mat descriptor;                             ///< 1x32 CV_8U (of the reference observation)
     cv::Vec3b color{0, 0, 0};                       ///< BGR
-    KeyframeId ref_kf = kNoId;                      ///< keyframe that created it
+    /// The keyframe its position moves with when a loop corrects the keyframes: the one
+    /// that created it, or, once that one is culled, its oldest remaining observer.
+    KeyframeId ref_kf = kNoId;
+    KeyframeId created_kf = kNoId;  ///< keyframe that created it (its age; may be culled)
     int n_visible = 0;                              ///< times it projected inside a tracked frame
     int n_found = 0;  ///< times it was matched (inlier) in a tracked frame
     std::vector<std::pair<KeyframeId, int>> observations;  ///< (keyframe, keypoint index)
