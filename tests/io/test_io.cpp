@@ -31,7 +31,6 @@
 
 #include <sys/resource.h>
 
-
 namespace fs = std::filesystem;
 using namespace devslam;
 

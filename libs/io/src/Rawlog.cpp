@@ -451,9 +451,7 @@ void RawlogWriter::write(const core::Frame& f) {
         const std::string base = "frame_" + std::to_string(count_);
         mrpt::img::CImage::setImagesPathBase(images_dir_);
         const std::string rgb_path = images_dir_ + "/" + base + "_rgb.png";
-        if (!obs->intensityImage.saveToFile(rgb_path))
-            throw std::runtime_error("cannot write '" + rgb_path + "'");
-        detail::requireWholePng(rgb_path);
+        detail::writePng(rgb_path, obs->intensityImage.asCvMatRef());
         obs->intensityImage.setExternalStorage(base + "_rgb.png");
         obs->rangeImage_convertToExternalStorage(base + "_depth.bin", images_dir_ + "/");
         // MRPT writes it through a gz stream that ignores what gzclose() returns (the end of

@@ -69,11 +69,9 @@ void closeWritten(WrittenFile& f, const std::string& error) {
     if (std::fclose(f.release()) != 0 || failed) throw std::runtime_error(error);
 }
 
-void writePng(const std::string& path, const cv::Mat& image) {
-    if (!cv::imwrite(path, image)) throw std::runtime_error("cannot write '" + path + "'");
-    requireWholePng(path);
-}
+namespace {
 
+// Throws unless the file ends with a PNG's IEND chunk (an image cut short does not).
 void requireWholePng(const std::string& path) {
     // The IEND chunk: length 0, type "IEND", CRC AE 42 60 82.
     static const char kEnd[12] = {0, 0, 0, 0, 'I', 'E', 'N', 'D', '\xAE', '\x42', '\x60', '\x82'};
@@ -84,6 +82,13 @@ void requireWholePng(const std::string& path) {
     if (!whole)
         throw std::runtime_error("cannot write '" + path +
                                  "': the file is cut short (disk full?)");
+}
+
+}  // namespace
+
+void writePng(const std::string& path, const cv::Mat& image) {
+    if (!cv::imwrite(path, image)) throw std::runtime_error("cannot write '" + path + "'");
+    requireWholePng(path);
 }
 
 }  // namespace devslam::io::detail

@@ -49,8 +49,4 @@ void closeWritten(WrittenFile& f, const std::string& error);
 /// there left a cut PNG behind a success. (PNG only: its last chunk, IEND, is checked.)
 void writePng(const std::string& path, const cv::Mat& image);
 
-/// Throws std::runtime_error "cannot write '<path>': ..." unless the file ends with a PNG's
-/// IEND chunk (an image cut short, e.g. by a full disk, does not).
-void requireWholePng(const std::string& path);
-
 }  // namespace devslam::io::detail

@@ -69,17 +69,16 @@ int Map::removeKeyframe(KeyframeId id) {
     const Keyframe& k = keyframe(id);
     int orphans = 0;
     for (std::size_t kp = 0; kp < k.landmark_of_kp.size(); ++kp) {
-        auto it = landmarks_.find(k.landmark_of_kp[kp]);
-        if (it == landmarks_.end()) continue;
-        auto& obs = it->second.observations;
-        obs.erase(std::remove(obs.begin(), obs.end(), std::make_pair(id, static_cast<int>(kp))),
-                  obs.end());
+        const LandmarkId lm = k.landmark_of_kp[kp];
+        Landmark* l = landmark(lm);
+        if (!l) continue;
+        removeObservation(lm, id, static_cast<int>(kp));
+        const auto& obs = l->observations;
         if (obs.empty()) {
-            landmarks_.erase(it);
+            landmarks_.erase(lm);
             ++orphans;
-        } else if (it->second.ref_kf == id) {
-            it->second.ref_kf =
-                std::min_element(obs.begin(), obs.end())->first;  // the oldest observer
+        } else if (l->ref_kf == id) {
+            l->ref_kf = std::min_element(obs.begin(), obs.end())->first;  // the oldest observer
         }
     }
     keyframes_.erase(id);

@@ -284,7 +284,8 @@ int Slam::cullKeyframes(KeyframeId newest) {
         // Its frames (a contiguous run: records_ is in time order and each frame references
         // the newest keyframe when it was tracked) keep their poses, relative to the
         // keyframe before it.
-        const KeyframeId p = std::prev(map_.keyframes().find(k))->first;  // exists: the first keyframe is kept
+        // (The keyframe before it exists: the first keyframe is kept.)
+        const KeyframeId p = std::prev(map_.keyframes().find(k))->first;
         const Eigen::Isometry3d T_p_k = map_.keyframe(p).T_wc.inverse() * map_.keyframe(k).T_wc;
         for (auto r = records_.rbegin(); r != records_.rend() && r->ref_kf >= k; ++r) {
             if (r->ref_kf != k) continue;
