@@ -566,6 +566,67 @@ TEST(Tracker, RelocalizationCannotJumpFarAfterAShortLoss) {
     EXPECT_TRUE(Tracker(o).relocPlausible(moved(5, 90), 100.0));
 }
 
+TEST(Tracker, ARevisitedPlaceIsTrackedAgainstItsOldKeyframe) {
+    // Keyframe 0 saw 300 points 2-3 m ahead; the camera then went 20 m away (keyframes 1..10,
+    // with nothing in common with keyframe 0) and is back where keyframe 0 was.
+    const auto K = fr1NoDist();
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<double> U(-1, 1);
+    std::uniform_int_distribution<int> byte(0, 255);
+    Map map;
+    Keyframe kf0;
+    kf0.T_wc = makePose(0, 0, 0, 0, 0, 0);
+    std::vector<Eigen::Vector3d> pts;
+    cv::Mat desc(300, 32, CV_8U);
+    for (int i = 0; i < 300; ++i) {
+        pts.emplace_back(U(rng) * 1.0, U(rng) * 0.7, 2.5 + U(rng) * 0.5);
+        for (int b = 0; b < 32; ++b) desc.at<unsigned char>(i, b) = static_cast<unsigned char>(byte(rng));
+    }
+    // The keypoints a camera at T_wc sees of the points (noise-free), with their depths.
+    const auto view = [&](const Eigen::Isometry3d& T_wc) {
+        FrameFeatures f;
+        for (int i = 0; i < 300; ++i) {
+            const Eigen::Vector3d pc = T_wc.inverse() * pts[i];
+            const auto uv = core::project(pc, K);
+            f.keypoints.emplace_back(
+                cv::Point2f(static_cast<float>(uv->x()), static_cast<float>(uv->y())), 7.f, -1.f,
+                1.f, 0);
+            f.depth.push_back(static_cast<float>(pc.z()));
+            f.points_c.push_back(pc);
+        }
+        f.descriptors = desc.clone();
+        return f;
+    };
+    kf0.features = view(kf0.T_wc);
+    const KeyframeId k0 = map.addKeyframe(kf0);
+    for (int i = 0; i < 300; ++i) (void)map.addLandmark(pts[i], desc.row(i), {}, k0, i);
+    for (int k = 1; k <= 10; ++k) {
+        Keyframe far;
+        far.T_wc = makePose(20.0 + 0.1 * k, 0, 0, 0, 0, 0);
+        map.addKeyframe(far);
+    }
+    const Eigen::Isometry3d T_now = makePose(0.03, -0.01, 0.02, 0.01, 0.02, 0);
+    const FrameFeatures f = view(T_now);
+    for (const int near : {0, 2}) {
+        TrackerOptions o;
+        o.near_keyframes = near;
+        Tracker tr(o);
+        tr.initialize(makePose(0.02, 0, 0.01, 0, 0.01, 0), 10.0);
+        const auto r = tr.track({&f, 10.033, std::nullopt}, map, K);
+        if (near == 0) {
+            // Relocalization finds keyframe 0, but the local map (the newest keyframes)
+            // holds none of its points.
+            EXPECT_FALSE(r.pose_valid) << r.reason;
+            EXPECT_EQ(tr.state(), TrackingState::Lost);
+        } else {
+            ASSERT_TRUE(r.pose_valid) << r.reason;
+            EXPECT_EQ(r.state, TrackingState::Ok) << "tracked, not relocalized";
+            EXPECT_GE(r.n_inliers, 290);
+            EXPECT_LT((r.T_wc.translation() - T_now.translation()).norm(), 1e-3);
+        }
+    }
+}
+
 TEST(Matching, HammingAndBruteForce) {
     cv::Mat a(3, 32, CV_8U, cv::Scalar(0)), b(3, 32, CV_8U, cv::Scalar(0));
     a.row(0).setTo(0xFF);

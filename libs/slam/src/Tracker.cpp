@@ -31,6 +31,7 @@ void TrackerOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, cons
                                   "refine_rounds",      "refine_iterations",
                                   "min_matches",        "min_inliers",
                                   "local_keyframes",    "max_motion_dt",
+                                  "near_keyframes",     "near_max_angle_deg",
                                   "reloc_keyframes",    "reloc_min_inliers",
                                   "reloc_max_hamming",  "reloc_ratio",
                                   "reloc_max_jump",     "reloc_max_speed",
@@ -50,6 +51,8 @@ void TrackerOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, cons
     min_matches = core::readInt(c, s, "min_matches", min_matches);
     min_inliers = core::readInt(c, s, "min_inliers", min_inliers);
     local_keyframes = core::readInt(c, s, "local_keyframes", local_keyframes);
+    near_keyframes = core::readInt(c, s, "near_keyframes", near_keyframes);
+    near_max_angle_deg = core::readDouble(c, s, "near_max_angle_deg", near_max_angle_deg);
     max_motion_dt = core::readDouble(c, s, "max_motion_dt", max_motion_dt);
     reloc_keyframes = core::readInt(c, s, "reloc_keyframes", reloc_keyframes);
     reloc_min_inliers = core::readInt(c, s, "reloc_min_inliers", reloc_min_inliers);
@@ -82,6 +85,10 @@ void TrackerOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, cons
     core::requireValue(min_inliers >= 6, s, "min_inliers", "must be >= 6");
     core::requireValue(local_keyframes >= 1 && local_keyframes <= 1000, s, "local_keyframes",
                        "must be in [1, 1000]");
+    core::requireValue(near_keyframes >= 0 && near_keyframes <= 1000, s, "near_keyframes",
+                       "must be in [0, 1000]");
+    core::requireValue(near_max_angle_deg > 0 && near_max_angle_deg <= 180, s,
+                       "near_max_angle_deg", "must be in (0, 180] [deg]");
     core::requireValue(max_motion_dt >= 0, s, "max_motion_dt",
                        "must be >= 0 [s] (0: no motion model)");
     core::requireValue(reloc_keyframes >= 1 && reloc_keyframes <= 1000, s, "reloc_keyframes",
@@ -112,6 +119,8 @@ void TrackerOptions::saveToConfig(mrpt::config::CConfigFileBase& c, const std::s
     core::writeKey(c, s, "min_matches", min_matches);
     core::writeKey(c, s, "min_inliers", min_inliers);
     core::writeKey(c, s, "local_keyframes", local_keyframes);
+    core::writeKey(c, s, "near_keyframes", near_keyframes);
+    core::writeKey(c, s, "near_max_angle_deg", near_max_angle_deg);
     core::writeKey(c, s, "max_motion_dt", max_motion_dt);
     core::writeKey(c, s, "reloc_keyframes", reloc_keyframes);
     core::writeKey(c, s, "reloc_min_inliers", reloc_min_inliers);
@@ -266,6 +275,26 @@ std::optional<Eigen::Isometry3d> Tracker::relocalize(const FrameFeatures& f, con
     return best;
 }
 
+std::vector<LandmarkId> Tracker::localMap(const Map& map, const Eigen::Isometry3d& T_wc) const {
+    auto kfs = map.lastKeyframes(static_cast<std::size_t>(opts_.local_keyframes));
+    if (opts_.near_keyframes > 0 && map.keyframes().size() > kfs.size()) {
+        // Keyframes are kept in id order, so the newest are the map's last entries.
+        const KeyframeId oldest_newest = kfs.front();
+        const double min_cos = std::cos(opts_.near_max_angle_deg * M_PI / 180.0);
+        const Eigen::Vector3d axis = T_wc.linear().col(2);
+        std::vector<std::pair<double, KeyframeId>> near;
+        for (const auto& [id, kf] : map.keyframes()) {
+            if (id >= oldest_newest) break;
+            if (kf.T_wc.linear().col(2).dot(axis) < min_cos) continue;
+            near.emplace_back((kf.T_wc.translation() - T_wc.translation()).norm(), id);
+        }
+        const std::size_t n = std::min(near.size(), static_cast<std::size_t>(opts_.near_keyframes));
+        std::partial_sort(near.begin(), near.begin() + static_cast<std::ptrdiff_t>(n), near.end());
+        for (std::size_t i = 0; i < n; ++i) kfs.push_back(near[i].second);
+    }
+    return map.landmarksOf(kfs);
+}
+
 TrackResult Tracker::track(const TrackInput& in, Map& map, const core::CameraIntrinsics& K) {
     TrackResult res;
     const FrameFeatures& f = *in.features;
@@ -282,7 +311,7 @@ TrackResult Tracker::track(const TrackInput& in, Map& map, const core::CameraInt
                               : predictPrevCur(in.timestamp);
     const Eigen::Isometry3d pred = last_T_wc_ * prev_cur.value_or(Eigen::Isometry3d::Identity());
     res.T_wc = pred;
-    const auto local = map.landmarksOf(map.lastKeyframes(opts_.local_keyframes));
+    const auto local = localMap(map, pred);
 
     std::optional<PoseRefineResult> ok;
     const bool was_lost = state_ == TrackingState::Lost;
@@ -292,7 +321,7 @@ TrackResult Tracker::track(const TrackInput& in, Map& map, const core::CameraInt
         // Relocalize against keyframes, then track the local map from that pose.
         TrackResult reloc_res;
         if (const auto T = relocalize(f, map, K, in.timestamp)) {
-            auto near = map.landmarksOf(map.lastKeyframes(opts_.local_keyframes));
+            const auto near = localMap(map, *T);
             std::vector<LandmarkId> reloc_in_view;
             ok = trackWithMap(f, map, K, *T, near, reloc_res, reloc_in_view);
             // The local map may pull the pose away again (its newest keyframes can be the

@@ -37,6 +37,11 @@ struct TrackerOptions {
     int min_matches = 20;         ///< fewer projection matches: wide search, then relocalize
     int min_inliers = 20;         ///< fewer inliers after refinement: tracking failed
     int local_keyframes = 10;     ///< the local map = landmarks of the last N keyframes
+    /// ... and of the N keyframes nearest the predicted camera (centre distance), among
+    /// those whose optical axis is within near_max_angle_deg of its own: a revisited place
+    /// is tracked against its old landmarks instead of growing new ones. 0: newest only.
+    int near_keyframes = 0;
+    double near_max_angle_deg = 45.0;  ///< [deg]
     double max_motion_dt = 0.25;  ///< [s] larger frame gaps: no velocity extrapolation
     int reloc_keyframes = 10;     ///< keyframes tried when relocalizing (newest, nearest)
     int reloc_min_inliers = 25;   ///< PnP inliers needed to relocalize
@@ -119,6 +124,10 @@ class Tracker {
     std::optional<Eigen::Isometry3d> relocalize(const FrameFeatures& f, const Map& map,
                                                 const core::CameraIntrinsics& K,
                                                 double timestamp) const;
+
+    /// The landmarks of the local map for a camera at `T_wc` (local_keyframes newest,
+    /// near_keyframes nearest).
+    std::vector<LandmarkId> localMap(const Map& map, const Eigen::Isometry3d& T_wc) const;
 
     TrackerOptions opts_;
     TrackingState state_ = TrackingState::NotInitialized;
