@@ -119,6 +119,8 @@ RunFigures readRun(const std::string& json_path) {
     f.fps_median = number("median_fps");
     f.fps_mean = number("mean_fps");
     f.lost = number("lost_frames");
+    f.keyframes = number("keyframes"), f.landmarks = number("landmarks");
+    f.map_mb = number("map_mb");
     f.moving_recall = number("mask_truth.moving_recall");
     f.moving_area_recall = number("mask_truth.moving_area_recall");
     f.mask_precision = number("mask_truth.precision");

@@ -36,6 +36,8 @@ struct RunFigures {
     // The run's masks against the renderer's person truth (NaN for real data)
     double moving_recall = NAN, moving_area_recall = NAN, mask_precision = NAN, static_masked = NAN,
            moving_instances = NAN, static_instances = NAN;
+    // The map at the end of the run (NaN in a run.json from before they were written)
+    double keyframes = NAN, landmarks = NAN, map_mb = NAN;
     std::optional<std::uint64_t> seed;  ///< the render it ran on (synthetic, seeded)
     std::filesystem::path dir;          ///< its output folder
     bool ok = false;         ///< a whole run over the whole input: no read error, not interrupted

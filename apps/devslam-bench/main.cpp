@@ -62,6 +62,7 @@ const std::string kRoot = DEVSLAM_SOURCE_DIR;
 const char* kUsage =
     "usage: devslam-bench [--config INI] [--repeats N] [--max-frames N] [--out DIR]\n"
     "                     [--results FILE|none] [--bin DIR] [--reuse-runs] [--render-jobs N]\n"
+    "       devslam-bench [--config INI] [--out DIR] --compare BEFORE\n"
     "--max-frames N: the first N frames of each sequence (0: whole sequences, also over the\n"
     "              INI's [bench] max_frames)\n"
     "--results none: write no RESULTS.md section (the tables and plots go to the output\n"
@@ -69,6 +70,10 @@ const char* kUsage =
     "--reuse-runs: keep the runs already in the output folder that this command would make\n"
     "              (resume a bench): a whole run.json, and a command.txt with this command\n"
     "              line and the same content of program, configs and input lists\n"
+    "--compare BEFORE: renders and runs nothing; compares the runs in the output folder\n"
+    "              (<out>/runs) with those of the same bench kept in the folder BEFORE (an\n"
+    "              earlier <out>/runs, copied aside), render for render: ATE, keyframes,\n"
+    "              landmarks and map size per sequence and mode, as a Markdown table\n"
     "--render-jobs N: renders made at once (default: [bench] render_jobs, else the CPU's\n"
     "              threads, at most 8); the SLAM runs, whose FPS is measured, always run one\n"
     "              at a time\n"
@@ -489,6 +494,7 @@ struct Args {
     int repeats = 0;                                   ///< --repeats, 0 = the INI's
     int render_jobs = 0;                               ///< --render-jobs, 0 = the INI's
     bool reuse = false;                                ///< --reuse-runs
+    std::string compare;                               ///< --compare: the earlier runs folder
     std::optional<std::size_t> max_frames;             ///< --max-frames
 };
 
@@ -514,6 +520,8 @@ std::optional<Args> parseArgs(int argc, char** argv) {
             a.bin = value();
         else if (k == "--reuse-runs")
             a.reuse = true;
+        else if (k == "--compare")
+            a.compare = value();
         else if (k == "--render-jobs")
             a.render_jobs = int(core::parseInteger(value(), "--render-jobs", 1, 64));
         else if (k == "-h" || k == "--help") {
@@ -604,6 +612,12 @@ std::time_t writtenAt(const fs::path& file) {
             fs::last_write_time(file) - fs::file_time_type::clock::now()));
 }
 
+/// A run's folder under <out>/runs/SEQ/MODE: [seedS_]rR.
+std::string runLeaf(const Input& in, int r) {
+    return (in.seed ? "seed" + std::to_string(*in.seed) + "_" : std::string()) + "r" +
+           std::to_string(r);
+}
+
 /// runs.csv's row for run `r` of `q` in mode `m` ("n/a" for the figures of a failed run,
 /// not the zeros of an empty RunFigures).
 std::string csvRow(const Sequence& q, const std::string& m, const std::string& seed, int r,
@@ -640,9 +654,7 @@ Runs runSlam(const Bench& b, const Args& a) {
             for (const auto& in : inputsOf(q, b.out_dir))
                 for (int r = 0; r < repeatsOf(b, q) && runsMode(q, b.out_dir, m); ++r) {
                     const std::string seed = in.seed ? std::to_string(*in.seed) : std::string();
-                    const fs::path dir =
-                        fs::path(b.out_dir) / "runs" / q.name / m /
-                        ((in.seed ? "seed" + seed + "_" : std::string()) + "r" + std::to_string(r));
+                    const fs::path dir = fs::path(b.out_dir) / "runs" / q.name / m / runLeaf(in, r);
                     fs::create_directories(dir);
                     std::string cmd = quote(a.bin + "/devslam-run") + " --input " + quote(in.path) +
                                       " --config " + quote(q.slam_config) + " --mode " + m +
@@ -1025,11 +1037,95 @@ std::string sectionMarkdown(const Args& a, const Bench& b, const Runs& runs, con
     return md.str();
 }
 
+/// --compare: the runs of <out>/runs against those in `before` (the same bench's runs,
+/// kept aside), each run with the one of the same render and repeat. Per sequence and mode:
+/// the medians of ATE RMSE, keyframes, landmarks and map size over the runs both have, and
+/// the geometric mean of the renders' own ratios (after / before: one render cannot rank two
+/// settings, the ATE moves by up to 2-3x between renders). Prints a Markdown table.
+int compareRuns(const Bench& b, const std::string& before) {
+    if (!fs::is_directory(before))
+        throw std::invalid_argument("--compare: no such folder '" + before + "'");
+    const fs::path after = fs::path(b.out_dir) / "runs";
+    std::ostringstream md;
+    md << "Runs in " << after.string() << " (after) against " << before
+       << " (before); medians over the runs both have, per-render ratio: geometric mean of "
+          "after / before on each render (median over its repeats)\n\n"
+       << "| sequence | mode | ATE before | ATE after | per-render ratio | renders lower | "
+          "keyframes before / after | landmarks before / after | map MB before / after | "
+          "median FPS before / after |\n"
+       << "|---|---|---|---|---|---|---|---|---|---|\n";
+    std::size_t pairs = 0, missing = 0;
+    std::map<std::string, std::pair<int, int>> lower_of;  // mode -> (sequences lower, of)
+    for (const auto& q : b.sequences)
+        for (const auto& m : b.modes) {
+            if (!runsMode(q, b.out_dir, m)) continue;
+            std::vector<RunFigures> was, now;  // paired runs, both whole
+            std::vector<double> logs;
+            int lower = 0;
+            for (const auto& in : inputsOf(q, b.out_dir)) {
+                std::vector<double> ate0, ate1;
+                for (int r = 0; r < repeatsOf(b, q); ++r) {
+                    const fs::path leaf = fs::path(q.name) / m / runLeaf(in, r);
+                    const RunFigures f0 = readRun((fs::path(before) / leaf / "run.json").string());
+                    const RunFigures f1 = readRun((after / leaf / "run.json").string());
+                    if (!f0.ok || !f1.ok) {
+                        ++missing;
+                        continue;
+                    }
+                    ++pairs;
+                    was.push_back(f0);
+                    now.push_back(f1);
+                    if (!std::isnan(f0.ate_rmse) && !std::isnan(f1.ate_rmse)) {
+                        ate0.push_back(f0.ate_rmse);
+                        ate1.push_back(f1.ate_rmse);
+                    }
+                }
+                if (ate0.empty()) continue;
+                const double r = core::median(ate1) / core::median(ate0);
+                if (std::isfinite(r) && r > 0) logs.push_back(std::log(r));
+                lower += r < 1;
+            }
+            if (was.empty()) continue;
+            const double a0 = med(was, &RunFigures::ate_rmse), a1 = med(now, &RunFigures::ate_rmse);
+            if (!std::isnan(a0) && !std::isnan(a1)) {
+                auto& [lo, of] = lower_of[m];
+                lo += a1 < a0;
+                ++of;
+            }
+            const auto both = [&](double RunFigures::*field, int prec) {
+                return fmt(med(was, field), prec) + " / " + fmt(med(now, field), prec);
+            };
+            md << "| " << q.name << " | " << m << " | " << fmt(a0, 5) << " | " << fmt(a1, 5)
+               << " | "
+               << (logs.empty() ? std::string("n/a")
+                                : fmt(std::exp(core::meanInterval95(logs).mean), 3))
+               << " | " << lower << " of " << logs.size() << " | "
+               << both(&RunFigures::keyframes, 1) << " | " << both(&RunFigures::landmarks, 0)
+               << " | " << both(&RunFigures::map_mb, 1) << " | "
+               << both(&RunFigures::fps_median, 1) << " |\n";
+        }
+    if (pairs == 0)
+        throw std::invalid_argument("--compare: " + before + " and " + after.string() +
+                                    " have no run of this bench in common (" +
+                                    std::to_string(missing) + " runs missing in one or both)");
+    md << "\nMedian ATE lower after than before:";
+    for (const auto& m : b.modes)
+        if (lower_of.count(m))
+            md << " " << m << " on " << lower_of[m].first << " of " << lower_of[m].second
+               << " sequences;";
+    md << " " << pairs << " runs compared";
+    if (missing) md << ", " << missing << " missing in one or both folders (left out)";
+    md << ".\n";
+    std::cout << md.str();
+    return 0;
+}
+
 int run(int argc, char** argv) {
     const std::optional<Args> args = parseArgs(argc, argv);
     if (!args) return 0;  // --help
     const Args& a = *args;
     const Bench b = benchOf(a);
+    if (!a.compare.empty()) return compareRuns(b, a.compare);
     // Before hours of work (after the output folder is made: the results may go in it).
     if (!a.results.empty()) core::checkResultsSection(a.results, "bench");
     renderSequences(b, a);

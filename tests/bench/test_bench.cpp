@@ -474,6 +474,72 @@ TEST(DevslamBench, ReuseRunsDoesNotKeepAnUnreadableRunJson) {
     EXPECT_NE(r.out.find("1 of 1 runs were kept"), std::string::npos) << r.out;
 }
 
+TEST(DevslamBench, CompareSetsEachRunBesideTheSameRenderBefore) {
+    // Two renders, two modes; runs written by hand (--compare renders and runs nothing).
+    const std::string root = DEVSLAM_SOURCE_DIR;
+    const devslam::test::TempDir d("devslam_");
+    const fs::path tmp = d.str();
+    std::ofstream(tmp / "bench.ini")
+        << "[bench]\nmodes = none dynamic\nrepeats = 1\nslam_config = " << root
+        << "/config_ini/slam_synthetic.ini\n[sequence_short]\nscenario = short_walking\n"
+           "seeds = 5 6\n";
+    const auto write = [&](const fs::path& runs, const std::string& mode, int seed, double ate,
+                           int keyframes) {
+        const fs::path dir = runs / "short" / mode / ("seed" + std::to_string(seed) + "_r0");
+        fs::create_directories(dir);
+        std::ofstream(dir / "run.json")
+            << "{\"read_error\": \"\", \"interrupted\": \"\", \"median_fps\": 30, "
+               "\"mean_fps\": 25, \"lost_frames\": 0, \"keyframes\": "
+            << keyframes << ", \"landmarks\": " << 10 * keyframes
+            << ", \"map_mb\": " << 0.1 * keyframes << ", \"ate\": {\"rmse\": " << ate << "}}\n";
+    };
+    const fs::path before = tmp / "before", after = tmp / "out/runs";
+    // dynamic: half the ATE on both renders; none: doubled on one, halved on the other.
+    write(before, "dynamic", 5, 0.02, 100), write(after, "dynamic", 5, 0.01, 50);
+    write(before, "dynamic", 6, 0.02, 100), write(after, "dynamic", 6, 0.01, 50);
+    write(before, "none", 5, 0.1, 80), write(after, "none", 5, 0.2, 80);
+    write(before, "none", 6, 0.2, 80), write(after, "none", 6, 0.1, 80);
+    const std::string args = "--config '" + (tmp / "bench.ini").string() + "' --out '" +
+                             (tmp / "out").string() + "' --compare '" + before.string() + "'";
+    auto r = devslam::test::runApp("devslam-bench", args);
+    ASSERT_EQ(r.rc, 0) << r.out;
+    EXPECT_NE(r.out.find("| short | dynamic | 0.02000 | 0.01000 | 0.500 | 2 of 2 | 100.0 / 50.0 | "
+                         "1000 / 500 | 10.0 / 5.0 | 30.0 / 30.0 |"),
+              std::string::npos)
+        << r.out;
+    EXPECT_NE(r.out.find("| short | none | 0.15000 | 0.15000 | 1.000 | 1 of 2 | 80.0 / 80.0 |"),
+              std::string::npos)
+        << r.out;
+    EXPECT_NE(r.out.find("none on 0 of 1 sequences; dynamic on 1 of 1 sequences; 4 runs "
+                         "compared."),
+              std::string::npos)
+        << r.out;
+    EXPECT_FALSE(fs::exists(tmp / "out/runs.csv")) << "nothing run";
+    // A run one side lacks is left out, and said so.
+    fs::remove_all(after / "short/none/seed6_r0");
+    r = devslam::test::runApp("devslam-bench", args);
+    ASSERT_EQ(r.rc, 0) << r.out;
+    EXPECT_NE(r.out.find("| short | none | 0.10000 | 0.20000 | 2.000 | 0 of 1 |"),
+              std::string::npos)
+        << r.out;
+    EXPECT_NE(r.out.find("3 runs compared, 1 missing in one or both folders (left out)."),
+              std::string::npos)
+        << r.out;
+    // A folder that is not there, or holds none of these runs: an error naming it.
+    r = devslam::test::runApp("devslam-bench", args + "x");
+    EXPECT_NE(r.rc, 0);
+    EXPECT_NE(r.out.find("--compare: no such folder '" + before.string() + "x'"),
+              std::string::npos)
+        << r.out;
+    fs::create_directories(tmp / "empty");
+    r = devslam::test::runApp("devslam-bench", "--config '" + (tmp / "bench.ini").string() +
+                                                   "' --out '" + (tmp / "out").string() +
+                                                   "' --compare '" + (tmp / "empty").string() +
+                                                   "'");
+    EXPECT_NE(r.rc, 0);
+    EXPECT_NE(r.out.find("have no run of this bench in common"), std::string::npos) << r.out;
+}
+
 TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
     const std::string root = DEVSLAM_SOURCE_DIR, bin = DEVSLAM_BIN_DIR;
     const fs::path tmp =
