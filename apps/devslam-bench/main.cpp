@@ -1082,7 +1082,8 @@ int compareRuns(const Bench& b, const std::string& before) {
                 }
                 if (ate0.empty()) continue;
                 const double r = core::median(ate1) / core::median(ate0);
-                if (std::isfinite(r) && r > 0) logs.push_back(std::log(r));
+                if (!std::isfinite(r) || r <= 0) continue;  // an ATE of 0 on one side
+                logs.push_back(std::log(r));
                 lower += r < 1;
             }
             if (was.empty()) continue;

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace devslam::slam {
 
@@ -229,19 +230,36 @@ bool Tracker::relocPlausible(const Eigen::Isometry3d& T_wc, double timestamp) co
            deg <= opts_.reloc_max_jump_deg + opts_.reloc_max_rate_deg * lost_s;
 }
 
+namespace {
+/// Appends to `kfs`, the map's newest keyframes (Map::lastKeyframes), up to `n` of the older
+/// ones nearest `T_wc` by camera centre (ties by id) among those whose optical axis has a
+/// cosine of at least `min_cos` with its own.
+void addNearestOlder(const Map& map, const Eigen::Isometry3d& T_wc, std::size_t n,
+                     double min_cos, std::vector<KeyframeId>& kfs) {
+    if (n == 0 || kfs.empty()) return;
+    // Keyframes are kept in id order, so the newest are the map's last entries.
+    const KeyframeId oldest_newest = kfs.front();
+    const Eigen::Vector3d axis = T_wc.linear().col(2);
+    std::vector<std::pair<double, KeyframeId>> near;
+    for (const auto& [id, kf] : map.keyframes()) {
+        if (id >= oldest_newest) break;
+        if (kf.T_wc.linear().col(2).dot(axis) < min_cos) continue;
+        near.emplace_back((kf.T_wc.translation() - T_wc.translation()).norm(), id);
+    }
+    n = std::min(n, near.size());
+    std::partial_sort(near.begin(), near.begin() + static_cast<std::ptrdiff_t>(n), near.end());
+    for (std::size_t i = 0; i < n; ++i) kfs.push_back(near[i].second);
+}
+}  // namespace
+
 std::optional<Eigen::Isometry3d> Tracker::relocalize(const FrameFeatures& f, const Map& map,
                                                      const core::CameraIntrinsics& K,
                                                      double timestamp) const {
-    // Candidates: the newest keyframes and the ones nearest to the last pose.
-    std::vector<std::pair<double, KeyframeId>> by_dist;
-    for (const auto& [id, kf] : map.keyframes())
-        by_dist.emplace_back((kf.T_wc.translation() - last_T_wc_.translation()).norm(), id);
-    std::sort(by_dist.begin(), by_dist.end());
+    // Candidates: the newest keyframes and the ones nearest to the last pose, facing anywhere.
     std::vector<KeyframeId> cands = map.lastKeyframes(opts_.reloc_keyframes / 2 + 1);
-    for (const auto& [d, id] : by_dist) {
-        if (static_cast<int>(cands.size()) >= opts_.reloc_keyframes) break;
-        if (std::find(cands.begin(), cands.end(), id) == cands.end()) cands.push_back(id);
-    }
+    addNearestOlder(map, last_T_wc_,
+                    static_cast<std::size_t>(opts_.reloc_keyframes) - cands.size(),
+                    -std::numeric_limits<double>::infinity(), cands);
     std::optional<Eigen::Isometry3d> best;
     int best_inliers = 0;
     for (KeyframeId id : cands) {
@@ -277,21 +295,8 @@ std::optional<Eigen::Isometry3d> Tracker::relocalize(const FrameFeatures& f, con
 
 std::vector<LandmarkId> Tracker::localMap(const Map& map, const Eigen::Isometry3d& T_wc) const {
     auto kfs = map.lastKeyframes(static_cast<std::size_t>(opts_.local_keyframes));
-    if (opts_.near_keyframes > 0 && map.keyframes().size() > kfs.size()) {
-        // Keyframes are kept in id order, so the newest are the map's last entries.
-        const KeyframeId oldest_newest = kfs.front();
-        const double min_cos = std::cos(opts_.near_max_angle_deg * M_PI / 180.0);
-        const Eigen::Vector3d axis = T_wc.linear().col(2);
-        std::vector<std::pair<double, KeyframeId>> near;
-        for (const auto& [id, kf] : map.keyframes()) {
-            if (id >= oldest_newest) break;
-            if (kf.T_wc.linear().col(2).dot(axis) < min_cos) continue;
-            near.emplace_back((kf.T_wc.translation() - T_wc.translation()).norm(), id);
-        }
-        const std::size_t n = std::min(near.size(), static_cast<std::size_t>(opts_.near_keyframes));
-        std::partial_sort(near.begin(), near.begin() + static_cast<std::ptrdiff_t>(n), near.end());
-        for (std::size_t i = 0; i < n; ++i) kfs.push_back(near[i].second);
-    }
+    addNearestOlder(map, T_wc, static_cast<std::size_t>(opts_.near_keyframes),
+                    std::cos(opts_.near_max_angle_deg * M_PI / 180.0), kfs);
     return map.landmarksOf(kfs);
 }
 
