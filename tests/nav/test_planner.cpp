@@ -180,6 +180,18 @@ TEST(GridPlanner, WaypointsWithinSpacingAndClear) {
         EXPECT_TRUE(p.segmentClear(prev, w, p.options().robot_radius));
         prev = w;
     }
+    // The same waypoints as indices into the path, increasing.
+    const auto idx = decimateWaypointIndices(p, *path, 1.5);
+    ASSERT_EQ(idx.size(), wps.size());
+    for (std::size_t i = 0; i < idx.size(); ++i) {
+        if (i > 0) {
+            EXPECT_GT(idx[i], idx[i - 1]);
+        }
+        ASSERT_LT(idx[i], path->points.size());
+        EXPECT_EQ(path->points[idx[i]].x, wps[i].x);
+        EXPECT_EQ(path->points[idx[i]].y, wps[i].y);
+    }
+    EXPECT_EQ(idx.back(), path->points.size() - 1);
 }
 
 TEST(Replan, TriggersOnBlockedPathAndSustainedDensity) {
@@ -199,10 +211,83 @@ TEST(Replan, TriggersOnBlockedPathAndSustainedDensity) {
 
 TEST(Replan, PathBlockedLooksAheadOnly) {
     const std::vector<TPoint2D> path{{0, 0}, {2, 0}, {4, 0}, {6, 0}};
-    EXPECT_TRUE(pathBlocked(path, {0.5, 0}, {{1.5, 0.1}}, 0.3, 2.0));
-    EXPECT_FALSE(pathBlocked(path, {0.5, 0}, {{1.5, 0.5}}, 0.3, 2.0));  // beside the path
-    EXPECT_FALSE(pathBlocked(path, {0.5, 0}, {{5.5, 0.0}}, 0.3, 2.0));  // beyond lookahead
-    EXPECT_FALSE(pathBlocked(path, {4.5, 0}, {{1.0, 0.0}}, 0.3, 2.0));  // behind the robot
+    const auto at = [&](const TPoint2D& robot) { return pathProgress(path, robot, 0, 1e9); };
+    EXPECT_EQ(at({0.5, 0}), 0u);
+    EXPECT_EQ(at({4.5, 0}), 2u);
+    EXPECT_TRUE(pathBlocked(path, at({0.5, 0}), {{1.5, 0.1}}, 0.3, 2.0));
+    EXPECT_FALSE(pathBlocked(path, at({0.5, 0}), {{1.5, 0.5}}, 0.3, 2.0));  // beside the path
+    EXPECT_FALSE(pathBlocked(path, at({0.5, 0}), {{5.5, 0.0}}, 0.3, 2.0));  // beyond lookahead
+    EXPECT_FALSE(pathBlocked(path, at({4.5, 0}), {{1.0, 0.0}}, 0.3, 2.0));  // behind the robot
+    EXPECT_EQ(pathProgress({}, {0, 0}, 0, 2.0), 0u);
+    EXPECT_EQ(pathProgress(path, {5.5, 0}, 99, 2.0), 2u);  // past the end: the last segment
+    EXPECT_EQ(pathProgress(path, {0, 0}, 99, 2.0), 1u);    // 2 m back from it, no further
+}
+
+// A path that folds back past the robot (out along y = 0, round, back along y = 0.6, as a
+// grid path of 5 cm steps): a robot pushed 0.35 m off the outward leg is nearer the way back.
+// Its progress stays on the outward leg, so a person standing 1 m ahead of it blocks the path;
+// taking the nearest segment anywhere checked the way back and missed the person.
+TEST(Replan, ProgressAlongAFoldedPathFollowsTheRobot) {
+    std::vector<TPoint2D> path;
+    for (int i = 0; i <= 60; ++i) path.emplace_back(0.05 * i, 0.0);
+    for (int i = 1; i <= 12; ++i) path.emplace_back(3.0, 0.05 * i);
+    for (int i = 1; i <= 60; ++i) path.emplace_back(3.0 - 0.05 * i, 0.6);
+    const TPoint2D robot{0.2, 0.35};
+    const std::vector<TPoint2D> person{{1.2, 0.0}};
+
+    const std::size_t anywhere = pathProgress(path, robot, 0, 1e9);
+    ASSERT_GT(anywhere, 72u) << "the way back is nearer";
+    EXPECT_FALSE(pathBlocked(path, anywhere, person, 0.3, 2.0));
+
+    std::size_t seg = 0;
+    for (const double x : {0.0, 0.1, 0.2}) {  // the robot's last steps
+        const std::size_t next = pathProgress(path, {x, x < 0.2 ? 0.0 : 0.35}, seg, 2.0);
+        EXPECT_GE(next, seg);
+        seg = next;
+    }
+    EXPECT_EQ(seg, 3u) << "the outward segment ending beside the robot (x 0.15-0.20)";
+    EXPECT_TRUE(pathBlocked(path, seg, person, 0.3, 2.0));
+    // It moves on along the way back once the robot gets there.
+    for (int i = 3; i <= 30; ++i) seg = pathProgress(path, {0.1 * i, 0.0}, seg, 2.0);
+    for (int i = 30; i >= 10; --i) seg = pathProgress(path, {0.1 * i, 0.6}, seg, 2.0);
+    EXPECT_EQ(seg, 111u) << "the way back, the segment ending at x = 1.0";
+    // Pushed back 1 m along the way back, it is followed there; the outward leg, 0.6 m away
+    // beside it but 4 m back along the path, is out of reach.
+    EXPECT_EQ(pathProgress(path, {2.0, 0.6}, seg, 2.0), 91u) << "back to x = 2.0";
+    EXPECT_GT(pathProgress(path, {2.0, 0.25}, seg, 2.0), 72u) << "the outward leg is behind";
+}
+
+// When MRPT gives up and no new plan is found, the navigator sends the old path on from the
+// waypoint ahead of the robot's progress. On the folded path, a robot pushed off the outward
+// leg is nearest a waypoint of the way back, across the fold from it.
+TEST(Replan, WaypointAheadFollowsProgressNotDistance) {
+    EXPECT_EQ(waypointAhead({}, 3), 0u);
+    const std::vector<std::size_t> idx{10, 20, 30, 40};
+    EXPECT_EQ(waypointAhead(idx, 0), 0u);
+    EXPECT_EQ(waypointAhead(idx, 9), 0u);   // segment 9 ends at point 10
+    EXPECT_EQ(waypointAhead(idx, 10), 1u);  // at point 10 already: the next
+    EXPECT_EQ(waypointAhead(idx, 39), 3u);
+    EXPECT_EQ(waypointAhead(idx, 40), 3u);  // past the last: the last (the goal)
+
+    std::vector<TPoint2D> path;
+    for (int i = 0; i <= 60; ++i) path.emplace_back(0.05 * i, 0.0);
+    for (int i = 1; i <= 12; ++i) path.emplace_back(3.0, 0.05 * i);
+    for (int i = 1; i <= 60; ++i) path.emplace_back(3.0 - 0.05 * i, 0.6);
+    std::vector<std::size_t> wp;  // every 10th point and the goal
+    for (std::size_t i = 10; i < path.size(); i += 10) wp.push_back(i);
+    if (wp.back() != path.size() - 1) wp.push_back(path.size() - 1);
+    const TPoint2D robot{0.2, 0.35};
+    std::size_t seg = 0;
+    for (const double x : {0.0, 0.1}) seg = pathProgress(path, {x, 0.0}, seg, 2.0);
+    seg = pathProgress(path, robot, seg, 2.0);
+    const auto ahead = path[wp[waypointAhead(wp, seg)]];
+    EXPECT_NEAR(ahead.x, 0.5, 1e-9);
+    EXPECT_NEAR(ahead.y, 0.0, 1e-9);
+    const auto nearest = *std::min_element(wp.begin(), wp.end(), [&](auto a, auto b) {
+        return std::hypot(path[a].x - robot.x, path[a].y - robot.y) <
+               std::hypot(path[b].x - robot.x, path[b].y - robot.y);
+    });
+    EXPECT_NEAR(path[nearest].y, 0.6, 1e-9) << "nearest anywhere: on the way back";
 }
 
 // A person sensed beside the goal (or the robot) is stamped on the replanning map, and the
@@ -259,10 +344,9 @@ TEST(Replan, OnlyPointsTheMapDoesNotHoldCount) {
     EXPECT_DOUBLE_EQ(left[0].x, 4.0);
     // A route 0.3 m from the wall is blocked by the person only.
     const std::vector<TPoint2D> route{{0.5, 1.7}, {5.5, 1.7}};
-    EXPECT_TRUE(pathBlocked(route, {0.5, 1.7}, sensed, 0.30, 6.0)) << "all points";
-    EXPECT_FALSE(
-        pathBlocked(route, {0.5, 1.7}, unmappedPoints(planner, {sensed[0], sensed[1]}), 0.30, 6.0));
-    EXPECT_TRUE(pathBlocked(route, {0.5, 1.7}, left, 0.30, 6.0));
+    EXPECT_TRUE(pathBlocked(route, 0, sensed, 0.30, 6.0)) << "all points";
+    EXPECT_FALSE(pathBlocked(route, 0, unmappedPoints(planner, {sensed[0], sensed[1]}), 0.30, 6.0));
+    EXPECT_TRUE(pathBlocked(route, 0, left, 0.30, 6.0));
 }
 
 // config_ini/nav_reactive.ini is the one navigation INI shipped (the world files have their

@@ -117,8 +117,8 @@ double GridPlanner::clearance(const mrpt::math::TPoint2D& p) const {
     return clearance_[x + y * w_];
 }
 
-std::optional<mrpt::math::TPoint2D> GridPlanner::nearestTraversable(
-    const mrpt::math::TPoint2D& p, double max_dist) const {
+std::optional<mrpt::math::TPoint2D> GridPlanner::nearestTraversable(const mrpt::math::TPoint2D& p,
+                                                                    double max_dist) const {
     if (w_ == 0) throw std::logic_error("GridPlanner: setMap() was not called");
     const int px = grid_.x2idx(p.x), py = grid_.y2idx(p.y);
     if (px < 0 || py < 0 || px >= w_ || py >= h_) return std::nullopt;
@@ -255,12 +255,15 @@ bool GridPlanner::segmentClear(const mrpt::math::TPoint2D& a, const mrpt::math::
     return true;
 }
 
-std::vector<mrpt::math::TPoint2D> decimateWaypoints(const GridPlanner& planner,
-                                                    const GridPath& path, double max_spacing) {
+std::vector<std::size_t> decimateWaypointIndices(const GridPlanner& planner, const GridPath& path,
+                                                 double max_spacing) {
     if (max_spacing <= 0) throw std::invalid_argument("decimateWaypoints: max_spacing <= 0");
-    std::vector<mrpt::math::TPoint2D> out;
+    std::vector<std::size_t> out;
     const auto& p = path.points;
-    if (p.size() < 2) return p;
+    if (p.size() < 2) {
+        for (std::size_t i = 0; i < p.size(); i++) out.push_back(i);
+        return out;
+    }
     const auto& o = planner.options();
     const double wanted = o.robot_radius + o.inflation_margin;
     size_t anchor = 0;
@@ -274,9 +277,17 @@ std::vector<mrpt::math::TPoint2D> decimateWaypoints(const GridPlanner& planner,
             const double need = std::max(o.robot_radius, std::min(wanted, path_min));
             if (planner.segmentClear(p[anchor], p[j], need)) best = j;
         }
-        out.push_back(p[best]);
+        out.push_back(best);
         anchor = best;
     }
+    return out;
+}
+
+std::vector<mrpt::math::TPoint2D> decimateWaypoints(const GridPlanner& planner,
+                                                    const GridPath& path, double max_spacing) {
+    std::vector<mrpt::math::TPoint2D> out;
+    for (const std::size_t i : decimateWaypointIndices(planner, path, max_spacing))
+        out.push_back(path.points[i]);
     return out;
 }
 

@@ -236,10 +236,13 @@ bool Navigator::start(const mrpt::maps::COccupancyGridMap2D& map, const mrpt::ma
 
 void Navigator::setPath(const GridPath& p) {
     path_ = p;
+    path_segment_ = 0;
     // planner_ holds the map the path was planned on: a replanned path's shortcuts are checked
     // against the sensed obstacles it went round, not only the static map's walls.
     const double spacing = std::min(opts_.planner.waypoint_spacing, 0.9 * ref_distance_);
-    waypoints_ = decimateWaypoints(planner_, path_, spacing);
+    waypoint_path_index_ = decimateWaypointIndices(planner_, path_, spacing);
+    waypoints_.clear();
+    for (const std::size_t i : waypoint_path_index_) waypoints_.push_back(path_.points[i]);
 }
 
 void Navigator::sendWaypoints(std::size_t first) {
@@ -322,21 +325,20 @@ NavState Navigator::step(double t) {
             sensed.emplace_back(gx, gy);
         }
     }
+    // Progress moves by at most the lookahead a step (forward, or back where people pushed the
+    // robot back): the nearest segment anywhere can be one of a path folding back past the
+    // robot, not the ones ahead of it.
+    path_segment_ =
+        pathProgress(path_.points, {pose.x, pose.y}, path_segment_, opts_.replan.blocked_lookahead);
     if (st == mrpt::nav::CAbstractNavigator::NAV_ERROR ||
         st == mrpt::nav::CAbstractNavigator::IDLE) {
         // MRPT gave up ("not approaching target") or ended short of the goal: replan
         if (st == mrpt::nav::CAbstractNavigator::NAV_ERROR) nav_->resetNavError();
         trigger_.reset(t);
         if (!replan(pose, sensed)) {
-            // Keep trying with the previous path, from its waypoint nearest the robot: from
-            // its first, MRPT would drive back to where the path began.
-            const auto away = [&](const mrpt::math::TPoint2D& w) {
-                return std::hypot(w.x - pose.x, w.y - pose.y);
-            };
-            const auto nearest = std::min_element(
-                waypoints_.begin(), waypoints_.end(),
-                [&](const auto& a, const auto& b) { return away(a) < away(b); });
-            sendWaypoints(static_cast<std::size_t>(nearest - waypoints_.begin()));
+            // Keep trying with the previous path, from the waypoint ahead of the robot's
+            // progress along it: from its first, MRPT would drive back to where the path began.
+            sendWaypoints(waypointAhead(waypoint_path_index_, path_segment_));
         }
         return NavState::Navigating;
     }
@@ -347,8 +349,8 @@ NavState Navigator::step(double t) {
     // worlds instead of 48, docs/nav.md).
     const auto unmapped = unmappedPoints(planner_, sensed);
     const double radius = opts_.planner.robot_radius + opts_.replan.blocked_margin;
-    const bool blocked = pathBlocked(path_.points, {pose.x, pose.y}, unmapped, radius,
-                                     opts_.replan.blocked_lookahead);
+    const bool blocked =
+        pathBlocked(path_.points, path_segment_, unmapped, radius, opts_.replan.blocked_lookahead);
     const double density = reactive.vfhTargetDensity();
     const ReplanReason why = trigger_.update({t, blocked, std::max(0.0, density)});
     if (why != ReplanReason::None) (void)replan(pose, sensed);

@@ -84,22 +84,45 @@ double pointSegmentDistance(const mrpt::math::TPoint2D& p, const mrpt::math::TPo
 }
 }  // namespace
 
-bool pathBlocked(const std::vector<mrpt::math::TPoint2D>& path, const mrpt::math::TPoint2D& robot,
-                 const std::vector<mrpt::math::TPoint2D>& obstacles, double radius,
-                 double lookahead) {
-    if (path.size() < 2 || obstacles.empty()) return false;
-    // closest segment to the robot
-    size_t first = 0;
+std::size_t pathProgress(const std::vector<mrpt::math::TPoint2D>& path,
+                         const mrpt::math::TPoint2D& robot, std::size_t from, double window) {
+    if (path.size() < 2) return 0;
+    from = std::min(from, path.size() - 2);
+    const auto length = [&](std::size_t i) {
+        return std::hypot(path[i + 1].x - path[i].x, path[i + 1].y - path[i].y);
+    };
+    std::size_t lo = from;  // back to `window` before segment `from` begins
+    for (double back = 0; lo > 0 && back + length(lo - 1) <= window; lo--) back += length(lo - 1);
+    std::size_t nearest = from;
     double best = std::numeric_limits<double>::infinity();
-    for (size_t i = 0; i + 1 < path.size(); i++) {
+    double ahead = 0;  // path length from segment `from`'s start to segment i's
+    for (std::size_t i = lo; i + 1 < path.size(); i++) {
+        if (i > from) ahead += length(i - 1);
+        if (ahead > window) break;
         const double d = pointSegmentDistance(robot, path[i], path[i + 1]);
         if (d < best) {
             best = d;
-            first = i;
+            nearest = i;
         }
     }
+    return nearest;
+}
+
+std::size_t waypointAhead(const std::vector<std::size_t>& waypoint_path_index,
+                          std::size_t segment) {
+    if (waypoint_path_index.empty()) return 0;
+    const auto it =
+        std::upper_bound(waypoint_path_index.begin(), waypoint_path_index.end(), segment);
+    if (it == waypoint_path_index.end()) return waypoint_path_index.size() - 1;
+    return static_cast<std::size_t>(it - waypoint_path_index.begin());
+}
+
+bool pathBlocked(const std::vector<mrpt::math::TPoint2D>& path, std::size_t segment,
+                 const std::vector<mrpt::math::TPoint2D>& obstacles, double radius,
+                 double lookahead) {
+    if (path.size() < 2 || obstacles.empty()) return false;
     double travelled = 0;
-    for (size_t i = first; i + 1 < path.size() && travelled < lookahead; i++) {
+    for (size_t i = segment; i + 1 < path.size() && travelled < lookahead; i++) {
         for (const auto& o : obstacles)
             if (pointSegmentDistance(o, path[i], path[i + 1]) < radius) return true;
         travelled += std::hypot(path[i + 1].x - path[i].x, path[i + 1].y - path[i].y);

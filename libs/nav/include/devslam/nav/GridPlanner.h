@@ -17,6 +17,7 @@
 #include <mrpt/maps/COccupancyGridMap2D.h>
 #include <mrpt/math/TPoint2D.h>
 
+#include <cstddef>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -109,6 +110,11 @@ class GridPlanner {
 [[nodiscard]] std::vector<mrpt::math::TPoint2D> decimateWaypoints(const GridPlanner& planner,
                                                                   const GridPath& path,
                                                                   double max_spacing);
+
+/// decimateWaypoints()'s waypoints as indices into `path.points` (increasing).
+[[nodiscard]] std::vector<std::size_t> decimateWaypointIndices(const GridPlanner& planner,
+                                                               const GridPath& path,
+                                                               double max_spacing);
 
 /// Sum of segment lengths of a polyline [m].
 [[nodiscard]] double polylineLength(const std::vector<mrpt::math::TPoint2D>& pts);

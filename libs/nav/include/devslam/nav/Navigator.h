@@ -39,7 +39,7 @@ struct NavigatorOptions {
     /// [m] extra room kept from people: the robot interface surrounds each sensed point it
     /// knows to be on a person with a ring of points this far out (SimRobot; 0 = off).
     double person_margin = 0.10;
-    bool log_file = false;       ///< write an MRPT .reactivenavlog
+    bool log_file = false;  ///< write an MRPT .reactivenavlog
     std::string log_directory = "reactivenav.logs";
     std::string ptg_cache_directory = "";  ///< "" = a folder in the system temp dir
     bool verbose = false;  ///< MRPT navigator log level INFO instead of ERROR (not in INI)
@@ -97,7 +97,9 @@ class Navigator {
     mrpt::maps::COccupancyGridMap2D static_map_;
     ReplanTrigger trigger_;
     GridPath first_path_, path_;
+    std::size_t path_segment_ = 0;  ///< the robot's progress along path_ (pathProgress)
     std::vector<mrpt::math::TPoint2D> waypoints_;
+    std::vector<std::size_t> waypoint_path_index_;  ///< each waypoint's index in path_.points
     mrpt::math::TPoint2D goal_;
     double goal_tolerance_ = 0.3;
     double ref_distance_ = 2.0;

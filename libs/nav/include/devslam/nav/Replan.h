@@ -57,10 +57,29 @@ class ReplanTrigger {
     double dense_since_ = -1;  ///< time the density went above threshold, -1 if below
 };
 
+/// The robot's progress along `path`: the segment (i: path[i] -> path[i+1]) nearest `robot`
+/// among those that begin within `window` [m] of path length before or after segment `from`
+/// begins (the first of equally near ones). Called each step with the last result as `from`,
+/// it follows the robot along the path, forward or pushed back, a window at a time: on a path
+/// that folds back past the robot (round a pillar, into a room beside the corridor), the
+/// nearest segment anywhere is one the robot has not reached, and the segments really ahead
+/// of it would go unchecked. 0 for a path of fewer than 2 points.
+[[nodiscard]] std::size_t pathProgress(const std::vector<mrpt::math::TPoint2D>& path,
+                                       const mrpt::math::TPoint2D& robot, std::size_t from,
+                                       double window);
+
+/// The waypoint the robot heads for at progress `segment` (pathProgress()), given each
+/// waypoint's index into the path (increasing, decimateWaypointIndices()): the first beyond
+/// the segment's start, else the last; 0 when there is none. Nearest the robot anywhere would
+/// be, on a path folding back past it, a waypoint on the way back, across what the path goes
+/// round.
+[[nodiscard]] std::size_t waypointAhead(const std::vector<std::size_t>& waypoint_path_index,
+                                        std::size_t segment);
+
 /// True when a point of `obstacles` (world frame) lies within `radius` [m] of the path
-/// polyline, looking ahead `lookahead` [m] from the path point closest to `robot`.
-[[nodiscard]] bool pathBlocked(const std::vector<mrpt::math::TPoint2D>& path,
-                               const mrpt::math::TPoint2D& robot,
+/// polyline, looking ahead `lookahead` [m] of path length from the start of segment
+/// `segment` (pathProgress()).
+[[nodiscard]] bool pathBlocked(const std::vector<mrpt::math::TPoint2D>& path, std::size_t segment,
                                const std::vector<mrpt::math::TPoint2D>& obstacles, double radius,
                                double lookahead);
 
