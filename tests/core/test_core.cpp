@@ -13,8 +13,8 @@
 
 #include <opencv2/core/utility.hpp>
 
-#include "Scratch.h"
 #include "ConfigRoundTrip.h"
+#include "Scratch.h"
 
 #include <atomic>
 #include <filesystem>
@@ -24,9 +24,9 @@
 #include <thread>
 #include <typeinfo>
 
-#include <sys/wait.h>
 #include <fcntl.h>
 #include <sys/file.h>
+#include <sys/wait.h>
 #include <unistd.h>
 #include <chrono>
 #include <cmath>
@@ -126,8 +126,7 @@ TEST(Camera, EveryKeyRoundTrips) {
         [](const devslam::test::Ini& in, devslam::test::Ini& out) {
             CameraIntrinsics::fromConfig(in, "camera").saveToConfig(out, "camera");
         },
-        {{}, {}, {{"camera", "preset"}}},
-        devslam::test::Ini("[camera]\npreset = freiburg1\n"));
+        {{}, {}, {{"camera", "preset"}}}, devslam::test::Ini("[camera]\npreset = freiburg1\n"));
 }
 
 TEST(Config, WrittenRealsReadBackExactly) {
@@ -194,12 +193,14 @@ TEST(Config, FilterIniFollowsRunFilterConfigWithOverrides) {
         return std::string();
     };
     EXPECT_EQ(refusal("dynamic_filtr.detect_every=3"),
-              bad + " [run] filter_overrides item 'dynamic_filtr.detect_every=3': section "
-                    "'dynamic_filtr' is not one of the filter's (detector, dynamic_filter)");
+              bad +
+                  " [run] filter_overrides item 'dynamic_filtr.detect_every=3': section "
+                  "'dynamic_filtr' is not one of the filter's (detector, dynamic_filter)");
     EXPECT_EQ(refusal("dynamic_filter.mask_margin=3 dynamic_filter.Mask_Margin=4"),
-              bad + " [run] filter_overrides item 'dynamic_filter.Mask_Margin=4': "
-                    "[dynamic_filter] Mask_Margin is set twice (also "
-                    "'dynamic_filter.mask_margin=3')");
+              bad +
+                  " [run] filter_overrides item 'dynamic_filter.Mask_Margin=4': "
+                  "[dynamic_filter] Mask_Margin is set twice (also "
+                  "'dynamic_filter.mask_margin=3')");
     const std::string missing = dir + "/missing.ini";
     std::ofstream(missing) << "[run]\nfilter_config = nowhere.ini\n";
     try {
@@ -233,8 +234,14 @@ TEST(Parse, NumbersAreReadInFullOrRejected) {
               "[a] k: expected a number, got '0.5m'");
     // strtod reads C's hexadecimal ("0x10" = 16): no INI reader takes it for a number.
     for (const char* bad : {"", "  ", "abc", "1,5", "nan", "inf", "1e999", "2 3", "0x10", "0x1p-5",
-                            "0X1P3"})
+                            "0X1P3", "-1e999"})
         EXPECT_NE(invalidArgument([&] { (void)parseNumber(bad, "x"); }), "") << bad;
+    // An underflow is the subnormal or zero it rounds to, as Python's float() reads it:
+    // strtod flags it ERANGE like an overflow, and it was refused.
+    EXPECT_DOUBLE_EQ(parseNumber("1e-320", "x"), 1e-320);
+    EXPECT_GT(parseNumber("1e-320", "x"), 0.0);
+    EXPECT_EQ(parseNumber("-1e-400", "x"), 0.0);
+    EXPECT_EQ(parseNumber("2.2250738585072014e-308", "x"), 2.2250738585072014e-308);
 }
 
 TEST(Parse, AnOptionsValueIsNotTheNextOption) {
@@ -331,7 +338,8 @@ TEST(Config, OverrideListsKeepBracketedValuesWhole) {
     mrpt::config::CConfigFileMemory mem;
     applyOverrides(mem, overrideItems("p.path=[3.5 2.1]"));
     EXPECT_EQ(mem.read_string("p", "path", ""), "[3.5 2.1]");
-    const std::string msg = invalidArgument([] { (void)overrideItems("p.path=[3.5 2.1", "x.ini set"); });
+    const std::string msg =
+        invalidArgument([] { (void)overrideItems("p.path=[3.5 2.1", "x.ini set"); });
     EXPECT_EQ(msg, "x.ini set 'p.path=[3.5 2.1': a '[' is not closed");
 }
 
@@ -342,8 +350,7 @@ TEST(Config, SectionsComeInTheFilesOrder) {
     std::vector<std::string> sorted;
     cfg->getAllSections(sorted);
     ASSERT_EQ(sorted.size(), 3u);  // MRPT's own list is sorted, hence this helper
-    EXPECT_EQ(sectionsInFileOrder(*cfg, path),
-              (std::vector<std::string>{"zeta", "alpha", "mid"}));
+    EXPECT_EQ(sectionsInFileOrder(*cfg, path), (std::vector<std::string>{"zeta", "alpha", "mid"}));
     // A file that cannot be read again still gives every section, in MRPT's order.
     EXPECT_EQ(sectionsInFileOrder(*cfg, path + ".gone"), sorted);
     const std::string keys = devslam::test::scratchPath("devslam_keys").string() + ".ini";
@@ -394,8 +401,9 @@ TEST(Config, RepeatedKeysAndSectionsAreRefused) {
     // A comment ending in '\' takes the next line into it: a key there is lost (here MRPT
     // read the default instead of n = 20); a comment there is not.
     EXPECT_EQ(error("[orb]\n# see C:\\docs\\\nn = 20\n"),
-              path + " line 2: a comment ends in '\\', so MRPT reads line 3 ('n = 20') as part "
-                     "of it");
+              path +
+                  " line 2: a comment ends in '\\', so MRPT reads line 3 ('n = 20') as part "
+                  "of it");
     EXPECT_EQ(error("[orb]\n#   a command \\\n#       --more \\\n\nn = 20\n"), "");
     // A define whose value holds its own name is used once (the check ran for ever).
     EXPECT_EQ(error("@define A ${A}\n[a]\n${A} = 4\n"), "");

@@ -18,10 +18,10 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
+#include <algorithm>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
-#include <algorithm>
 #include <fstream>
 #include <functional>
 #include <limits>
@@ -251,6 +251,14 @@ TEST(TrajectoryIO, RoundTripAndErrors) {
     writeText(d.str("bad.txt"), "1 0x1p-3 0 0 0 0 0 1\n");
     expectError([&] { (void)io::readTumTrajectory(d.str("bad.txt")); },
                 "line 1: tx '0x1p-3' is not a number");
+    // ... but reads an underflowing number as the TUM tools do (std::stod threw on it).
+    writeText(d.str("tiny.txt"), "1 0 0 0 1e-320 0 0 1\n2 0 0 1e-400 0 0 0 1\n");
+    const auto tiny = io::readTumTrajectory(d.str("tiny.txt"));
+    ASSERT_EQ(tiny.size(), 2u);
+    EXPECT_EQ(tiny[1].pose.z(), 0.0);
+    writeText(d.str("bad.txt"), "1 1e400 0 0 0 0 0 1\n");
+    expectError([&] { (void)io::readTumTrajectory(d.str("bad.txt")); },
+                "line 1: tx '1e400' is not a number");
     writeText(d.str("bad.txt"), "# only comments\n");
     expectError([&] { (void)io::readTumTrajectory(d.str("bad.txt")); }, "no poses");
     expectError([&] { (void)io::readTumTrajectory(d.str("missing.txt")); }, "cannot open");
@@ -710,9 +718,8 @@ TEST(Rawlog, StampsThatDoNotIncreaseAreRefused) {
     while (auto f = tum.next()) frames.push_back(*f);
     ASSERT_EQ(frames.size(), 4u);
     const double t0 = frames[0].timestamp;
-    for (const auto& [name, t2, kind] :
-         {std::tuple{"dup.rawlog", t0 + 0.1, "duplicate"},
-          std::tuple{"back.rawlog", t0 - 1.0, "unsorted"}}) {
+    for (const auto& [name, t2, kind] : {std::tuple{"dup.rawlog", t0 + 0.1, "duplicate"},
+                                         std::tuple{"back.rawlog", t0 - 1.0, "unsorted"}}) {
         const std::string path = d.str(name);
         {
             io::RawlogWriter w(path, {});
@@ -762,8 +769,7 @@ TEST(Rawlog, StampsThatDoNotIncreaseAreRefused) {
                                              " timestamp .* \\(previous frame 7 at " + a + "\\)");
         w.close();
         EXPECT_EQ(io::readTumList(out + "/rgb.txt").size(), 1u);
-        EXPECT_EQ(std::distance(fs::directory_iterator(out + "/rgb"), fs::directory_iterator{}),
-                  1);
+        EXPECT_EQ(std::distance(fs::directory_iterator(out + "/rgb"), fs::directory_iterator{}), 1);
     }
 }
 
@@ -797,9 +803,15 @@ TEST(VideoReader, BadFilesAndOptionsNameTheFile) {
     { std::ofstream(tmp.str("text.avi")) << "not a video\n"; }
     expectError([&] { io::VideoReader v(tmp.str("text.avi"), {}); }, R"(text\.avi)");
     expectError<std::invalid_argument>(
-        [&] { io::VideoReader v(kTum + "/rgb.txt", {0.0, 0.0}); }, "plane_depth");
+        [&] {
+            io::VideoReader v(kTum + "/rgb.txt", {0.0, 0.0});
+        },
+        "plane_depth");
     expectError<std::invalid_argument>(
-        [&] { io::VideoReader v(kTum + "/rgb.txt", {2.0, -1.0}); }, "focal");
+        [&] {
+            io::VideoReader v(kTum + "/rgb.txt", {2.0, -1.0});
+        },
+        "focal");
     // openRgbd does not take videos for RGB-D input, and says where they can go.
     expectError([&] { (void)io::openRgbd(tmp.str("text.avi")); },
                 R"(text\.avi: a video has no depth)");

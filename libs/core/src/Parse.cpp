@@ -34,17 +34,18 @@ bool hexadecimal(const std::string& t) {
     return t.find_first_of("xX") != std::string::npos;
 }
 
-/// `t` read in full as one finite number (no trailing characters, no overflow, no nan/inf,
-/// no hexadecimal).
+}  // namespace
+
 bool readFinite(const std::string& t, double& v) {
     if (hexadecimal(t)) return false;
     char* end = nullptr;
     errno = 0;
     v = std::strtod(t.c_str(), &end);
-    return !t.empty() && end == t.c_str() + t.size() && errno != ERANGE && std::isfinite(v);
+    // strtod sets ERANGE on underflow too ("1e-320", "1e-400": a subnormal or 0), which
+    // Python's float() reads without complaint; only overflow (+-HUGE_VAL) is refused.
+    const bool overflow = errno == ERANGE && std::fabs(v) > 1.0;
+    return !t.empty() && end == t.c_str() + t.size() && !overflow && std::isfinite(v);
 }
-
-}  // namespace
 
 double parseNumber(const std::string& text, const std::string& what) {
     double v = 0;
@@ -63,10 +64,8 @@ long long parseInteger(const std::string& text, const std::string& what, long lo
     long long v = std::strtoll(t.c_str(), &end, 10);
     if (end != t.c_str() + t.size() || errno == ERANGE) {
         if (hexadecimal(t)) fail(what, "an integer", text);
-        errno = 0;
-        const double d = std::strtod(t.c_str(), &end);
-        if (end != t.c_str() + t.size() || errno == ERANGE || !std::isfinite(d) ||
-            d != std::floor(d) || std::fabs(d) > 9007199254740992.0)
+        double d = 0;
+        if (!readFinite(t, d) || d != std::floor(d) || std::fabs(d) > 9007199254740992.0)
             fail(what, "an integer", text);
         v = static_cast<long long>(d);
     }
@@ -96,9 +95,9 @@ std::vector<double> parseNumberList(const std::string& text, const std::string& 
     const auto open = std::count(text.begin(), text.end(), '[');
     const auto close = std::count(text.begin(), text.end(), ']');
     if (open != close || open > 1 ||
-        (open == 1 && (text.find('[') > text.find(']') ||
-                       text.find_first_not_of(" \t") != text.find('[') ||
-                       text.find_last_not_of(" \t") != text.find(']'))))
+        (open == 1 &&
+         (text.find('[') > text.find(']') || text.find_first_not_of(" \t") != text.find('[') ||
+          text.find_last_not_of(" \t") != text.find(']'))))
         throw std::invalid_argument(what + ": '" + text +
                                     "' has unmatched brackets (write [a b c] or a b c)");
     std::string t = text;
@@ -136,7 +135,9 @@ bool endsWith(const std::string& text, const std::string& suffix) {
 }
 
 namespace {
-bool anOption(const std::string& word) { return word.rfind("--", 0) == 0; }
+bool anOption(const std::string& word) {
+    return word.rfind("--", 0) == 0;
+}
 }  // namespace
 
 std::string optionValue(const std::vector<std::string>& args, std::size_t& i) {

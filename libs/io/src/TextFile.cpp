@@ -1,5 +1,7 @@
 #include "TextFile.h"
 
+#include <devslam/core/Parse.h>
+
 #include <opencv2/imgcodecs.hpp>
 
 #include <algorithm>
@@ -30,15 +32,10 @@ void forEachDataLine(const std::string& path,
 
 double parseNumber(const std::string& token, const std::string& path, int line,
                    const std::string& what) {
-    std::size_t used = 0;
+    // Not std::stod: it also reads hexadecimal ("0x1p-3"), which the TUM tools' float()
+    // refuses, and throws on an underflow ("1e-320"), which float() reads as ~0.
     double v = 0;
-    try {
-        // stod also reads hexadecimal ("0x1p-3"), which the TUM tools' float() refuses.
-        if (token.find_first_of("xX") == std::string::npos) v = std::stod(token, &used);
-    } catch (const std::exception&) {
-        used = 0;
-    }
-    if (used != token.size() || !std::isfinite(v))
+    if (!core::readFinite(token, v))
         throw std::runtime_error(lineError(path, line, what + " '" + token + "' is not a number"));
     return v;
 }
@@ -80,8 +77,7 @@ void requireWholePng(const std::string& path) {
     const bool whole = in && in.tellg() >= 12 && in.seekg(-12, std::ios::end) &&
                        in.read(tail, 12) && std::equal(tail, tail + 12, kEnd);
     if (!whole)
-        throw std::runtime_error("cannot write '" + path +
-                                 "': the file is cut short (disk full?)");
+        throw std::runtime_error("cannot write '" + path + "': the file is cut short (disk full?)");
 }
 
 }  // namespace

@@ -21,6 +21,12 @@ namespace devslam::core {
 /// "<what>: expected a number, got '<text>'".
 [[nodiscard]] double parseNumber(const std::string& text, const std::string& what);
 
+/// Whether `text` (no surrounding blanks) reads in full as one finite number, into `v`: no
+/// trailing characters, no nan, inf or overflow ("1e400"), no C hexadecimal ("0x1p-3", which
+/// Python's float() refuses). An underflow ("1e-400") reads as the subnormal or 0 it rounds
+/// to, as in Python.
+[[nodiscard]] bool readFinite(const std::string& text, double& v);
+
 /// An integer in [min, max]. Written in full as parseNumber accepts it, with an integral
 /// value ("1e3" is 1000, "2.5" is an error). Throws std::invalid_argument naming `what`,
 /// the text and, when it is outside them, the bounds.
