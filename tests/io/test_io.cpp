@@ -7,10 +7,14 @@
 #include <devslam/io/VideoReader.h>
 
 #include <gtest/gtest.h>
+#include <mrpt/img/CImage.h>
 #include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/io/CMemoryStream.h>
+#include <mrpt/obs/CActionCollection.h>
 #include <mrpt/obs/CObservation3DRangeScan.h>
+#include <mrpt/obs/CSensoryFrame.h>
+#include <mrpt/poses/CPose3D.h>
 #include <mrpt/serialization/CArchive.h>
 
 #include "Scratch.h"
@@ -19,6 +23,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
@@ -532,6 +537,159 @@ TEST(Rawlog, ImpossibleCamerasAndDepthUnitsAreErrors) {
     const auto no_unit = written([](auto& o) { o.rangeUnits = 0; });
     expectError([&] { io::RawlogReader r(no_unit); },
                 R"(observation 0: depth_scale must be finite and > 0)");
+}
+
+namespace {
+// A 640x480 observation whose depth camera sees one point only, at depth pixel (600, 450): 2 m
+// (range_is_depth) or 2 m of range along its ray. Both cameras at one place, fx = fy = 500,
+// principal point in the middle; each with radial distortion k1 as given.
+mrpt::obs::CObservation3DRangeScan onePointObservation(double depth_k1, double colour_k1,
+                                                       bool range_is_depth = true) {
+    mrpt::obs::CObservation3DRangeScan o;
+    o.hasIntensityImage = true;
+    o.intensityImage =
+        mrpt::img::CImage(cv::Mat(480, 640, CV_8UC3, cv::Scalar(90, 90, 90)), mrpt::img::DEEP_COPY);
+    o.hasRangeImage = true;
+    o.rangeImage_setSize(480, 640);
+    o.rangeImage.fill(0);
+    o.rangeUnits = 0.0002f;
+    o.rangeImage(450, 600) = 10000;  // 2 m
+    o.range_is_depth = range_is_depth;
+    for (auto* cam : {&o.cameraParams, &o.cameraParamsIntensity}) {
+        cam->ncols = 640;
+        cam->nrows = 480;
+        cam->setIntrinsicParamsFromValues(500, 500, 319.5, 239.5);
+    }
+    o.cameraParams.setDistortionPlumbBob(depth_k1, 0, 0, 0, 0);
+    o.cameraParamsIntensity.setDistortionPlumbBob(colour_k1, 0, 0, 0, 0);
+    o.relativePoseIntensityWRTDepth = mrpt::poses::CPose3D(0, 0, 0, -M_PI / 2, 0, -M_PI / 2);
+    return o;
+}
+
+// The one pixel of `depth` that holds a depth, and that depth.
+std::tuple<cv::Point, float> onlyDepth(const cv::Mat& depth) {
+    EXPECT_EQ(cv::countNonZero(depth > 0), 1);
+    cv::Point at;
+    double hi = 0;
+    cv::minMaxLoc(depth, nullptr, &hi, nullptr, &at);
+    return {at, static_cast<float>(hi)};
+}
+}  // namespace
+
+// A registered depth pixel lands where the colour lens puts its point, the raw pixel where
+// the SLAM looks it up; with pinhole projections only, an OpenNI colour lens (k1 0.06, k2
+// 0.04) moved depth up to ~20 px from its colour near the corners.
+TEST(Rawlog, DepthIsRegisteredThroughBothLenses) {
+    const double k1 = 0.1;
+    const double x = (600 - 319.5) / 500, y = (450 - 239.5) / 500, r2 = x * x + y * y;
+    {  // pinhole depth camera, distorted colour: pushed outwards by (1 + k1 r^2)
+        const auto f = io::frameFromObservation(onePointObservation(0, k1), "o");
+        const auto [at, z] = onlyDepth(f.depth);
+        EXPECT_EQ(at.x, std::lround(319.5 + 500 * x * (1 + k1 * r2)));  // 614, not 600
+        EXPECT_EQ(at.y, std::lround(239.5 + 500 * y * (1 + k1 * r2)));  // 460, not 450
+        EXPECT_NEAR(z, 2.0, 1e-6);
+        EXPECT_EQ(f.K.dist[0], k1);
+    }
+    {  // distorted depth camera (range along the ray), pinhole colour
+        const auto f = io::frameFromObservation(onePointObservation(-k1, 0, false), "o");
+        const auto [at, z] = onlyDepth(f.depth);
+        // Its colour pixel's ray, distorted by the depth lens, is the depth pixel again.
+        const double cx = (at.x - 319.5) / 500, cy = (at.y - 239.5) / 500;
+        const double d = 1 - k1 * (cx * cx + cy * cy);
+        EXPECT_NEAR(319.5 + 500 * cx * d, 600, 0.75);
+        EXPECT_NEAR(239.5 + 500 * cy * d, 450, 0.75);
+        // z from the range along the depth pixel's true ray (undistorted by fixed point)
+        double ux = x, uy = y;
+        for (int i = 0; i < 50; ++i) {
+            const double f2 = 1 - k1 * (ux * ux + uy * uy);
+            ux = x / f2;
+            uy = y / f2;
+        }
+        EXPECT_NEAR(z, 2.0 / std::sqrt(1 + ux * ux + uy * uy), 1e-5);
+    }
+    {  // one lens for both, same place and pixels: registered as it is
+        const auto f = io::frameFromObservation(onePointObservation(k1, k1), "o");
+        const auto [at, z] = onlyDepth(f.depth);
+        EXPECT_EQ(at, cv::Point(600, 450));
+        EXPECT_NEAR(z, 2.0, 1e-6);
+    }
+}
+
+// A calibration made for another resolution puts the principal point in the wrong pixels: a
+// 640x480 one on a 320x240 image passed every check, its principal point in the corner.
+TEST(Rawlog, ACalibrationForAnotherImageSizeIsRefused) {
+    auto o = onePointObservation(0, 0);
+    o.cameraParamsIntensity.ncols = 320;
+    o.cameraParamsIntensity.nrows = 240;
+    expectError([&] { (void)io::frameFromObservation(o, "x.rawlog observation 3"); },
+                R"(x\.rawlog observation 3: colour camera: its calibration is for 320x240 but )"
+                R"(the image is 640x480)");
+    o = onePointObservation(0, 0);
+    o.cameraParams.nrows = 240;
+    expectError([&] { (void)io::frameFromObservation(o, "o"); },
+                R"(o: depth camera: its calibration is for 640x240 but the image is 640x480)");
+}
+
+// Two RGB-D sensors in one rawlog, read without a sensor label, gave both cameras' frames
+// as one camera's (interleaved), or, synchronised in one sensory frame, "duplicate timestamp"
+// as if the file were damaged.
+TEST(Rawlog, TwoSensorsWithoutALabelAreRefused) {
+    TempDir d;
+    auto obs = [](const char* label, double t) {
+        auto o = mrpt::obs::CObservation3DRangeScan::Create(onePointObservation(0, 0));
+        o->sensorLabel = label;
+        o->timestamp = mrpt::Clock::fromDouble(t);
+        return o;
+    };
+    const std::string interleaved = d.str("two.rawlog"), synced = d.str("synced.rawlog");
+    {
+        mrpt::io::CFileGZOutputStream out(interleaved);
+        auto a = mrpt::serialization::archiveFrom(out);
+        a << *obs("KINECT_L", 1.0) << *obs("KINECT_R", 1.01) << *obs("KINECT_L", 1.03);
+    }
+    {
+        mrpt::io::CFileGZOutputStream out(synced);
+        auto a = mrpt::serialization::archiveFrom(out);
+        mrpt::obs::CSensoryFrame sf;
+        sf.insert(obs("KINECT_L", 1.0));
+        sf.insert(obs("KINECT_R", 1.0));
+        a << mrpt::obs::CActionCollection() << sf;
+    }
+    for (const auto& path : {interleaved, synced}) {
+        expectError([&] { io::RawlogReader r(path); },
+                    R"(\.rawlog: RGB-D observations of more than one sensor \('KINECT_L' from )"
+                    R"(observation 0, 'KINECT_R' at observation 1\): choose one with \[dataset\] )"
+                    R"(sensor_label)");
+        io::ReaderOptions o;
+        o.allow_damaged = true;  // it is not damage
+        expectError([&] { io::RawlogReader r(path, o); }, "more than one sensor");
+        o.sensor_label = "KINECT_R";
+        io::RawlogReader r(path, o);
+        EXPECT_EQ(r.size(), 1u);
+    }
+    io::ReaderOptions o;
+    o.sensor_label = "KINECT_L";
+    EXPECT_EQ(io::RawlogReader(interleaved, o).size(), 2u);
+}
+
+// Intrinsics given for a rawlog are for its images' size, as a TUM folder's are.
+TEST(Rawlog, GivenIntrinsicsOfAnotherSizeAreRefused) {
+    TempDir d;
+    const std::string path = d.str("one.rawlog");
+    {
+        mrpt::io::CFileGZOutputStream out(path);
+        mrpt::serialization::archiveFrom(out) << onePointObservation(0, 0);
+    }
+    io::ReaderOptions o;
+    o.intrinsics = core::CameraIntrinsics::fromPreset("freiburg1").scaled(0.5);
+    expectError([&] { io::RawlogReader r(path, o); },
+                R"(one\.rawlog: the given camera intrinsics are for 320x240 but observation 0's )"
+                R"(colour image is 640x480)");
+    o.intrinsics = core::CameraIntrinsics::fromPreset("freiburg1");
+    io::RawlogReader r(path, o);
+    const auto f = r.next();
+    ASSERT_TRUE(f.has_value());
+    EXPECT_EQ(f->K.fx, o.intrinsics->fx);
 }
 
 TEST(Rawlog, ReadsMrptsOwnOpenNiObservation) {

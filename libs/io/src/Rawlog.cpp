@@ -2,6 +2,7 @@
 
 #include "TextFile.h"
 
+#include <devslam/core/Camera.h>
 #include <devslam/core/GzFile.h>
 #include <devslam/core/Pose.h>
 
@@ -15,9 +16,9 @@
 #include <mrpt/serialization/CArchive.h>
 #include <mrpt/system/filesystem.h>
 
+#include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
-
 
 #include <cmath>
 #include <cstdio>
@@ -57,43 +58,116 @@ double roundedScale(float range_units) {
 }
 
 // Depth image in metres in the depth camera (range_is_depth handled).
+// Each pixel of camera `K` (K.width x K.height, row-major) with its lens distortion removed:
+// the pixel the pinhole backprojection is exact for. Computed once per camera (the frames of
+// a rawlog share one).
+const std::vector<cv::Point2f>& undistortedGrid(const core::CameraIntrinsics& K) {
+    thread_local core::CameraIntrinsics cached;
+    thread_local std::vector<cv::Point2f> grid;
+    if (!grid.empty() && cached == K) return grid;
+    std::vector<cv::Point2f> px;
+    px.reserve(static_cast<std::size_t>(K.width) * static_cast<std::size_t>(K.height));
+    for (int v = 0; v < K.height; ++v)
+        for (int u = 0; u < K.width; ++u)
+            px.emplace_back(static_cast<float>(u), static_cast<float>(v));
+    grid = core::undistortPixels(px, K);
+    cached = K;
+    return grid;
+}
+
+core::CameraIntrinsics depthCamera(const CObservation3DRangeScan& o) {
+    auto K = core::CameraIntrinsics::fromMrpt(o.cameraParams);
+    K.width = static_cast<int>(o.rangeImage.cols());
+    K.height = static_cast<int>(o.rangeImage.rows());
+    return K;
+}
+
 cv::Mat depthInDepthCamera(const CObservation3DRangeScan& o) {
     const int H = static_cast<int>(o.rangeImage.rows()), W = static_cast<int>(o.rangeImage.cols());
     const cv::Mat raw(H, W, CV_16UC1, const_cast<uint16_t*>(o.rangeImage.data()));
     cv::Mat m;
     raw.convertTo(m, CV_32F, o.rangeUnits);
-    if (!o.range_is_depth) {  // Euclidean range along the pixel ray -> z
-        const auto& c = o.cameraParams;
+    if (!o.range_is_depth) {  // Euclidean range along the pixel's ray -> z
+        const auto K = depthCamera(o);
+        const auto& ray = undistortedGrid(K);
         for (int v = 0; v < H; ++v)
             for (int u = 0; u < W; ++u) {
-                const double x = (u - c.cx()) / c.fx(), y = (v - c.cy()) / c.fy();
+                const auto& q = ray[static_cast<std::size_t>(v) * W + u];
+                const double x = (q.x - K.cx) / K.fx, y = (q.y - K.cy) / K.fy;
                 m.at<float>(v, u) /= static_cast<float>(std::sqrt(1 + x * x + y * y));
             }
     }
     return m;
 }
 
-// Reprojects depth from the depth camera into the colour camera (z-buffered, nearest pixel).
-cv::Mat registerDepth(const CObservation3DRangeScan& o, const cv::Mat& depth, int W, int H) {
-    const auto& dc = o.cameraParams;
-    const auto& ic = o.cameraParamsIntensity;
+// Reprojects depth from the depth camera into the colour camera (z-buffered, nearest pixel),
+// through both lenses: a depth pixel is undistorted before it is backprojected, and its point
+// lands on the colour image where the colour lens puts it (the raw, distorted pixel, where
+// the SLAM looks depth up). With pinhole models only, an OpenNI colour lens (k1 0.06, k2 0.04)
+// put depth up to ~20 px from its colour near the image corners.
+cv::Mat registerDepth(const CObservation3DRangeScan& o, const cv::Mat& depth,
+                      const core::CameraIntrinsics& Kc) {
+    const auto Kd = depthCamera(o);
+    const auto& ray = undistortedGrid(Kd);
     // colour optical <- depth optical
     const mrpt::poses::CPose3D T = (o.relativePoseIntensityWRTDepth - opticalInObs());
     const Eigen::Isometry3d Tci = core::toIsometry(T).inverse();
-    cv::Mat out(H, W, CV_32F, cv::Scalar(0));
+    const int W = Kc.width, H = Kc.height;
+    // The colour image's extent in normalized coordinates (its border undistorted), with a
+    // margin: the distortion polynomial folds points far outside the view back into it.
+    float x0 = 0, x1 = 0, y0 = 0, y1 = 0;
+    if (Kc.distorted()) {
+        std::vector<cv::Point2f> border;
+        for (int k = 0; k <= 32; ++k) {
+            const float u = static_cast<float>(k * (W - 1)) / 32,
+                        v = static_cast<float>(k * (H - 1)) / 32;
+            border.insert(
+                border.end(),
+                {{u, 0}, {u, static_cast<float>(H - 1)}, {0, v}, {static_cast<float>(W - 1), v}});
+        }
+        x0 = y0 = std::numeric_limits<float>::max();
+        x1 = y1 = std::numeric_limits<float>::lowest();
+        for (const auto& b : core::undistortPixels(border, Kc)) {
+            const float x = static_cast<float>((b.x - Kc.cx) / Kc.fx);
+            const float y = static_cast<float>((b.y - Kc.cy) / Kc.fy);
+            x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
+        }
+        const float mx = 0.05f * (x1 - x0), my = 0.05f * (y1 - y0);
+        x0 -= mx, x1 += mx, y0 -= my, y1 += my;
+    }
+    std::vector<cv::Point3f> pts;  // in the colour camera's optical frame
+    pts.reserve(static_cast<std::size_t>(cv::countNonZero(depth > 0)));
     for (int v = 0; v < depth.rows; ++v)
         for (int u = 0; u < depth.cols; ++u) {
             const float z = depth.at<float>(v, u);
             if (!(z > 0)) continue;
-            const Eigen::Vector3d p((u - dc.cx()) * z / dc.fx(), (v - dc.cy()) * z / dc.fy(), z);
-            const Eigen::Vector3d q = Tci * p;
+            const auto& r = ray[static_cast<std::size_t>(v) * depth.cols + u];
+            const Eigen::Vector3d q = Tci * core::backproject(r.x, r.y, z, Kd);
             if (q.z() <= 0) continue;
-            const int ui = static_cast<int>(std::lround(ic.fx() * q.x() / q.z() + ic.cx()));
-            const int vi = static_cast<int>(std::lround(ic.fy() * q.y() / q.z() + ic.cy()));
-            if (ui < 0 || vi < 0 || ui >= W || vi >= H) continue;
-            auto& d = out.at<float>(vi, ui);
-            if (d == 0 || q.z() < d) d = static_cast<float>(q.z());
+            if (Kc.distorted()) {
+                const double x = q.x() / q.z(), y = q.y() / q.z();
+                if (x < x0 || x > x1 || y < y0 || y > y1) continue;
+            }
+            pts.emplace_back(static_cast<float>(q.x()), static_cast<float>(q.y()),
+                             static_cast<float>(q.z()));
         }
+    std::vector<cv::Point2f> px;
+    if (Kc.distorted() && !pts.empty()) {
+        const cv::Mat D(1, 5, CV_64F, const_cast<double*>(Kc.dist.data()));
+        cv::projectPoints(pts, cv::Vec3d(0, 0, 0), cv::Vec3d(0, 0, 0), Kc.cvMatrix(), D, px);
+    } else {
+        px.reserve(pts.size());
+        for (const auto& q : pts)
+            px.emplace_back(static_cast<float>(Kc.fx * q.x / q.z + Kc.cx),
+                            static_cast<float>(Kc.fy * q.y / q.z + Kc.cy));
+    }
+    cv::Mat out(H, W, CV_32F, cv::Scalar(0));
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+        const long ui = std::lround(px[i].x), vi = std::lround(px[i].y);
+        if (ui < 0 || vi < 0 || ui >= W || vi >= H) continue;
+        auto& d = out.at<float>(static_cast<int>(vi), static_cast<int>(ui));
+        if (d == 0 || pts[i].z < d) d = pts[i].z;
+    }
     return out;
 }
 
@@ -164,22 +238,26 @@ core::Frame frameFromObservation(const CObservation3DRangeScan& o, const std::st
           std::tuple{"depth", &o.cameraParams, static_cast<int>(o.rangeImage.cols()),
                      static_cast<int>(o.rangeImage.rows())}}) {
         auto K = core::CameraIntrinsics::fromMrpt(*cam);
+        // A calibration made for another resolution has its principal point and focal
+        // lengths in the wrong pixels (a 640x480 one on a 320x240 image still passes the
+        // checks below, its principal point in the image's corner).
+        if (cam->ncols != 0 && cam->nrows != 0 && (K.width != w || K.height != h))
+            throw std::runtime_error(what + ": " + name + " camera: its calibration is for " +
+                                     std::to_string(K.width) + "x" + std::to_string(K.height) +
+                                     " but the image is " + std::to_string(w) + "x" +
+                                     std::to_string(h));
         K.width = w;
         K.height = h;
         if (const std::string p = K.problem(); !p.empty())
             throw std::runtime_error(what + ": " + name + " camera: " + p);
     }
-    const cv::Mat depth = depthInDepthCamera(o);
-    const bool same_camera = o.doDepthAndIntensityCamerasCoincide() &&
-                             o.cameraParams.fx() == o.cameraParamsIntensity.fx() &&
-                             o.cameraParams.fy() == o.cameraParamsIntensity.fy() &&
-                             o.cameraParams.cx() == o.cameraParamsIntensity.cx() &&
-                             o.cameraParams.cy() == o.cameraParamsIntensity.cy() &&
-                             depth.size() == f.bgr.size();
-    f.depth = same_camera ? depth : registerDepth(o, depth, f.bgr.cols, f.bgr.rows);
     f.K = core::CameraIntrinsics::fromMrpt(o.cameraParamsIntensity);
     f.K.width = f.bgr.cols;
     f.K.height = f.bgr.rows;
+    const cv::Mat depth = depthInDepthCamera(o);
+    // (registered depth: one camera, the same pixels, lens included)
+    const bool same_camera = o.doDepthAndIntensityCamerasCoincide() && depthCamera(o) == f.K;
+    f.depth = same_camera ? depth : registerDepth(o, depth, f.K);
     f.rgb_source = what;
     f.depth_source = what;
     core::validateFrame(f, what);
@@ -248,10 +326,22 @@ RawlogReader::RawlogReader(std::string path, ReaderOptions opts)
     // Scan once: count frames, find damage, take the intrinsics of the first frame.
     std::size_t skipped = 0;
     bool saw_sf = false, saw_obs = false;
+    // Not damage: a rawlog of two RGB-D sensors read without a label gave both cameras' frames
+    // as one camera's (or, synchronised in one sensory frame, a "duplicate timestamp").
+    struct MixedSensors : std::runtime_error {
+        using std::runtime_error::runtime_error;
+    };
+    std::string first_label;
     try {
         Stream s(path_);
         double last_t = 0;
         while (auto o = s.next(opts_.sensor_label, skipped, saw_sf, saw_obs)) {
+            if (n_frames_ == 0) first_label = o->sensorLabel;
+            if (opts_.sensor_label.empty() && o->sensorLabel != first_label)
+                throw MixedSensors(path_ + ": RGB-D observations of more than one sensor ('" +
+                                   first_label + "' from observation 0, '" + o->sensorLabel +
+                                   "' at observation " + std::to_string(n_frames_) +
+                                   "): choose one with [dataset] sensor_label");
             if (const std::string m = missingExternalFile(*o); !m.empty())
                 throw std::runtime_error("observation " + std::to_string(n_frames_) +
                                          ": external file '" + m + "' not found");
@@ -259,11 +349,10 @@ RawlogReader::RawlogReader(std::string path, ReaderOptions opts)
             // before it are the intact part).
             const double t = mrpt::Clock::toDouble(o->timestamp);
             if (n_frames_ > 0 && !(t > last_t))
-                throw std::runtime_error(
-                    "observation " + std::to_string(n_frames_) + ": " +
-                    detail::stampNotAfter(t, last_t, detail::stampText(t)) +
-                    " (previous observation " + std::to_string(n_frames_ - 1) + " at " +
-                    detail::stampText(last_t) + ")");
+                throw std::runtime_error("observation " + std::to_string(n_frames_) + ": " +
+                                         detail::stampNotAfter(t, last_t, detail::stampText(t)) +
+                                         " (previous observation " + std::to_string(n_frames_ - 1) +
+                                         " at " + detail::stampText(last_t) + ")");
             last_t = t;
             if (n_frames_ == 0) {
                 o->load();
@@ -274,6 +363,8 @@ RawlogReader::RawlogReader(std::string path, ReaderOptions opts)
         }
         if (const std::string gz = core::gzipDamage(path_); !gz.empty())
             throw std::runtime_error("truncated or corrupt gzip stream (" + gz + ")");
+    } catch (const MixedSensors&) {
+        throw;
     } catch (const std::exception& e) {
         damage_ =
             path_ + ": " + e.what() + " after " + std::to_string(n_frames_) + " RGB-D observations";
@@ -287,7 +378,16 @@ RawlogReader::RawlogReader(std::string path, ReaderOptions opts)
                                       ? std::string()
                                       : " with label '" + opts_.sensor_label + "'") +
                                  " (" + std::to_string(skipped) + " other observations)");
-    if (opts_.intrinsics) K_ = *opts_.intrinsics;
+    if (opts_.intrinsics) {
+        // As a TUM folder's: intrinsics given for another resolution are refused up front.
+        const auto& K = *opts_.intrinsics;
+        if (K.width != K_.width || K.height != K_.height)
+            throw std::runtime_error(path_ + ": the given camera intrinsics are for " +
+                                     std::to_string(K.width) + "x" + std::to_string(K.height) +
+                                     " but observation 0's colour image is " +
+                                     std::to_string(K_.width) + "x" + std::to_string(K_.height));
+        K_ = K;
+    }
     stream_ = std::make_unique<Stream>(path_);
 }
 
@@ -340,7 +440,10 @@ std::optional<core::Frame> RawlogReader::next() {
         throw std::runtime_error(what + ": " + core::innermostMessage(msg));
     }
     o->unload();
-    if (opts_.intrinsics) f.K = *opts_.intrinsics;
+    if (opts_.intrinsics) {
+        f.K = *opts_.intrinsics;
+        core::validateFrame(f, what);  // (a later observation of another size)
+    }
     f.index = index;
     return f;
 }
