@@ -216,6 +216,52 @@ TEST(World, AbsurdValuesAreErrorsNamingTheKey) {
               "");
 }
 
+// Values the simulator (Bullet, in single precision) or the planner's grid cannot hold ran
+// silently wrong, or failed when the run started, naming no file.
+TEST(World, ValuesBulletAndTheGridCannotHoldAreErrors) {
+    const std::string world = "[world]\nx_min=0\nx_max=10\ny_min=0\ny_max=10\n";
+    const std::string robot = "[robot]\nstart_x=1\nstart_y=1\n";
+    const std::string goal = "[goal]\nx=9\ny=9\n";
+    EXPECT_EQ(errorOf(world + robot + goal + "[obstacles]\nb = box 5 5 4 0.2 1e9\n"),
+              "w.ini [obstacles] b: yaw_deg must be in [-360, 360] deg");
+    EXPECT_EQ(errorOf(world + robot + goal + "[obstacles]\nb = box 5 5 4 0.2 -360\n"), "");
+    EXPECT_EQ(errorOf(world + robot + goal + "[laser]\nrange = 1e39\n"),
+              "w.ini [laser] range: must be in (0, 100] m");
+    EXPECT_EQ(errorOf(world + robot + goal + "[laser]\nrange = 100\n"), "");
+    EXPECT_EQ(errorOf("[world]\nx_min=1000000\nx_max=1000020\ny_min=0\ny_max=10\n"
+                      "[robot]\nstart_x=1000002\nstart_y=1\n[goal]\nx=1000018\ny=9\n"),
+              "w.ini [world] x_min: must be within +-10000 m (Bullet's single precision)");
+    for (const char* name : {"../../x", "a/b", ".."})
+        EXPECT_EQ(errorOf(world + "name = " + name + "\n" + robot + goal),
+                  "w.ini [world] name: must be a file name: not '.' or '..', no '/' or '\\'")
+            << name;
+    // MRPT's grid holds the bounds in whole cells: 10.02 m at 0.05 m is 200 cells, 10.0 m.
+    EXPECT_EQ(errorOf("[world]\nx_min=0\nx_max=10.02\ny_min=0\ny_max=10\nboundary_walls=false\n" +
+                      robot + "[goal]\nx=10.01\ny=9\n"),
+              "w.ini [goal] x: the goal (10.01, 9) lies outside the planner's grid [0, 10] x [0, "
+              "10] m (the bounds in whole cells of grid_resolution 0.05 m): move it inside, or "
+              "widen the bounds");
+    EXPECT_EQ(errorOf("[world]\nx_min=0\nx_max=10.02\ny_min=0\ny_max=10\nboundary_walls=false\n" +
+                      robot + "[goal]\nx=9.9\ny=9\n"),
+              "");
+    // A 1 cm wall across a person's path: sampled every 2 cm, the path stepped over it.
+    const std::string thin = world + robot + goal + "[obstacles]\nw = wall 5.005 5 0.01 4\n";
+    EXPECT_EQ(errorOf(thin + "[pedestrians]\np = scripted 1 0.2 0 4 5 6.03 5\n"),
+              "w.ini [pedestrians] p: its path from (4, 5) to (6.03, 5) runs through obstacle "
+              "'w'");
+    // ... along a face, touching it, is allowed; past its end, and round a cylinder, too.
+    EXPECT_EQ(errorOf(world + robot + goal +
+                      "[obstacles]\nf = wall 5 5 0.5 4\n[pedestrians]\np = scripted 1 0.2 0 "
+                      "5.25 3.5 5.25 6.5\n"),
+              "");
+    EXPECT_EQ(errorOf(thin + "[pedestrians]\np = scripted 1 0.2 0 4 7.5 6 7.5\n"), "");
+    const std::string pillar = world + robot + goal + "[obstacles]\nc = cylinder 5 5 0.5\n";
+    EXPECT_EQ(errorOf(pillar + "[pedestrians]\np = scripted 1 0.2 0 4 5.4 6 5.4\n"),
+              "w.ini [pedestrians] p: its path from (4, 5.4) to (6, 5.4) runs through obstacle "
+              "'c'");
+    EXPECT_EQ(errorOf(pillar + "[pedestrians]\np = scripted 1 0.2 0 4 5.6 6 5.6\n"), "");
+}
+
 TEST(World, DistanceToRotatedBox) {
     Obstacle o;
     o.cx = 1;
@@ -473,9 +519,8 @@ TEST(RandomWorlds, SameSeedSameWorldAndAlwaysSolvable) {
             planner.setMap(rasterize(a));
             const auto path = planner.plan({a.robot.start.x, a.robot.start.y}, a.goal);
             ASSERT_TRUE(path.has_value()) << what << ": no path from start to goal";
-            EXPECT_GE(path->length, std::hypot(a.goal.x - a.robot.start.x,
-                                               a.goal.y - a.robot.start.y) -
-                                        0.1)
+            EXPECT_GE(path->length,
+                      std::hypot(a.goal.x - a.robot.start.x, a.goal.y - a.robot.start.y) - 0.1)
                 << what;
         }
 }

@@ -2,6 +2,7 @@
 #include <devslam/sim/SimRobot.h>
 #include <devslam/sim/Simulator.h>
 
+#include <devslam/nav/GridPlanner.h>
 #include <devslam/nav/RoutePicture.h>
 
 #include <mrpt/core/Clock.h>
@@ -64,7 +65,15 @@ EpisodeResult runEpisode(const WorldSpec& world, const mrpt::config::CConfigFile
     const auto statics = staticObstacles(world);
     nav::Navigator navigator(robot, nav_ini, nav_opts);
     res.holonomic_method = navigator.holonomicMethod();
-    if (!navigator.start(grid, world.robot.start, world.goal, world.goal_tolerance)) {
+    bool started = false;
+    try {
+        started = navigator.start(grid, world.robot.start, world.goal, world.goal_tolerance);
+    } catch (const nav::PlanningError& e) {  // a start or goal the planner cannot stand on
+        res.outcome = Outcome::NoPath;
+        res.reason = (world.source.empty() ? world.name : world.source) + ": " + e.what();
+        return res;
+    }
+    if (!started) {
         res.outcome = Outcome::NoPath;
         res.reason = navigator.lastError();
         return res;

@@ -126,6 +126,10 @@ Obstacle parseObstacle(const mrpt::config::CConfigFileBase& c, const std::string
         o.sx = v[2];
         o.sy = v[3];
         o.yaw = v.size() == 5 ? mrpt::DEG2RAD(v[4]) : 0.0;
+        // Bullet takes the angle in single precision: 1e9 deg turned its box ~0.5 rad off the
+        // one the grid and the checks here use.
+        if (!(std::abs(o.yaw) <= 2 * M_PI + 1e-9))
+            fail(source, s, k, "yaw_deg must be in [-360, 360] deg");
         // 1e300 reached the rasterizer's integer cell indices
         if (!(o.sx > 0 && o.sy > 0 && o.sx <= 1000 && o.sy <= 1000))
             fail(source, s, k, "sizes must be in (0, 1000] m");
@@ -212,6 +216,17 @@ void validateBoundsAndTiming(const WorldSpec& w) {
     const auto& src = w.source;
     if (!(w.x_max > w.x_min)) fail(src, "world", "x_max", "must be > x_min");
     if (!(w.y_max > w.y_min)) fail(src, "world", "y_max", "must be > y_min");
+    // The name makes the default picture's file name (out/nav_<name>.png): "../../x" wrote
+    // outside out/, "a/b" into a folder.
+    if (w.name == "." || w.name == ".." || w.name.find_first_of("/\\") != std::string::npos)
+        fail(src, "world", "name", "must be a file name: not '.' or '..', no '/' or '\\'");
+    // Bullet simulates in single precision: at 1e6 m one float step is 6 cm, more than the
+    // robot moves in a physics step, and it never moved.
+    constexpr double kMaxCoordinate = 1e4;
+    for (const auto& [key, v] :
+         {std::pair{"x_min", w.x_min}, {"x_max", w.x_max}, {"y_min", w.y_min}, {"y_max", w.y_max}})
+        if (std::abs(v) > kMaxCoordinate)
+            fail(src, "world", key, "must be within +-10000 m (Bullet's single precision)");
     if (w.grid_resolution <= 0 || w.grid_resolution > 0.5)
         fail(src, "world", "grid_resolution", "must be in (0, 0.5] m");
     // The occupancy grid holds every cell of the bounds; MRPT counts them in 32 bits.
@@ -256,7 +271,9 @@ void validateRobotAndLaser(const WorldSpec& w) {
         fail(src, "robot", "max_ang_acc_deg", "must be at most 3600 deg/s^2");
     if (w.robot.max_w > mrpt::DEG2RAD(720.0) + 1e-9)
         fail(src, "robot", "max_w_deg", "must be at most 720 deg/s");
-    if (!(w.laser.range > 0)) fail(src, "laser", "range", "must be > 0 m");
+    // (1e39 made every ray's end inf in Bullet's floats: nothing was ever hit)
+    if (!(w.laser.range > 0 && w.laser.range <= 100))
+        fail(src, "laser", "range", "must be in (0, 100] m");
     if (w.laser.rays < 2 || w.laser.rays > 100000)
         fail(src, "laser", "rays", "must be in [2, 100000]");
     if (!(w.laser.rate > 0)) fail(src, "laser", "rate_hz", "must be > 0");
@@ -329,15 +346,31 @@ void validateEndpoints(const WorldSpec& w, const std::vector<Obstacle>& statics)
     // and obstacles grow to whole cells: up to about 1.7 cells less than the exact distance.
     // A goal or start the exact test passes can still be one the planner refuses; say so here,
     // in the world file's terms, rather than as a planning error when the run starts.
+    // MRPT's grid covers the bounds rounded to whole cells: a goal or start in the sliver
+    // it leaves out was refused only when the run started, as a planning error naming no file.
+    const auto grid = rasterize(w);
+    const mrpt::math::TPoint2D start{w.robot.start.x, w.robot.start.y};
+    for (const auto& [what, section, key, p] : {std::tuple{"goal", "goal", "x", w.goal},
+                                                std::tuple{"start", "robot", "start_x", start}}) {
+        const int ix = grid.x2idx(p.x), iy = grid.y2idx(p.y);
+        if (ix >= 0 && iy >= 0 && ix < static_cast<int>(grid.getSizeX()) &&
+            iy < static_cast<int>(grid.getSizeY()))
+            continue;
+        std::ostringstream m;
+        m << "the " << what << " (" << p.x << ", " << p.y << ") lies outside the planner's grid ["
+          << grid.getXMin() << ", " << grid.getXMax() << "] x [" << grid.getYMin() << ", "
+          << grid.getYMax() << "] m (the bounds in whole cells of grid_resolution "
+          << w.grid_resolution << " m): move it inside, or widen the bounds";
+        fail(src, section, key, m.str());
+    }
     if (!statics.empty()) {
         nav::GridPlannerOptions po;
         po.robot_radius = w.robot.radius;
         nav::GridPlanner planner(po);
-        planner.setMap(rasterize(w));
+        planner.setMap(grid);
         for (const auto& [what, section, key, p] :
              {std::tuple{"goal", "goal", "x", w.goal},
-              std::tuple{"start", "robot", "start_x",
-                         mrpt::math::TPoint2D{w.robot.start.x, w.robot.start.y}}}) {
+              std::tuple{"start", "robot", "start_x", start}}) {
             const double c = planner.clearance(p);
             if (c >= w.robot.radius) continue;
             const Obstacle* nearest = &statics.front();
@@ -353,6 +386,37 @@ void validateEndpoints(const WorldSpec& w, const std::vector<Obstacle>& statics)
             fail(src, section, key, m.str());
         }
     }
+}
+
+/// Whether the segment a-b enters the inside of `o` (touching its edge does not count). Exact:
+/// the path check sampled every 2 cm and let a person walk through a 1 cm wall.
+bool segmentEntersObstacle(const Obstacle& o, const mrpt::math::TPoint2D& a,
+                           const mrpt::math::TPoint2D& b) {
+    const double dx = b.x - a.x, dy = b.y - a.y;
+    if (o.shape == Obstacle::Shape::Cylinder) {
+        const double len2 = dx * dx + dy * dy;
+        const double t =
+            len2 > 0 ? std::clamp(((o.cx - a.x) * dx + (o.cy - a.y) * dy) / len2, 0.0, 1.0) : 0.0;
+        return std::hypot(a.x + t * dx - o.cx, a.y + t * dy - o.cy) < o.radius;
+    }
+    // In the box's frame, the part of the segment strictly inside |x| < sx/2, |y| < sy/2
+    // (Liang-Barsky clipping): it enters when that part has a length.
+    const double c = std::cos(o.yaw), s = std::sin(o.yaw);
+    const double ax = c * (a.x - o.cx) + s * (a.y - o.cy),
+                 ay = -s * (a.x - o.cx) + c * (a.y - o.cy);
+    const double ux = c * dx + s * dy, uy = -s * dx + c * dy;
+    double lo = 0, hi = 1;
+    for (const auto& [p0, d, half] : {std::tuple{ax, ux, o.sx / 2}, std::tuple{ay, uy, o.sy / 2}}) {
+        if (d == 0) {
+            if (!(std::abs(p0) < half)) return false;
+            continue;
+        }
+        double t0 = (-half - p0) / d, t1 = (half - p0) / d;
+        if (t0 > t1) std::swap(t0, t1);
+        lo = std::max(lo, t0);
+        hi = std::min(hi, t1);
+    }
+    return lo < hi;
 }
 
 /// Each pedestrian: inside the bounds, off the robot's start, and never through an obstacle.
@@ -400,14 +464,10 @@ void validatePedestrians(const WorldSpec& w, const std::vector<Obstacle>& static
                      "starts at " + at(p0) + ", inside obstacle '" + o.name + "'");
             for (std::size_t k = 0; k < legs; ++k) {
                 const auto &a = p.path[k], &b = p.path[k + 1];
-                const int n = 1 + static_cast<int>(std::hypot(b.x - a.x, b.y - a.y) / 0.02);
-                for (int i = 0; i <= n; ++i) {
-                    const double u = double(i) / n;
-                    if (distanceToObstacle(o, {a.x + u * (b.x - a.x), a.y + u * (b.y - a.y)}) < 0)
-                        fail(src, "pedestrians", p.name,
-                             "its path from " + at(a) + " to " + at(b) +
-                                 " runs through obstacle '" + o.name + "'");
-                }
+                if (segmentEntersObstacle(o, a, b))
+                    fail(src, "pedestrians", p.name,
+                         "its path from " + at(a) + " to " + at(b) + " runs through obstacle '" +
+                             o.name + "'");
             }
         }
     }
