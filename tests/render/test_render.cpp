@@ -384,23 +384,33 @@ TEST(RenderSequence, StopEndsTheRenderWithTheFramesBeforeItWritten) {
     o.rawlog_path = tmp.str("seq.rawlog");
     o.max_frames = 5;
     int asked = 0;
-    o.stop = [&] { return ++asked == 4; };  // asked first, then before frames 0, 1, 2
+    // Asked first, then before frames 1, 2 and 3: not before frame 0, when the old outputs
+    // are gone already (a stop there left a folder that was neither render, and devslam-synth
+    // said it was "left as it was").
+    o.stop = [&] { return ++asked == 4; };
     const auto sum = writeSequence(sc, o);
     EXPECT_TRUE(sum.stopped);
-    EXPECT_EQ(sum.n_frames, 2u);
+    EXPECT_EQ(sum.n_frames, 3u);
     EXPECT_EQ(asked, 4);
     EXPECT_FALSE(fs::exists(o.out_dir + "/render.txt"));
     EXPECT_FALSE(isRenderCurrent(sc, o));
     auto tum = io::openRgbd(o.out_dir, {});
-    EXPECT_EQ(tum->size(), std::optional<std::size_t>(2));
-    EXPECT_EQ(io::readTumTrajectory(o.out_dir + "/groundtruth.txt").size(), 2u);
-    EXPECT_EQ(io::RawlogReader(o.rawlog_path).size(), std::optional<std::size_t>(2));
+    EXPECT_EQ(tum->size(), std::optional<std::size_t>(3));
+    EXPECT_EQ(io::readTumTrajectory(o.out_dir + "/groundtruth.txt").size(), 3u);
+    EXPECT_EQ(io::RawlogReader(o.rawlog_path).size(), std::optional<std::size_t>(3));
     EXPECT_TRUE(fs::exists(o.out_dir + "/camera.ini"));
     std::size_t person_rows = 0;
     std::istringstream persons(readFile(o.out_dir + "/persons.txt"));
     for (std::string line; std::getline(persons, line);)
         person_rows += !line.empty() && line[0] != '#';
-    EXPECT_EQ(person_rows, 2 * sc.people.size());
+    EXPECT_EQ(person_rows, 3 * sc.people.size());
+    // A stop asked right after the first check: the first frame is written all the same.
+    asked = 0;
+    o.stop = [&] { return ++asked >= 2; };
+    const auto one = writeSequence(sc, o);
+    EXPECT_TRUE(one.stopped);
+    EXPECT_EQ(one.n_frames, 1u);
+    EXPECT_EQ(io::readTumTrajectory(o.out_dir + "/groundtruth.txt").size(), 1u);
 
     // Not stopped: the whole render, and render.txt.
     o.stop = [] { return false; };
@@ -462,6 +472,22 @@ TEST(RenderSequence, RefusesToOverwriteWhatItDidNotRender) {
     EXPECT_NO_THROW(checkOutputs(sc, o));  // render.txt
     EXPECT_EQ(writeSequence(sc, o).n_frames, 1u);
 
+    // Another folder's labels/ (a YOLO dataset), ground truth or preview are not ours to
+    // replace: they went without a word.
+    for (const char* name : {"labels/0001.txt", "groundtruth.txt", "camera.ini", "preview.png"}) {
+        const std::string other = tmp.str("other");
+        fs::remove_all(other);
+        fs::create_directories(fs::path(other + "/" + name).parent_path());
+        std::ofstream(other + "/" + name) << "theirs\n";
+        WriteOptions w = o;
+        w.out_dir = other;
+        const std::string top = fs::path(name).begin()->string();
+        expectMessage(
+            [&] { (void)writeSequence(sc, w); },
+            "output folder '" + other + "' holds " + top + ", not of a devslam-synth render");
+        EXPECT_EQ(readFile(other + "/" + name), "theirs\n");
+    }
+
     const std::string ini = tmp.str("s.ini");
     std::ofstream(ini) << "[scenario]\n";
     o.rawlog_path = ini;
@@ -490,8 +516,9 @@ TEST(DevslamSynth, RefusesOutputsThatAreNotItsOwnAndMissingValues) {
     std::ofstream(ini) << "[scenario]\n";
     for (const auto& [args, says] : std::vector<std::pair<std::string, std::string>>{
              {"short_walking -o " + tum + " --frames 2",
-              "output folder '" + tum + "' already holds a TUM sequence (rgb.txt) that "
-              "devslam-synth did not render"},
+              "output folder '" + tum +
+                  "' already holds a TUM sequence (rgb.txt) that "
+                  "devslam-synth did not render"},
              {"short_walking -o " + tmp.str("so") + " --frames 2 --rawlog " + ini,
               "rawlog '" + ini + "': the name must end in .rawlog"},
              {"--cut-texture " + photo + " 178,88,102,292 " + photo,
@@ -567,6 +594,17 @@ TEST(RenderSequence, GesturingHandIsRenderedAndLabelled) {
 
 // The walking person of the short scenario: moving, visible, and the labelled pixels lie at
 // the person's distance from the camera.
+// A photo smaller than the 8 x 8 px panel crop failed in an OpenCV assertion naming no file.
+TEST(RenderGeometry, ATinyTextureIsRefusedNamingTheFile) {
+    TempDir tmp;
+    const std::string tiny = tmp.str("tiny.png");
+    ASSERT_TRUE(cv::imwrite(tiny, cv::Mat(4, 4, CV_8UC3, cv::Scalar(10, 200, 30))));
+    auto sc = bareRoom({1.0, 2.0, 1.5}, {4.0, 2.0, 1.5});
+    sc.room.wall_textures = {tiny};
+    expectMessage([&] { SequenceRenderer r(sc); },
+                  "render: texture '" + tiny + "' is 4x4 px; at least 8x8 needed");
+}
+
 TEST(RenderSequence, PersonTruthIsConsistent) {
     SequenceRenderer r(smallShort());
     const auto f = r.render(30);
@@ -811,17 +849,20 @@ TEST(Scenario, ShippedFilesLoadAndTyposAreReported) {
     const std::string room_text = readFile(kSynth + "/office_room.ini");
     const auto expectRoomMessage = [&](auto&& edit, const std::string& msg) {
         std::string r = room_text;
-        for (std::size_t p = r.find("../../data"); p != std::string::npos;
-             p = r.find("../../data"))
+        for (std::size_t p = r.find("../../data"); p != std::string::npos; p = r.find("../../data"))
             r.replace(p, 10, kRoot + "/data");
         edit(r);
         std::ofstream(tmp.str("bad_room.ini")) << r;
-        expectMessage([&] { (void)loadScenario(withEdit(text, "room = " + kSynth + "/office_room.ini",
-                                                        "room = " + tmp.str("bad_room.ini"))); },
-                      msg);
+        expectMessage(
+            [&] {
+                (void)loadScenario(withEdit(text, "room = " + kSynth + "/office_room.ini",
+                                            "room = " + tmp.str("bad_room.ini")));
+            },
+            msg);
     };
     for (const auto& bad_msg :
-         {std::pair<std::string, std::string>{"wall_blur     = -1", "bad_room.ini [room] wall_blur: must be 0..100"},
+         {std::pair<std::string, std::string>{"wall_blur     = -1",
+                                              "bad_room.ini [room] wall_blur: must be 0..100"},
           {"floor_blur    = x", "floor_blur"}}) {
         const std::string& bad = bad_msg.first;
         expectRoomMessage(
@@ -854,8 +895,8 @@ TEST(Scenario, ShippedFilesLoadAndTyposAreReported) {
                   "unknown section [persn_1]");
     expectMessage(
         [&] {
-            (void)loadScenario(withEdit(text, "n_frames        = 60",
-                                        "n_frames = 60\ntexture_filter = cubic"));
+            (void)loadScenario(
+                withEdit(text, "n_frames        = 60", "n_frames = 60\ntexture_filter = cubic"));
         },
         "[scenario] texture_filter: must be linear or nearest, got 'cubic'");
     expectMessage([&] { (void)loadScenario(withEdit(text, "kind    = walking", "kind = flying")); },
@@ -958,6 +999,25 @@ TEST(Scenario, ShippedFilesLoadAndTyposAreReported) {
                   tmp.str("s.ini") + " [trajectory] type: unknown trajectory type 'spiral'");
     expectMessage([&] { (void)loadScenario(base, {"camera.width=16000"}); },
                   tmp.str("s.ini") + " [camera] width/height: must be 1..4096 [px]");
+    expectMessage(
+        [&] {
+            (void)loadScenario(
+                base, {"camera.width=4", "camera.height=4", "camera.cx=1.5", "camera.cy=1.5"});
+        },
+        tmp.str("s.ini") + " [camera] width/height: must be at least 8 px");
+    // Depth a TUM PNG cannot hold (16 bits of 1/5000 m) failed at the first far frame, after
+    // the old outputs were gone.
+    expectMessage([&] { (void)loadScenario(base, {"depth_noise.max_range=20"}); },
+                  tmp.str("s.ini") + " [depth_noise] max_range: must be at most 13.107 m");
+    EXPECT_NO_THROW((void)loadScenario(base, {"depth_noise.enabled=false"}));
+    expectMessage(
+        [&] {
+            (void)loadScenario(withEdit(text, "n_frames        = 60",
+                                        "n_frames = 60\nroom_set = room.size=[20,5,2.8]"),
+                               {"depth_noise.enabled=false"});
+        },
+        "[scenario] far_clip: with [depth_noise] enabled = false the depth reaches");
+    (void)withEdit(text, "n_frames", "n_frames");  // s.ini (= base) as it was
     expectMessage([&] { (void)loadScenario(base, {"scenario.n_frames=0"}); },
                   tmp.str("s.ini") + " [scenario] n_frames: must be >= 1");
     expectMessage([&] { (void)loadScenario(base, {"person_9.speed=1"}); },  // a new person
@@ -1012,9 +1072,9 @@ TEST(Scenario, TheCameraAndThePeopleStayInTheRoom) {
     // half of each period; only every 300th frame of these 60000 was checked (10 s: always the
     // same phase), and it passed.
     try {
-        (void)render::loadScenario(path, {"scenario.duration=2000",
-                                          "trajectory.position=[0.1 2.5 1.3]",
-                                          "trajectory.period=[7 9 0.5]"});
+        (void)render::loadScenario(path,
+                                   {"scenario.duration=2000", "trajectory.position=[0.1 2.5 1.3]",
+                                    "trajectory.period=[7 9 0.5]"});
         ADD_FAILURE() << "a camera that leaves the room was accepted";
     } catch (const std::invalid_argument& e) {
         EXPECT_NE(std::string(e.what()).find("outside the room"), std::string::npos) << e.what();

@@ -36,8 +36,7 @@ std::string toString(PersonKind k) {
 }
 
 mrpt::poses::CPose3D personPhotoPose(const PersonSpec& p, const PersonState& s,
-                                     const Eigen::Vector3d& eye,
-                                     const Eigen::Vector3d& first_eye) {
+                                     const Eigen::Vector3d& eye, const Eigen::Vector3d& first_eye) {
     const Eigen::Vector3d& b = s.position;
     const Eigen::Vector3d& facing = p.kind == PersonKind::Walking ? eye : first_eye;
     const double yaw = std::atan2(-(facing.x() - b.x()), facing.y() - b.y());

@@ -99,11 +99,10 @@ void readRoom(const std::string& path, RoomSpec& room) {
     core::applyOverrides(*cfg, room.overrides, "room_set item");
     const std::string base = dirOf(path);
     const std::string s = "room";
-    core::requireKnownKeys(
-        *cfg, s,
-        {"size", "panel_width", "panel_height", "wall_textures", "floor_textures", "wall_blur",
-         "floor_blur"},
-        path);
+    core::requireKnownKeys(*cfg, s,
+                           {"size", "panel_width", "panel_height", "wall_textures",
+                            "floor_textures", "wall_blur", "floor_blur"},
+                           path);
     room.source = path;
     room.size = vec3(*cfg, s, "size", path, true);
     room.panel_width = core::readDouble(*cfg, s, "panel_width", room.panel_width);
@@ -123,10 +122,10 @@ void readRoom(const std::string& path, RoomSpec& room) {
     }
     room.wall_blur = core::readDouble(*cfg, s, "wall_blur", 0.0);
     room.floor_blur = core::readDouble(*cfg, s, "floor_blur", 0.0);
-    core::requireValue(room.wall_blur >= 0 && room.wall_blur <= 100, "room",
-                       "wall_blur", "must be 0..100 [px]");
-    core::requireValue(room.floor_blur >= 0 && room.floor_blur <= 100, "room",
-                       "floor_blur", "must be 0..100 [px]");
+    core::requireValue(room.wall_blur >= 0 && room.wall_blur <= 100, "room", "wall_blur",
+                       "must be 0..100 [px]");
+    core::requireValue(room.floor_blur >= 0 && room.floor_blur <= 100, "room", "floor_blur",
+                       "must be 0..100 [px]");
     room.wall_textures =
         resolveImages(requiredText(*cfg, s, "wall_textures"), base, path + " [room] wall_textures");
     room.floor_textures = resolveImages(requiredText(*cfg, s, "floor_textures"), base,
@@ -137,14 +136,12 @@ void readRoom(const std::string& path, RoomSpec& room) {
         box.name = b;
         box.base = vec3(*cfg, b, "base", path, true);
         box.size = vec3(*cfg, b, "size", path, true);
-        core::requireValue(box.size.minCoeff() > 0, b, "size",
-                           "must be > 0 [m]");
+        core::requireValue(box.size.minCoeff() > 0, b, "size", "must be > 0 [m]");
         box.yaw = core::readDouble(*cfg, b, "yaw_deg", 0.0) * kPi / 180.0;
         box.textures =
             resolveImages(requiredText(*cfg, b, "textures"), base, path + " [" + b + "] textures");
         box.blur = core::readDouble(*cfg, b, "blur", 0.0);
-        core::requireValue(box.blur >= 0 && box.blur <= 100, b, "blur",
-                           "must be 0..100 [px]");
+        core::requireValue(box.blur >= 0 && box.blur <= 100, b, "blur", "must be 0..100 [px]");
         room.boxes.push_back(std::move(box));
     }
 }
@@ -204,8 +201,7 @@ PersonSpec loadPerson(const mrpt::config::CConfigFileBase& cfg, const std::strin
     if (xy.size() < 2 || xy.size() % 2)
         throw std::invalid_argument(where + " path: need x y pairs");
     for (std::size_t i = 0; i < xy.size(); i += 2) p.path.emplace_back(xy[i], xy[i + 1]);
-    core::requireValue(p.height > 0.2 && p.height < 3.0, s, "height",
-                       "must be in (0.2, 3) [m]");
+    core::requireValue(p.height > 0.2 && p.height < 3.0, s, "height", "must be in (0.2, 3) [m]");
     core::requireValue(p.speed >= 0 && p.speed < 5, s, "speed", "must be in [0, 5) [m/s]");
     core::requireValue(p.sway_period > 0, s, "sway_period", "must be > 0 [s]");
     core::requireValue(std::abs(p.gesture_deg) <= 90, s, "gesture_deg",
@@ -230,11 +226,11 @@ Scenario readScenario(const std::string& path, const std::vector<std::string>& o
     sc.source = path;
     sc.overrides = overrides;
     const std::string s = "scenario";
-    core::requireKnownKeys(*cfg, s,
-                           {"name", "room", "duration", "n_frames", "rate_hz", "t0", "seed",
-                            "rgb_noise_sigma", "near_clip", "far_clip", "texture_filter",
-                            "room_set"},
-                           path);
+    core::requireKnownKeys(
+        *cfg, s,
+        {"name", "room", "duration", "n_frames", "rate_hz", "t0", "seed", "rgb_noise_sigma",
+         "near_clip", "far_clip", "texture_filter", "room_set"},
+        path);
     sc.name = cfg->read_string(s, "name", fs::path(path).stem().string());
     core::requireValue(!sc.name.empty() && sc.name.find('/') == std::string::npos &&
                            sc.name != "." && sc.name != "..",
@@ -255,9 +251,9 @@ Scenario readScenario(const std::string& path, const std::vector<std::string>& o
         throw std::invalid_argument(
             path + " [scenario]: give exactly one of 'duration' [s] or 'n_frames'");
     // A sequence is minutes long: a billion frames started a render of days.
-    core::requireValue(n <= kMaxFrames, s, "n_frames",
-                       "must be at most " + std::to_string(kMaxFrames) + " (" +
-                           std::to_string(n) + " given)");
+    core::requireValue(
+        n <= kMaxFrames, s, "n_frames",
+        "must be at most " + std::to_string(kMaxFrames) + " (" + std::to_string(n) + " given)");
     core::requireValue(duration * sc.rate_hz <= kMaxFrames + 0.5, s, "duration",
                        "gives more than " + std::to_string(kMaxFrames) +
                            " frames at rate_hz (duration * rate_hz)");
@@ -273,16 +269,17 @@ Scenario readScenario(const std::string& path, const std::vector<std::string>& o
     sc.near_clip = core::readDouble(*cfg, s, "near_clip", sc.near_clip);
     sc.far_clip = core::readDouble(*cfg, s, "far_clip", sc.far_clip);
     const std::string filter = cfg->read_string(s, "texture_filter", "linear");
-    core::requireValue(filter == "linear" || filter == "nearest", s,
-                       "texture_filter", "must be linear or nearest, got '" + filter + "'");
+    core::requireValue(filter == "linear" || filter == "nearest", s, "texture_filter",
+                       "must be linear or nearest, got '" + filter + "'");
     sc.texture_linear = filter == "linear";
-    core::requireValue(sc.rgb_noise_sigma >= 0, "scenario", "rgb_noise_sigma",
-                       "must be >= 0");
-    core::requireValue(sc.near_clip > 0 && sc.far_clip > sc.near_clip, "scenario",
-                       "far_clip", "need 0 < near_clip < far_clip [m]");
+    core::requireValue(sc.rgb_noise_sigma >= 0, "scenario", "rgb_noise_sigma", "must be >= 0");
+    core::requireValue(sc.near_clip > 0 && sc.far_clip > sc.near_clip, "scenario", "far_clip",
+                       "need 0 < near_clip < far_clip [m]");
 
     sc.K = cfg->sectionExists("camera") ? core::CameraIntrinsics::fromConfig(*cfg, "camera")
                                         : core::CameraIntrinsics::fromPreset("freiburg3");
+    core::requireValue(sc.K.width >= 8 && sc.K.height >= 8, "camera", "width/height",
+                       "must be at least 8 px (the renderer's smallest image)");
     for (double d : sc.K.dist)
         if (d != 0.0)
             throw std::invalid_argument(path +
@@ -291,8 +288,8 @@ Scenario readScenario(const std::string& path, const std::vector<std::string>& o
     std::string room = requiredText(*cfg, s, "room");
     if (fs::path(room).is_relative())
         room = (fs::path(dirOf(path)) / room).lexically_normal().string();
-    sc.room.overrides = core::overrideItems(cfg->read_string(s, "room_set", ""),
-                                            path + " [" + s + "] room_set");
+    sc.room.overrides =
+        core::overrideItems(cfg->read_string(s, "room_set", ""), path + " [" + s + "] room_set");
     if (!fs::is_regular_file(room))
         throw std::invalid_argument(path + " [scenario] room: no such file '" + room + "'");
     try {
@@ -306,9 +303,28 @@ Scenario readScenario(const std::string& path, const std::vector<std::string>& o
     if (cfg->sectionExists("depth_noise")) sc.depth_noise.loadFromConfig(*cfg, "depth_noise");
     for (const auto& p : sectionsWithPrefix(*cfg, "person_")) {
         if (p.size() <= std::string("person_").size())
-            throw std::invalid_argument("[" + p + "]: a person's section needs a name after "
+            throw std::invalid_argument("[" + p +
+                                        "]: a person's section needs a name after "
                                         "'person_'");
         sc.people.push_back(loadPerson(*cfg, p, path));
+    }
+    // The label images hold a person's id in 8 bits, 0 for no one: person 256 was written as 0.
+    if (sc.people.size() > 255)
+        throw std::invalid_argument(path + ": " + std::to_string(sc.people.size()) +
+                                    " [person_*] sections; at most 255");
+    // A TUM depth PNG (and the rawlog) holds 16 bits of 1/5000 m: at most 13.1 m. Deeper
+    // depth failed the render at its first far frame, after the old outputs were gone.
+    constexpr double kMaxDepth = 65535.0 / 5000.0;
+    if (sc.depth_noise.enabled) {
+        core::requireValue(sc.depth_noise.max_range <= kMaxDepth, "depth_noise", "max_range",
+                           "must be at most 13.107 m (16-bit TUM depth at 5000 per metre)");
+    } else {
+        const double deepest = std::min(sc.far_clip, sc.room.size.norm());
+        core::requireValue(deepest <= kMaxDepth, "scenario", "far_clip",
+                           "with [depth_noise] enabled = false the depth reaches " +
+                               std::to_string(deepest) +
+                               " m (far_clip or the room's diagonal); a TUM depth PNG holds at "
+                               "most 13.107 m: lower far_clip");
     }
     // The camera and the people inside the room: outside it they rendered walls seen from
     // behind, or nobody, without a word.
@@ -332,9 +348,9 @@ Scenario readScenario(const std::string& path, const std::vector<std::string>& o
         const auto T = cameraPoseAt(sc.trajectory, sc.elapsed(i));
         if (inRoom(T.x(), T.y()) && T.z() > 0 && T.z() < R.z()) continue;
         std::ostringstream m;
-        m << "the camera at t = " << sc.elapsed(i) << " s is at (" << T.x() << ", " << T.y()
-          << ", " << T.z() << "), outside the room (0.." << R.x() << " x 0.." << R.y() << " x 0.."
-          << R.z() << " m)";
+        m << "the camera at t = " << sc.elapsed(i) << " s is at (" << T.x() << ", " << T.y() << ", "
+          << T.z() << "), outside the room (0.." << R.x() << " x 0.." << R.y() << " x 0.." << R.z()
+          << " m)";
         core::requireValue(false, "trajectory", "position", m.str());
     }
 

@@ -171,6 +171,11 @@ struct SequenceRenderer::Impl {
         if (it != photos.end()) return it->second;
         cv::Mat img = cv::imread(path, cv::IMREAD_COLOR);
         if (img.empty()) throw std::runtime_error("render: cannot read texture '" + path + "'");
+        // (panelCrop cuts at least 8 x 8 px: a smaller photo failed in an OpenCV assertion)
+        if (img.cols < 8 || img.rows < 8)
+            throw std::runtime_error("render: texture '" + path + "' is " +
+                                     std::to_string(img.cols) + "x" + std::to_string(img.rows) +
+                                     " px; at least 8x8 needed");
         if (blur > 0) cv::GaussianBlur(img, img, cv::Size(), blur);
         return photos.emplace(key, img).first->second;
     }
@@ -189,8 +194,8 @@ struct SequenceRenderer::Impl {
             for (int i = 0; i < nx; ++i) {
                 const double x0 = i * W / nx, x1 = (i + 1) * W / nx;
                 const double y0 = j * H / ny, y1 = (j + 1) * H / ny;
-                const cv::Mat crop =
-                    panelCrop(photo(files[counter++ % files.size()], blur), rng, (x1 - x0) / (y1 - y0));
+                const cv::Mat crop = panelCrop(photo(files[counter++ % files.size()], blur), rng,
+                                               (x1 - x0) / (y1 - y0));
                 auto obj = CSetOfTexturedTriangles::Create();
                 addQuad(*obj, origin + ex * x0 + ey * y0, origin + ex * x1 + ey * y0,
                         origin + ex * x1 + ey * y1, origin + ex * x0 + ey * y1, 0.f, 0.f, 1.f, 1.f);

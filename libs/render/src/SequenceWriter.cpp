@@ -32,7 +32,9 @@ std::string readWholeFile(const std::string& path) {
     return ss.str();
 }
 
-fs::path signaturePath(const WriteOptions& o) { return fs::path(o.out_dir) / "render.txt"; }
+fs::path signaturePath(const WriteOptions& o) {
+    return fs::path(o.out_dir) / "render.txt";
+}
 
 /// An INI file's settings as text: comments (# and ; lines, // to the end of a line), blank
 /// lines and spaces at the ends dropped, so that editing a comment keeps a render current.
@@ -72,8 +74,7 @@ std::string renderSignature(const Scenario& sc, const WriteOptions& o) {
     for (const auto& t : textures) {
         std::error_code ec;
         const auto size = fs::file_size(t, ec);
-        s << "texture " << t << " " << (ec ? std::string("missing") : std::to_string(size))
-          << "\n";
+        s << "texture " << t << " " << (ec ? std::string("missing") : std::to_string(size)) << "\n";
     }
     return s.str();
 }
@@ -97,6 +98,14 @@ void checkOutputs(const Scenario& sc, const WriteOptions& o) {
             "output folder '" + o.out_dir +
             "' already holds a TUM sequence (rgb.txt) that devslam-synth did not render (no "
             "render.txt or persons.txt); remove it or name another folder");
+    // Nor are another folder's labels/, ground truth, camera.ini or preview.png, which a
+    // render replaces (a YOLO dataset's labels/ went without a word).
+    if (!o.out_dir.empty() && !fs::exists(dir / "render.txt") && !fs::exists(dir / "persons.txt"))
+        for (const char* name : {"labels", "groundtruth.txt", "camera.ini", "preview.png"})
+            if (fs::exists(dir / name))
+                throw std::invalid_argument("output folder '" + o.out_dir + "' holds " + name +
+                                            ", not of a devslam-synth render (no render.txt or "
+                                            "persons.txt); remove it or name another folder");
     if (o.rawlog_path.empty()) return;
     const std::string ext = ".rawlog";
     const auto& r = o.rawlog_path;
@@ -151,7 +160,9 @@ WriteSummary writeSequence(const Scenario& sc, const WriteOptions& o,
     std::vector<double> ms;
     std::size_t i = 0;
     for (; i < n; ++i) {
-        if (o.stop && o.stop()) {
+        // Not before the first frame: the earlier render's files are gone already, and a
+        // stop with none written would leave a folder that is neither render.
+        if (i > 0 && o.stop && o.stop()) {
             sum.stopped = true;
             break;
         }
