@@ -60,6 +60,8 @@ struct Args {
     bool modes_only = false;        ///< --bench without the ablation and the long run
     bool allow_damaged = false;     ///< a damaged input: run on what is intact
     bool out_given = false;         ///< --out was on the command line
+    bool results_given = false;     ///< --results was on the command line
+    bool section_given = false;     ///< --section was on the command line
 };
 
 Args parse(int argc, char** argv) {
@@ -76,17 +78,19 @@ Args parse(int argc, char** argv) {
         else if (k == "--out") {
             a.out = value(i);
             a.out_given = true;
-        } else if (k == "--results")
+        } else if (k == "--results") {
             a.results = value(i);
-        else if (k == "--max-frames")
+            a.results_given = true;
+        } else if (k == "--max-frames")
             a.max_frames = std::size_t(core::parseInteger(value(i), "--max-frames", 0));
         else if (k == "--bench")
             a.bench = int(core::parseInteger(value(i), "--bench", 1, 1000));
         else if (k == "--quiet")
             a.quiet = true;
-        else if (k == "--section")
+        else if (k == "--section") {
             a.section = value(i);
-        else if (k == "--modes-only")
+            a.section_given = true;
+        } else if (k == "--modes-only")
             a.modes_only = true;
         else if (k == "--replay")
             a.replay = int(core::parseInteger(value(i), "--replay", 1, 1000));
@@ -102,7 +106,9 @@ Args parse(int argc, char** argv) {
     }
     // Found now, not when the run's results are written (after the whole run): a file where
     // the folder or one above it goes, or a folder it cannot be made in. Nothing is created.
-    if (!a.out.empty()) {
+    // (--bench writes no run folder: its default --out, relative to where it was started,
+    // refused a bench started in a folder it cannot write in)
+    if (a.bench == 0 && !a.out.empty()) {
         namespace fs = std::filesystem;
         fs::path p = fs::absolute(a.out).lexically_normal();
         if (fs::exists(p) && !fs::is_directory(p))
@@ -115,6 +121,14 @@ Args parse(int argc, char** argv) {
             throw std::invalid_argument("--out '" + a.out + "': cannot write in '" + p.string() +
                                         "'");
     }
+    if (a.bench == 0)
+        for (const auto& [given, option] : {std::pair{a.results_given, "--results"},
+                                            {a.section_given, "--section"},
+                                            {a.modes_only, "--modes-only"}})
+            if (given)
+                throw std::invalid_argument(std::string(option) +
+                                            " goes with --bench N only (a single run writes no "
+                                            "table)");
     if (a.bench > 0) {
         // Its table says it ran the INI as it is on every frame of the input, in all modes.
         for (const auto& [given, option] : {std::pair{a.max_frames > 0, "--max-frames"},
@@ -434,10 +448,11 @@ std::string benchLongRun(const Args& a) {
 int runBench(const Args& a) {
     std::string md = benchHeader(a) + benchModes(a);
     if (!a.modes_only) md += benchAblations(a) + benchLongRun(a);
-    md += "\nPeak RSS is per run (VmHWM reset before each run). Wall-clock FPS depends on the "
-          "load and the drifting speed of this 2-core VM; the CPU time per frame (all threads) "
-          "is printed by `devslam-run` beside it. Measured on " +
-          core::measuredOnLine() + ".\n";
+    md +=
+        "\nPeak RSS is per run (VmHWM reset before each run). Wall-clock FPS depends on the "
+        "load and the drifting speed of this 2-core VM; the CPU time per frame (all threads) "
+        "is printed by `devslam-run` beside it. Measured on " +
+        core::measuredOnLine() + ".\n";
     core::replaceResultsSection(a.results, a.section, md);
     std::cout << md;
     return 0;

@@ -1,12 +1,12 @@
 // Smoke tests of the devslam-run app: outputs written and loadable, bad input reported.
 #include <gtest/gtest.h>
 
-#include "Command.h"
-#include "Scratch.h"
 #include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/maps/COccupancyGridMap2D.h>
 #include <mrpt/opengl/COpenGLScene.h>
 #include <mrpt/serialization/CArchive.h>
+#include "Command.h"
+#include "Scratch.h"
 
 #include <csignal>
 #include <cstdlib>
@@ -19,7 +19,6 @@
 #include <string>
 #include <tuple>
 #include <vector>
-
 
 namespace fs = std::filesystem;
 
@@ -153,6 +152,12 @@ TEST(DevslamRun, BadInputIsReported) {
     EXPECT_NE(r.out.find("--section 'nav': devslam-run writes 'slam' or 'slam-synthetic'"),
               std::string::npos)
         << r.out;
+    // ... and its options are refused without it (a run went on, writing no table).
+    for (const char* opt : {"--section slam", "--modes-only", "--results /tmp/R.md"}) {
+        r = run(std::string("--max-frames 2 ") + opt);
+        EXPECT_EQ(r.rc, 1) << opt;
+        EXPECT_NE(r.out.find(" goes with --bench N only"), std::string::npos) << r.out;
+    }
     std::ofstream(ini) << "# R\n<!-- END slam -->\n";
     r = run("--bench 1 --modes-only --results " + ini.string());
     EXPECT_EQ(r.rc, 1);
@@ -182,8 +187,8 @@ TEST(DevslamRun, BadInputIsReported) {
 // folder named "--quiet" and ran. Every app names the option instead, and runs nothing.
 TEST(Apps, AnOptionsValueIsNotTheNextOption) {
     const std::string fr1 = std::string(DEVSLAM_SOURCE_DIR) + "/data/tum/fr1_xyz_first37";
-    for (const auto& [app, args, says] : std::vector<std::tuple<std::string, std::string,
-                                                                std::string>>{
+    for (const auto& [app, args, says] :
+         std::vector<std::tuple<std::string, std::string, std::string>>{
              {"devslam-run", "--mode none --out --quiet", "--out needs a value"},
              {"devslam-run", "--input --mode none --quiet --out ''", "--input needs a value"},
              {"devslam-overlay", "--input synthetic:walking --frames 2 --out --quiet",
@@ -227,8 +232,8 @@ TEST(DevslamConvert, RefusesToWriteOverAnExistingRawlog) {
     const fs::path dir = d.str();
     const std::string tum = std::string(DEVSLAM_SOURCE_DIR) + "/data/tum/fr1_xyz_first37";
     const fs::path keep = dir / "keep.rawlog";
-    auto c = devslam::test::runApp("devslam-convert",
-                                   tum + " " + keep.string() + " --max-frames 5");
+    auto c =
+        devslam::test::runApp("devslam-convert", tum + " " + keep.string() + " --max-frames 5");
     ASSERT_EQ(c.rc, 0) << c.out;
     const auto size = fs::file_size(keep);
     // a TUM folder whose second depth image does not decode
@@ -244,9 +249,9 @@ TEST(DevslamConvert, RefusesToWriteOverAnExistingRawlog) {
 
     c = devslam::test::runApp("devslam-convert", (dir / "bad").string() + " " + keep.string());
     EXPECT_EQ(c.rc, 1) << c.out;
-    EXPECT_NE(c.out.find("OUTPUT '" + keep.string() +
-                         "' already exists; remove it or name another"),
-              std::string::npos)
+    EXPECT_NE(
+        c.out.find("OUTPUT '" + keep.string() + "' already exists; remove it or name another"),
+        std::string::npos)
         << c.out;
     EXPECT_EQ(fs::file_size(keep), size);
     c = devslam::test::runApp("devslam-convert", keep.string() + " " + (dir / "x").string());
@@ -287,15 +292,13 @@ TEST(DevslamConvert, NoFrameConvertedIsAFailure) {
             ++n;
         }
     };
-    firstTwo("rgb.txt", "rgb", [](const fs::path&, const fs::path& to) {
-        std::ofstream(to) << "not a png";
-    });
-    firstTwo("depth.txt", "depth", [](const fs::path& from, const fs::path& to) {
-        fs::copy_file(from, to);
-    });
-    const auto c = devslam::test::runApp(
-        "devslam-convert", (dir / "in").string() + " " + (dir / "out").string() +
-                               " --allow-damaged --camera freiburg1");
+    firstTwo("rgb.txt", "rgb",
+             [](const fs::path&, const fs::path& to) { std::ofstream(to) << "not a png"; });
+    firstTwo("depth.txt", "depth",
+             [](const fs::path& from, const fs::path& to) { fs::copy_file(from, to); });
+    const auto c = devslam::test::runApp("devslam-convert",
+                                         (dir / "in").string() + " " + (dir / "out").string() +
+                                             " --allow-damaged --camera freiburg1");
     EXPECT_EQ(c.rc, 1) << c.out;
     EXPECT_NE(c.out.find("left out (frames that do not decode): 2"), std::string::npos) << c.out;
     EXPECT_NE(c.out.find("no frame converted; " + (dir / "out").string() + " holds none"),
@@ -534,9 +537,9 @@ TEST(DevslamRun, MissingPersonTruthStopsTheRunAndKeepsTheFramesDone) {
 
     for (const auto& [mode, frames] : {std::pair{"none", 6u}, {"truth", 5u}}) {
         const fs::path out = dir / (std::string("run_") + mode);
-        const auto r = run("--input '" + seq.string() + "' --config " +
-                           DEVSLAM_SOURCE_DIR + "/config_ini/slam_synthetic.ini --mode " + mode +
-                           " --quiet --out " + out.string());
+        const auto r =
+            run("--input '" + seq.string() + "' --config " + DEVSLAM_SOURCE_DIR +
+                "/config_ini/slam_synthetic.ini --mode " + mode + " --quiet --out " + out.string());
         EXPECT_EQ(r.rc, 1) << r.out;
         EXPECT_NE(r.out.find("persons.txt: no entry for frame " + stamp), std::string::npos)
             << r.out;

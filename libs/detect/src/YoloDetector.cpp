@@ -55,8 +55,8 @@ std::vector<std::string> readNames(const std::string& path) {
 }
 
 const std::vector<std::string> kYoloKeys{
-    "detector",     "model",          "weights",       "names",   "input_width",
-    "input_height", "conf_threshold", "nms_threshold", "classes", "validate_on_load",
+    "detector",         "model",          "weights",       "names",   "input_width",
+    "input_height",     "conf_threshold", "nms_threshold", "classes", "validate_on_load",
     "fast_convolutions"};
 }  // namespace
 
@@ -266,13 +266,14 @@ std::vector<Detection> YoloDetector::detect(const cv::Mat& bgr) {
         for (int r = 0; r < out.rows; ++r) {
             const float* row = out.ptr<float>(r);
             const float obj = row[4];
-            if (obj < conf) continue;
+            // (not `obj < conf`: a NaN from corrupted weights passed every test below)
+            if (!(obj >= conf)) continue;
             for (std::size_t k = 0; k < wanted_.size(); ++k) {
                 // cv::dnn's darknet region layer already multiplies class scores by
                 // objectness; ONNX (YOLOv5-style) outputs keep them separate.
                 const float cls = row[5 + wanted_[k]];
                 const float score = onnx_ ? obj * cls : cls;
-                if (score < conf) continue;
+                if (!(score >= conf)) continue;
                 double cx = row[0], cy = row[1], w = row[2], h = row[3];
                 if (onnx_) {  // input pixels -> normalized
                     cx /= opts_.input_width;
@@ -280,6 +281,9 @@ std::vector<Detection> YoloDetector::detect(const cv::Mat& bgr) {
                     cy /= opts_.input_height;
                     h /= opts_.input_height;
                 }
+                if (!std::isfinite(cx) || !std::isfinite(cy) || !std::isfinite(w) ||
+                    !std::isfinite(h))
+                    continue;
                 boxes[k].emplace_back((cx - w / 2) * bgr.cols, (cy - h / 2) * bgr.rows,
                                       w * bgr.cols, h * bgr.rows);
                 scores[k].push_back(score);
@@ -293,7 +297,7 @@ std::vector<Detection> YoloDetector::detect(const cv::Mat& bgr) {
         cv::dnn::NMSBoxes(boxes[k], scores[k], conf, nms, keep);
         for (int i : keep) {
             const cv::Rect2f b = cv::Rect2f(boxes[k][i]) & image;
-            if (b.area() <= 0.f) continue;
+            if (!(b.area() > 0.f)) continue;
             dets.push_back({b, wanted_[k], names_[wanted_[k]], scores[k][i]});
         }
     }
