@@ -38,7 +38,9 @@ options:
 )";
 
 /// Whether the output is a rawlog (else a TUM folder), by its name as given.
-bool isRawlog(const std::string& out) { return devslam::core::endsWith(out, ".rawlog"); }
+bool isRawlog(const std::string& out) {
+    return devslam::core::endsWith(out, ".rawlog");
+}
 
 /// The writers open their output before the first frame is read: an output that is the
 /// input (or holds another sequence) would be emptied before it was read.
@@ -112,8 +114,10 @@ struct Conversion {
     // --allow-damaged, is left out and the rest converted. The readers pass such a frame.
     std::string stopped;
     std::vector<std::string> undecodable;
-    int interrupted = 0;   // the signal that stopped the conversion
-    double depth_gap = 0;  // [s] the largest colour-depth stamp difference written
+    std::string write_error;  // the writer refused a frame (or the disk did): stopped there
+    bool removed = false;     // nothing converted: the output this run made was removed
+    int interrupted = 0;      // the signal that stopped the conversion
+    double depth_gap = 0;     // [s] the largest colour-depth stamp difference written
 
     template <class Writer>
     void copy(devslam::io::RgbdReader& reader, Writer& out, const Args& args,
@@ -140,7 +144,12 @@ struct Conversion {
             if ((interrupted = devslam::core::stopSignal())) break;
             if (f->depth_timestamp)
                 depth_gap = std::max(depth_gap, std::abs(*f->depth_timestamp - f->timestamp));
-            out.write(*f);
+            try {
+                out.write(*f);
+            } catch (const std::exception& e) {
+                write_error = e.what();  // the frames before it stay written, closed whole
+                break;
+            }
             bar.update(++n);
         }
     }
@@ -161,22 +170,30 @@ struct Conversion {
         if (!undecodable.empty())
             std::cout << "left out (frames that do not decode): " << undecodable.size()
                       << ", the first: " << undecodable.front() << "\n";
-        if (n == 0 && stopped.empty() && !interrupted) {  // every frame left out
-            std::cerr << "devslam-convert: no frame converted; " << args.output
-                      << " holds none\n";
+        // An output with no frame would only stand in the way of the next try (an existing
+        // output is refused), so the one this run made is removed.
+        const std::string holds =
+            removed ? "nothing was written (" + args.output + " removed)"
+                    : args.output + " holds the " + std::to_string(n) + " frames before it";
+        if (n == 0 && stopped.empty() && write_error.empty() && !interrupted) {
+            std::cerr << "devslam-convert: no frame converted (every one left out); "
+                      << (removed ? holds : args.output + " holds none") << "\n";
+            return 1;
+        }
+        if (!write_error.empty()) {
+            std::cerr << "devslam-convert: " << write_error << "\ndevslam-convert: stopped there; "
+                      << holds << "\n";
             return 1;
         }
         if (!stopped.empty()) {
             std::cerr << "devslam-convert: " << stopped << "\ndevslam-convert: stopped there; "
-                      << args.output << " holds the " << n
-                      << " frames before it (--allow-damaged leaves such frames out and "
-                         "converts the rest)\n";
+                      << holds
+                      << " (--allow-damaged leaves such frames out and converts the rest)\n";
             return 1;
         }
         if (interrupted) {
             std::cerr << "devslam-convert: interrupted (" << devslam::core::signalName(interrupted)
-                      << "); " << args.output << " holds the " << n
-                      << " frames converted before it\n";
+                      << "); " << holds << "\n";
             return 1;
         }
         return 0;
@@ -199,6 +216,9 @@ int convert(int argc, char** argv) {
         const std::size_t total = std::min(reader->size().value_or(0), args.max_frames);
         devslam::core::ProgressBar bar("converting", total);
         Conversion c;
+        const bool existed = std::filesystem::exists(args.output);
+        const std::string images = devslam::io::rawlogImagesDir(args.output);
+        const bool images_existed = std::filesystem::exists(images);
         if (isRawlog(args.output)) {
             devslam::io::RawlogWriter out(args.output, args.wo);
             c.copy(*reader, out, args, bar);
@@ -211,6 +231,13 @@ int convert(int argc, char** argv) {
             out.close();
         }
         bar.finish();
+        if (c.n == 0 && !existed) {
+            std::error_code ec;
+            std::filesystem::remove_all(args.output, ec);
+            c.removed = !ec;
+            if (isRawlog(args.output) && args.wo.external_images && !images_existed)
+                std::filesystem::remove_all(images, ec);
+        }
         return c.report(*reader, args);
     } catch (const devslam::io::DamagedInput& e) {
         std::cerr << "devslam-convert: " << e.what() << "\n";

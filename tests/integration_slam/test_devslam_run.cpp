@@ -1,4 +1,7 @@
 // Smoke tests of the devslam-run app: outputs written and loadable, bad input reported.
+#include <devslam/io/Rawlog.h>
+#include <devslam/io/TumReader.h>
+
 #include <gtest/gtest.h>
 
 #include <mrpt/io/CFileGZInputStream.h>
@@ -301,9 +304,49 @@ TEST(DevslamConvert, NoFrameConvertedIsAFailure) {
                                              " --allow-damaged --camera freiburg1");
     EXPECT_EQ(c.rc, 1) << c.out;
     EXPECT_NE(c.out.find("left out (frames that do not decode): 2"), std::string::npos) << c.out;
-    EXPECT_NE(c.out.find("no frame converted; " + (dir / "out").string() + " holds none"),
+    EXPECT_NE(c.out.find("no frame converted (every one left out); nothing was written (" +
+                         (dir / "out").string() + " removed)"),
               std::string::npos)
         << c.out;
+    // The empty output is gone, so the next try is not refused for it.
+    EXPECT_FALSE(fs::exists(dir / "out"));
+    const auto again = devslam::test::runApp(
+        "devslam-convert",
+        (dir / "in").string() + " " + (dir / "out2.rawlog").string() + " --camera freiburg1");
+    EXPECT_EQ(again.rc, 1) << again.out;
+    EXPECT_NE(again.out.find("stopped there; nothing was written (" +
+                             (dir / "out2.rawlog").string() + " removed)"),
+              std::string::npos)
+        << again.out;
+    EXPECT_FALSE(fs::exists(dir / "out2.rawlog"));
+}
+
+// A frame the writer refuses stops the conversion with the frames before it, the output
+// closed whole: a TUM folder holds depth up to 65535 / 5000 m, a rawlog in millimetres more.
+TEST(DevslamConvert, AFrameTheWriterRefusesStopsThere) {
+    const devslam::test::TempDir d("devslam_");
+    const fs::path dir = d.str();
+    devslam::io::TumReader tum(std::string(DEVSLAM_SOURCE_DIR) + "/data/tum/fr1_xyz_first37");
+    {
+        devslam::io::RawlogWriter w((dir / "far.rawlog").string(), {});
+        for (std::size_t i = 0; i < 3; ++i) {
+            devslam::core::Frame f = tum.read(i);
+            f.depth_scale = 1000;  // millimetres: up to 65.5 m
+            if (i == 1) f.depth.at<float>(10, 10) = 20.f;
+            w.write(f);
+        }
+        w.close();
+    }
+    const auto c = devslam::test::runApp(
+        "devslam-convert", (dir / "far.rawlog").string() + " " + (dir / "tum").string());
+    EXPECT_EQ(c.rc, 1) << c.out;
+    EXPECT_NE(c.out.find("does not fit"), std::string::npos) << c.out;
+    EXPECT_NE(
+        c.out.find("stopped there; " + (dir / "tum").string() + " holds the 1 frames before it"),
+        std::string::npos)
+        << c.out;
+    devslam::io::TumReader back((dir / "tum").string());
+    EXPECT_EQ(back.size(), 1u);
 }
 
 TEST(DevslamRun, TruncatedRawlogRunsOnItsIntactPartWhenAsked) {
