@@ -453,8 +453,10 @@ int runBench(const Args& a) {
         "load and the drifting speed of this 2-core VM; the CPU time per frame (all threads) "
         "is printed by `devslam-run` beside it. Measured on " +
         core::measuredOnLine() + ".\n";
+    // Printed first: a results file that cannot be written after the whole bench must not
+    // take the table with it.
+    std::cout << md << std::flush;
     core::replaceResultsSection(a.results, a.section, md);
-    std::cout << md;
     return 0;
 }
 

@@ -558,6 +558,20 @@ TEST(Results, SectionsAreReplacedInPlaceAndBrokenMarkersRefused) {
     EXPECT_NO_THROW(checkResultsSection(path, "b"));
     EXPECT_THROW(checkResultsSection(path, "B c"), std::invalid_argument);
     EXPECT_THROW(checkResultsSection(path + "_none/R.md", "b"), std::runtime_error);
+    // A folder no file can be made in (as root too): refused before the work, not after it.
+    try {
+        checkResultsSection("/proc/R.md", "b");
+        ADD_FAILURE() << "no error";
+    } catch (const std::runtime_error& e) {
+        EXPECT_NE(std::string(e.what()).find("results file '/proc/R.md': cannot write in '/proc'"),
+                  std::string::npos)
+            << e.what();
+    }
+    const auto folder = std::filesystem::path(path).parent_path();
+    for (const auto& f : std::filesystem::directory_iterator(folder))
+        EXPECT_EQ(f.path().filename().string().rfind(".devslam-results-probe", 0),
+                  std::string::npos)
+            << "the probe is removed";
     EXPECT_THROW(checkResultsSection(std::filesystem::path(path).parent_path().string(), "b"),
                  std::runtime_error);
     EXPECT_EQ(read(), broken);

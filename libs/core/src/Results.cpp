@@ -82,6 +82,16 @@ void checkResultsSection(const std::string& path, const std::string& name) {
     if (!std::filesystem::is_directory(folder))
         throw std::runtime_error("results file '" + path + "': no folder '" + folder.string() +
                                  "'");
+    // The file is replaced through a '.part' beside it, at the end of a long bench: a folder
+    // it cannot be made in lost the whole bench's table then. Probed by making a file there,
+    // which also holds for root and for a read-only mount, where access() does not tell.
+    const auto probe = folder / (".devslam-results-probe-" + std::to_string(::getpid()));
+    const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0600);
+    if (fd < 0)
+        throw std::runtime_error("results file '" + path + "': cannot write in '" +
+                                 folder.string() + "' (" + std::strerror(errno) + ")");
+    ::close(fd);
+    ::unlink(probe.c_str());
 }
 
 namespace {
@@ -113,7 +123,7 @@ std::filesystem::path followLinks(const std::string& link) {
 /// writers that take it wait; a folder that cannot be opened is not locked (the write then
 /// names the problem).
 class FolderLock {
-public:
+  public:
     explicit FolderLock(const std::string& file) {
         std::error_code ec;
         const auto abs = std::filesystem::absolute(followLinks(file), ec);
@@ -129,7 +139,7 @@ public:
     FolderLock(const FolderLock&) = delete;
     FolderLock& operator=(const FolderLock&) = delete;
 
-private:
+  private:
     int fd_ = -1;
 };
 }  // namespace
