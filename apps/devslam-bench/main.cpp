@@ -40,9 +40,9 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <iterator>
 #include <functional>
 #include <iostream>
+#include <iterator>
 #include <map>
 #include <mutex>
 #include <sstream>
@@ -196,6 +196,13 @@ Bench readBench(const std::string& path) {
             throw std::invalid_argument(
                 path + " [" + (cfg->keyExists(s, "slam_config") ? s : std::string("bench")) +
                 "] slam_config: no such file '" + q.slam_config + "'");
+        // ... and read, with the filter INI it names: a syntax error in the last sequence's
+        // INI stopped the bench there, hours into it, with no table.
+        {
+            const std::string filter =
+                core::filterIniPath(*core::loadIni(q.slam_config), q.slam_config);
+            if (filter != q.slam_config) (void)core::loadIni(filter);
+        }
         if (!q.path.empty() && !fs::exists(q.path))
             throw std::invalid_argument(path + " [" + s + "] path: no such file or folder '" +
                                         q.path + "'");
@@ -263,9 +270,10 @@ Bench readBench(const std::string& path) {
         std::none_of(b.sequences.begin(), b.sequences.end(), [](const Sequence& q) {
             return !q.scenario.empty() || eval::PersonTruth::available(q.path);
         }))
-        throw std::invalid_argument(path + " [bench] modes: truth needs person truth, which "
-                                           "no sequence has (a scenario, or a devslam-synth "
-                                           "folder as path)");
+        throw std::invalid_argument(path +
+                                    " [bench] modes: truth needs person truth, which "
+                                    "no sequence has (a scenario, or a devslam-synth "
+                                    "folder as path)");
     b.targets = bench::loadTargets(*cfg, path, b.names(), b.modes);
     return b;
 }
@@ -704,7 +712,7 @@ Runs runSlam(const Bench& b, const Args& a) {
                     if (!f.ok) {
                         runs.failed.push_back((dir / "log.txt").string());
                         std::cerr << "  devslam-run failed ("
-                                  << (rc != 0                 ? endedBy(rc)
+                                  << (rc != 0                ? endedBy(rc)
                                       : f.unreadable.empty() ? std::string("no readable run.json")
                                                              : f.unreadable)
                                   << "):\n"
@@ -754,8 +762,14 @@ void keepMedianPlot(const Bench& b, const Sequence& q, const std::string& m,
             nearest = r;
     if (!nearest || !fs::exists(v[*nearest].dir / "trajectory.png")) return;
     const fs::path src = v[*nearest].dir / "trajectory.png";
-    fs::copy_file(src, fs::path(b.out_dir) / (q.name + "_" + m + "_trajectory.png"),
-                  fs::copy_options::overwrite_existing);
+    // A copy that fails (a read-only file left by another user, a full disk) loses that one
+    // plot, not every table after it.
+    const fs::path dst = fs::path(b.out_dir) / (q.name + "_" + m + "_trajectory.png");
+    std::error_code ec;
+    fs::copy_file(src, dst, fs::copy_options::overwrite_existing, ec);
+    if (ec)
+        std::cerr << "devslam-bench: warning: plot not copied to " << dst.string() << " ("
+                  << ec.message() << ")\n";
     // Beside RESULTS.md, for its figures (the diagnostic truth mode's plots stay in the
     // results folder).
     if (!results.empty() && m != "truth") {  // copied with the section, if whole
@@ -1102,8 +1116,8 @@ int compareRuns(const Bench& b, const std::string& before) {
                                 : fmt(std::exp(core::meanInterval95(logs).mean), 3))
                << " | " << lower << " of " << logs.size() << " | "
                << both(&RunFigures::keyframes, 1) << " | " << both(&RunFigures::landmarks, 0)
-               << " | " << both(&RunFigures::map_mb, 1) << " | "
-               << both(&RunFigures::fps_median, 1) << " |\n";
+               << " | " << both(&RunFigures::map_mb, 1) << " | " << both(&RunFigures::fps_median, 1)
+               << " |\n";
         }
     if (pairs == 0)
         throw std::invalid_argument("--compare: " + before + " and " + after.string() +

@@ -32,6 +32,8 @@
 #include <random>
 #include <sstream>
 
+#include <unistd.h>
+
 namespace {
 using Clock = std::chrono::steady_clock;
 
@@ -222,9 +224,19 @@ std::optional<int> parseArgs(int argc, char** argv, Args& a) {
         if (a.quick) a.per_category = 2;
         // A smoke test leaves the committed pictures alone, as it leaves RESULTS.md.
         if (a.quick && !png_dir_given) a.png_dir = "out/devslam-nav-bench";
-        // Found now, not after the whole benchmark has run.
+        // Found now, not after the whole benchmark has run (the folder was made at the end,
+        // without its parents, and "" wrote /nav_bench_*.png).
+        if (a.png_dir.empty()) throw std::invalid_argument("--png-dir is empty");
         if (std::filesystem::exists(a.png_dir) && !std::filesystem::is_directory(a.png_dir))
             throw std::invalid_argument("--png-dir '" + a.png_dir + "' is a file, not a folder");
+        // Nothing is made yet (a refused run leaves no folder): the nearest folder that is
+        // there must take the rest.
+        auto up = std::filesystem::absolute(a.png_dir).lexically_normal();
+        while (!up.empty() && up != up.root_path() && !std::filesystem::exists(up))
+            up = up.parent_path();
+        if (!std::filesystem::is_directory(up) || ::access(up.c_str(), W_OK | X_OK) != 0)
+            throw std::invalid_argument("--png-dir '" + a.png_dir + "': cannot write in '" +
+                                        up.string() + "'");
         if (a.methods.empty()) throw std::invalid_argument("--methods is empty");
     } catch (const std::exception& e) {
         std::cerr << "devslam-nav-bench: " << e.what() << "\n";
@@ -383,8 +395,7 @@ std::string categoryTables(const Args& a, const std::vector<devslam::sim::Catego
                << t.n << ") | " << pct(t.collision, t.n) << " (" << t.static_collision << " / "
                << t.person_collision << ") | " << pct(t.timeout, t.n)
                << (t.no_run > 0 ? " (+" + std::to_string(t.no_run) + " no path or error)" : "")
-               << " | "
-               << (t.success_time.empty() ? "-" : num(st.mean, 1)) << " | "
+               << " | " << (t.success_time.empty() ? "-" : num(st.mean, 1)) << " | "
                << (t.ratio.empty() ? "-" : num(rt.mean, 2)) << " | " << num(sc.mean, 3) << " |";
             if (people && !t.people_clearance.empty()) {
                 const auto pc = devslam::core::summarize(t.people_clearance);
@@ -433,7 +444,7 @@ std::string timingMarkdown(const Args& a, const Episodes& ep) {
 /// Each category's first world with its first method's run, and the success-rate chart.
 void writePictures(const Args& a, const std::vector<devslam::sim::Category>& cats,
                    const Episodes& ep) {
-    mrpt::system::createDirectory(a.png_dir);
+    std::filesystem::create_directories(a.png_dir);
     for (std::size_t c = 0; c < ep.pictures.size(); ++c)
         devslam::sim::writeEpisodePng(
             ep.pictures[c].world, ep.pictures[c].run,

@@ -47,8 +47,7 @@ std::size_t countLines(const std::string& s) {
 
 TEST(DevslamBench, TwoFrameSmokeRunOfTheWholeCommand) {
     const std::string root = DEVSLAM_SOURCE_DIR, bin = DEVSLAM_BIN_DIR;
-    const fs::path tmp =
-        devslam::test::scratchPath("devslam_bench_smoke");
+    const fs::path tmp = devslam::test::scratchPath("devslam_bench_smoke");
     fs::remove_all(tmp);
     fs::create_directories(tmp);
     std::ofstream(tmp / "bench.ini")
@@ -140,8 +139,7 @@ TEST(DevslamBench, TwoFrameSmokeRunOfTheWholeCommand) {
     // The targets, checked on the medians: one that every run meets, one that none can
     // ("*": the worst sequence shown), and one without a figure (two frames give no ATE),
     // which is not met.
-    EXPECT_NE(results.find("| a_fps: short dynamic fps >= 0.001 | "), std::string::npos)
-        << results;
+    EXPECT_NE(results.find("| a_fps: short dynamic fps >= 0.001 | "), std::string::npos) << results;
     EXPECT_NE(results.find("| b_fps: * dynamic fps >= 1e+09 | "), std::string::npos) << results;
     EXPECT_NE(results.find("| c_ratio: fr1 dynamic ate/none <= 1e+09 | n/a | **no** | 0 of 0 |  |"),
               std::string::npos)
@@ -155,8 +153,9 @@ TEST(DevslamBench, TwoFrameSmokeRunOfTheWholeCommand) {
     EXPECT_EQ(countLines(targets), 1u + 3u) << targets;
     const auto row = [&](const std::string& key) {
         const auto at = targets.find("\n" + key + ",");
-        return at == std::string::npos ? std::string()
-                                       : targets.substr(at + 1, targets.find('\n', at + 1) - at - 1);
+        return at == std::string::npos
+                   ? std::string()
+                   : targets.substr(at + 1, targets.find('\n', at + 1) - at - 1);
     };
     EXPECT_EQ(row("a_fps").rfind("a_fps,short,dynamic,fps,>=,0.001,", 0), 0u) << targets;
     const auto endsWith = [](const std::string& a, const std::string& b) {
@@ -210,9 +209,11 @@ TEST(RunJson, ScalarsAreFoundByTheirWholePath) {
     ASSERT_TRUE(s);
     std::map<std::string, std::pair<bool, std::string>> got;
     for (const auto& [k, v] : *s) got[k] = {v.string, v.text};
-    const std::map<std::string, std::pair<bool, std::string>> want{
-        {"a.b", {false, "1.5e-3"}}, {"a.c", {true, R"(x\"y)"}}, {"t", {false, "true"}},
-        {"n", {false, "null"}},     {"s", {true, ""}}};
+    const std::map<std::string, std::pair<bool, std::string>> want{{"a.b", {false, "1.5e-3"}},
+                                                                   {"a.c", {true, R"(x\"y)"}},
+                                                                   {"t", {false, "true"}},
+                                                                   {"n", {false, "null"}},
+                                                                   {"s", {true, ""}}};
     EXPECT_EQ(got, want);
     for (const char* bad : {"", " ", "{", R"({"a": 1} x)", R"({"a" 1})", R"({"a": "b})",
                             R"({"a": [1,]})", R"({"a": 1,})", "{a: 1}", R"({"a": tru})"})
@@ -269,16 +270,21 @@ TEST(RunJson, EachFigureComesFromItsOwnObject) {
 TEST(BenchTargets, MediansDecideRendersAreCountedOneByOne) {
     using devslam::bench::Target;
     // ATE per (sequence, mode, seed); "r" is a real sequence (one input, no seed).
-    const std::map<std::tuple<std::string, std::string, std::optional<std::uint64_t>>, double>
-        ate = {{{"s", "dynamic", 1}, 1.0}, {{"s", "all", 1}, 2.0},   // 0.5
-               {{"s", "dynamic", 2}, 3.0}, {{"s", "all", 2}, 2.0},   // 1.5
-               {{"s", "dynamic", 3}, 2.5}, {{"s", "all", 3}, 1.0},   // 2.5
-               {{"r", "dynamic", std::nullopt}, 0.5}, {{"r", "all", std::nullopt}, 1.0}};
+    const std::map<std::tuple<std::string, std::string, std::optional<std::uint64_t>>, double> ate =
+        {{{"s", "dynamic", 1}, 1.0},
+         {{"s", "all", 1}, 2.0},  // 0.5
+         {{"s", "dynamic", 2}, 3.0},
+         {{"s", "all", 2}, 2.0},  // 1.5
+         {{"s", "dynamic", 3}, 2.5},
+         {{"s", "all", 3}, 1.0},  // 2.5
+         {{"r", "dynamic", std::nullopt}, 0.5},
+         {{"r", "all", std::nullopt}, 1.0}};
     const auto median = [&](const std::string& seq, const std::string& mode,
                             std::optional<std::uint64_t> seed) -> double {
         std::vector<double> v;
         for (const auto& [k, x] : ate)
-            if (std::get<0>(k) == seq && std::get<1>(k) == mode && (!seed || std::get<2>(k) == seed))
+            if (std::get<0>(k) == seq && std::get<1>(k) == mode &&
+                (!seed || std::get<2>(k) == seed))
                 v.push_back(x);
         if (v.empty()) return std::numeric_limits<double>::quiet_NaN();
         std::sort(v.begin(), v.end());
@@ -446,9 +452,8 @@ TEST(DevslamBench, ReuseRunsDoesNotKeepAnUnreadableRunJson) {
     const devslam::test::TempDir d("devslam_");
     const fs::path tmp = d.str();
     std::ofstream(tmp / "bench.ini")
-        << "[bench]\nmodes = none\nrepeats = 1\nmax_frames = 3\n[sequence_tiny]\npath = "
-        << root << "/data/tum/fr1_xyz_first37\nslam_config = " << root
-        << "/config_ini/slam_tum_fr1.ini\n";
+        << "[bench]\nmodes = none\nrepeats = 1\nmax_frames = 3\n[sequence_tiny]\npath = " << root
+        << "/data/tum/fr1_xyz_first37\nslam_config = " << root << "/config_ini/slam_tum_fr1.ini\n";
     const std::string args = "--config '" + (tmp / "bench.ini").string() +
                              "' --results none --out '" + (tmp / "out").string() + "'";
     const fs::path json = tmp / "out/runs/tiny/none/r0/run.json";
@@ -459,10 +464,10 @@ TEST(DevslamBench, ReuseRunsDoesNotKeepAnUnreadableRunJson) {
         std::ofstream(json) << bad;
         r = devslam::test::runApp("devslam-bench", args + " --reuse-runs");
         EXPECT_EQ(r.rc, 0) << r.out;
-        EXPECT_NE(r.out.find("WARNING: not kept: " + json.string() +
-                             " is not a whole JSON object"),
+        EXPECT_NE(r.out.find("WARNING: not kept: " + json.string() + " is not a whole JSON object"),
                   std::string::npos)
-            << bad << "\n" << r.out;
+            << bad << "\n"
+            << r.out;
         EXPECT_EQ(r.out.find("runs were kept from an earlier invocation"), std::string::npos)
             << r.out;
         EXPECT_NE(readFile(json).find("\"per_frame\""), std::string::npos) << "made again";
@@ -528,8 +533,7 @@ TEST(DevslamBench, CompareSetsEachRunBesideTheSameRenderBefore) {
     // A folder that is not there, or holds none of these runs: an error naming it.
     r = devslam::test::runApp("devslam-bench", args + "x");
     EXPECT_NE(r.rc, 0);
-    EXPECT_NE(r.out.find("--compare: no such folder '" + before.string() + "x'"),
-              std::string::npos)
+    EXPECT_NE(r.out.find("--compare: no such folder '" + before.string() + "x'"), std::string::npos)
         << r.out;
     fs::create_directories(tmp / "empty");
     r = devslam::test::runApp("devslam-bench", "--config '" + (tmp / "bench.ini").string() +
@@ -542,8 +546,7 @@ TEST(DevslamBench, CompareSetsEachRunBesideTheSameRenderBefore) {
 
 TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
     const std::string root = DEVSLAM_SOURCE_DIR, bin = DEVSLAM_BIN_DIR;
-    const fs::path tmp =
-        devslam::test::scratchPath("devslam_bench_bad");
+    const fs::path tmp = devslam::test::scratchPath("devslam_bench_bad");
     fs::remove_all(tmp);
     fs::create_directories(tmp);
     const auto refused = [&](const std::string& ini) {
@@ -556,6 +559,8 @@ TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
         EXPECT_FALSE(fs::exists(tmp / "out/runs.csv")) << ini << ": nothing may run";
         return readFile(tmp / "log.txt");
     };
+    std::ofstream(tmp / "dup.ini") << "[tracker]\nmin_matches = 5\nmin_matches = 6\n";
+    std::ofstream(tmp / "nofilter.ini") << "[run]\nfilter_config = nowhere_filter.ini\n";
     const std::string fr1 = "path = " + root + "/data/tum/fr1_xyz_first37\n";
     const std::string synth = "[sequence_a]\nscenario = short_walking\n";
     const std::string real = "[sequence_a]\n" + fr1;
@@ -578,6 +583,9 @@ TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
         {"[sequence_a]\npath = " + root + "/data/tum/no_such_folder\n",
          "bench.ini [sequence_a] path: no such file or folder '"},
         {real + "slam_config = nowhere.ini\n", "bench.ini [sequence_a] slam_config: no such file"},
+        // A broken SLAM INI, or the filter INI it names, is read before any run too.
+        {real + "slam_config = " + (tmp / "dup.ini").string() + "\n", "dup.ini"},
+        {real + "slam_config = " + (tmp / "nofilter.ini").string() + "\n", "nowhere_filter.ini"},
         {"[bench]\nslam_config = /nowhere.ini\n" + synth,
          "bench.ini [bench] slam_config: no such file '/nowhere.ini'"},
         {real + "name = fr1/xyz\n", "bench.ini [sequence_a] name: 'fr1/xyz' (letters, digits"},
@@ -611,8 +619,8 @@ TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
          "[targets] x,y: a target's name is letters, digits"},
     };
     for (const auto& [ini, msg] : cases)
-        EXPECT_NE(refused(ini).find(msg), std::string::npos)
-            << ini << "\n" << readFile(tmp / "log.txt");
+        EXPECT_NE(refused(ini).find(msg), std::string::npos) << ini << "\n"
+                                                             << readFile(tmp / "log.txt");
     // A run that fails (here: a folder that is no TUM sequence) is counted and named; the
     // results file keeps its last whole bench, and the exit status says so.
     fs::create_directories(tmp / "not_tum");
@@ -684,8 +692,9 @@ TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
                              (tmp / "mine").string() + "' --results none > '" +
                              (tmp / "log.txt").string() + "' 2>&1";
     EXPECT_EQ(std::system(mine.c_str()), 0) << readFile(tmp / "log.txt");
-    EXPECT_NE(readFile(tmp / "mine/synth/m/render.txt").find("--- " + (tmp / "conf/mine.ini").string()),
-              std::string::npos)
+    EXPECT_NE(
+        readFile(tmp / "mine/synth/m/render.txt").find("--- " + (tmp / "conf/mine.ini").string()),
+        std::string::npos)
         << readFile(tmp / "mine/synth/m/render.txt");
     fs::remove_all(tmp);
 }
@@ -729,8 +738,7 @@ TEST(DevslamSynth, CtrlCKeepsTheFramesRenderedSoFar) {
 // compared on several renders, docs/dynamic.md); a bad value is refused.
 TEST(DevslamSynth, SeedOptionGivesAnotherRenderOfTheSameScene) {
     const std::string bin = DEVSLAM_BIN_DIR;
-    const fs::path tmp =
-        devslam::test::scratchPath("devslam_synth_seed");
+    const fs::path tmp = devslam::test::scratchPath("devslam_synth_seed");
     fs::remove_all(tmp);
     fs::create_directories(tmp);
     auto render = [&](const std::string& name, const std::string& extra) {

@@ -291,9 +291,9 @@ TEST(IntegrationNav, AppsSmokeTest) {
         set("log_file", "true");
         set("log_directory", out + "/ini_navlog");
         std::ofstream(out + "/nav.ini") << ini;
-        const auto r = devslam::test::runApp("devslam-nav", kSrc + "/sim_worlds/paper_fig6.ini --png " +
-                                                                out + "/ini.png --config " + out +
-                                                                "/nav.ini");
+        const auto r =
+            devslam::test::runApp("devslam-nav", kSrc + "/sim_worlds/paper_fig6.ini --png " + out +
+                                                     "/ini.png --config " + out + "/nav.ini");
         EXPECT_EQ(r.rc, 0) << r.out;
         mrpt::system::CDirectoryExplorer::TFileInfoList ini_logs;
         mrpt::system::CDirectoryExplorer::explore(out + "/ini_navlog", FILE_ATTRIB_ARCHIVE,
@@ -357,6 +357,17 @@ TEST(IntegrationNav, AppsSmokeTest) {
     EXPECT_NE(r.out.find("--png-dir '" + out + "/a_file' is a file, not a folder"),
               std::string::npos)
         << r.out;
+    // ... or empty (it wrote /nav_bench_*.png), or under a file: also refused up front. A
+    // folder whose parents are not there yet is made at the end, parents and all.
+    r = devslam::test::runApp("devslam-nav-bench", "--quick --png-dir ''");
+    EXPECT_EQ(r.rc, 2);
+    EXPECT_NE(r.out.find("--png-dir is empty"), std::string::npos) << r.out;
+    r = devslam::test::runApp("devslam-nav-bench", "--quick --png-dir " + out + "/a_file/png");
+    EXPECT_EQ(r.rc, 2);
+    EXPECT_NE(
+        r.out.find("--png-dir '" + out + "/a_file/png': cannot write in '" + out + "/a_file'"),
+        std::string::npos)
+        << r.out;
 }
 
 // Ctrl-C stops devslam-nav-bench after the current episode: the tables of the episodes done
@@ -404,8 +415,8 @@ TEST(IntegrationNav, NavBenchCtrlCPrintsTheEpisodesDone) {
 // or as a second world ("more than one world file given"): the option is named instead.
 TEST(IntegrationNav, OptionWithoutValueIsNamed) {
     const std::string world = kSrc + "/sim_worlds/paper_fig6.ini";
-    for (const auto& [app, args, says] : std::vector<std::tuple<std::string, std::string,
-                                                                std::string>>{
+    for (const auto& [app, args, says] :
+         std::vector<std::tuple<std::string, std::string, std::string>>{
              {"devslam-nav", world + " --method --png x.png",
               "devslam-nav: --method needs a value"},
              {"devslam-nav", world + " --png", "devslam-nav: --png needs a value"},
