@@ -80,9 +80,8 @@ const std::vector<dynamic::SyntheticFrame>& sequence(const dynamic::SyntheticOpt
     std::ostringstream k;  // every option a test changes
     k << static_cast<int>(so.person) << "/" << so.person_x0 << "/" << so.n_frames << "/"
       << so.person_speed << "/" << so.person_depth << "/" << so.person_height << "/"
-      << so.person_direction.transpose() << "/"
-      << so.cam_velocity.transpose() << "/" << so.cam_rate_deg.transpose() << "/"
-      << so.depth_noise;
+      << so.person_direction.transpose() << "/" << so.cam_velocity.transpose() << "/"
+      << so.cam_rate_deg.transpose() << "/" << so.depth_noise;
     const std::string key = k.str();
     auto it = cache.find(key);
     if (it == cache.end())
@@ -230,9 +229,9 @@ TEST(DynamicFilter, StaticPeopleRegionIsTheStaticPersonsBox) {
         double weight;
         bool silhouette;
     };
-    for (const Case c : {Case{MaskMode::Dynamic, 0.5, true}, Case{MaskMode::Dynamic, 0.5, false},
-                         Case{MaskMode::Dynamic, 1.0, true},
-                         Case{MaskMode::AllPersons, 0.5, true}}) {
+    for (const Case c :
+         {Case{MaskMode::Dynamic, 0.5, true}, Case{MaskMode::Dynamic, 0.5, false},
+          Case{MaskMode::Dynamic, 1.0, true}, Case{MaskMode::AllPersons, 0.5, true}}) {
         auto fo = testOptions();
         fo.mode = c.mode;
         fo.static_person_weight = c.weight;
@@ -240,9 +239,8 @@ TEST(DynamicFilter, StaticPeopleRegionIsTheStaticPersonsBox) {
         auto det = std::make_unique<ScriptedDetector>();
         ScriptedDetector* script = det.get();
         DynamicObjectFilter filter(fo, std::move(det));
-        const std::string what = dynamic::toString(c.mode) + " weight " +
-                                 std::to_string(c.weight) + " silhouette " +
-                                 std::to_string(c.silhouette);
+        const std::string what = dynamic::toString(c.mode) + " weight " + std::to_string(c.weight) +
+                                 " silhouette " + std::to_string(c.silhouette);
         int statics = 0;
         for (std::size_t k = 0; k < seq.size(); ++k) {
             ASSERT_TRUE(seq[k].person_box.has_value()) << "frame " << k;
@@ -345,9 +343,10 @@ TEST(DynamicFilter, ADistortedCameraIsCompensatedLikeAPinholeOne) {
     const auto seq = dynamic::makeSyntheticSequence(so, wallTexture(), personSprite());
     const auto pinhole = staticResiduals(seq, {0, 0, 0, 0, 0});
     const auto fr1 = staticResiduals(seq, core::CameraIntrinsics::fromPreset("fr1").dist);
-    std::printf("static residuals, 90th / 99th percentile [px]: pinhole %.2f / %.2f, "
-                "fr1 distortion %.2f / %.2f\n",
-                pinhole.first, pinhole.second, fr1.first, fr1.second);
+    std::printf(
+        "static residuals, 90th / 99th percentile [px]: pinhole %.2f / %.2f, "
+        "fr1 distortion %.2f / %.2f\n",
+        pinhole.first, pinhole.second, fr1.first, fr1.second);
     // (Uncompensated: 0.43 / 1353 px against the pinhole camera's 0.19 / 0.34.)
     EXPECT_LE(fr1.first, pinhole.first + 0.05);
     EXPECT_LE(fr1.second, pinhole.second + 0.15);
@@ -392,8 +391,10 @@ TEST(DynamicFilter, HysteresisReleasesAfterQuietFrames) {
         int released = -1;
         for (int k = 12; k < 24 && released < 0; ++k)
             if (states[k] == BoxState::Static) released = k;
-        std::printf("walked 12 frames, then stood: released at frame %d (release_frames %d, "
-                    "slow_frames %d)\n", released, release, slow_frames);
+        std::printf(
+            "walked 12 frames, then stood: released at frame %d (release_frames %d, "
+            "slow_frames %d)\n",
+            released, release, slow_frames);
         ASSERT_GE(released, 12 + release - 1) << "not released too early (-1: never)";
         EXPECT_LE(released, 12 + release + window) << "released after quiet frames";
         for (int k = released; k < 24; ++k) EXPECT_EQ(states[k], BoxState::Static) << k;
@@ -468,9 +469,9 @@ TEST(DynamicFilter, FrameOfAnotherSizeStartsAfresh) {
             EXPECT_GT(detect::iou(out.boxes[0].box, box), 0.99f);
         }
         for (const auto& fp : out.flow)
-            ASSERT_TRUE(cv::Rect2f(0.f, 0.f, static_cast<float>(f.bgr.cols),
-                                   static_cast<float>(f.bgr.rows))
-                            .contains(fp.cur))
+            ASSERT_TRUE(
+                cv::Rect2f(0.f, 0.f, static_cast<float>(f.bgr.cols), static_cast<float>(f.bgr.rows))
+                    .contains(fp.cur))
                 << "frame " << i;
     }
 }
@@ -496,7 +497,9 @@ TEST(DynamicFilter, OptionsSetInCodeAreChecked) {
              {"lk_window", [](auto& o) { o.lk_window = 12; }},
              {"static_person_weight", [](auto& o) { o.static_person_weight = 0; }},
              {"static_person_weight", [](auto& o) { o.static_person_weight = 1.5; }},
-             {"static_person_gate", [](auto& o) { o.static_person_gate = 0.5; }}}) {
+             {"static_person_gate", [](auto& o) { o.static_person_gate = 0.5; }},
+             // (a (2 m + 1)^2 dilation kernel per box and frame: 100000 asked for 40 GB)
+             {"mask_margin", [](auto& o) { o.mask_margin = 100000; }}}) {
         auto o = testOptions();
         set(o);
         try {
@@ -535,7 +538,8 @@ TEST(DynamicFilter, FrameSmallerThanTheFlowWindowIsRefused) {
                 << e.what();
         }
     }
-    for (std::size_t i = 0; i < 3; ++i) EXPECT_NO_THROW((void)filter.step(crop(40, i), std::nullopt));
+    for (std::size_t i = 0; i < 3; ++i)
+        EXPECT_NO_THROW((void)filter.step(crop(40, i), std::nullopt));
 }
 
 TEST(DynamicFilter, EachCornerIsTrackedOnce) {
@@ -746,8 +750,8 @@ TEST(DynamicFilter, RealTumFramesHaveNoMovingRegion) {
                 std::printf(" box%d %d/%d", box.id, box.n_dynamic_points, box.n_points);
             for (const auto& box : a.boxes)
                 std::printf(" yolo box%d (%.0f %.0f %.0fx%.0f) %s %d/%d", box.id, box.box.x,
-                            box.box.y, box.box.width, box.box.height,
-                            toString(box.state).c_str(), box.n_dynamic_points, box.n_points);
+                            box.box.y, box.box.width, box.box.height, toString(box.state).c_str(),
+                            box.n_dynamic_points, box.n_points);
             std::printf("\n");
         }
         EXPECT_TRUE(a.detector_ran);
@@ -951,9 +955,10 @@ TEST(DynamicFilter, DepthBandFindsAWalkerInABoxOfBackground) {
         }
         *person_cover = cover / frames;
         *box_masked = masked / frames;
-        std::printf("box 3x wide, fg_depth_band %.1f, silhouette %d: moving in %d/%d frames, "
-                    "person covered %.2f, box masked %.2f\n",
-                    band, silhouette, moving, frames, *person_cover, *box_masked);
+        std::printf(
+            "box 3x wide, fg_depth_band %.1f, silhouette %d: moving in %d/%d frames, "
+            "person covered %.2f, box masked %.2f\n",
+            band, silhouette, moving, frames, *person_cover, *box_masked);
         return std::pair(moving, frames);
     };
     double cover = 0, masked = 0;
@@ -1004,9 +1009,10 @@ TEST(DynamicFilter, NarrowSilhouetteBandKeepsTheWallRightBehindAPerson) {
         }
         *person_cover = cover / frames;
         *box_masked = masked / frames;
-        std::printf("wall 0.6 m behind, silhouette_depth_band %.1f: person covered %.2f, box "
-                    "masked %.2f\n",
-                    silhouette_band, *person_cover, *box_masked);
+        std::printf(
+            "wall 0.6 m behind, silhouette_depth_band %.1f: person covered %.2f, box "
+            "masked %.2f\n",
+            silhouette_band, *person_cover, *box_masked);
     };
     double cover_wide = 0, masked_wide = 0, cover_narrow = 0, masked_narrow = 0;
     run(0.0, &cover_wide, &masked_wide);  // 0: fg_depth_band's band
@@ -1136,9 +1142,10 @@ TEST(DynamicFilter, SlowMoverThresholdIsASpeedNearTheCamera) {
     near.n_frames = kFrames;
     const RunStats a = runSynthetic(near, px_only, true);
     const RunStats b = runSynthetic(near, speed, true);
-    std::printf("0.07 m/s at 1.2 m: moving in %d/%d frames (pixel threshold), %d/%d "
-                "(slow_speed 0.15)\n",
-                a.moving, a.frames, b.moving, b.frames);
+    std::printf(
+        "0.07 m/s at 1.2 m: moving in %d/%d frames (pixel threshold), %d/%d "
+        "(slow_speed 0.15)\n",
+        a.moving, a.frames, b.moving, b.frames);
     EXPECT_GE(a.moving, a.frames - px_only.slow_frames - 2) << "the pixel test should flag them";
     EXPECT_LE(b.moving, b.frames / 5);
 
@@ -1148,8 +1155,7 @@ TEST(DynamicFilter, SlowMoverThresholdIsASpeedNearTheCamera) {
     far.person_x0 = -0.3;
     far.n_frames = kFrames;
     const RunStats c = runSynthetic(far, speed, true);
-    std::printf("0.2 m/s at 2.2 m: moving in %d/%d frames (slow_speed 0.15)\n", c.moving,
-                c.frames);
+    std::printf("0.2 m/s at 2.2 m: moving in %d/%d frames (slow_speed 0.15)\n", c.moving, c.frames);
     EXPECT_GE(c.moving, c.frames - speed.slow_frames);
 }
 
@@ -1216,9 +1222,10 @@ TEST(DynamicFilter, WalkerGoingAwayIsCaughtThroughQuantizedDepth) {
     const auto with_depth = testOptions();
     const RunStats a = runSynthetic(so, flow_only, true, {}, kinect);
     const RunStats b = runSynthetic(so, with_depth, true, {}, kinect);
-    std::printf("walking away through quantized depth: moving in %d/%d frames by flow, %d/%d "
-                "with depth_frames %d\n",
-                a.moving, a.frames, b.moving, b.frames, with_depth.depth_frames);
+    std::printf(
+        "walking away through quantized depth: moving in %d/%d frames by flow, %d/%d "
+        "with depth_frames %d\n",
+        a.moving, a.frames, b.moving, b.frames, with_depth.depth_frames);
     EXPECT_LE(a.moving, a.frames / 3) << "the flow alone already sees this walker";
     EXPECT_GE(b.moving, b.frames - with_depth.depth_frames - 3);
     // The same person standing still, through the same steps, is not flagged.
@@ -1291,10 +1298,11 @@ TEST(DynamicFilter, MovingTracksOutliveDetectorMisses) {
                 covered += cv::countNonZero(out.mask(p)) >= 0.5 * p.area();
             }
         }
-        std::printf("%s person, no detections after frame %d: tracked in %d/%d later frames, "
-                    "mask on them in %d\n",
-                    motion == dynamic::PersonMotion::Walking ? "walking" : "standing",
-                    kLastDetection, tracked, frames, covered);
+        std::printf(
+            "%s person, no detections after frame %d: tracked in %d/%d later frames, "
+            "mask on them in %d\n",
+            motion == dynamic::PersonMotion::Walking ? "walking" : "standing", kLastDetection,
+            tracked, frames, covered);
         ASSERT_GT(frames, 5);
         if (motion == dynamic::PersonMotion::Walking) {
             EXPECT_EQ(tracked, frames);

@@ -189,7 +189,8 @@ TEST(PoseSolver, LowWeightReducesTheBiasOfAShiftedGroup) {
     FrameFeatures f;
     int shifted = 0;
     for (auto& o : obs) {
-        if (person.contains(cv::Point2f(static_cast<float>(o.uv.x()), static_cast<float>(o.uv.y())))) {
+        if (person.contains(
+                cv::Point2f(static_cast<float>(o.uv.x()), static_cast<float>(o.uv.y())))) {
             o.uv.x() += 2.0;
             ++shifted;
         }
@@ -241,7 +242,8 @@ TEST(PoseSolver, GateExponentDecidesWhatAWeightDoesToTheOutlierTest) {
         }
         for (std::size_t i = 0; i < 20; ++i) ASSERT_EQ(f.weight[i], 0.5f) << i;
         const auto ref = refinePose(obs, T_true, K, {});
-        for (std::size_t i = 0; i < 10; ++i) EXPECT_EQ(ref.inlier[i], p > 0 ? 1 : 0) << p << " " << i;
+        for (std::size_t i = 0; i < 10; ++i)
+            EXPECT_EQ(ref.inlier[i], p > 0 ? 1 : 0) << p << " " << i;
         for (std::size_t i = 10; i < obs.size(); ++i) EXPECT_EQ(ref.inlier[i], 1) << p << " " << i;
         if (p <= 0) {
             EXPECT_LT((ref.T_wc.translation() - T_true.translation()).norm(), 1e-4) << p;
@@ -580,7 +582,8 @@ TEST(Tracker, ARevisitedPlaceIsTrackedAgainstItsOldKeyframe) {
     cv::Mat desc(300, 32, CV_8U);
     for (int i = 0; i < 300; ++i) {
         pts.emplace_back(U(rng) * 1.0, U(rng) * 0.7, 2.5 + U(rng) * 0.5);
-        for (int b = 0; b < 32; ++b) desc.at<unsigned char>(i, b) = static_cast<unsigned char>(byte(rng));
+        for (int b = 0; b < 32; ++b)
+            desc.at<unsigned char>(i, b) = static_cast<unsigned char>(byte(rng));
     }
     // The keypoints a camera at T_wc sees of the points (noise-free), with their depths.
     const auto view = [&](const Eigen::Isometry3d& T_wc) {
@@ -630,7 +633,7 @@ TEST(Tracker, ARevisitedPlaceIsTrackedAgainstItsOldKeyframe) {
 TEST(Matching, HammingAndBruteForce) {
     cv::Mat a(3, 32, CV_8U, cv::Scalar(0)), b(3, 32, CV_8U, cv::Scalar(0));
     a.row(0).setTo(0xFF);
-    b.row(2).setTo(0xFF);  // a0 <-> b2 (distance 0)
+    b.row(2).setTo(0xFF);      // a0 <-> b2 (distance 0)
     b.at<uchar>(1, 0) = 0x0F;  // a1 and a2 (zeros): b0 at 0, b1 at 4 -> b0 (0 <= 0.8 * 4)
     EXPECT_EQ(hamming32(a.ptr<uchar>(0), b.ptr<uchar>(0)), 256);
     EXPECT_EQ(hamming32(a.ptr<uchar>(1), b.ptr<uchar>(1)), 4);
@@ -776,8 +779,7 @@ TEST(LocalBundleAdjuster, ReducesPoseAndPointErrors) {
     EXPECT_EQ(res.n_landmarks, 300);
     EXPECT_LT(res.final_cost, 0.01 * res.initial_cost);
     for (int k = 1; k < 4; ++k)
-        EXPECT_LT((map.keyframe(k).T_wc.translation() - sc.gt[k].translation()).norm(), 1e-3)
-            << k;
+        EXPECT_LT((map.keyframe(k).T_wc.translation() - sc.gt[k].translation()).norm(), 1e-3) << k;
     EXPECT_TRUE(map.keyframe(0).T_wc.isApprox(sc.gt[0]));
     double worst = 0;
     for (std::size_t i = 0; i < sc.pts.size(); ++i) {
@@ -870,7 +872,10 @@ TEST(Config, EveryShippedSlamIniLoadsAndUnknownKeysAreRejected) {
     }
     for (const auto& [text, message] : std::vector<std::pair<std::string, std::string>>{
              {"[grid_map]\nresolution = 1e9\n", "[grid_map] resolution: must be in"},
-             {"[grid_map]\nmargin = 1e9\n", "[grid_map] margin/max_range: must be in"}}) {
+             {"[grid_map]\nmargin = 1e9\n", "[grid_map] margin/max_range: must be in"},
+             // refused at the end of the run before, when the map was written
+             {"[grid_map]\nresolution = 0.001\nmargin = 10\n",
+              "[grid_map] margin: 2 x margin / resolution squared is more than the 1e8"}}) {
         mrpt::config::CConfigFileMemory c(text);
         GridMapOptions g;
         try {
@@ -903,8 +908,18 @@ TEST(Config, EveryShippedSlamIniLoadsAndUnknownKeysAreRejected) {
              {"[orb]\nfast_threshold = -1\n", "[orb] fast_threshold: must be in [1, 255]"},
              {"[pose_graph]\nmax_iterations = 1e9\n", "[pose_graph] max_iterations: must be in"},
              {"[tracker]\nmax_depth = 0\n", "[tracker] max_depth: must be > 0"},
-             {"[tracker]\nfine_radius = 0\n", "[tracker] fine_radius: must be > 0"},
-             {"[loop_closure]\nsigma_r_deg = 0\n", "[loop_closure] sigma_r_deg: must be > 0"},
+             {"[tracker]\nfine_radius = 0\n", "[tracker] fine_radius: must be in (0, 2000]"},
+             {"[loop_closure]\nsigma_r_deg = 0\n",
+              "[loop_closure] sigma_r_deg: must be in [1e-6, 1e3]"},
+             // Past an int's range the matcher's grid cells were undefined (every frame lost);
+             // a sigma of 1e-200 gave the pose graph infinite information.
+             {"[tracker]\nsearch_radius = 1e11\n", "[tracker] search_radius: must be in (0, 2000]"},
+             {"[tracker]\nwide_radius_factor = 1e10\n",
+              "[tracker] wide_radius_factor: must be >= 1, and search_radius x"},
+             {"[mapping]\nodometry_sigma_t = 1e-200\n",
+              "[mapping] odometry_sigma_t: must be in [1e-6, 1e3] [m]"},
+             {"[loop_closure]\nsigma_t = 1e200\n",
+              "[loop_closure] sigma_t: must be in [1e-6, 1e3]"},
              {"[local_ba]\nchi2_mono = -1\n", "[local_ba] chi2_mono: must be > 0"},
              // (a window of 1 was accepted and adjusted nothing, silently)
              {"[local_ba]\nwindow = 1\n", "[local_ba] window: must be in [2, 30]"}}) {

@@ -102,10 +102,9 @@ std::optional<float> stableDepth(const cv::Mat& depth, const cv::Point2f& p, dou
 /// width, 15-55 % of the height), where a detected person box is nearly always on the
 /// person even when the rest of the box shows background or a desk in front of the legs.
 std::optional<float> personDepth(const cv::Mat& depth, const cv::Rect2f& box, double max_depth) {
-    const cv::Rect torso =
-        cv::Rect(cv::Rect2f(box.x + 0.3f * box.width, box.y + 0.15f * box.height,
-                            0.4f * box.width, 0.4f * box.height)) &
-        cv::Rect(0, 0, depth.cols, depth.rows);
+    const cv::Rect torso = cv::Rect(cv::Rect2f(box.x + 0.3f * box.width, box.y + 0.15f * box.height,
+                                               0.4f * box.width, 0.4f * box.height)) &
+                           cv::Rect(0, 0, depth.cols, depth.rows);
     if (torso.width < 2 || torso.height < 2) return std::nullopt;
     std::vector<float> z;
     z.reserve(static_cast<std::size_t>(torso.area() / 4 + 1));
@@ -121,7 +120,9 @@ std::optional<float> personDepth(const cv::Mat& depth, const cv::Rect2f& box, do
 }
 
 /// Half-width [m] of the depth band around a person's depth z that belongs to them.
-float depthBand(double band, float z) { return static_cast<float>(band) + 0.1f * z; }
+float depthBand(double band, float z) {
+    return static_cast<float>(band) + 0.1f * z;
+}
 
 /// static_person_gate's INI names and the exponents (Options::static_person_gate) they stand
 /// for: read, written and checked from this one table.
@@ -202,8 +203,7 @@ void DynamicObjectFilter::Options::loadFromConfig(const mrpt::config::CConfigFil
     mask_silhouette = core::readBool(c, s, "mask_silhouette", mask_silhouette);
     silhouette_depth_band = core::readDouble(c, s, "silhouette_depth_band", silhouette_depth_band);
     silhouette_grow = core::readDouble(c, s, "silhouette_grow", silhouette_grow);
-    static_person_weight =
-        core::readDouble(c, s, "static_person_weight", static_person_weight);
+    static_person_weight = core::readDouble(c, s, "static_person_weight", static_person_weight);
     if (c.keyExists(s, "static_person_gate")) {
         const std::string g = c.read_string(s, "static_person_gate", "");
         const auto it = std::find_if(kGates.begin(), kGates.end(),
@@ -285,7 +285,9 @@ void DynamicObjectFilter::Options::validate(const std::string& s) const {
     core::requireValue(hide_unseen_frames >= 0, s, "hide_unseen_frames", "must be >= 0");
     core::requireValue(forget_unseen_frames >= hide_unseen_frames, s, "forget_unseen_frames",
                        "must be >= hide_unseen_frames");
-    core::requireValue(mask_margin >= 0, s, "mask_margin", "must be >= 0");
+    // (a dilation kernel of (2 m + 1)^2 bytes per masked box and frame: 100000 asked 40 GB)
+    core::requireValue(mask_margin >= 0 && mask_margin <= 500, s, "mask_margin",
+                       "must be in [0, 500] [px]");
 }
 
 void DynamicObjectFilter::Options::saveToConfig(mrpt::config::CConfigFileBase& c,
@@ -447,8 +449,8 @@ struct DynamicObjectFilter::Impl {
                                         const Options& o) const;
     /// 6. Per-box evidence (Algorithm 1 with residual flow) and the state's hysteresis.
     ///    dt: [s] since the previous frame (<= 0: unknown).
-    void classifyBoxes(const Residuals& r, const core::Frame& frame, double dt,
-                       const Options& o, FilterOutput& out);
+    void classifyBoxes(const Residuals& r, const core::Frame& frame, double dt, const Options& o,
+                       FilterOutput& out);
     /// Forgets tracks unseen for more than forget_unseen_frames steps.
     void forgetUnseen(const Options& o);
     /// 7. The boxes to report and the mask (out.boxes, out.mask).
@@ -487,13 +489,12 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
     // image smaller than that window (a 1x1 frame gave cv::resize an empty size) is refused.
     const int min_side =
         static_cast<int>(std::ceil(opts_.lk_window / std::min(opts_.flow_scale, 1.0)));
-    if (opts_.mode != MaskMode::None &&
-        (frame.bgr.cols < min_side || frame.bgr.rows < min_side))
-        throw std::invalid_argument(
-            "dynamic filter: frame " + std::to_string(frame.index) + " is " +
-            std::to_string(frame.bgr.cols) + "x" + std::to_string(frame.bgr.rows) +
-            " px; the flow needs at least " + std::to_string(min_side) + "x" +
-            std::to_string(min_side) + " (lk_window / flow_scale)");
+    if (opts_.mode != MaskMode::None && (frame.bgr.cols < min_side || frame.bgr.rows < min_side))
+        throw std::invalid_argument("dynamic filter: frame " + std::to_string(frame.index) +
+                                    " is " + std::to_string(frame.bgr.cols) + "x" +
+                                    std::to_string(frame.bgr.rows) +
+                                    " px; the flow needs at least " + std::to_string(min_side) +
+                                    "x" + std::to_string(min_side) + " (lk_window / flow_scale)");
     FilterOutput out;
     out.mask = cv::Mat::zeros(frame.bgr.size(), CV_8UC1);
     if (opts_.mode == MaskMode::None) return out;
@@ -543,8 +544,7 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
         im.residualFlow(frame, flow, T_prev_cur, opts_, res, out);
         lap(times.residuals);
     }
-    im.classifyBoxes(res, frame, have_prev ? frame.timestamp - im.prev_timestamp : 0.0, opts_,
-                     out);
+    im.classifyBoxes(res, frame, have_prev ? frame.timestamp - im.prev_timestamp : 0.0, opts_, out);
     im.forgetUnseen(opts_);
     lap(times.evidence);
     im.drawMask(frame, have_prev, opts_, out);
@@ -602,10 +602,9 @@ PointFlow DynamicObjectFilter::Impl::trackCorners(const Options& o, const cv::Re
             if (o.fg_depth_band > 0 && t.depth) {  // t.depth: the previous step's
                 const float zp = *t.depth, h = depthBand(o.fg_depth_band, zp);
                 const cv::Rect full =
-                    cv::Rect(cv::Rect2f(static_cast<float>(roi.x / sc),
-                                        static_cast<float>(roi.y / sc),
-                                        static_cast<float>(roi.width / sc),
-                                        static_cast<float>(roi.height / sc))) &
+                    cv::Rect(cv::Rect2f(
+                        static_cast<float>(roi.x / sc), static_cast<float>(roi.y / sc),
+                        static_cast<float>(roi.width / sc), static_cast<float>(roi.height / sc))) &
                     cv::Rect(0, 0, prev_depth.cols, prev_depth.rows);
                 cv::Mat band;
                 cv::inRange(prev_depth(full), zp - h, zp + h, band);
@@ -776,9 +775,9 @@ Eigen::Isometry3d DynamicObjectFilter::Impl::egoMotion(
     cv::eigen2cv(Kc.matrix(), K_cv);
     std::vector<int> inliers;
     // (OpenCV's RANSAC uses its own fixed-seed RNG: runs are repeatable.)
-    const bool ok = cv::solvePnPRansac(bg_obj, bg_img, K_cv, cv::noArray(), rvec, tvec, true,
-                                       100, static_cast<float>(o.ransac_reprojection), 0.99,
-                                       inliers, cv::SOLVEPNP_ITERATIVE);
+    const bool ok = cv::solvePnPRansac(bg_obj, bg_img, K_cv, cv::noArray(), rvec, tvec, true, 100,
+                                       static_cast<float>(o.ransac_reprojection), 0.99, inliers,
+                                       cv::SOLVEPNP_ITERATIVE);
     // At least a quarter of the background points: walkers the detector missed, and the
     // clutter around the boxes, can be many of them.
     if (ok && static_cast<int>(inliers.size()) >= o.min_background_points &&
@@ -799,9 +798,8 @@ Eigen::Isometry3d DynamicObjectFilter::Impl::egoMotion(
 }
 
 void DynamicObjectFilter::Impl::residualFlow(const core::Frame& frame, const PointFlow& f,
-                                             const Eigen::Isometry3d& T_prev_cur,
-                                             const Options& o, Residuals& r,
-                                             FilterOutput& out) const {
+                                             const Eigen::Isometry3d& T_prev_cur, const Options& o,
+                                             Residuals& r, FilterOutput& out) const {
     // The threshold adapts to frames where even the background fits badly (rgb/depth time
     // offset, motion blur): a point is dynamic above max(threshold1, background_factor *
     // 90th percentile of the background residuals).
@@ -922,8 +920,8 @@ void DynamicObjectFilter::Impl::classifyBoxes(const Residuals& r, const core::Fr
             continue;
         }
         t.unseen = 0;
-        bool moving = n_dyn >= o.threshold2_count &&
-                      n_dyn >= o.threshold2_fraction * static_cast<double>(n);
+        bool moving =
+            n_dyn >= o.threshold2_count && n_dyn >= o.threshold2_fraction * static_cast<double>(n);
         if (o.slow_frames > 0) {
             // Slow walkers: the mean of the box's per-step median residual vectors. A
             // walker who stops keeps it above the threshold for up to slow_frames - 1
@@ -952,8 +950,8 @@ void DynamicObjectFilter::Impl::classifyBoxes(const Residuals& r, const core::Fr
             // The interquartile mean, not the median, of the box's depth residuals: depth
             // comes in disparity steps (2 cm at 2.6 m), larger than a walker's change a frame
             // there, and where the band holds static points too (most likely the floor at the
-            // feet), the median sat at 0 in most frames. A walker of walking_towards was Static for 100
-            // frames; masked 86.8 -> 91.6 % of their frames (docs/dynamic.md, session 14).
+            // feet), the median sat at 0 in most frames. A walker of walking_towards was Static for
+            // 100 frames; masked 86.8 -> 91.6 % of their frames (docs/dynamic.md, session 14).
             if (rz.size() >= static_cast<std::size_t>(o.min_points)) {
                 t.depth_history.push_back(static_cast<float>(
                     core::interquartileMean(std::vector<double>(rz.begin(), rz.end()))));
@@ -986,11 +984,10 @@ void DynamicObjectFilter::Impl::forgetUnseen(const Options& o) {
     // remembered, so that a walker who comes back (through the border they left by, from
     // behind someone) is matched and masked at once instead of collecting evidence anew.
     if (o.hide_unseen_frames > 0)
-        tracks.erase(std::remove_if(tracks.begin(), tracks.end(),
-                                    [&](const Track& t) {
-                                        return t.unseen > o.forget_unseen_frames;
-                                    }),
-                     tracks.end());
+        tracks.erase(
+            std::remove_if(tracks.begin(), tracks.end(),
+                           [&](const Track& t) { return t.unseen > o.forget_unseen_frames; }),
+            tracks.end());
 }
 
 /// Clears the set pixels of `sil` not 8-connected to one inside `inner` (a rectangle in
@@ -1014,8 +1011,8 @@ void keepConnectedTo(cv::Mat& sil, const cv::Rect& inner) {
     }
 }
 
-void DynamicObjectFilter::Impl::drawMask(const core::Frame& frame, bool have_prev,
-                                         const Options& o, FilterOutput& out) const {
+void DynamicObjectFilter::Impl::drawMask(const core::Frame& frame, bool have_prev, const Options& o,
+                                         FilterOutput& out) const {
     // Whole boxes, dilated by the margin. On a frame with no previous one every box is
     // Unknown, walkers and sitters alike: masking them all there would be all_persons for
     // that frame (mask_unknown_first_frame).

@@ -44,8 +44,11 @@ void LoopOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, const s
     core::requireValue(confirm_keyframes >= 0, s, "confirm_keyframes", "must be >= 0");
     core::requireValue(confirm_t > 0, s, "confirm_t", "must be > 0 [m]");
     core::requireValue(confirm_deg > 0, s, "confirm_deg", "must be > 0");
-    core::requireValue(sigma_t > 0, s, "sigma_t", "must be > 0 [m]");
-    core::requireValue(sigma_r_deg > 0, s, "sigma_r_deg", "must be > 0");
+    // The pose graph's information is 1 / sigma^2: 1e-200 made it inf, 1e200 zero.
+    core::requireValue(sigma_t >= 1e-6 && sigma_t <= 1e3, s, "sigma_t",
+                       "must be in [1e-6, 1e3] [m]");
+    core::requireValue(sigma_r_deg >= 1e-6 && sigma_r_deg <= 1e3, s, "sigma_r_deg",
+                       "must be in [1e-6, 1e3] [deg]");
 }
 
 void LoopOptions::saveToConfig(mrpt::config::CConfigFileBase& c, const std::string& s) const {

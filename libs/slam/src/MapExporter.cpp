@@ -105,6 +105,11 @@ void GridMapOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, cons
                        "need min_height < max_height");
     core::requireValue(margin >= 0 && margin <= 100 && max_range > 0 && max_range <= 1000, s,
                        "margin/max_range", "must be in [0, 100] / (0, 1000] [m]");
+    // The margins alone make (2 margin / resolution)^2 cells: over the 1e8 the grid may have,
+    // the map was refused only when written, at the end of the run.
+    core::requireValue(std::pow(2 * margin / resolution, 2) <= 1e8, s, "margin",
+                       "2 x margin / resolution squared is more than the 1e8 cells a grid may "
+                       "have: lower margin or coarsen resolution");
 }
 
 std::optional<mrpt::maps::COccupancyGridMap2D> buildOccupancyGrid(const Map& map,

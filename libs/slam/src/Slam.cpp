@@ -17,8 +17,7 @@ void MappingOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, cons
         c, s,
         {"min_init_points", "cull_min_found_ratio", "cull_min_visible", "cull_keyframe_age",
          "cull_ratio_keyframes", "redundant_keyframe_ratio", "redundant_keyframe_observers",
-         "odometry_sigma_t", "odometry_sigma_r_deg", "depth_time_compensation",
-         "refine_frames"});
+         "odometry_sigma_t", "odometry_sigma_r_deg", "depth_time_compensation", "refine_frames"});
     depth_time_compensation =
         core::readBool(c, s, "depth_time_compensation", depth_time_compensation);
     refine_frames = core::readBool(c, s, "refine_frames", refine_frames);
@@ -45,8 +44,11 @@ void MappingOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, cons
                        "redundant_keyframe_ratio", "must be in [0, 1] (0: no keyframe culling)");
     core::requireValue(redundant_keyframe_observers >= 1, s, "redundant_keyframe_observers",
                        "must be >= 1");
-    core::requireValue(odometry_sigma_t > 0, s, "odometry_sigma_t", "must be > 0 [m]");
-    core::requireValue(odometry_sigma_r_deg > 0, s, "odometry_sigma_r_deg", "must be > 0");
+    // The pose graph's information is 1 / sigma^2: 1e-200 made it inf, 1e200 zero.
+    core::requireValue(odometry_sigma_t >= 1e-6 && odometry_sigma_t <= 1e3, s, "odometry_sigma_t",
+                       "must be in [1e-6, 1e3] [m]");
+    core::requireValue(odometry_sigma_r_deg >= 1e-6 && odometry_sigma_r_deg <= 1e3, s,
+                       "odometry_sigma_r_deg", "must be in [1e-6, 1e3] [deg]");
 }
 
 void MappingOptions::saveToConfig(mrpt::config::CConfigFileBase& c, const std::string& s) const {
@@ -171,8 +173,8 @@ TrackResult Slam::track(const core::Frame& frame, const FrameFeatures& features,
         for (std::size_t i = 0; i < features.size(); ++i) {
             const LandmarkId lm = res.landmark_of_kp[i];
             if (lm == kNoId) continue;
-            rec.obs.emplace_back(lm, observationOf(features, i, Eigen::Vector3d::Zero(),
-                                                   opts_.orb.scale_factor));
+            rec.obs.emplace_back(
+                lm, observationOf(features, i, Eigen::Vector3d::Zero(), opts_.orb.scale_factor));
         }
     }
     records_.push_back(std::move(rec));

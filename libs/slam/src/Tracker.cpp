@@ -63,9 +63,15 @@ void TrackerOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, cons
     reloc_max_speed = core::readDouble(c, s, "reloc_max_speed", reloc_max_speed);
     reloc_max_jump_deg = core::readDouble(c, s, "reloc_max_jump_deg", reloc_max_jump_deg);
     reloc_max_rate_deg = core::readDouble(c, s, "reloc_max_rate_deg", reloc_max_rate_deg);
-    core::requireValue(projection.radius > 0, s, "search_radius", "must be > 0 [px]");
-    core::requireValue(fine_radius > 0, s, "fine_radius", "must be > 0 [px]");
-    core::requireValue(wide_radius_factor >= 1, s, "wide_radius_factor", "must be >= 1");
+    // Bounded: the matcher's grid cells are ints, and 1e11 px cast to none (undefined; on
+    // x86 no cell at all, and every frame lost).
+    core::requireValue(projection.radius > 0 && projection.radius <= 2000, s, "search_radius",
+                       "must be in (0, 2000] [px]");
+    core::requireValue(fine_radius > 0 && fine_radius <= 2000, s, "fine_radius",
+                       "must be in (0, 2000] [px]");
+    core::requireValue(wide_radius_factor >= 1 && projection.radius * wide_radius_factor <= 2000, s,
+                       "wide_radius_factor",
+                       "must be >= 1, and search_radius x wide_radius_factor at most 2000 [px]");
     core::requireValue(projection.max_hamming > 0 && projection.max_hamming <= 256, s,
                        "max_hamming", "must be in (0, 256]");
     core::requireValue(projection.ratio > 0 && projection.ratio <= 1, s, "match_ratio",
@@ -80,16 +86,16 @@ void TrackerOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, cons
     // Per frame: a billion rounds ran forever, deaf to Ctrl-C between frames.
     core::requireValue(refine.rounds >= 1 && refine.rounds <= 10, s, "refine_rounds",
                        "must be in [1, 10]");
-    core::requireValue(refine.iterations >= 1 && refine.iterations <= 1000, s,
-                       "refine_iterations", "must be in [1, 1000]");
+    core::requireValue(refine.iterations >= 1 && refine.iterations <= 1000, s, "refine_iterations",
+                       "must be in [1, 1000]");
     core::requireValue(min_matches >= 6, s, "min_matches", "must be >= 6");
     core::requireValue(min_inliers >= 6, s, "min_inliers", "must be >= 6");
     core::requireValue(local_keyframes >= 1 && local_keyframes <= 1000, s, "local_keyframes",
                        "must be in [1, 1000]");
     core::requireValue(near_keyframes >= 0 && near_keyframes <= 1000, s, "near_keyframes",
                        "must be in [0, 1000]");
-    core::requireValue(near_max_angle_deg > 0 && near_max_angle_deg <= 180, s,
-                       "near_max_angle_deg", "must be in (0, 180] [deg]");
+    core::requireValue(near_max_angle_deg > 0 && near_max_angle_deg <= 180, s, "near_max_angle_deg",
+                       "must be in (0, 180] [deg]");
     core::requireValue(max_motion_dt >= 0, s, "max_motion_dt",
                        "must be >= 0 [s] (0: no motion model)");
     core::requireValue(reloc_keyframes >= 1 && reloc_keyframes <= 1000, s, "reloc_keyframes",
@@ -234,8 +240,8 @@ namespace {
 /// Appends to `kfs`, the map's newest keyframes (Map::lastKeyframes), up to `n` of the older
 /// ones nearest `T_wc` by camera centre (ties by id) among those whose optical axis has a
 /// cosine of at least `min_cos` with its own.
-void addNearestOlder(const Map& map, const Eigen::Isometry3d& T_wc, std::size_t n,
-                     double min_cos, std::vector<KeyframeId>& kfs) {
+void addNearestOlder(const Map& map, const Eigen::Isometry3d& T_wc, std::size_t n, double min_cos,
+                     std::vector<KeyframeId>& kfs) {
     if (n == 0 || kfs.empty()) return;
     // Keyframes are kept in id order, so the newest are the map's last entries.
     const KeyframeId oldest_newest = kfs.front();
@@ -257,8 +263,7 @@ std::optional<Eigen::Isometry3d> Tracker::relocalize(const FrameFeatures& f, con
                                                      double timestamp) const {
     // Candidates: the newest keyframes and the ones nearest to the last pose, facing anywhere.
     std::vector<KeyframeId> cands = map.lastKeyframes(opts_.reloc_keyframes / 2 + 1);
-    addNearestOlder(map, last_T_wc_,
-                    static_cast<std::size_t>(opts_.reloc_keyframes) - cands.size(),
+    addNearestOlder(map, last_T_wc_, static_cast<std::size_t>(opts_.reloc_keyframes) - cands.size(),
                     -std::numeric_limits<double>::infinity(), cands);
     std::optional<Eigen::Isometry3d> best;
     int best_inliers = 0;
