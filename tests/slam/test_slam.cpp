@@ -913,6 +913,8 @@ TEST(Config, EveryShippedSlamIniLoadsAndUnknownKeysAreRejected) {
               "[loop_closure] sigma_r_deg: must be in [1e-6, 1e3]"},
              // Past an int's range the matcher's grid cells were undefined (every frame lost);
              // a sigma of 1e-200 gave the pose graph infinite information.
+             {"[keyframes]\nmin_tracked = 100000\n",
+              "[keyframes] min_tracked: must be in [0, [orb] n_features]"},
              {"[tracker]\nsearch_radius = 1e11\n", "[tracker] search_radius: must be in (0, 2000]"},
              {"[tracker]\nwide_radius_factor = 1e10\n",
               "[tracker] wide_radius_factor: must be >= 1, and search_radius x"},

@@ -104,6 +104,12 @@ SlamOptions SlamOptions::fromConfig(const mrpt::config::CConfigFileBase& cfg) {
     o.pose_graph.max_iterations = core::readInt(cfg, "pose_graph", "max_iterations", 100);
     core::requireValue(o.pose_graph.max_iterations > 0 && o.pose_graph.max_iterations <= 10000,
                        "pose_graph", "max_iterations", "must be in [1, 10000]");
+    // More than a frame can track meant no keyframe after the first: the map stopped growing
+    // and the track was lost once the camera left its view.
+    core::requireValue(
+        o.keyframes.min_tracked >= 0 && o.keyframes.min_tracked <= o.orb.n_features, "keyframes",
+        "min_tracked",
+        "must be in [0, [orb] n_features] (" + std::to_string(o.orb.n_features) + ")");
     // The level sigmas of tracking and BA follow the ORB pyramid.
     o.local_ba.scale_factor = o.orb.scale_factor;
     o.tracker.scale_factor = o.orb.scale_factor;
