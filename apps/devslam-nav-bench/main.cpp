@@ -32,8 +32,6 @@
 #include <random>
 #include <sstream>
 
-#include <unistd.h>
-
 namespace {
 using Clock = std::chrono::steady_clock;
 
@@ -231,10 +229,8 @@ std::optional<int> parseArgs(int argc, char** argv, Args& a) {
             throw std::invalid_argument("--png-dir '" + a.png_dir + "' is a file, not a folder");
         // Nothing is made yet (a refused run leaves no folder): the nearest folder that is
         // there must take the rest.
-        auto up = std::filesystem::absolute(a.png_dir).lexically_normal();
-        while (!up.empty() && up != up.root_path() && !std::filesystem::exists(up))
-            up = up.parent_path();
-        if (!std::filesystem::is_directory(up) || ::access(up.c_str(), W_OK | X_OK) != 0)
+        const auto up = devslam::core::nearestExisting(a.png_dir);
+        if (!std::filesystem::is_directory(up) || !devslam::core::canMakeFilesIn(up))
             throw std::invalid_argument("--png-dir '" + a.png_dir + "': cannot write in '" +
                                         up.string() + "'");
         if (a.methods.empty()) throw std::invalid_argument("--methods is empty");

@@ -15,8 +15,6 @@
 #include <devslam/core/Results.h>
 #include <devslam/core/Stats.h>
 
-#include <unistd.h>
-
 #include <filesystem>
 #include <iostream>
 #include <sstream>
@@ -110,14 +108,14 @@ Args parse(int argc, char** argv) {
     // refused a bench started in a folder it cannot write in)
     if (a.bench == 0 && !a.out.empty()) {
         namespace fs = std::filesystem;
-        fs::path p = fs::absolute(a.out).lexically_normal();
-        if (fs::exists(p) && !fs::is_directory(p))
+        const fs::path full = fs::absolute(a.out).lexically_normal();
+        if (fs::exists(full) && !fs::is_directory(full))
             throw std::invalid_argument("--out '" + a.out + "': a file is there, not a folder");
-        while (!p.empty() && p != p.root_path() && !fs::exists(p)) p = p.parent_path();
+        const fs::path p = core::nearestExisting(a.out);
         if (!fs::is_directory(p))
             throw std::invalid_argument("--out '" + a.out + "': '" + p.string() +
                                         "' is a file, not a folder");
-        if (::access(p.c_str(), W_OK | X_OK) != 0)
+        if (!core::canMakeFilesIn(p))
             throw std::invalid_argument("--out '" + a.out + "': cannot write in '" + p.string() +
                                         "'");
     }

@@ -569,8 +569,7 @@ TEST(Results, SectionsAreReplacedInPlaceAndBrokenMarkersRefused) {
     }
     const auto folder = std::filesystem::path(path).parent_path();
     for (const auto& f : std::filesystem::directory_iterator(folder))
-        EXPECT_EQ(f.path().filename().string().rfind(".devslam-results-probe", 0),
-                  std::string::npos)
+        EXPECT_EQ(f.path().filename().string().rfind(".devslam-write-probe", 0), std::string::npos)
             << "the probe is removed";
     EXPECT_THROW(checkResultsSection(std::filesystem::path(path).parent_path().string(), "b"),
                  std::runtime_error);

@@ -63,8 +63,7 @@ long long parseInteger(const std::string& text, const std::string& what, long lo
     errno = 0;
     long long v = std::strtoll(t.c_str(), &end, 10);
     if (end != t.c_str() + t.size() || errno == ERANGE) {
-        if (hexadecimal(t)) fail(what, "an integer", text);
-        double d = 0;
+        double d = 0;  // (readFinite refuses hexadecimal)
         if (!readFinite(t, d) || d != std::floor(d) || std::fabs(d) > 9007199254740992.0)
             fail(what, "an integer", text);
         v = static_cast<long long>(d);

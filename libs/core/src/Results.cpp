@@ -83,15 +83,26 @@ void checkResultsSection(const std::string& path, const std::string& name) {
         throw std::runtime_error("results file '" + path + "': no folder '" + folder.string() +
                                  "'");
     // The file is replaced through a '.part' beside it, at the end of a long bench: a folder
-    // it cannot be made in lost the whole bench's table then. Probed by making a file there,
-    // which also holds for root and for a read-only mount, where access() does not tell.
-    const auto probe = folder / (".devslam-results-probe-" + std::to_string(::getpid()));
-    const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0600);
-    if (fd < 0)
+    // it cannot be made in lost the whole bench's table then.
+    if (!canMakeFilesIn(folder))
         throw std::runtime_error("results file '" + path + "': cannot write in '" +
                                  folder.string() + "' (" + std::strerror(errno) + ")");
+}
+
+bool canMakeFilesIn(const std::filesystem::path& dir) {
+    const auto probe = dir / (".devslam-write-probe-" + std::to_string(::getpid()));
+    const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL, 0600);
+    if (fd < 0) return false;  // errno says why
     ::close(fd);
     ::unlink(probe.c_str());
+    return true;
+}
+
+std::filesystem::path nearestExisting(const std::string& folder) {
+    namespace fs = std::filesystem;
+    fs::path p = fs::absolute(folder).lexically_normal();
+    while (!p.empty() && p != p.root_path() && !fs::exists(p)) p = p.parent_path();
+    return p;
 }
 
 namespace {

@@ -82,13 +82,13 @@ core::CameraIntrinsics depthCamera(const CObservation3DRangeScan& o) {
     return K;
 }
 
-cv::Mat depthInDepthCamera(const CObservation3DRangeScan& o) {
+// The depth image in metres along the depth camera's axis; `K` is depthCamera(o).
+cv::Mat depthInDepthCamera(const CObservation3DRangeScan& o, const core::CameraIntrinsics& K) {
     const int H = static_cast<int>(o.rangeImage.rows()), W = static_cast<int>(o.rangeImage.cols());
     const cv::Mat raw(H, W, CV_16UC1, const_cast<uint16_t*>(o.rangeImage.data()));
     cv::Mat m;
     raw.convertTo(m, CV_32F, o.rangeUnits);
     if (!o.range_is_depth) {  // Euclidean range along the pixel's ray -> z
-        const auto K = depthCamera(o);
         const auto& ray = undistortedGrid(K);
         for (int v = 0; v < H; ++v)
             for (int u = 0; u < W; ++u) {
@@ -106,8 +106,7 @@ cv::Mat depthInDepthCamera(const CObservation3DRangeScan& o) {
 // the SLAM looks depth up). With pinhole models only, an OpenNI colour lens (k1 0.06, k2 0.04)
 // put depth up to ~20 px from its colour near the image corners.
 cv::Mat registerDepth(const CObservation3DRangeScan& o, const cv::Mat& depth,
-                      const core::CameraIntrinsics& Kc) {
-    const auto Kd = depthCamera(o);
+                      const core::CameraIntrinsics& Kd, const core::CameraIntrinsics& Kc) {
     const auto& ray = undistortedGrid(Kd);
     // colour optical <- depth optical
     const mrpt::poses::CPose3D T = (o.relativePoseIntensityWRTDepth - opticalInObs());
@@ -254,10 +253,11 @@ core::Frame frameFromObservation(const CObservation3DRangeScan& o, const std::st
     f.K = core::CameraIntrinsics::fromMrpt(o.cameraParamsIntensity);
     f.K.width = f.bgr.cols;
     f.K.height = f.bgr.rows;
-    const cv::Mat depth = depthInDepthCamera(o);
+    const auto Kd = depthCamera(o);
+    const cv::Mat depth = depthInDepthCamera(o, Kd);
     // (registered depth: one camera, the same pixels, lens included)
-    const bool same_camera = o.doDepthAndIntensityCamerasCoincide() && depthCamera(o) == f.K;
-    f.depth = same_camera ? depth : registerDepth(o, depth, f.K);
+    const bool same_camera = o.doDepthAndIntensityCamerasCoincide() && Kd == f.K;
+    f.depth = same_camera ? depth : registerDepth(o, depth, Kd, f.K);
     f.rgb_source = what;
     f.depth_source = what;
     core::validateFrame(f, what);

@@ -8,6 +8,7 @@
 ///   devslam::core::replaceResultsSection("docs/RESULTS.md", "detect", markdown);
 
 #include <ctime>
+#include <filesystem>
 #include <string>
 
 namespace devslam::core {
@@ -35,6 +36,15 @@ void writeFileWhole(const std::string& path, const std::string& text);
 /// Whether the output `out` exists and is the file or folder `in` (another spelling, a link):
 /// writing it would destroy `in`. False when `in` cannot be compared (it does not exist).
 [[nodiscard]] bool sameFile(const std::string& in, const std::string& out);
+
+/// Whether a file can be made in the folder `dir`: probed by making one there and removing it
+/// (access() says yes to root, and on a read-only mount).
+[[nodiscard]] bool canMakeFilesIn(const std::filesystem::path& dir);
+
+/// Where making the folder `folder` (with its parents) starts: `folder` itself, absolute, when
+/// it exists, else the nearest of its parents that does (a file, perhaps); for checking an
+/// output folder before a long job without making it.
+[[nodiscard]] std::filesystem::path nearestExisting(const std::string& folder);
 
 /// What replaceResultsSection would throw for `path` and `name`, found before a command's
 /// work (a bad name, broken markers, a folder, a missing parent folder); writes nothing.
