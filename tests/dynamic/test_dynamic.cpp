@@ -1097,6 +1097,29 @@ TEST(DynamicFilter, BorderSnapLetsTheSilhouetteReachTheBorder) {
     EXPECT_EQ(cv::countNonZero(snapped), person.area()) << "nothing of the wall";
 }
 
+TEST(DynamicFilter, BorderSnapZeroSnapsOnlyAMarginThatCrossesTheBorder) {
+    // mask_border_snap = S snaps a side whose dilated edge (box + mask_margin) comes within
+    // S px of the border; with S = 0, a side whose margin already crosses it. The person 2 m
+    // away fills the right part of a box 30 px from the left border (x 60-130) and touches,
+    // by an arm at the box's top (x 30-60, y 60-100), a pole at their depth along the border
+    // (x 0-30). The pole's lower part is farther than the margin from the box's silhouette:
+    // it is masked only where the silhouette may follow the person's pixels to the border.
+    const cv::Rect person(60, 60, 70, 340), arm(30, 60, 30, 40), pole(0, 60, 30, 340);
+    const cv::Rect low_pole(0, 220, 20, 180);
+    const core::Frame f = wallWithNearRegions({person, arm, pole});
+    const cv::Rect2f box(30.f, 60.f, 100.f, 340.f);
+    const auto masks = [&](int margin, int snap) {
+        return silhouetteMask(f, box, [&](auto& fo) {
+            fo.mask_margin = margin;
+            fo.mask_border_snap = snap;
+        });
+    };
+    EXPECT_EQ(maskedFraction(masks(20, 0), low_pole), 0.0) << "a 20 px margin stays off the border";
+    EXPECT_EQ(maskedFraction(masks(20, 40), low_pole), 1.0) << "its edge is 10 px from it";
+    EXPECT_EQ(maskedFraction(masks(40, 0), low_pole), 1.0) << "a 40 px margin crosses it";
+    EXPECT_EQ(maskedFraction(masks(40, 0), cv::Rect(0, 60, 30, 80)), 1.0) << "the arm's margin";
+}
+
 TEST(DynamicFilter, SlowWalkerIsCaughtByItsMeanResidualFlow) {
     // A person walking at 0.2 m/s 2.2 m away moves about 1.6 px a frame after ego-motion
     // compensation: under threshold1 (2 px) for nearly every point, so per-frame evidence

@@ -1040,6 +1040,8 @@ void DynamicObjectFilter::Impl::drawMask(const core::Frame& frame, bool have_pre
         const auto W = static_cast<float>(size.width), H = static_cast<float>(size.height);
         float x0 = t.tb.box.x - m, y0 = t.tb.box.y - m;
         float x1 = t.tb.box.br().x + m, y1 = t.tb.box.br().y + m;
+        // (snap 0 still snaps a side whose margin crosses the border: the silhouette below
+        // may then follow the person's pixels to it, as the clipped whole box reaches it)
         const bool snap_l = x0 < snap;
         const bool snap_t = y0 < snap;
         const bool snap_r = x1 > W - snap;

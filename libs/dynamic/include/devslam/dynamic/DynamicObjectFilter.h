@@ -208,10 +208,12 @@ class DynamicObjectFilter {
         /// this masks every person, seated ones too, in the frame the SLAM builds its
         /// first keyframe from. Off by default (docs/dynamic.md, session 11).
         bool mask_unknown_first_frame = false;
-        /// [px] a masked box edge this close to the image border is extended to it: a
-        /// person cut off by the border is detected with a box that stops short of it,
-        /// leaving a strip of the person unmasked. With mask_silhouette the silhouette may
-        /// reach the border on that side, through the person's pixels.
+        /// [px] a masked box edge (the box grown by mask_margin) this close to the image
+        /// border is extended to it: a person cut off by the border is detected with a box
+        /// that stops short of it, leaving a strip of the person unmasked. 0 snaps only an
+        /// edge the margin takes past the border (the whole box is clipped there anyway).
+        /// With mask_silhouette the silhouette may reach the border on a snapped side,
+        /// through the person's pixels.
         int mask_border_snap = 0;
         /// false: the whole (dilated) box is masked, as in the paper. true: only the box's
         /// pixels within the person's depth band (silhouette_depth_band, else fg_depth_band,
