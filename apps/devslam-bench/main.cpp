@@ -668,6 +668,7 @@ Runs runSlam(const Bench& b, const Args& a) {
                                       " --config " + quote(q.slam_config) + " --mode " + m +
                                       " --out " + quote(dir.string()) + " --quiet";
                     if (b.max_frames) cmd += " --max-frames " + std::to_string(b.max_frames);
+                    const std::string again = cmd;  // for a failed run's message
                     cmd += " > " + quote((dir / "log.txt").string()) + " 2>&1";
                     std::cout << "[" << ++done << "/" << runs.total << "] " << q.name << " " << m
                               << (in.seed ? " seed " + seed : std::string()) << " run " << r + 1
@@ -717,7 +718,8 @@ Runs runSlam(const Bench& b, const Args& a) {
                                                              : f.unreadable)
                                   << "):\n"
                                   << lastLines((dir / "log.txt").string(), 3)
-                                  << "  (whole output: " << (dir / "log.txt").string() << ")\n";
+                                  << "  (whole output: " << (dir / "log.txt").string()
+                                  << ")\n  to run it again: " << again << "\n";
                     }
                     runs.of[{q.name, m}].push_back(f);
                     runs.csv += csvRow(q, m, seed, r, f);

@@ -637,6 +637,10 @@ TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
     const std::string log = readFile(tmp / "log.txt");
     EXPECT_NE(log.find("devslam-run failed (exit 1):\n  devslam-run: "), std::string::npos) << log;
     EXPECT_NE(log.find("folder has no rgb.txt"), std::string::npos) << log;
+    EXPECT_NE(log.find("  to run it again: '" + bin + "/devslam-run' --input '" +
+                       (tmp / "not_tum").string() + "' --config "),
+              std::string::npos)
+        << log;
     EXPECT_NE(log.find("1 of 2 runs failed (the first: "), std::string::npos) << log;
     EXPECT_NE(log.find("RESULTS.md left as it was; --reuse-runs runs only those again"),
               std::string::npos)
