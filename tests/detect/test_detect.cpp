@@ -14,6 +14,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <string>
 #include <tuple>
 #include <vector>
@@ -141,6 +142,44 @@ TEST(DetectYolo, OnnxOutputIsDecoded) {
     ASSERT_EQ(d2.size(), 2u);
     EXPECT_EQ(d2[0].class_name, "dog");  // highest score first (0.95 x 0.9)
     EXPECT_NEAR(d2[0].box.x, (80.f - 20.f) * 2.f, 1e-3);
+}
+
+TEST(DetectYolo, NonFiniteOutputsAreDropped) {
+    // constant_yolo.onnx with two of its rows patched (its constant rows lie in the file as
+    // raw floats): the first person's objectness and the second person's centre x become
+    // NaN, as from corrupted weights. Neither is reported, nor makes the others NaN: the dog
+    // still is, unchanged. (The decoder drops a NaN at several steps - scores, box, the
+    // clipped box's area - each written so that a NaN fails it; with all of them written
+    // as `x < threshold`, the NaN centre came out as a box.)
+    const std::string src = kRoot + "/tests/detect/data/constant_yolo.onnx";
+    std::ifstream in(src, std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), {});
+    const auto patch = [&](std::vector<float> row, std::size_t k) {
+        const std::string key(reinterpret_cast<const char*>(row.data()), row.size() * 4);
+        const auto at = bytes.find(key);
+        ASSERT_NE(at, std::string::npos) << "row not found in " << src;
+        ASSERT_EQ(bytes.find(key, at + 1), std::string::npos);
+        const float nan = std::numeric_limits<float>::quiet_NaN();
+        bytes.replace(at + 4 * k, 4, reinterpret_cast<const char*>(&nan), 4);
+    };
+    patch({160.f, 160.f, 64.f, 192.f, 0.9f}, 4);  // objectness of the 0.72 person
+    patch({164.f, 160.f, 64.f, 192.f, 0.9f}, 0);  // centre x of the 0.45 person
+    const fs::path dir = devslam::test::scratchPath("devslam_test_detect_nan");
+    fs::create_directories(dir);
+    const std::string model = (dir / "nan_yolo.onnx").string();
+    std::ofstream(model, std::ios::binary) << bytes;
+    detect::YoloDetector::Options o;
+    o.model = model;
+    o.weights = "";
+    o.classes = {"person", "dog"};
+    detect::YoloDetector det(o);
+    const auto dets = det.detect(cv::Mat(480, 640, CV_8UC3, cv::Scalar(30, 60, 90)));
+    ASSERT_EQ(dets.size(), 1u);
+    EXPECT_EQ(dets[0].class_name, "dog");
+    EXPECT_NEAR(dets[0].score, 0.95f * 0.9f, 1e-5);
+    EXPECT_NEAR(dets[0].box.x, (80.f - 20.f) * 2.f, 1e-3);
+    EXPECT_NEAR(dets[0].box.width, 40.f * 2.f, 1e-3);
+    fs::remove_all(dir);
 }
 
 TEST(DetectYolo, MissingWeightsGiveAClearError) {
