@@ -447,6 +447,50 @@ TEST(RenderSequence, ARenderThatDiesHalfWayLeavesNoOldGroundTruth) {
     EXPECT_FALSE(fs::exists(o.out_dir + "/groundtruth.txt"));
 }
 
+// A --rawlog that cannot be written, or that is not this folder's, is refused before the
+// folder is touched: an unwritable one cost the earlier render its ground truth and lists,
+// and a rawlog of someone else's was written over.
+TEST(RenderSequence, ARawlogItCannotOrMayNotWriteLeavesTheEarlierRenderAsItWas) {
+    TempDir tmp;
+    const Scenario sc = smallShort();
+    WriteOptions o;
+    o.out_dir = tmp.str("seq");
+    o.max_frames = 2;
+    (void)writeSequence(sc, o);
+    ASSERT_TRUE(isRenderCurrent(sc, o));
+    const std::string list = readFile(o.out_dir + "/rgb.txt");
+    const std::string gt = readFile(o.out_dir + "/groundtruth.txt");
+    const std::string file = tmp.str("f.txt");
+    std::ofstream(file) << "a file\n";
+    const std::string theirs = tmp.str("theirs.rawlog");
+    std::ofstream(theirs) << "their data\n";
+    fs::create_directories(tmp.str("dir.rawlog"));
+    for (const auto& [rawlog, says] : std::vector<std::pair<std::string, std::string>>{
+             {file + "/x.rawlog", "rawlog '" + file + "/x.rawlog': cannot write in '" + file},
+             {tmp.str("dir.rawlog"), "rawlog '" + tmp.str("dir.rawlog") + "' is a folder"},
+             {theirs, "rawlog '" + theirs + "' exists and is not one that a render into '" +
+                          o.out_dir + "' wrote"}}) {
+        WriteOptions w = o;
+        w.rawlog_path = rawlog;
+        expectMessage([&] { (void)writeSequence(sc, w); }, says);
+        EXPECT_TRUE(isRenderCurrent(sc, o)) << rawlog;
+        EXPECT_EQ(readFile(o.out_dir + "/rgb.txt"), list) << rawlog;
+        EXPECT_EQ(readFile(o.out_dir + "/groundtruth.txt"), gt) << rawlog;
+    }
+    EXPECT_EQ(readFile(theirs), "their data\n");
+    EXPECT_EQ(readFile(file), "a file\n");
+    // The rawlog a render into the folder wrote is written again, whole or stopped (resumed).
+    WriteOptions w = o;
+    w.rawlog_path = tmp.str("mine.rawlog");
+    (void)writeSequence(sc, w);
+    EXPECT_NO_THROW((void)writeSequence(sc, w));
+    EXPECT_EQ(io::RawlogReader(w.rawlog_path).size(), std::optional<std::size_t>(2));
+    // Not into another folder's render, though.
+    WriteOptions other = w;
+    other.out_dir = tmp.str("other");
+    expectMessage([&] { checkOutputs(sc, other); }, "exists and is not one that a render into");
+}
+
 // A real TUM folder (rgb.txt, no render.txt or persons.txt) is not written over, and a
 // rawlog that is not named .rawlog, or is the scenario file, is refused (fuzz: both were
 // overwritten with rc 0); a render's own folder, whole or stopped, is rendered again.

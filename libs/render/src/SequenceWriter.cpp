@@ -36,6 +36,19 @@ fs::path signaturePath(const WriteOptions& o) {
     return fs::path(o.out_dir) / "render.txt";
 }
 
+/// The line naming the rawlog a render writes (render.txt; "# " before it in persons.txt).
+std::string rawlogLine(const WriteOptions& o) {
+    return "rawlog " + fs::absolute(o.rawlog_path).string();
+}
+
+/// Whether the text file `path` exists and has a line equal to `line`.
+bool hasLine(const fs::path& path, const std::string& line) {
+    std::ifstream f(path);
+    for (std::string l; std::getline(f, l);)
+        if (l == line) return true;
+    return false;
+}
+
 /// An INI file's settings as text: comments (# and ; lines, // to the end of a line), blank
 /// lines and spaces at the ends dropped, so that editing a comment keeps a render current.
 std::string iniSettings(const std::string& path) {
@@ -63,7 +76,7 @@ std::string renderSignature(const Scenario& sc, const WriteOptions& o) {
         if (!file.empty()) s << "--- " << file << "\n" << iniSettings(file);
     for (const auto& item : sc.overrides) s << "set " << item << "\n";
     // Written in the same pass: a render without it, or into another file, is another render.
-    if (!o.rawlog_path.empty()) s << "rawlog " << fs::absolute(o.rawlog_path).string() << "\n";
+    if (!o.rawlog_path.empty()) s << rawlogLine(o) << "\n";
     // Texture contents are not hashed: their paths and sizes catch a replaced photo of
     // another size, not one of the very same byte count.
     std::vector<std::string> textures = sc.room.wall_textures;
@@ -115,6 +128,21 @@ void checkOutputs(const Scenario& sc, const WriteOptions& o) {
         if (!file.empty() && core::sameFile(file, r))
             throw std::invalid_argument("rawlog '" + r + "' is the " + what + " file '" + file +
                                         "': writing it would destroy it; name another");
+    // Found here, not when the writer opens it: by then the folder's earlier render had lost
+    // its ground truth and lists (an unwritable --rawlog cost a whole render).
+    if (fs::is_directory(r)) throw std::invalid_argument("rawlog '" + r + "' is a folder");
+    const fs::path parent = core::nearestExisting(fs::path(r).parent_path().string());
+    if (!fs::is_directory(parent) || !core::canMakeFilesIn(parent))
+        throw std::invalid_argument("rawlog '" + r + "': cannot write in '" + parent.string() +
+                                    "'");
+    // A rawlog this folder's render did not write is someone's data (devslam-convert refuses
+    // to overwrite one too). The render names the one it writes in persons.txt, from the
+    // start, and in render.txt, at the end: a stopped render is resumed into the same file.
+    const std::string mine = rawlogLine(o);
+    if (fs::exists(r) && !hasLine(fs::path(o.out_dir) / "persons.txt", "# " + mine) &&
+        !hasLine(signaturePath(o), mine))
+        throw std::invalid_argument("rawlog '" + r + "' exists and is not one that a render into '" +
+                                    o.out_dir + "' wrote; remove it or name another");
 }
 
 WriteSummary writeSequence(const Scenario& sc, const WriteOptions& o,
@@ -146,6 +174,7 @@ WriteSummary writeSequence(const Scenario& sc, const WriteOptions& o,
     std::ofstream persons(persons_path);
     if (!persons) throw std::runtime_error("cannot write '" + persons_path + "'");
     persons << "# person truth of devslam-synth scenario " << sc.name << "\n"
+            << (o.rawlog_path.empty() ? std::string() : "# " + rawlogLine(o) + "\n")
             << kPersonsHeader << "\n";
     io::TumWriter tum(o.out_dir, "devslam-synth scenario " + sc.name);
     std::unique_ptr<io::RawlogWriter> rawlog;
