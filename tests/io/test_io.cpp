@@ -672,6 +672,68 @@ TEST(Rawlog, TwoSensorsWithoutALabelAreRefused) {
     EXPECT_EQ(io::RawlogReader(interleaved, o).size(), 2u);
 }
 
+// Two rawlogs of different cameras joined (cat a b > c): the frames after the join were read
+// with their own camera but the reader (and devslam-run, devslam-convert) gave the first
+// one's. The camera that changes is refused where it changes, as damage: the frames before
+// are the intact part.
+TEST(Rawlog, ACameraThatChangesMidStreamIsRefusedWhereItChanges) {
+    TempDir d;
+    const auto obs = [](double t, double fx, int w, int h, bool calibrated) {
+        auto o = onePointObservation(0, 0);
+        const cv::Mat small(h, w, CV_8UC3, cv::Scalar(90, 90, 90));
+        if (w != 640) {
+            o.intensityImage = mrpt::img::CImage(small, mrpt::img::DEEP_COPY);
+            o.rangeImage_setSize(h, w);
+            o.rangeImage.fill(0);
+            o.rangeImage(h / 2, w / 2) = 10000;
+        }
+        for (auto* cam : {&o.cameraParams, &o.cameraParamsIntensity}) {
+            cam->ncols = calibrated ? w : 0;
+            cam->nrows = calibrated ? h : 0;
+            // (uncalibrated: the same numbers whatever the size)
+            cam->setIntrinsicParamsFromValues(fx, fx, calibrated ? 0.5 * w - 0.5 : 319.5,
+                                              calibrated ? 0.5 * h - 0.5 : 239.5);
+        }
+        o.timestamp = mrpt::Clock::fromDouble(t);
+        return o;
+    };
+    const auto write = [&](const std::string& name, const std::vector<double>& fx,
+                           const std::vector<int>& w, bool calibrated) {
+        const std::string path = d.str(name);
+        mrpt::io::CFileGZOutputStream out(path);
+        auto a = mrpt::serialization::archiveFrom(out);
+        for (std::size_t k = 0; k < fx.size(); ++k)
+            a << obs(1.0 + 0.1 * double(k), fx[k], w[k], w[k] * 3 / 4, calibrated);
+        return path;
+    };
+    // Another focal length, and another size with its calibration: found by the scan at open.
+    for (const auto& path : {write("fx.rawlog", {500, 500, 400}, {640, 640, 640}, true),
+                             write("size.rawlog", {500, 500, 50}, {640, 640, 64}, true)}) {
+        expectError([&] { io::RawlogReader r(path); },
+                    R"(\.rawlog: observation 2: colour camera .* differs from observation 0's )"
+                    R"(640x480 fx 500 fy 500 cx 319\.5 cy 239\.5: a rawlog of one camera is )"
+                    R"(expected after 2 RGB-D observations)");
+        io::ReaderOptions allow;
+        allow.allow_damaged = true;
+        io::RawlogReader partial(path, allow);
+        EXPECT_EQ(partial.size(), 2u);
+        std::size_t n = 0;
+        while (const auto f = partial.next()) {
+            EXPECT_EQ(f->K.fx, 500.0);
+            ++n;
+        }
+        EXPECT_EQ(n, 2u);
+    }
+    // Uncalibrated sizes (ncols 0: the image's size is taken): the same calibration, another
+    // image size, found when the frame is read; the frames before it were read.
+    const std::string raw = write("uncal.rawlog", {500, 500}, {640, 320}, false);
+    io::RawlogReader r(raw);
+    ASSERT_TRUE(r.next().has_value());
+    expectError([&] { (void)r.next(); },
+                R"(uncal\.rawlog observation 1: its colour image is 320x240, observation 0's )"
+                R"(640x480: a rawlog of one camera is expected)");
+}
+
 // Intrinsics given for a rawlog are for its images' size, as a TUM folder's are.
 TEST(Rawlog, GivenIntrinsicsOfAnotherSizeAreRefused) {
     TempDir d;

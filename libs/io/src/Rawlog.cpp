@@ -26,6 +26,7 @@
 #include <filesystem>
 #include <limits>
 #include <new>
+#include <sstream>
 #include <stdexcept>
 #include <tuple>
 #include <utility>
@@ -319,6 +320,20 @@ struct RawlogReader::Stream {
     }
 };
 
+namespace {
+/// "colour camera 640x480 fx 517.3 ... differs from observation 0's ...".
+std::string cameraChange(const mrpt::img::TCamera& now, const mrpt::img::TCamera& first) {
+    const auto text = [](const mrpt::img::TCamera& c) {
+        std::ostringstream s;
+        s << c.ncols << "x" << c.nrows << " fx " << c.fx() << " fy " << c.fy() << " cx "
+          << c.cx() << " cy " << c.cy();
+        return s.str();
+    };
+    return "colour camera " + text(now) + " differs from observation 0's " + text(first) +
+           ": a rawlog of one camera is expected";
+}
+}  // namespace
+
 RawlogReader::RawlogReader(std::string path, ReaderOptions opts)
     : path_(std::move(path)), opts_(std::move(opts)) {
     if (!fs::is_regular_file(path_)) throw std::runtime_error(path_ + ": rawlog file not found");
@@ -332,6 +347,7 @@ RawlogReader::RawlogReader(std::string path, ReaderOptions opts)
         using std::runtime_error::runtime_error;
     };
     std::string first_label;
+    mrpt::img::TCamera first_cam;
     try {
         Stream s(path_);
         double last_t = 0;
@@ -358,6 +374,13 @@ RawlogReader::RawlogReader(std::string path, ReaderOptions opts)
                 o->load();
                 K_ = frameFromObservation(*o, path_ + " observation 0").K;
                 o->unload();
+                first_cam = o->cameraParamsIntensity;
+            } else if (!(core::CameraIntrinsics::fromMrpt(o->cameraParamsIntensity) ==
+                         core::CameraIntrinsics::fromMrpt(first_cam))) {
+                // (Two rawlogs joined with cat: the frames after the join were tracked with
+                // the first camera's model.) The frames before it are the intact part.
+                throw std::runtime_error("observation " + std::to_string(n_frames_) + ": " +
+                                         cameraChange(o->cameraParamsIntensity, first_cam));
             }
             ++n_frames_;
         }
@@ -443,6 +466,13 @@ std::optional<core::Frame> RawlogReader::next() {
     if (opts_.intrinsics) {
         f.K = *opts_.intrinsics;
         core::validateFrame(f, what);  // (a later observation of another size)
+    } else if (!(f.K == K_)) {
+        // The scan compared the calibrations; an uncalibrated size (ncols 0) takes the
+        // image's, which only a decoded image shows.
+        throw std::runtime_error(what + ": its colour image is " + std::to_string(f.K.width) +
+                                 "x" + std::to_string(f.K.height) + ", observation 0's " +
+                                 std::to_string(K_.width) + "x" + std::to_string(K_.height) +
+                                 ": a rawlog of one camera is expected");
     }
     f.index = index;
     return f;
