@@ -195,6 +195,33 @@ TEST(Rpe, ReproducesEvaluateRpeQuirks) {
     EXPECT_THROW((void)eval::computeRpe(line, rotated, o), std::invalid_argument);
 }
 
+// A delta longer than the estimate leaves no pair, however long: at 1e16 s the search in
+// double precision (stamps of 1.3e9 s) paired every pose with the first one, and gave figures.
+TEST(Rpe, ADeltaLongerThanTheRunLeavesNoPair) {
+    core::Trajectory gt, est;
+    for (int i = 0; i < 30; ++i) {
+        const double t = 1305031102.175304 + 0.1 * i;
+        gt.push_back({t, CPose3D(0.01 * i, 0, 0, 0, 0, 0)});
+        est.push_back({t, CPose3D(0.011 * i, 0, 0, 0, 0, 0)});
+    }
+    eval::RpeOptions o;
+    o.delta = 2.5;  // the span is 2.9 s
+    EXPECT_GE(eval::computeRpe(gt, est, o).n_pairs, 2u);
+    for (const double delta : {3.0, 1e6, 1e16, 1e300}) {
+        o.delta = delta;
+        try {
+            (void)eval::computeRpe(gt, est, o);
+            ADD_FAILURE() << "delta " << delta << " s gave pairs";
+        } catch (const std::invalid_argument& e) {
+            EXPECT_NE(std::string(e.what()).find("RPE: no pose pair"), std::string::npos)
+                << e.what();
+        }
+    }
+    o.delta_in_frames = true;
+    o.delta = 1e19;  // frames
+    EXPECT_THROW((void)eval::computeRpe(gt, est, o), std::invalid_argument);
+}
+
 // evaluate_rpe.py refuses trajectories that overlap at one estimate pose ("Number of overlap
 // in the timestamps is too small"): ground truth at 0 and 100 s, the estimate at 0..10 s,
 // every estimate stamp meets the ground truth at 0 s, whose nearest estimate stamp is 0 s.

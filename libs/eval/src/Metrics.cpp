@@ -138,7 +138,12 @@ RpeResult computeRpe(const core::Trajectory& gt, const core::Trajectory& est,
     const double gt_max_dt = 2.0 * core::median(intervals);
 
     std::vector<double> trans, rot;
-    for (std::size_t i = 0; i < se.size(); ++i) {
+    // A delta past the estimate's whole span pairs each pose with the last one, and such
+    // pairs are dropped: none is left. Searched for, a delta of 1e16 s swamps the stamps in
+    // double precision (every |stamp - target| rounds to the same number) and paired each pose
+    // with the first one.
+    const bool any_pair = opts.delta <= index.back() - index.front();
+    for (std::size_t i = 0; any_pair && i < se.size(); ++i) {
         const std::size_t j = findClosestIndex(index, index[i] + opts.delta);
         if (j == se.size() - 1) continue;  // evaluate_rpe.py drops pairs ending at the last pose
         const std::size_t g0 = findClosestIndex(sg, se[i] + opts.offset);
