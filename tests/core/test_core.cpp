@@ -407,6 +407,9 @@ TEST(Config, RepeatedKeysAndSectionsAreRefused) {
     EXPECT_EQ(error("[orb]\n#   a command \\\n#       --more \\\n\nn = 20\n"), "");
     // A define whose value holds its own name is used once (the check ran for ever).
     EXPECT_EQ(error("@define A ${A}\n[a]\n${A} = 4\n"), "");
+    // A variable no @define gives: MRPT's message, with the file (it named none).
+    EXPECT_EQ(error("[a]\nk = 1\nr = ${REF_DIST}\n"),
+              path + ": Line 3: Unknown variable `${REF_DIST}`");
     // Not repeats: one key in two sections, comments, a value continued on the next lines.
     EXPECT_EQ(error("[a]\nk = 1\n# k = 2\n; k = 3\n// k = 4\n[b]\nk = 5\nf = \\\n"
                     "  var k := 1; \\\n  k = 2\n"),

@@ -433,6 +433,19 @@ TEST(NavConfig, MrptSectionsAreReadStrictly) {
               std::string::npos);
     EXPECT_EQ(errorOf("CHolonomicND", "factorWeights", "1 0.5 x 0.4"),
               "x.ini [CHolonomicND] factorWeights: 'x' is not a number");
+    // Values MRPT asserts on only while navigating: a speed limit of 0 or below gave an MRPT
+    // stack trace at every step (and the run went on); factorWeights of the wrong length a
+    // message with no file that stopped mid-sentence.
+    for (const char* k : {"robotMax_V_mps", "robotMax_W_degps"})
+        for (const char* v : {"0", "-1"})
+            EXPECT_EQ(errorOf("CAbstractPTGBasedReactive", k, v),
+                      std::string("x.ini [CAbstractPTGBasedReactive] ") + k + ": must be > 0")
+                << k << " = " << v;
+    EXPECT_EQ(errorOf("CHolonomicND", "factorWeights", "1.0"),
+              "x.ini [CHolonomicND] factorWeights: expected 4 numbers, got 1");
+    EXPECT_EQ(errorOf("CHolonomicFullEval", "factorWeights", "[0.25]"),
+              "x.ini [CHolonomicFullEval] factorWeights: expected 7 numbers, got 1");
+    EXPECT_EQ(errorOf("CHolonomicFullEval", "factorWeights", "1 1 1 0 1 1 1"), "");
     EXPECT_EQ(errorOf("CHolonomicVFHPlus", "window", "0.6x"),
               "x.ini [CHolonomicVFHPlus] window: expected a number, got '0.6x'");
     // The PTGs: their count, classes and each class's own keys.

@@ -1,4 +1,5 @@
 #include <devslam/core/Config.h>
+#include <devslam/core/GzFile.h>
 #include <devslam/core/Parse.h>
 
 #include <algorithm>
@@ -125,7 +126,13 @@ std::unique_ptr<mrpt::config::CConfigFileMemory> loadIni(const std::string& path
     ss << in.rdbuf();
     if (in.bad()) throw std::runtime_error("cannot read INI file '" + path + "'");
     refuseMisreadLines(ss.str(), path);
-    return std::make_unique<mrpt::config::CConfigFileMemory>(ss.str());
+    try {
+        return std::make_unique<mrpt::config::CConfigFileMemory>(ss.str());
+    } catch (const std::exception& e) {
+        // MRPT's parser says "Line 73: Unknown variable ${REF_DIST}" (an @define missing or
+        // misspelt) and names no file.
+        throw std::runtime_error(path + ": " + innermostMessage(e.what()));
+    }
 }
 
 void applyOverrides(mrpt::config::CConfigFileMemory& cfg, const std::vector<std::string>& items,

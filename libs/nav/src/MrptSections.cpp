@@ -165,6 +165,26 @@ void checkMrptSections(const mrpt::config::CConfigFileBase& c, const std::string
             {{std::regex("score[0-9]+_(name|formula)|movement_assert[0-9]+", std::regex::icase),
               Kind::Text}});
     }
+    // Values MRPT asserts on only while navigating (a speed limit of 0 or below printed an
+    // MRPT stack trace at every step, and the robot still got there) or with a message that
+    // names no file and stops mid-sentence (factorWeights of the wrong length).
+    core::namingSource(source, [&] {
+        const std::string ptg = "CAbstractPTGBasedReactive";
+        for (const char* k : {"robotMax_V_mps", "robotMax_W_degps"})
+            if (c.keyExists(ptg, k))
+                core::requireValue(core::readDouble(c, ptg, k, 0.0) > 0, ptg, k, "must be > 0");
+        for (const auto& [section, n] :
+             {std::pair{std::string("CHolonomicND"), CHolonomicND::TOptions().factorWeights.size()},
+              {std::string("CHolonomicFullEval"),
+               CHolonomicFullEval::TOptions().factorWeights.size()}})
+            if (c.keyExists(section, "factorWeights")) {
+                const auto w = core::parseNumberList(c.read_string(section, "factorWeights", ""),
+                                                     "[" + section + "] factorWeights");
+                core::requireValue(w.size() == n, section, "factorWeights",
+                                   "expected " + std::to_string(n) + " numbers, got " +
+                                       std::to_string(w.size()));
+            }
+    });
     // Ours: its own strict reader names the file.
     if (c.sectionExists("CHolonomicVFHPlus")) {
         VfhPlusOptions v;
