@@ -75,7 +75,10 @@ cv::Mat drawOverlay(const core::Frame& f, const dynamic::FilterOutput& out) {
     cv::Mat gray;
     cv::cvtColor(f.bgr, gray, cv::COLOR_BGR2GRAY);
     std::vector<cv::KeyPoint> kps;
-    cv::ORB::create(1000)->detect(gray, kps);
+    // ORB keeps keypoints edgeThreshold (31) px from the border, so a smaller image has none;
+    // a 1 px one made cv::ORB assert inside cv::resize.
+    const auto orb = cv::ORB::create(1000);
+    if (std::min(gray.cols, gray.rows) > 2 * orb->getEdgeThreshold()) orb->detect(gray, kps);
     for (const auto& kp : kps)
         if (!out.mask.empty() && out.mask.at<uchar>(cvRound(kp.pt.y), cvRound(kp.pt.x)))
             cv::drawMarker(img, kp.pt, {255, 0, 255}, cv::MARKER_TILTED_CROSS, 6, 1);

@@ -54,6 +54,31 @@ TEST(DevslamOverlay, RunsOnTheShippedTumFramesThroughASlamIni) {
     EXPECT_EQ(pngsIn(d.str()), 3);
 }
 
+// A 1x1 TUM folder in mode none: one overlay per frame (cv::ORB, for the dropped keypoints,
+// asserted inside cv::resize on an image that small).
+TEST(DevslamOverlay, ATinyFrameGetsItsOverlay) {
+    devslam::test::TempDir d("devslam_overlay_");
+    const std::string in = d.str("tiny");
+    fs::create_directories(in + "/rgb");
+    fs::create_directories(in + "/depth");
+    std::ofstream(in + "/camera.ini") << "[camera]\nfx = 50\nfy = 50\ncx = 0\ncy = 0\nwidth = 1\n"
+                                         "height = 1\ndist = [0 0 0 0 0]\n";
+    std::ofstream rgb(in + "/rgb.txt"), depth(in + "/depth.txt");
+    for (const char* t : {"100.0", "100.1"}) {
+        ASSERT_TRUE(cv::imwrite(in + "/rgb/" + t + ".png", cv::Mat(1, 1, CV_8UC3, cv::Scalar(9))));
+        ASSERT_TRUE(
+            cv::imwrite(in + "/depth/" + t + ".png", cv::Mat(1, 1, CV_16UC1, cv::Scalar(5000))));
+        rgb << t << " rgb/" << t << ".png\n";
+        depth << t << " depth/" << t << ".png\n";
+    }
+    rgb.close();
+    depth.close();
+    const auto r = runApp("devslam-overlay", "--input " + in + " --mode none --out " + d.str("o"));
+    ASSERT_EQ(r.rc, 0) << r.out;
+    EXPECT_EQ(pngsIn(d.str("o")), 2);
+    EXPECT_EQ(cv::imread(d.str("o/overlay_00001.png")).size(), cv::Size(1, 1));
+}
+
 TEST(DevslamOverlay, BadInputIsNamed) {
     devslam::test::TempDir d("devslam_overlay_");
     const std::string out = " --out " + d.str("o");

@@ -466,6 +466,29 @@ TEST(OrbExtractor, MaskDropsKeypointsAndDepthIsRangeChecked) {
     EXPECT_THROW((void)orb.extract(f, cv::Mat(10, 10, CV_8UC1)), std::invalid_argument);
 }
 
+// A frame too small for the pyramid (a 1x1 TUM folder) is refused naming it and its size;
+// cv::ORB asserted inside cv::resize. The smallest that passes runs and finds nothing.
+TEST(OrbExtractor, AFrameTooSmallForThePyramidIsRefused) {
+    OrbExtractor orb({});  // 4 levels at 1.3: level 3 of a 1 px side is cvRound(0.46) = 0
+    core::Frame f;
+    f.index = 7;
+    f.rgb_source = "tiny/rgb/1.png";
+    f.bgr = cv::Mat(1, 1, CV_8UC3, cv::Scalar(9, 9, 9));
+    f.depth = cv::Mat(1, 1, CV_32FC1, cv::Scalar(1.0f));
+    try {
+        (void)orb.extract(f, cv::Mat());
+        ADD_FAILURE() << "accepted";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_EQ(std::string(e.what()),
+                  "orb extractor: frame 7 (tiny/rgb/1.png) is 1x1 px, too small for the ORB "
+                  "pyramid's 4 levels ([orb] n_levels, scale_factor): its last level would "
+                  "have no pixel");
+    }
+    f.bgr = cv::Mat(2, 5, CV_8UC3, cv::Scalar(9, 9, 9));
+    f.depth = cv::Mat(2, 5, CV_32FC1, cv::Scalar(1.0f));
+    EXPECT_EQ(orb.extract(f, cv::Mat()).size(), 0u);
+}
+
 TEST(OrbExtractor, KeypointsOnOcclusionEdgesGetNoDepth) {
     // A person-like step in depth (1.5 m in front of a 3 m wall) at column 320: corners on
     // the edge would take either depth while moving with the front object. Within the 5x5

@@ -150,6 +150,16 @@ FrameFeatures OrbExtractor::extract(const core::Frame& frame, const cv::Mat& mas
         throw std::invalid_argument("orb extractor: mask must be CV_8UC1 of the frame size");
     FrameFeatures f;
     if (frame.bgr.empty()) return f;
+    // cv::ORB scales level l to cvRound(side / scale_factor^l) px and asserts inside
+    // cv::resize when that is 0 (a 1x1 frame): refused here, naming the frame.
+    const int side = std::min(frame.bgr.cols, frame.bgr.rows);
+    if (cvRound(side / std::pow(opts_.scale_factor, opts_.n_levels - 1)) < 1)
+        throw std::invalid_argument(
+            "orb extractor: frame " + std::to_string(frame.index) +
+            (frame.rgb_source.empty() ? std::string() : " (" + frame.rgb_source + ")") + " is " +
+            std::to_string(frame.bgr.cols) + "x" + std::to_string(frame.bgr.rows) +
+            " px, too small for the ORB pyramid's " + std::to_string(opts_.n_levels) +
+            " levels ([orb] n_levels, scale_factor): its last level would have no pixel");
     cv::Mat gray;
     cv::cvtColor(frame.bgr, gray, cv::COLOR_BGR2GRAY);
     std::vector<cv::KeyPoint> kps;
