@@ -573,7 +573,7 @@ TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
         {"[bench]\nrepeats = 2x\n" + real, "bench.ini [bench] repeats: expected an integer"},
         {real + "[sequense_b]\n" + fr1,
          "bench.ini: unknown section [sequense_b] (known: bench, sequence_*, targets)"},
-        {real + "seed = 5\n", "seed"},
+        {real + "seed = 5\n", "bench.ini [sequence_a]: unknown key 'seed' (known: "},
         {"[bench]\nmax_frames = -1\n" + real, "bench.ini [bench] max_frames: must be >= 0"},
         {"[bench]\nrender_jobs = -1\n" + real, "bench.ini [bench] render_jobs: must be 0..64"},
         {"[bench]\nmodes = none Dynamic\n" + real,
@@ -614,7 +614,8 @@ TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
         {real + "[targets]\nx = a dynamic speed <= 1\n", "unknown figure 'speed'"},
         {real + "[targets]\nx = a dynamic ate/truth <= 1\n", "ratio 'ate/truth'"},
         {real + "[targets]\nx = a dynamic ate =< 1\n", "unknown comparison '=<'"},
-        {real + "[targets]\nx = * dynamic ate <= 1x\n", "[targets] x"},
+        {real + "[targets]\nx = * dynamic ate <= 1x\n",
+         "bench.ini [targets] x: expected a number, got '1x'"},
         {real + "[targets]\nx,y = a dynamic ate <= 1\n",
          "[targets] x,y: a target's name is letters, digits"},
     };

@@ -482,9 +482,14 @@ TEST(Config, StrictReadsNameSectionKeyAndValue) {
               "[a] typo_num: expected a number, got '0.5.1'");
     EXPECT_EQ(invalidArgument([&] { (void)readBool(mem, "a", "typo_bool", true); }),
               "[a] typo_bool: expected true or false, got 'ture'");
-    EXPECT_NE(invalidArgument([&] { (void)readInt(mem, "a", "empty", 3); }), "");
-    EXPECT_NE(invalidArgument([&] { (void)readUint64(mem, "a", "neg_seed", 0); }), "");
-    EXPECT_NE(invalidArgument([&] { (void)readInt(mem, "a", "huge", 0); }), "");  // > int
+    for (const auto& [key, read] :
+         std::vector<std::pair<std::string, std::function<void()>>>{
+             {"empty", [&] { (void)readInt(mem, "a", "empty", 3); }},
+             {"neg_seed", [&] { (void)readUint64(mem, "a", "neg_seed", 0); }},
+             {"huge", [&] { (void)readInt(mem, "a", "huge", 0); }}}) {  // huge: > int
+        const std::string e = invalidArgument(read);
+        EXPECT_EQ(e.rfind("[a] " + key + ": ", 0), 0u) << e;
+    }
     EXPECT_EQ(invalidArgument([&] { (void)readInt(mem, "a", "x", 0); }),
               "[a] x: expected an integer, got '0.25'");
 }
@@ -851,10 +856,22 @@ TEST(Frame, ValidateNamesTheProblem) {
     f.bgr = cv::Mat(480, 640, CV_8UC3, cv::Scalar(0));
     f.depth = cv::Mat(480, 640, CV_32FC1, cv::Scalar(1.0f));
     EXPECT_NO_THROW(validateFrame(f, "x"));
+    const auto problem = [&] {
+        try {
+            validateFrame(f, "x.png");
+        } catch (const std::runtime_error& e) {
+            return std::string(e.what());
+        }
+        return std::string("accepted");
+    };
     f.depth = cv::Mat(240, 320, CV_32FC1, cv::Scalar(1.0f));
-    EXPECT_THROW(validateFrame(f, "x"), std::runtime_error);
+    EXPECT_EQ(problem(), "x.png: depth is 320x240 but colour is 640x480");
     f.depth = cv::Mat(480, 640, CV_16UC1);
-    EXPECT_THROW(validateFrame(f, "x"), std::runtime_error);
+    EXPECT_EQ(problem(), "x.png: depth must be float metres (CV_32FC1)");
+    f.depth = cv::Mat(480, 640, CV_32FC1, cv::Scalar(1.0f));
+    f.K.width = 320;
+    EXPECT_EQ(problem(), "x.png: intrinsics are for 320x" + std::to_string(f.K.height) +
+                             " but the image is 640x480");
 }
 
 // The first SIGINT/SIGTERM is recorded and the program goes on; a child's std::system status

@@ -30,6 +30,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <regex>
 #include <sstream>
 #include <tuple>
@@ -304,6 +305,13 @@ TEST(IntegrationNav, AppsSmokeTest) {
     const std::string bad = bin + "/devslam-nav " + kSrc +
                             "/tests/sim/data/obstacle_on_goal.ini > " + out + "/bad.txt 2>&1";
     EXPECT_EQ(WEXITSTATUS(std::system(bad.c_str())), 2);
+    {
+        std::ifstream in(out + "/bad.txt");
+        const std::string said((std::istreambuf_iterator<char>(in)), {});
+        EXPECT_NE(said.find("obstacle_on_goal.ini [goal] x: the goal lies inside obstacle 'box_5'"),
+                  std::string::npos)
+            << said;
+    }
     // An unknown method or a picture of another format: refused before the run. A picture
     // that cannot be written is an error after the result line, which is kept.
     const auto nav = [&](const std::string& args) {
@@ -330,8 +338,24 @@ TEST(IntegrationNav, AppsSmokeTest) {
     EXPECT_EQ(std::system(bench.c_str()), 0) << bench;
     EXPECT_TRUE(mrpt::system::fileExists(out + "/nav_bench_success.png"));
     EXPECT_TRUE(mrpt::system::fileExists(out + "/RESULTS.md"));  // not the repository's
-    const std::string md = mrpt::system::getFileSize(out + "/bench.md") > 0 ? "ok" : "";
-    EXPECT_EQ(md, "ok");
+    {
+        // Its tables: one world per category and VFHPlus alone, so each row counts one run.
+        std::ifstream in(out + "/bench.md");
+        const std::string md((std::istreambuf_iterator<char>(in)), {});
+        for (const char* category :
+             {"### open_clutter", "### corridor_people", "### office", "### obstacle_near_goal"})
+            EXPECT_NE(md.find(category), std::string::npos) << category << "\n" << md;
+        std::size_t rows = 0;
+        for (std::size_t at = md.find("| VFHPlus | "); at != std::string::npos;
+             at = md.find("| VFHPlus | ", at + 1)) {
+            const std::string row = md.substr(at, md.find('\n', at) - at);
+            EXPECT_TRUE(row.find("(1/1)") != std::string::npos ||
+                        row.find("(0/1)") != std::string::npos)
+                << row;
+            ++rows;
+        }
+        EXPECT_EQ(rows, 4u) << md;
+    }
     // Refused before any run: a method twice, --quick with a count, a results file whose
     // section markers are broken (no pictures are written for a table that is not).
     const auto navBench = [&](const std::string& args) {
