@@ -263,7 +263,24 @@ int main(int argc, char** argv) {
             bar.update(++k);
         }
         bar.finish();
-        std::cout << "wrote " << written << " overlays to " << a.out_dir << "\n";
+        // An earlier run's overlays past this one's (or between, with --every) would pass for
+        // this run's: removed once this run's are all written.
+        std::vector<fs::path> stale;
+        for (const auto& e : fs::directory_iterator(a.out_dir)) {
+            const std::string name = e.path().filename().string();
+            std::size_t index = 0;
+            char tail = 0;
+            if (name.size() == 17 &&
+                std::sscanf(name.c_str(), "overlay_%5zu.pn%c", &index, &tail) == 2 && tail == 'g' &&
+                (index >= k || index % static_cast<std::size_t>(a.every) != 0))
+                stale.push_back(e.path());
+        }
+        for (const auto& p : stale) fs::remove(p);
+        std::cout << "wrote " << written << " overlays to " << a.out_dir
+                  << (stale.empty() ? std::string()
+                                    : " (removed " + std::to_string(stale.size()) +
+                                          " of an earlier run)")
+                  << "\n";
     } catch (const std::exception& e) {
         std::cerr << "devslam-overlay: " << e.what() << "\n";
         return 1;

@@ -41,6 +41,17 @@ TEST(DevslamOverlay, WritesOneOverlayPerFrame) {
                "--input synthetic:static --frames 6 --every 2 --out " + d.str("b"));
     ASSERT_EQ(r.rc, 0) << r.out;
     EXPECT_EQ(pngsIn(d.str("b")), 3);
+    // Again into a: the first run's overlays past this one's are removed (they passed for
+    // this run's); other files stay.
+    std::ofstream(d.str("a/notes.png")) << "mine";
+    r = runApp("devslam-overlay", "--input synthetic:walking --frames 3 --out " + d.str("a"));
+    ASSERT_EQ(r.rc, 0) << r.out;
+    EXPECT_NE(r.out.find("wrote 3 overlays to " + d.str("a") + " (removed 3 of an earlier run)"),
+              std::string::npos)
+        << r.out;
+    EXPECT_EQ(pngsIn(d.str("a")), 4);
+    EXPECT_FALSE(fs::exists(d.str("a/overlay_00003.png")));
+    EXPECT_TRUE(fs::exists(d.str("a/notes.png")));
 }
 
 // The shipped real frames through a SLAM INI, whose [run] filter_config names the filter INI.

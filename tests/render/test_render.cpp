@@ -447,6 +447,27 @@ TEST(RenderSequence, ARenderThatDiesHalfWayLeavesNoOldGroundTruth) {
     EXPECT_FALSE(fs::exists(o.out_dir + "/groundtruth.txt"));
 }
 
+// A shorter render into the folder of a longer one: the longer one's images past the last
+// frame went unlisted but stayed, and passed for this render's beside its lists.
+TEST(RenderSequence, AShorterRenderLeavesNoImagesOfTheLongerOne) {
+    TempDir tmp;
+    const Scenario sc = smallShort();
+    WriteOptions o;
+    o.out_dir = tmp.str("seq");
+    o.max_frames = 4;
+    (void)writeSequence(sc, o);
+    const auto count = [&](const char* sub) {
+        return std::distance(fs::directory_iterator(o.out_dir + "/" + sub),
+                             fs::directory_iterator{});
+    };
+    ASSERT_EQ(count("rgb"), 4);
+    o.max_frames = 2;
+    (void)writeSequence(sc, o);
+    EXPECT_EQ(count("rgb"), 2);
+    EXPECT_EQ(count("depth"), 2);
+    EXPECT_EQ(io::openRgbd(o.out_dir, {})->size(), std::optional<std::size_t>(2));
+}
+
 // A --rawlog that cannot be written, or that is not this folder's, is refused before the
 // folder is touched: an unwritable one cost the earlier render its ground truth and lists,
 // and a rawlog of someone else's was written over.
@@ -518,7 +539,8 @@ TEST(RenderSequence, RefusesToOverwriteWhatItDidNotRender) {
 
     // Another folder's labels/ (a YOLO dataset), ground truth or preview are not ours to
     // replace: they went without a word.
-    for (const char* name : {"labels/0001.txt", "groundtruth.txt", "camera.ini", "preview.png"}) {
+    for (const char* name : {"labels/0001.txt", "groundtruth.txt", "camera.ini", "preview.png",
+                             "rgb/1.png", "depth/1.png"}) {
         const std::string other = tmp.str("other");
         fs::remove_all(other);
         fs::create_directories(fs::path(other + "/" + name).parent_path());

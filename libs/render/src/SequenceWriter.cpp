@@ -114,7 +114,8 @@ void checkOutputs(const Scenario& sc, const WriteOptions& o) {
     // Nor are another folder's labels/, ground truth, camera.ini or preview.png, which a
     // render replaces (a YOLO dataset's labels/ went without a word).
     if (!o.out_dir.empty() && !fs::exists(dir / "render.txt") && !fs::exists(dir / "persons.txt"))
-        for (const char* name : {"labels", "groundtruth.txt", "camera.ini", "preview.png"})
+        for (const char* name :
+             {"labels", "groundtruth.txt", "camera.ini", "preview.png", "rgb", "depth"})
             if (fs::exists(dir / name))
                 throw std::invalid_argument("output folder '" + o.out_dir + "' holds " + name +
                                             ", not of a devslam-synth render (no render.txt or "
@@ -162,6 +163,9 @@ WriteSummary writeSequence(const Scenario& sc, const WriteOptions& o,
     // Until the last frame is written the folder is not a current render; an earlier
     // render's ground truth and intrinsics go too, so that a run killed half-way leaves no
     // old trajectory beside the new frames (written again at the end, or at a stop).
+    // (A folder of ours, whole or stopped; checkOutputs refused any other that has images.)
+    const bool ours =
+        fs::exists(signaturePath(o)) || fs::exists(fs::path(o.out_dir) / "persons.txt");
     std::error_code ec;
     fs::remove(signaturePath(o), ec);
     fs::remove(fs::path(o.out_dir) / "groundtruth.txt", ec);
@@ -176,6 +180,9 @@ WriteSummary writeSequence(const Scenario& sc, const WriteOptions& o,
     persons << "# person truth of devslam-synth scenario " << sc.name << "\n"
             << (o.rawlog_path.empty() ? std::string() : "# " + rawlogLine(o) + "\n")
             << kPersonsHeader << "\n";
+    // An earlier, longer render's images past this one's last frame stayed, unlisted.
+    if (ours)
+        for (const char* images : {"rgb", "depth"}) fs::remove_all(fs::path(o.out_dir) / images);
     io::TumWriter tum(o.out_dir, "devslam-synth scenario " + sc.name);
     std::unique_ptr<io::RawlogWriter> rawlog;
     if (!o.rawlog_path.empty())
