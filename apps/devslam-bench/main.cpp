@@ -1086,6 +1086,11 @@ int compareRuns(const Bench& b, const std::string& before) {
                     const RunFigures f1 = readRun((after / leaf / "run.json").string());
                     if (!f0.ok || !f1.ok) {
                         ++missing;
+                        // A run.json that is there but broken is named, as --reuse-runs does.
+                        for (const auto* f : {&f0, &f1})
+                            if (!f->unreadable.empty())
+                                std::cerr << "devslam-bench: --compare: " << f->unreadable
+                                          << ": left out\n";
                         continue;
                     }
                     ++pairs;

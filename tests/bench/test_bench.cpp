@@ -530,6 +530,18 @@ TEST(DevslamBench, CompareSetsEachRunBesideTheSameRenderBefore) {
     EXPECT_NE(r.out.find("3 runs compared, 1 missing in one or both folders (left out)."),
               std::string::npos)
         << r.out;
+    // One cut short (a run killed while writing it) is left out too, and named.
+    const fs::path cut = before / "short/dynamic/seed6_r0/run.json";
+    fs::resize_file(cut, 50);
+    r = devslam::test::runApp("devslam-bench", args);
+    ASSERT_EQ(r.rc, 0) << r.out;
+    EXPECT_NE(r.out.find("devslam-bench: --compare: " + cut.string() +
+                         " is not a whole JSON object (empty, cut short or garbage): left out"),
+              std::string::npos)
+        << r.out;
+    EXPECT_NE(r.out.find("2 runs compared, 2 missing in one or both folders (left out)."),
+              std::string::npos)
+        << r.out;
     // A folder that is not there, or holds none of these runs: an error naming it.
     r = devslam::test::runApp("devslam-bench", args + "x");
     EXPECT_NE(r.rc, 0);
