@@ -1049,6 +1049,18 @@ TEST(Scenario, ShippedFilesLoadAndTyposAreReported) {
                   "[person_2] gesture_pivot: must be [across down]");
     expectMessage([&] { (void)loadScenario(base, {"person_2.gesture_period=0"}); },
                   "[person_2] gesture_period: must be > 0 [s]");
+    // Given without a gesture (gesture_deg 0), a region or pivot is checked all the same.
+    expectMessage([&] { (void)loadScenario(base, {"person_2.gesture_region=bogus"}); },
+                  "[person_2] gesture_region: 'bogus' is not a number");
+    expectMessage([&] { (void)loadScenario(base, {"person_2.gesture_pivot=[0.8,1.2]"}); },
+                  "[person_2] gesture_pivot: must be [across down]");
+    EXPECT_NO_THROW((void)loadScenario(base, {"person_2.gesture_pivot=[0.8,0.2]"}));
+    // A bob or sway no person makes.
+    expectMessage([&] { (void)loadScenario(base, {"person_2.bob=-5"}); },
+                  tmp.str("s.ini") + " [person_2] bob: must be in [0, 0.3] [m]");
+    expectMessage([&] { (void)loadScenario(base, {"person_2.bob=1e9"}); }, "bob: must be in");
+    expectMessage([&] { (void)loadScenario(base, {"person_2.sway_deg=90"}); },
+                  "[person_2] sway_deg: must be in [-45, 45] [deg]");
     // The camera's sections name the file too, and are checked when loaded, not at the render.
     expectMessage([&] { (void)loadScenario(base, {"trajectory.typ=xyz"}); },
                   tmp.str("s.ini") + " [trajectory]: unknown key 'typ'");

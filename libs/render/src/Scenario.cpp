@@ -181,19 +181,23 @@ PersonSpec loadPerson(const mrpt::config::CConfigFileBase& cfg, const std::strin
     p.bob = core::readDouble(cfg, s, "bob", p.bob);
     p.gesture_deg = core::readDouble(cfg, s, "gesture_deg", p.gesture_deg);
     p.gesture_period = core::readDouble(cfg, s, "gesture_period", p.gesture_period);
-    if (p.gestures()) {
+    // Required for a gesture; checked whenever given (a person stilled with --set
+    // gesture_deg=0 keeps the file's, and a bad one went unnoticed until gesture_deg was set).
+    const auto unit = [](double v) { return v >= 0 && v <= 1; };
+    if (p.gestures() || cfg.keyExists(s, "gesture_region")) {
         const auto r = core::parseNumberList(requiredText(cfg, s, "gesture_region"),
                                              where + " gesture_region", 4);
-        const auto c = core::parseNumberList(requiredText(cfg, s, "gesture_pivot"),
-                                             where + " gesture_pivot", 2);
         p.gesture_region = {r[0], r[1], r[2], r[3]};
-        p.gesture_pivot = {c[0], c[1]};
-        const auto unit = [](double v) { return v >= 0 && v <= 1; };
         core::requireValue(
             unit(r[0]) && unit(r[1]) && unit(r[2]) && unit(r[3]) && r[0] < r[2] && r[1] < r[3], s,
             "gesture_region",
             "must be [left top right bottom], fractions of the photo in [0, 1] "
             "with left < right and top < bottom");
+    }
+    if (p.gestures() || cfg.keyExists(s, "gesture_pivot")) {
+        const auto c = core::parseNumberList(requiredText(cfg, s, "gesture_pivot"),
+                                             where + " gesture_pivot", 2);
+        p.gesture_pivot = {c[0], c[1]};
         core::requireValue(unit(c[0]) && unit(c[1]), s, "gesture_pivot",
                            "must be [across down], fractions of the photo in [0, 1]");
     }
@@ -204,6 +208,9 @@ PersonSpec loadPerson(const mrpt::config::CConfigFileBase& cfg, const std::strin
     core::requireValue(p.height > 0.2 && p.height < 3.0, s, "height", "must be in (0.2, 3) [m]");
     core::requireValue(p.speed >= 0 && p.speed < 5, s, "speed", "must be in [0, 5) [m/s]");
     core::requireValue(p.sway_period > 0, s, "sway_period", "must be > 0 [s]");
+    // (A person bobbing 1e9 m, or swaying over, rendered without a word.)
+    core::requireValue(std::abs(p.sway_deg) <= 45, s, "sway_deg", "must be in [-45, 45] [deg]");
+    core::requireValue(p.bob >= 0 && p.bob <= 0.3, s, "bob", "must be in [0, 0.3] [m]");
     core::requireValue(std::abs(p.gesture_deg) <= 90, s, "gesture_deg",
                        "must be in [-90, 90] [deg]");
     core::requireValue(p.gesture_period > 0, s, "gesture_period", "must be > 0 [s]");
