@@ -4,6 +4,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 
@@ -125,6 +126,21 @@ PersonTruth::FrameTruth PersonTruth::frame(double timestamp, cv::Size expected) 
             "person labels '" + label_path + "' are " + std::to_string(f.labels.cols) + "x" +
             std::to_string(f.labels.rows) + ", the frame is " + std::to_string(expected.width) +
             "x" + std::to_string(expected.height));
+    // Every labelled id is a person of this frame's rows (devslam-synth lists every person in
+    // every frame): another render's labels, or a hand-edited persons.txt, were scored against
+    // the wrong people without a word.
+    int hist[256] = {};
+    for (int r = 0; r < f.labels.rows; ++r) {
+        const uchar* row = f.labels.ptr<uchar>(r);
+        for (int c = 0; c < f.labels.cols; ++c) ++hist[row[c]];
+    }
+    for (int id = 1; id < 256; ++id)
+        if (hist[id] > 0 && std::none_of(it->second.begin(), it->second.end(),
+                                         [&](const PersonEntry& p) { return p.id == id; }))
+            throw std::runtime_error("person labels '" + label_path + "' hold id " +
+                                     std::to_string(id) + ", which " + folder_ +
+                                     "/persons.txt does not list for frame " + stamp +
+                                     " (labels of another render?)");
     f.persons = &it->second;
     return f;
 }
