@@ -81,6 +81,19 @@ void expectFramesEqual(const core::Frame& a, const core::Frame& b) {
     EXPECT_EQ(a.K, b.K);
 }
 
+/// The frames of a damaged rawlog read with allow_damaged: its intact part, which must be
+/// `n` frames (counted at open and read).
+std::vector<core::Frame> intactFrames(const std::string& path, std::size_t n) {
+    io::ReaderOptions allow;
+    allow.allow_damaged = true;
+    io::RawlogReader partial(path, allow);
+    EXPECT_EQ(partial.size(), n) << path;
+    std::vector<core::Frame> frames;
+    while (auto f = partial.next()) frames.push_back(std::move(*f));
+    EXPECT_EQ(frames.size(), n) << path;
+    return frames;
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------- TUM folders
@@ -717,16 +730,7 @@ TEST(Rawlog, ACameraThatChangesMidStreamIsRefusedWhereItChanges) {
                     R"(\.rawlog: observation 2: colour camera .* differs from observation 0's )"
                     R"(640x480 fx 500 fy 500 cx 319\.5 cy 239\.5: a rawlog of one camera is )"
                     R"(expected after 2 RGB-D observations)");
-        io::ReaderOptions allow;
-        allow.allow_damaged = true;
-        io::RawlogReader partial(path, allow);
-        EXPECT_EQ(partial.size(), 2u);
-        std::size_t n = 0;
-        while (const auto f = partial.next()) {
-            EXPECT_EQ(f->K.fx, 500.0);
-            ++n;
-        }
-        EXPECT_EQ(n, 2u);
+        for (const auto& f : intactFrames(path, 2)) EXPECT_EQ(f.K.fx, 500.0);
     }
     // Uncalibrated sizes (ncols 0: the image's size is taken): the same calibration, another
     // image size, found when the frame is read; the frames before it were read.
@@ -968,13 +972,7 @@ TEST(Rawlog, StampsThatDoNotIncreaseAreRefused) {
         expectError([&] { io::RawlogReader r(path); },
                     std::string(name).replace(std::string(name).find('.'), 1, "\\.") +
                         ": observation 2: " + msg);
-        io::ReaderOptions allow;
-        allow.allow_damaged = true;
-        io::RawlogReader partial(path, allow);
-        EXPECT_EQ(partial.size(), 2u);
-        std::size_t n = 0;
-        while (partial.next()) ++n;
-        EXPECT_EQ(n, 2u);
+        (void)intactFrames(path, 2);
     }
 
     // The TUM writer: a duplicate (also one within the microsecond the names keep) or an

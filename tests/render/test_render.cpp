@@ -57,6 +57,15 @@ Scenario smallShort() {
     return sc;
 }
 
+/// smallShort's first `frames` frames rendered into tmp/seq: the options that made them.
+WriteOptions renderedSeq(const TempDir& tmp, std::size_t frames) {
+    WriteOptions o;
+    o.out_dir = tmp.str("seq");
+    o.max_frames = frames;
+    (void)writeSequence(smallShort(), o);
+    return o;
+}
+
 /// An empty 4 x 4 x 3 m room and a camera that does not move.
 Scenario bareRoom(const Eigen::Vector3d& eye, const Eigen::Vector3d& target) {
     Scenario sc;
@@ -434,10 +443,7 @@ TEST(RenderSequence, StopEndsTheRenderWithTheFramesBeforeItWritten) {
 TEST(RenderSequence, ARenderThatDiesHalfWayLeavesNoOldGroundTruth) {
     TempDir tmp;
     const Scenario sc = smallShort();
-    WriteOptions o;
-    o.out_dir = tmp.str("seq");
-    o.max_frames = 4;
-    (void)writeSequence(sc, o);
+    WriteOptions o = renderedSeq(tmp, 4);
     ASSERT_TRUE(fs::exists(o.out_dir + "/groundtruth.txt"));
     const auto dies = [](std::size_t done, std::size_t) {
         if (done == 2) throw std::runtime_error("killed");
@@ -452,10 +458,7 @@ TEST(RenderSequence, ARenderThatDiesHalfWayLeavesNoOldGroundTruth) {
 TEST(RenderSequence, AShorterRenderLeavesNoImagesOfTheLongerOne) {
     TempDir tmp;
     const Scenario sc = smallShort();
-    WriteOptions o;
-    o.out_dir = tmp.str("seq");
-    o.max_frames = 4;
-    (void)writeSequence(sc, o);
+    WriteOptions o = renderedSeq(tmp, 4);
     const auto count = [&](const char* sub) {
         return std::distance(fs::directory_iterator(o.out_dir + "/" + sub),
                              fs::directory_iterator{});
@@ -474,10 +477,7 @@ TEST(RenderSequence, AShorterRenderLeavesNoImagesOfTheLongerOne) {
 TEST(RenderSequence, ARawlogItCannotOrMayNotWriteLeavesTheEarlierRenderAsItWas) {
     TempDir tmp;
     const Scenario sc = smallShort();
-    WriteOptions o;
-    o.out_dir = tmp.str("seq");
-    o.max_frames = 2;
-    (void)writeSequence(sc, o);
+    WriteOptions o = renderedSeq(tmp, 2);
     ASSERT_TRUE(isRenderCurrent(sc, o));
     const std::string list = readFile(o.out_dir + "/rgb.txt");
     const std::string gt = readFile(o.out_dir + "/groundtruth.txt");
