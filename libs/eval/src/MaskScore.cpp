@@ -128,7 +128,8 @@ PersonTruth::FrameTruth PersonTruth::frame(double timestamp, cv::Size expected) 
             "x" + std::to_string(expected.height));
     // Every labelled id is a person of this frame's rows (devslam-synth lists every person in
     // every frame): another render's labels, or a hand-edited persons.txt, were scored against
-    // the wrong people without a word.
+    // the wrong people without a word. Unusable truth, as a missing label image: the run ends
+    // there and keeps the frames before.
     int hist[256] = {};
     for (int r = 0; r < f.labels.rows; ++r) {
         const uchar* row = f.labels.ptr<uchar>(r);
@@ -137,7 +138,7 @@ PersonTruth::FrameTruth PersonTruth::frame(double timestamp, cv::Size expected) 
     for (int id = 1; id < 256; ++id)
         if (hist[id] > 0 && std::none_of(it->second.begin(), it->second.end(),
                                          [&](const PersonEntry& p) { return p.id == id; }))
-            throw std::runtime_error("person labels '" + label_path + "' hold id " +
+            throw MissingTruth("person labels '" + label_path + "' hold id " +
                                      std::to_string(id) + ", which " + folder_ +
                                      "/persons.txt does not list for frame " + stamp +
                                      " (labels of another render?)");

@@ -70,7 +70,7 @@ struct MaskScore {
 };
 
 /// A frame whose person truth is missing or unreadable (no persons.txt entry, no label
-/// image): a damaged folder, which a run treats as its end (devslam-run keeps the frames
+/// image, a labelled id its entries do not list): a damaged folder, which a run treats as its end (devslam-run keeps the frames
 /// before it).
 struct MissingTruth : std::runtime_error {
     using std::runtime_error::runtime_error;
