@@ -286,6 +286,17 @@ TEST(Parse, ExtensionsInAnyCase) {
 
 // An output that is an input, under another spelling or through a link, is told apart from
 // a file of its own.
+// Where making a folder starts: the folder, else its nearest existing parent; "" (the parent
+// of a bare file name, devslam-synth --rawlog x.rawlog) is the working folder, where
+// fs::absolute threw.
+TEST(Results, NearestExistingStartsAtTheWorkingFolderForNoFolder) {
+    namespace fs = std::filesystem;
+    EXPECT_EQ(nearestExisting(""), fs::current_path().lexically_normal());
+    EXPECT_EQ(nearestExisting("."), fs::current_path().lexically_normal());
+    const fs::path tmp = fs::temp_directory_path();
+    EXPECT_EQ(nearestExisting((tmp / "devslam_no_such/a/b").string()), tmp.lexically_normal());
+}
+
 TEST(Results, SameFileSeesThroughSpellingsAndLinks) {
     devslam::test::TempDir d("devslam_core_");
     namespace fs = std::filesystem;

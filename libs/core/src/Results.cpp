@@ -100,7 +100,9 @@ bool canMakeFilesIn(const std::filesystem::path& dir) {
 
 std::filesystem::path nearestExisting(const std::string& folder) {
     namespace fs = std::filesystem;
-    fs::path p = fs::absolute(folder).lexically_normal();
+    // "" is the working folder (the parent_path() of a bare file name; fs::absolute throws).
+    fs::path p = fs::absolute(folder.empty() ? std::string(".") : folder).lexically_normal();
+    if (p.filename().empty() && p != p.root_path()) p = p.parent_path();  // "a/b/" -> "a/b"
     while (!p.empty() && p != p.root_path() && !fs::exists(p)) p = p.parent_path();
     return p;
 }
