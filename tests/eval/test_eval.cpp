@@ -197,7 +197,8 @@ TEST(Rpe, ReproducesEvaluateRpeQuirks) {
 
 // A delta longer than the estimate leaves no pair, however long: at 1e16 s the search in
 // double precision (stamps of 1.3e9 s) paired every pose with the first one, and gave figures.
-TEST(Rpe, ADeltaLongerThanTheRunLeavesNoPair) {
+// One shorter than half a frame interval leaves none either.
+TEST(Rpe, ADeltaLongerThanTheRunOrUnderHalfAFrameLeavesNoPair) {
     core::Trajectory gt, est;
     for (int i = 0; i < 30; ++i) {
         const double t = 1305031102.175304 + 0.1 * i;
@@ -220,6 +221,22 @@ TEST(Rpe, ADeltaLongerThanTheRunLeavesNoPair) {
     o.delta_in_frames = true;
     o.delta = 1e19;  // frames
     EXPECT_THROW((void)eval::computeRpe(gt, est, o), std::invalid_argument);
+    // Under half the frame interval (0.1 s) each pose is closest to itself: no pair, not a
+    // perfect RPE over 29 pairs of a pose with itself (evaluate_rpe.py's figure).
+    o.delta_in_frames = false;
+    for (const double delta : {0.01, 1e-9}) {
+        o.delta = delta;
+        try {
+            const auto r = eval::computeRpe(gt, est, o);
+            ADD_FAILURE() << "delta " << delta << " s: " << r.n_pairs << " pairs, RMSE "
+                          << r.trans.rmse;
+        } catch (const std::invalid_argument& e) {
+            EXPECT_NE(std::string(e.what()).find("RPE: no pose pair"), std::string::npos)
+                << e.what();
+        }
+    }
+    o.delta = 0.06;  // over half: the next pose
+    EXPECT_EQ(eval::computeRpe(gt, est, o).n_pairs, 28u);
 }
 
 // evaluate_rpe.py refuses trajectories that overlap at one estimate pose ("Number of overlap

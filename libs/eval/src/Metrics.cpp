@@ -146,6 +146,9 @@ RpeResult computeRpe(const core::Trajectory& gt, const core::Trajectory& est,
     for (std::size_t i = 0; any_pair && i < se.size(); ++i) {
         const std::size_t j = findClosestIndex(index, index[i] + opts.delta);
         if (j == se.size() - 1) continue;  // evaluate_rpe.py drops pairs ending at the last pose
+        // A delta under half the frame interval finds the pose itself: evaluate_rpe.py counts
+        // that pair (no motion, error 0) and gives a perfect RPE; it is no relative pose.
+        if (j == i) continue;
         const std::size_t g0 = findClosestIndex(sg, se[i] + opts.offset);
         const std::size_t g1 = findClosestIndex(sg, se[j] + opts.offset);
         if (std::abs(sg[g0] - (se[i] + opts.offset)) > gt_max_dt ||
