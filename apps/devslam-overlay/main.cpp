@@ -11,6 +11,7 @@
 //                   [--config config_ini/dynamic_filter.ini] [--mode none|all_persons|dynamic]
 //                   [--every N] [--threads N] [--no-prior]
 #include <devslam/core/Config.h>
+#include <devslam/core/Interrupt.h>
 #include <devslam/core/Parse.h>
 #include <devslam/core/Progress.h>
 #include <devslam/dynamic/DynamicObjectFilter.h>
@@ -220,6 +221,9 @@ void writeOverlay(const std::string& out_dir, std::size_t k, const core::Frame& 
 }  // namespace
 
 int main(int argc, char** argv) {
+    // Ctrl-C or SIGTERM: the overlay being written is finished, the run stops there (an
+    // overlay cut in the middle of its write was left empty, among an earlier run's).
+    core::installStopHandler("devslam-overlay");
     const auto parsed = parseArgs(argc, argv);
     if (const int* rc = std::get_if<int>(&parsed)) return *rc;
     const Args& a = std::get<Args>(parsed);
@@ -244,7 +248,7 @@ int main(int argc, char** argv) {
         Input in = openInput(a);
         core::ProgressBar bar("overlay", in.total);
         std::size_t k = 0, written = 0;
-        while (true) {
+        while (!core::stopSignal()) {
             std::optional<core::Frame> f;
             std::optional<Eigen::Isometry3d> prior;
             if (!in.synth.empty()) {
@@ -264,7 +268,15 @@ int main(int argc, char** argv) {
         }
         bar.finish();
         // An earlier run's overlays past this one's (or between, with --every) would pass for
-        // this run's: removed once this run's are all written.
+        // this run's: removed once this run's are all written (an interrupted run leaves
+        // them, and says so: it would otherwise lose them for a run it did not finish).
+        const int sig = core::stopSignal();
+        if (sig) {
+            std::cerr << "devslam-overlay: interrupted (" << core::signalName(sig) << ") after "
+                      << k << " frames: wrote " << written << " overlays to " << a.out_dir
+                      << "; overlays there of later frames are an earlier run's\n";
+            core::exitBySignal(sig);
+        }
         std::vector<fs::path> stale;
         for (const auto& e : fs::directory_iterator(a.out_dir)) {
             const std::string name = e.path().filename().string();

@@ -8,9 +8,11 @@
 
 #include <opencv2/imgcodecs.hpp>
 
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <regex>
 #include <string>
 
 namespace fs = std::filesystem;
@@ -88,6 +90,31 @@ TEST(DevslamOverlay, ATinyFrameGetsItsOverlay) {
     ASSERT_EQ(r.rc, 0) << r.out;
     EXPECT_EQ(pngsIn(d.str("o")), 2);
     EXPECT_EQ(cv::imread(d.str("o/overlay_00001.png")).size(), cv::Size(1, 1));
+}
+
+// Ctrl-C: the overlay being written is finished, the run stops there, says how far it got and
+// exits 130. It stopped at once, silent, and left the overlay it was writing empty.
+TEST(DevslamOverlay, CtrlCStopsAfterAWholeOverlay) {
+    devslam::test::TempDir d("devslam_overlay_");
+    // 400 frames (tens of seconds); the signal once the progress shows frames done.
+    const auto r = devslam::test::signalAppWhen(
+        "devslam-overlay", "--input synthetic:walking --frames 400 --out " + d.str("o"), "/s",
+        SIGINT, d.str("log.txt"));
+    ASSERT_TRUE(r.signalled) << "it ended before the signal:\n" << r.out;
+    EXPECT_EQ(r.rc, 130) << r.out;
+    std::smatch m;
+    ASSERT_TRUE(std::regex_search(
+        r.out, m,
+        std::regex(R"(devslam-overlay: interrupted \(SIGINT\) after (\d+) frames: wrote (\d+) )"
+                   R"(overlays to )")))
+        << r.out;
+    const int done = std::stoi(m[1]);
+    EXPECT_EQ(std::stoi(m[2]), done);
+    EXPECT_GT(done, 0);
+    EXPECT_LT(done, 400);
+    EXPECT_EQ(pngsIn(d.str("o")), done);
+    for (const auto& e : fs::directory_iterator(d.str("o")))
+        EXPECT_GT(fs::file_size(e.path()), 0u) << e.path();
 }
 
 TEST(DevslamOverlay, BadInputIsNamed) {
