@@ -727,6 +727,18 @@ TEST(Results, FilesAreWrittenWholeAndHashedByContent) {
     EXPECT_EQ(devslam::core::fileHash(f), h);
     devslam::core::writeFileWhole(f, "twO\n");
     EXPECT_NE(devslam::core::fileHash(f), h);
+    // A device is written into, not renamed over (as root, a .part renamed over /dev/null
+    // would have replaced it): /dev/null stays a device, /dev/full is a named write error.
+    devslam::core::writeFileWhole("/dev/null", "gone\n");
+    EXPECT_FALSE(std::filesystem::is_regular_file("/dev/null"));
+    EXPECT_FALSE(std::filesystem::exists("/dev/null.part"));
+    try {
+        devslam::core::writeFileWhole("/dev/full", std::string(1 << 16, 'x'));
+        ADD_FAILURE() << "written";
+    } catch (const std::runtime_error& e) {
+        EXPECT_EQ(std::string(e.what()), "cannot write '/dev/full': No space left on device");
+    }
+    EXPECT_FALSE(std::filesystem::is_regular_file("/dev/full"));
     EXPECT_EQ(devslam::core::fileHash((dir / "missing").string()), "");
     // The file keeps its permissions, and a link to it stays a link.
     namespace fs = std::filesystem;

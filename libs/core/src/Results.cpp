@@ -170,6 +170,20 @@ void writeFileWhole(const std::string& link, const std::string& text) {
     // plain file: the file it points to is written instead, beside itself (and made, as a
     // shell's `>` would, when the link's target does not exist yet).
     const std::string path = followLinks(link).string();
+    // A device or pipe (/dev/null, /dev/full, a FIFO) is written into, as a shell's `>` does:
+    // renamed over, a .part made beside it would have replaced /dev/null itself (as root).
+    if (const fs::file_status st = fs::status(path, ec);
+        !ec && fs::exists(st) && !fs::is_regular_file(st)) {
+        if (fs::is_directory(st)) throw std::runtime_error("cannot write '" + path + "': a folder");
+        errno = 0;
+        std::ofstream out(path, std::ios::binary);
+        out << text;
+        out.flush();
+        if (!out)
+            throw std::runtime_error("cannot write '" + path +
+                                     "': " + (errno ? std::strerror(errno) : "write failed"));
+        return;
+    }
     const std::string part = path + ".part";
     {
         errno = 0;

@@ -1,6 +1,8 @@
 #include <devslam/eval/Plot.h>
 #include <devslam/eval/Report.h>
 
+#include <devslam/core/Results.h>
+
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -94,10 +96,8 @@ std::string toJson(const AteResult* ate, const RpeResult* rpe, const RpeOptions*
 
 void writeJson(const std::string& path, const AteResult* ate, const RpeResult* rpe,
                const RpeOptions* ro) {
-    std::ofstream out(path);
-    out << toJson(ate, rpe, ro);
-    out.close();  // flushed here: a full disk is found now, not lost in the destructor
-    if (!out) throw std::runtime_error("cannot write '" + path + "'");
+    // Whole or not at all: a full disk left an empty file in place of the earlier one.
+    core::writeFileWhole(path, toJson(ate, rpe, ro));
 }
 
 void plotAte(const std::string& path, const AteResult& ate, const std::string& title) {
