@@ -364,6 +364,21 @@ std::string headerMarkdown(const Args& a, const devslam::nav::NavigatorOptions& 
     return md.str();
 }
 
+/// The pictures' folder as the tables link to it: relative to the results file's folder
+/// (docs/RESULTS.md -> "images"), or to the working folder when there is none. Written as
+/// "images/" whatever --png-dir was, the links of --results elsewhere led nowhere.
+std::string imageLink(const Args& a) {
+    namespace fs = std::filesystem;
+    const fs::path from = a.results.empty()
+                              ? fs::current_path()
+                              : fs::absolute(a.results).lexically_normal().parent_path();
+    const fs::path rel = fs::absolute(a.png_dir).lexically_normal().lexically_relative(from);
+    std::string link = rel.empty() ? fs::absolute(a.png_dir).lexically_normal().string()
+                                   : rel.generic_string();
+    while (link.size() > 1 && link.back() == '/') link.pop_back();
+    return link;
+}
+
 /// A table per category reached, a row per method that ran there (and its picture, after a
 /// whole run).
 std::string categoryTables(const Args& a, const std::vector<devslam::sim::Category>& cats,
@@ -407,7 +422,7 @@ std::string categoryTables(const Args& a, const std::vector<devslam::sim::Catego
         }
         md << "\n";
         if (!ep.stopped)  // the pictures are made only by a whole run
-            md << "![" << devslam::sim::toString(cats[c]) << "](images/nav_bench_"
+            md << "![" << devslam::sim::toString(cats[c]) << "](" << imageLink(a) << "/nav_bench_"
                << devslam::sim::toString(cats[c]) << ".png)\n\n";
     }
     return md.str();
@@ -420,7 +435,7 @@ std::string timingMarkdown(const Args& a, const Episodes& ep) {
     const double vfh_ms = timeVfhStep();
     const double astar_ms = timeAStar400(&astar_len);
     std::ostringstream md;
-    md << "![success rates](images/nav_bench_success.png)\n\n"
+    md << "![success rates](" << imageLink(a) << "/nav_bench_success.png)\n\n"
        << "### Timing (thread CPU time, so shared-machine load does not inflate it)\n\n| "
           "measure | median |\n|---|---|\n"
        << "| one VFH+ step (`vfhPlusStep`, 121 sectors, synthetic fields, 2000 calls) | "

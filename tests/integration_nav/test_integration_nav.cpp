@@ -355,6 +355,8 @@ TEST(IntegrationNav, AppsSmokeTest) {
             ++rows;
         }
         EXPECT_EQ(rows, 4u) << md;
+        // The pictures are linked where they are, relative to the results file (both in out).
+        EXPECT_NE(md.find("![success rates](./nav_bench_success.png)"), std::string::npos) << md;
     }
     // Refused before any run: a method twice, --quick with a count, a results file whose
     // section markers are broken (no pictures are written for a table that is not).
