@@ -115,6 +115,7 @@ struct Conversion {
     std::string stopped;
     std::vector<std::string> undecodable;
     std::string write_error;  // the writer refused a frame (or the disk did): stopped there
+    std::string close_error;  // closing the output failed: its end (or ground truth) is lost
     bool removed = false;     // nothing converted: the output this run made was removed
     int interrupted = 0;      // the signal that stopped the conversion
     double depth_gap = 0;     // [s] the largest colour-depth stamp difference written
@@ -174,7 +175,18 @@ struct Conversion {
         // output is refused), so the one this run made is removed.
         const std::string holds =
             removed ? "nothing was written (" + args.output + " removed)"
-                    : args.output + " holds the " + std::to_string(n) + " frames before it";
+            : !close_error.empty()
+                ? args.output + " holds the " + std::to_string(n) +
+                      " frames before it, but not whole (" + close_error + ")"
+                : args.output + " holds the " + std::to_string(n) + " frames before it";
+        if (!close_error.empty() && write_error.empty() && stopped.empty() && !interrupted) {
+            std::cerr << "devslam-convert: " << close_error << "\ndevslam-convert: "
+                      << (removed ? holds
+                                  : args.output + " holds the " + std::to_string(n) +
+                                        " frames written, but is not whole")
+                      << "\n";
+            return 1;
+        }
         if (n == 0 && stopped.empty() && write_error.empty() && !interrupted) {
             std::cerr << "devslam-convert: no frame converted (every one left out); "
                       << (removed ? holds : args.output + " holds none") << "\n";
@@ -219,16 +231,28 @@ int convert(int argc, char** argv) {
         const bool existed = std::filesystem::exists(args.output);
         const std::string images = devslam::io::rawlogImagesDir(args.output);
         const bool images_existed = std::filesystem::exists(images);
+        // Closing the output can fail too (a full disk: the rawlog's end, the ground truth):
+        // caught, so that an output without a frame is still removed and the first error,
+        // not the closing one, is the one reported.
+        const auto finish = [&](auto&& step) {
+            try {
+                step();
+            } catch (const std::exception& e) {
+                if (c.close_error.empty()) c.close_error = e.what();
+            }
+        };
         if (isRawlog(args.output)) {
             devslam::io::RawlogWriter out(args.output, args.wo);
             c.copy(*reader, out, args, bar);
-            out.close();
+            finish([&] { out.close(); });
         } else {
             devslam::io::TumWriter out(args.output,
                                        "converted by devslam-convert from " + args.input);
             c.copy(*reader, out, args, bar);
-            if (auto gt = reader->groundTruth()) out.writeGroundTruth(*gt);
-            out.close();
+            finish([&] {
+                if (auto gt = reader->groundTruth()) out.writeGroundTruth(*gt);
+            });
+            finish([&] { out.close(); });
         }
         bar.finish();
         if (c.n == 0 && !existed) {

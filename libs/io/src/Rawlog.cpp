@@ -594,13 +594,20 @@ void RawlogWriter::write(const core::Frame& f) {
             throw std::runtime_error("cannot write '" + depth_path + "': " + d + " (disk full?)");
     }
     auto arch = mrpt::serialization::archiveFrom(static_cast<mrpt::io::CStream&>(*stream_));
-    if (opts_.sensory_frames) {
-        mrpt::obs::CActionCollection acts;  // no odometry: an empty action keeps the layout
-        mrpt::obs::CSensoryFrame sf;
-        sf.insert(obs);
-        arch << acts << sf;
-    } else {
-        arch << *obs;
+    try {
+        if (opts_.sensory_frames) {
+            mrpt::obs::CActionCollection acts;  // no odometry: an empty action keeps the layout
+            mrpt::obs::CSensoryFrame sf;
+            sf.insert(obs);
+            arch << acts << sf;
+        } else {
+            arch << *obs;
+        }
+    } catch (const std::exception& e) {
+        // MRPT's message is a stack trace ("Cannot write bytes to stream!"): its first line,
+        // with the file and frame.
+        throw std::runtime_error("cannot write rawlog '" + path_ + "' at " + what + ": " +
+                                 core::innermostMessage(e.what()) + " (disk full?)");
     }
     ++count_;
 }
