@@ -40,7 +40,7 @@ double number(const std::string& opt, const std::string& v, bool positive = fals
 
 }  // namespace
 
-int main(int argc, char** argv) {
+static int appMain(int argc, char** argv) {
     try {
         std::vector<std::string> pos;
         devslam::eval::AteOptions ao;
@@ -130,4 +130,10 @@ int main(int argc, char** argv) {
         std::cerr << "devslam-eval: " << e.what() << "\n";
         return 1;
     }
+}
+
+int main(int argc, char** argv) {
+    // The figures go to the standard output: one that cannot be written (a full disk behind
+    // '>') lost them while the program said 0.
+    return devslam::core::withStandardOutput("devslam-eval", appMain(argc, argv));
 }

@@ -5,6 +5,7 @@
 #include <devslam/core/Config.h>
 #include <devslam/core/GzFile.h>
 #include <devslam/core/Parse.h>
+#include <devslam/core/Results.h>
 #include <devslam/nav/CHolonomicVFHPlus.h>
 #include <devslam/nav/MapPlan.h>
 #include <devslam/sim/Episode.h>
@@ -113,7 +114,7 @@ void usage() {
 }
 }  // namespace
 
-int main(int argc, char** argv) {
+static int appMain(int argc, char** argv) {
     std::string world_path, png, navlog, map, from = "0,0", to;
     std::string config = std::string(DEVSLAM_SOURCE_DIR) + "/config_ini/nav_reactive.ini";
     std::string method;  // empty: the INI's [navigator] holonomic_method
@@ -200,4 +201,10 @@ int main(int argc, char** argv) {
         std::cerr << "devslam-nav: " << devslam::core::innermostMessage(e.what()) << "\n";
         return 2;
     }
+}
+
+int main(int argc, char** argv) {
+    // The figures go to the standard output: one that cannot be written (a full disk behind
+    // '>') lost them while the program said 0.
+    return devslam::core::withStandardOutput("devslam-nav", appMain(argc, argv));
 }

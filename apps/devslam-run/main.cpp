@@ -481,5 +481,5 @@ int main(int argc, char** argv) {
     // Stopped by Ctrl-C, after writing what was done: end by the signal, so that a shell
     // script running this stops too.
     if (const int sig = core::stopSignal()) core::exitBySignal(sig);
-    return rc;
+    return core::withStandardOutput("devslam-run", rc);  // its summary is the result
 }

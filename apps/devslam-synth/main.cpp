@@ -220,5 +220,5 @@ int main(int argc, char** argv) {
     }
     // After Ctrl-C, with every file closed: end by the signal, so that a script stops too.
     if (const int sig = core::stopSignal()) core::exitBySignal(sig);
-    return rc;
+    return core::withStandardOutput("devslam-synth", rc);
 }

@@ -476,6 +476,13 @@ TEST(Report, RefusesOverflowNonFiniteJsonAndOutputsThatAreInputs) {
         const auto r = devslam::test::runApp("devslam-eval", g + " " + e + " --json /dev/full");
         EXPECT_EQ(r.rc, 1) << r.out;
         EXPECT_NE(r.out.find("cannot write '/dev/full'"), std::string::npos) << r.out;
+        // The figures on a standard output that cannot take them: an error, not 0.
+        const std::string err = d.str("stdout_full.txt");
+        const std::string cmd = std::string(DEVSLAM_BIN_DIR) + "/devslam-eval " + g + " " + e +
+                                " > /dev/full 2> '" + err + "'";
+        EXPECT_EQ(WEXITSTATUS(std::system(cmd.c_str())), 1) << cmd;
+        EXPECT_EQ(text(err),
+                  "devslam-eval: cannot write the standard output (No space left on device)\n");
     }
 }
 

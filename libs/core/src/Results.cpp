@@ -11,6 +11,7 @@
 #include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <sstream>
 #include <stdexcept>
 #include <thread>
@@ -206,6 +207,15 @@ void writeFileWhole(const std::string& link, const std::string& text) {
         std::filesystem::remove(part, ec);
         throw std::runtime_error("cannot write '" + path + "': " + why);
     }
+}
+
+int withStandardOutput(const char* program, int rc) {
+    errno = 0;
+    std::cout.flush();
+    if (std::cout) return rc;
+    std::cerr << program << ": cannot write the standard output"
+              << (errno ? std::string(" (") + std::strerror(errno) + ")" : std::string()) << "\n";
+    return rc == 0 ? 1 : rc;
 }
 
 bool sameFile(const std::string& in, const std::string& out) {

@@ -29,6 +29,11 @@ void replaceResultsSection(const std::string& path, const std::string& name,
 /// replaced, or made). Throws std::runtime_error naming the file when it cannot be written.
 void writeFileWhole(const std::string& path, const std::string& text);
 
+/// Flushes std::cout and returns `rc`, or 1 where `rc` is 0 and the standard output could not
+/// be written (a full disk behind '>': the figures were lost, and the program said 0), saying
+/// so on std::cerr as "<program>: cannot write the standard output".
+[[nodiscard]] int withStandardOutput(const char* program, int rc);
+
 /// FNV-1a (64 bit) of a file's bytes as 16 hex digits, "" when it cannot be read: tells
 /// whether a file's content changed (not a cryptographic hash).
 [[nodiscard]] std::string fileHash(const std::string& path);
