@@ -173,18 +173,14 @@ struct Conversion {
                       << ", the first: " << undecodable.front() << "\n";
         // An output with no frame would only stand in the way of the next try (an existing
         // output is refused), so the one this run made is removed.
+        const std::string kept = args.output + " holds the " + std::to_string(n) + " frames";
         const std::string holds =
             removed ? "nothing was written (" + args.output + " removed)"
-            : !close_error.empty()
-                ? args.output + " holds the " + std::to_string(n) +
-                      " frames before it, but not whole (" + close_error + ")"
-                : args.output + " holds the " + std::to_string(n) + " frames before it";
+                    : kept + " before it" +
+                          (close_error.empty() ? "" : ", but not whole (" + close_error + ")");
         if (!close_error.empty() && write_error.empty() && stopped.empty() && !interrupted) {
             std::cerr << "devslam-convert: " << close_error << "\ndevslam-convert: "
-                      << (removed ? holds
-                                  : args.output + " holds the " + std::to_string(n) +
-                                        " frames written, but is not whole")
-                      << "\n";
+                      << (removed ? holds : kept + " written, but is not whole") << "\n";
             return 1;
         }
         if (n == 0 && stopped.empty() && write_error.empty() && !interrupted) {

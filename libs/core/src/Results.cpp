@@ -164,6 +164,18 @@ void replaceResultsSection(const std::string& path, const std::string& name,
     writeFileWhole(path, withSection(path, name, markdown));
 }
 
+namespace {
+/// Writes `text` into `file` (made, or emptied first): "" when it went, else why not.
+std::string writeText(const std::string& file, const std::string& text) {
+    errno = 0;
+    std::ofstream out(file, std::ios::trunc | std::ios::binary);
+    out << text;
+    out.flush();
+    if (out) return "";
+    return errno ? std::strerror(errno) : "write failed";
+}
+}  // namespace
+
 void writeFileWhole(const std::string& link, const std::string& text) {
     namespace fs = std::filesystem;
     std::error_code ec;
@@ -171,36 +183,23 @@ void writeFileWhole(const std::string& link, const std::string& text) {
     // plain file: the file it points to is written instead, beside itself (and made, as a
     // shell's `>` would, when the link's target does not exist yet).
     const std::string path = followLinks(link).string();
+    const fs::file_status st = fs::status(path, ec);
+    const bool exists = !ec && fs::exists(st);
     // A device or pipe (/dev/null, /dev/full, a FIFO) is written into, as a shell's `>` does:
     // renamed over, a .part made beside it would have replaced /dev/null itself (as root).
-    if (const fs::file_status st = fs::status(path, ec);
-        !ec && fs::exists(st) && !fs::is_regular_file(st)) {
+    if (exists && !fs::is_regular_file(st)) {
         if (fs::is_directory(st)) throw std::runtime_error("cannot write '" + path + "': a folder");
-        errno = 0;
-        std::ofstream out(path, std::ios::binary);
-        out << text;
-        out.flush();
-        if (!out)
-            throw std::runtime_error("cannot write '" + path +
-                                     "': " + (errno ? std::strerror(errno) : "write failed"));
+        if (const std::string why = writeText(path, text); !why.empty())
+            throw std::runtime_error("cannot write '" + path + "': " + why);
         return;
     }
     const std::string part = path + ".part";
-    {
-        errno = 0;
-        std::ofstream out(part, std::ios::trunc | std::ios::binary);
-        out << text;
-        out.flush();
-        if (!out) {
-            const std::string why = errno ? std::strerror(errno) : "write failed";
-            out.close();
-            std::filesystem::remove(part, ec);
-            throw std::runtime_error("cannot write '" + part + "': " + why);
-        }
+    if (const std::string why = writeText(part, text); !why.empty()) {
+        std::filesystem::remove(part, ec);
+        throw std::runtime_error("cannot write '" + part + "': " + why);
     }
     // The file keeps its permissions (the .part got the default ones).
-    if (const fs::file_status st = fs::status(path, ec); !ec && fs::exists(st))
-        fs::permissions(part, st.permissions(), ec);
+    if (exists) fs::permissions(part, st.permissions(), ec);
     std::filesystem::rename(part, path, ec);
     if (ec) {
         const std::string why = ec.message();

@@ -348,6 +348,7 @@ RawlogReader::RawlogReader(std::string path, ReaderOptions opts)
     };
     std::string first_label;
     mrpt::img::TCamera first_cam;
+    core::CameraIntrinsics first_calibration;  // first_cam's, compared with each observation's
     try {
         Stream s(path_);
         double last_t = 0;
@@ -375,8 +376,9 @@ RawlogReader::RawlogReader(std::string path, ReaderOptions opts)
                 K_ = frameFromObservation(*o, path_ + " observation 0").K;
                 o->unload();
                 first_cam = o->cameraParamsIntensity;
+                first_calibration = core::CameraIntrinsics::fromMrpt(first_cam);
             } else if (!(core::CameraIntrinsics::fromMrpt(o->cameraParamsIntensity) ==
-                         core::CameraIntrinsics::fromMrpt(first_cam))) {
+                         first_calibration)) {
                 // (Two rawlogs joined with cat: the frames after the join were tracked with
                 // the first camera's model.) The frames before it are the intact part.
                 throw std::runtime_error("observation " + std::to_string(n_frames_) + ": " +

@@ -36,6 +36,16 @@ fs::path signaturePath(const WriteOptions& o) {
     return fs::path(o.out_dir) / "render.txt";
 }
 
+fs::path personsPath(const WriteOptions& o) {
+    return fs::path(o.out_dir) / "persons.txt";
+}
+
+/// Whether the output folder is a render of ours, whole (render.txt) or stopped (persons.txt,
+/// which every render writes before rgb.txt).
+bool isOwnRender(const WriteOptions& o) {
+    return fs::exists(signaturePath(o)) || fs::exists(personsPath(o));
+}
+
 /// The line naming the rawlog a render writes (render.txt; "# " before it in persons.txt).
 std::string rawlogLine(const WriteOptions& o) {
     return "rawlog " + fs::absolute(o.rawlog_path).string();
@@ -105,15 +115,14 @@ void checkOutputs(const Scenario& sc, const WriteOptions& o) {
     const fs::path dir(o.out_dir);
     // A real TUM folder's lists and ground truth would be overwritten (devslam-convert refuses
     // one too); a render of ours, whole or stopped, has persons.txt (written before rgb.txt).
-    if (!o.out_dir.empty() && fs::exists(dir / "rgb.txt") && !fs::exists(dir / "render.txt") &&
-        !fs::exists(dir / "persons.txt"))
+    if (!o.out_dir.empty() && fs::exists(dir / "rgb.txt") && !isOwnRender(o))
         throw std::invalid_argument(
             "output folder '" + o.out_dir +
             "' already holds a TUM sequence (rgb.txt) that devslam-synth did not render (no "
             "render.txt or persons.txt); remove it or name another folder");
     // Nor are another folder's labels/, ground truth, camera.ini or preview.png, which a
     // render replaces (a YOLO dataset's labels/ went without a word).
-    if (!o.out_dir.empty() && !fs::exists(dir / "render.txt") && !fs::exists(dir / "persons.txt"))
+    if (!o.out_dir.empty() && !isOwnRender(o))
         for (const char* name :
              {"labels", "groundtruth.txt", "camera.ini", "preview.png", "rgb", "depth"})
             if (fs::exists(dir / name))
@@ -140,7 +149,7 @@ void checkOutputs(const Scenario& sc, const WriteOptions& o) {
     // to overwrite one too). The render names the one it writes in persons.txt, from the
     // start, and in render.txt, at the end: a stopped render is resumed into the same file.
     const std::string mine = rawlogLine(o);
-    if (fs::exists(r) && !hasLine(fs::path(o.out_dir) / "persons.txt", "# " + mine) &&
+    if (fs::exists(r) && !hasLine(personsPath(o), "# " + mine) &&
         !hasLine(signaturePath(o), mine))
         throw std::invalid_argument("rawlog '" + r + "' exists and is not one that a render into '" +
                                     o.out_dir + "' wrote; remove it or name another");
@@ -163,9 +172,8 @@ WriteSummary writeSequence(const Scenario& sc, const WriteOptions& o,
     // Until the last frame is written the folder is not a current render; an earlier
     // render's ground truth and intrinsics go too, so that a run killed half-way leaves no
     // old trajectory beside the new frames (written again at the end, or at a stop).
-    // (A folder of ours, whole or stopped; checkOutputs refused any other that has images.)
-    const bool ours =
-        fs::exists(signaturePath(o)) || fs::exists(fs::path(o.out_dir) / "persons.txt");
+    // (checkOutputs refused a folder not ours that has images.)
+    const bool ours = isOwnRender(o);
     std::error_code ec;
     fs::remove(signaturePath(o), ec);
     fs::remove(fs::path(o.out_dir) / "groundtruth.txt", ec);
@@ -174,7 +182,7 @@ WriteSummary writeSequence(const Scenario& sc, const WriteOptions& o,
     // persons.txt before rgb.txt: a folder with rgb.txt and neither it nor render.txt is
     // no render of ours (checkOutputs), even when a run ended between the two.
     fs::create_directories(o.out_dir, ec);
-    const std::string persons_path = (fs::path(o.out_dir) / "persons.txt").string();
+    const std::string persons_path = personsPath(o).string();
     std::ofstream persons(persons_path);
     if (!persons) throw std::runtime_error("cannot write '" + persons_path + "'");
     persons << "# person truth of devslam-synth scenario " << sc.name << "\n"
