@@ -1216,5 +1216,5 @@ int main(int argc, char** argv) {
         std::cerr << "devslam-bench: " << e.what() << "\n";
     }
     if (const int sig = core::stopSignal()) core::exitBySignal(sig);
-    return rc;
+    return core::withStandardOutput("devslam-bench", rc);  // the tables are printed there too
 }

@@ -278,5 +278,5 @@ int main(int argc, char** argv) {
     const int rc = convert(argc, argv);
     // After Ctrl-C, with the output closed: end by the signal, so that a script stops too.
     if (const int sig = devslam::core::stopSignal()) devslam::core::exitBySignal(sig);
-    return rc;
+    return devslam::core::withStandardOutput("devslam-convert", rc);
 }

@@ -541,9 +541,7 @@ std::string detectEverySection(const Frames& fr, const dynamic::DynamicObjectFil
     return md.str();
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int appMain(int argc, char** argv) {
     // glibc serves large blocks with fresh pages (mmap, or heap it trims back) until a large
     // block is freed, which raises its thresholds for the rest of the process. Until then each
     // forward pass of the network faulted in about 640 new pages here, and the first detector
@@ -596,4 +594,9 @@ int main(int argc, char** argv) {
         return 1;
     }
     return 0;
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+    return core::withStandardOutput("devslam-filter-bench", appMain(argc, argv));
 }

@@ -463,9 +463,7 @@ void writePictures(const Args& a, const std::vector<devslam::sim::Category>& cat
             ep.pictures[c].world.name + " / " + ep.pictures[c].method);
     writeChart(a.png_dir + "/nav_bench_success.png", cats, a.methods, ep.tally);
 }
-}  // namespace
-
-int main(int argc, char** argv) {
+int appMain(int argc, char** argv) {
     devslam::core::installStopHandler("devslam-nav-bench");
     Args a;
     if (const auto rc = parseArgs(argc, argv, a)) return *rc;
@@ -514,4 +512,9 @@ int main(int argc, char** argv) {
         std::cerr << "devslam-nav-bench: " << e.what() << "\n";
         return 2;
     }
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+    return devslam::core::withStandardOutput("devslam-nav-bench", appMain(argc, argv));
 }

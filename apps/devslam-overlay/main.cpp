@@ -14,6 +14,7 @@
 #include <devslam/core/Interrupt.h>
 #include <devslam/core/Parse.h>
 #include <devslam/core/Progress.h>
+#include <devslam/core/Results.h>
 #include <devslam/dynamic/DynamicObjectFilter.h>
 #include <devslam/dynamic/SyntheticSequence.h>
 #include <devslam/io/RgbdReader.h>
@@ -25,6 +26,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include <cstdio>
+#include <optional>
 #include <filesystem>
 #include <iostream>
 #include <string>
@@ -199,12 +201,29 @@ Input openInput(const Args& a) {
     return in;
 }
 
-/// Frame k's overlay as DIR/overlay_<k>.png; `written` overlays came before it.
+/// Frame k's overlay file name: overlay_<k, 5 digits or more>.png.
+std::string overlayName(std::size_t k) {
+    std::string digits = std::to_string(k);
+    if (digits.size() < 5) digits.insert(0, 5 - digits.size(), '0');
+    return "overlay_" + digits + ".png";
+}
+
+/// The frame whose overlay `name` is, or nothing where overlayName does not make `name`
+/// (read back through overlayName, so the name has one spelling).
+std::optional<std::size_t> overlayIndex(const std::string& name) {
+    const std::size_t first = name.find_first_of("0123456789");
+    if (first == std::string::npos) return std::nullopt;
+    const std::string digits = name.substr(first, name.find_first_not_of("0123456789", first) - first);
+    if (digits.size() > 18) return std::nullopt;  // no frame count has as many (nor std::stoull)
+    const std::size_t k = std::stoull(digits);
+    if (overlayName(k) != name) return std::nullopt;
+    return k;
+}
+
+/// Frame k's overlay as DIR/overlayName(k); `written` overlays came before it.
 void writeOverlay(const std::string& out_dir, std::size_t k, const core::Frame& f,
                   const dynamic::FilterOutput& out, std::size_t written) {
-    char name[64];
-    std::snprintf(name, sizeof name, "overlay_%05zu.png", k);
-    const std::string file = (fs::path(out_dir) / name).string();
+    const std::string file = (fs::path(out_dir) / overlayName(k)).string();
     // Drawn outside the write's try: a drawing error is not a write error.
     const cv::Mat picture = drawOverlay(f, out);
     std::string why;
@@ -218,9 +237,7 @@ void writeOverlay(const std::string& out_dir, std::size_t k, const core::Frame& 
                                  " overlays written before it): " + why);
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int appMain(int argc, char** argv) {
     // Ctrl-C or SIGTERM: the overlay being written is finished, the run stops there (an
     // overlay cut in the middle of its write was left empty, among an earlier run's).
     core::installStopHandler("devslam-overlay");
@@ -279,12 +296,8 @@ int main(int argc, char** argv) {
         }
         std::vector<fs::path> stale;
         for (const auto& e : fs::directory_iterator(a.out_dir)) {
-            const std::string name = e.path().filename().string();
-            std::size_t index = 0;
-            char tail = 0;
-            if (name.size() == 17 &&
-                std::sscanf(name.c_str(), "overlay_%5zu.pn%c", &index, &tail) == 2 && tail == 'g' &&
-                (index >= k || index % static_cast<std::size_t>(a.every) != 0))
+            const auto index = overlayIndex(e.path().filename().string());
+            if (index && (*index >= k || *index % static_cast<std::size_t>(a.every) != 0))
                 stale.push_back(e.path());
         }
         for (const auto& p : stale) fs::remove(p);
@@ -298,4 +311,9 @@ int main(int argc, char** argv) {
         return 1;
     }
     return 0;
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+    return core::withStandardOutput("devslam-overlay", appMain(argc, argv));
 }

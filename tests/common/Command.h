@@ -23,9 +23,12 @@ struct CommandResult {
     bool signalled = false;  ///< signalAppWhen: the signal was sent (it had not ended before)
 };
 
-/// `<DEVSLAM_BIN_DIR>/<app> <args>` through the shell (quote arguments with spaces).
-inline CommandResult runApp(const std::string& app, const std::string& args) {
-    const std::string cmd = std::string(DEVSLAM_BIN_DIR) + "/" + app + " " + args + " 2>&1";
+/// `<DEVSLAM_BIN_DIR>/<app> <args> <redirect>` through the shell (quote arguments with
+/// spaces); its stderr, and its stdout where `redirect` does not send it elsewhere, are read.
+inline CommandResult runAppRedirected(const std::string& app, const std::string& args,
+                                      const std::string& redirect) {
+    const std::string cmd =
+        std::string(DEVSLAM_BIN_DIR) + "/" + app + " " + args + " 2>&1 " + redirect;
     CommandResult r;
     FILE* p = popen(cmd.c_str(), "r");
     if (!p) return r;
@@ -34,6 +37,17 @@ inline CommandResult runApp(const std::string& app, const std::string& args) {
     const int st = pclose(p);
     r.rc = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
     return r;
+}
+
+/// `<DEVSLAM_BIN_DIR>/<app> <args>` through the shell (quote arguments with spaces).
+inline CommandResult runApp(const std::string& app, const std::string& args) {
+    return runAppRedirected(app, args, "");
+}
+
+/// `<app> <args>` with its standard output on /dev/full, as behind a '>' on a full disk: r.out
+/// is its stderr alone.
+inline CommandResult runAppOntoFullDisk(const std::string& app, const std::string& args) {
+    return runAppRedirected(app, args, "> /dev/full");
 }
 
 /// Ctrl-C at a terminal, simulated: runs `<app> <args>` in a process group of its own with

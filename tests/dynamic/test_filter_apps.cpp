@@ -54,6 +54,12 @@ TEST(DevslamOverlay, WritesOneOverlayPerFrame) {
     EXPECT_EQ(pngsIn(d.str("a")), 4);
     EXPECT_FALSE(fs::exists(d.str("a/overlay_00003.png")));
     EXPECT_TRUE(fs::exists(d.str("a/notes.png")));
+    // Its summary onto a full disk: an error, not 0 (the overlays are written all the same).
+    r = devslam::test::runAppOntoFullDisk(
+        "devslam-overlay", "--input synthetic:walking --frames 2 --out " + d.str("c"));
+    EXPECT_EQ(r.rc, 1) << r.out;
+    EXPECT_NE(r.out.find("devslam-overlay: cannot write the standard output (No space left on device)\n"), std::string::npos) << r.out;
+    EXPECT_EQ(pngsIn(d.str("c")), 2);
 }
 
 // The shipped real frames through a SLAM INI, whose [run] filter_config names the filter INI.
@@ -217,4 +223,9 @@ TEST(DevslamFilterBench, BadConfigStopsItBeforeAnyWork) {
     r = runApp("devslam-filter-bench", "--help");
     EXPECT_EQ(r.rc, 0) << r.out;
     EXPECT_NE(r.out.find("usage: devslam-filter-bench"), std::string::npos) << r.out;
+    // A standard output that cannot be written is an error (the quickest output is the usage:
+    // the tables take half a minute).
+    r = devslam::test::runAppOntoFullDisk("devslam-filter-bench", "--help");
+    EXPECT_EQ(r.rc, 1) << r.out;
+    EXPECT_EQ(r.out, "devslam-filter-bench: cannot write the standard output (No space left on device)\n") << r.out;
 }

@@ -477,11 +477,9 @@ TEST(Report, RefusesOverflowNonFiniteJsonAndOutputsThatAreInputs) {
         EXPECT_EQ(r.rc, 1) << r.out;
         EXPECT_NE(r.out.find("cannot write '/dev/full'"), std::string::npos) << r.out;
         // The figures on a standard output that cannot take them: an error, not 0.
-        const std::string err = d.str("stdout_full.txt");
-        const std::string cmd = std::string(DEVSLAM_BIN_DIR) + "/devslam-eval " + g + " " + e +
-                                " > /dev/full 2> '" + err + "'";
-        EXPECT_EQ(WEXITSTATUS(std::system(cmd.c_str())), 1) << cmd;
-        EXPECT_EQ(text(err),
+        const auto full = devslam::test::runAppOntoFullDisk("devslam-eval", g + " " + e);
+        EXPECT_EQ(full.rc, 1) << full.out;
+        EXPECT_EQ(full.out,
                   "devslam-eval: cannot write the standard output (No space left on device)\n");
     }
 }

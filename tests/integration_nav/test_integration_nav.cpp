@@ -375,6 +375,15 @@ TEST(IntegrationNav, AppsSmokeTest) {
     EXPECT_NE(r.out.find("section 'nav' needs"), std::string::npos) << r.out;
     EXPECT_EQ(r.out.find("nav-bench ["), std::string::npos) << "ran before refusing: " << r.out;
     EXPECT_FALSE(mrpt::system::directoryExists(out + "/refused"));
+    // With --results none the tables are on the standard output alone: onto a full disk they
+    // are lost, which is an error (the tables are bigger than the stream's buffer: they fail
+    // on the way, and the reason is gone by the end).
+    r = devslam::test::runAppOntoFullDisk(
+        "devslam-nav-bench",
+        "--per-category 1 --methods CHolonomicVFHPlus --results none --png-dir " + out + "/full");
+    EXPECT_EQ(r.rc, 1) << r.out;
+    EXPECT_NE(r.out.find("devslam-nav-bench: cannot write the standard output"), std::string::npos)
+        << r.out;
     // A --png-dir that is a file: refused with the options, not after the benchmark has run
     // (the usage it prints names "nav-bench [options]", so no progress-bar check here).
     std::ofstream(out + "/a_file") << "x";

@@ -260,6 +260,11 @@ TEST(DevslamConvert, RefusesToWriteOverAnExistingRawlog) {
     c = devslam::test::runApp("devslam-convert", keep.string() + " " + (dir / "x").string());
     EXPECT_EQ(c.rc, 0) << c.out;
     EXPECT_NE(c.out.find("wrote 5 frames"), std::string::npos) << c.out;
+    // Its summary onto a full disk: an error, not 0.
+    c = devslam::test::runAppOntoFullDisk("devslam-convert",
+                                          keep.string() + " " + (dir / "y").string());
+    EXPECT_EQ(c.rc, 1) << c.out;
+    EXPECT_NE(c.out.find("devslam-convert: cannot write the standard output (No space left on device)\n"), std::string::npos) << c.out;
 }
 
 // --max-frames 0 wrote a rawlog of no frames, which no reader opens.
