@@ -258,6 +258,7 @@ struct Episodes {
     std::size_t total = 0, done = 0;
     double sim_seconds = 0, wall = 0;  ///< [s]
     int stopped = 0;                   ///< the signal that stopped them (Ctrl-C), else 0
+    std::vector<std::string> errors;   ///< "world / method: message" of each episode that threw
     /// (category c, method m)'s tally; an empty one where none ran.
     [[nodiscard]] const Tally& of(std::size_t c, const std::string& m) const {
         static const Tally none;
@@ -312,30 +313,28 @@ Episodes runEpisodes(const Args& a, const mrpt::config::CConfigFileBase& ini,
     ep.total = cats.size() * a.per_category * a.methods.size();
     devslam::core::ProgressBar bar("nav-bench", ep.total);
     const auto t_start = Clock::now();
-    const auto run = [&]() -> int {
-        for (size_t c = 0; c < cats.size(); c++) {
-            for (int i = 0; i < a.per_category; i++) {
-                if (const int sig = devslam::core::stopSignal()) return sig;
-                auto planner_opts = nav_opts.planner;
-                const auto world = devslam::sim::randomWorld(cats[c], a.seed + i, planner_opts);
-                for (const auto& m : a.methods) {
-                    if (const int sig = devslam::core::stopSignal()) return sig;
-                    devslam::sim::EpisodeOptions eo;
-                    eo.holonomic_method = m;
-                    const auto r = devslam::sim::runEpisode(world, ini, nav_opts, eo);
-                    ep.sim_seconds += r.time;
-                    count(ep.tally[{static_cast<int>(c), m}], world, r);
-                    for (double s : r.step_seconds) ep.step_ms[m].push_back(1e3 * s);
-                    if (i == 0 && m == a.methods.front())  // pictured after the results
-                        ep.pictures.push_back({world, r, m});
-                    bar.update(++ep.done,
-                               std::string(devslam::sim::toString(cats[c])) + " " + shortName(m));
-                }
-            }
-        }
-        return 0;
-    };
-    ep.stopped = run();
+    devslam::sim::runEpisodeGrid(
+        cats, a.per_category, a.seed, a.methods, nav_opts.planner,
+        [&](const devslam::sim::WorldSpec& world, const std::string& m) {
+            devslam::sim::EpisodeOptions eo;
+            eo.holonomic_method = m;
+            return devslam::sim::runEpisode(world, ini, nav_opts, eo);
+        },
+        [&](const devslam::sim::GridEpisode& g) {
+            const auto& r = g.result;
+            ep.sim_seconds += r.time;
+            count(ep.tally[{static_cast<int>(g.category), g.method}], *g.world, r);
+            for (double s : r.step_seconds) ep.step_ms[g.method].push_back(1e3 * s);
+            if (g.index == 0 && g.method == a.methods.front())  // pictured after the results
+                ep.pictures.push_back({*g.world, r, g.method});
+            if (!g.error.empty())
+                ep.errors.push_back(std::string(devslam::sim::toString(cats[g.category])) +
+                                    " world " + std::to_string(a.seed + g.index) + " / " +
+                                    shortName(g.method) + ": " + g.error);
+            bar.update(++ep.done, std::string(devslam::sim::toString(cats[g.category])) + " " +
+                                      shortName(g.method));
+        },
+        [&] { return (ep.stopped = devslam::core::stopSignal()) != 0; });
     bar.finish();
     ep.wall = std::chrono::duration<double>(Clock::now() - t_start).count();
     return ep;
@@ -487,6 +486,15 @@ int appMain(int argc, char** argv) {
                << ep.done << " of " << ep.total
                << " episodes: the tables below cover those only.**\n\n";
         md << categoryTables(a, cats, ep);
+        if (!ep.errors.empty()) {
+            // Counted in the tables as "no path or error"; said here, as they are not results.
+            md << "**" << ep.errors.size() << " episode" << (ep.errors.size() == 1 ? "" : "s")
+               << " ended by an error** (counted as \"no path or error\"):\n\n";
+            for (const auto& e : ep.errors) md << "- " << e << "\n";
+            md << "\n";
+            std::cerr << "devslam-nav-bench: " << ep.errors.size()
+                      << " episodes ended by an error, listed under the tables\n";
+        }
         if (ep.stopped) {
             std::cout << md.str();
             std::cerr << "devslam-nav-bench: interrupted (" << devslam::core::signalName(ep.stopped)

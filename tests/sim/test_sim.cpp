@@ -487,6 +487,56 @@ TEST(SimRobot, PeopleGetARingOfPointsTheMarginOut) {
     }
 }
 
+// devslam-nav-bench's loop: every method on the same worlds, in order; an episode that throws
+// after the first is that episode's error and the rest run (one world lost the whole bench's
+// tallies); one that throws at a method's first episode ends them, naming it.
+TEST(RandomWorlds, EpisodeGridKeepsGoingPastAnErrorButNotPastAMethodThatCannotRun) {
+    const std::vector<Category> cats{Category::OpenClutter, Category::Office};
+    const std::vector<std::string> methods{"A", "B"};
+    std::vector<std::string> ran, done;
+    const auto episode = [&](const WorldSpec& w, const std::string& m) {
+        ran.push_back(w.name + "/" + m);
+        if (w.name == "office_2" && m == "B") throw std::runtime_error("bullet gave up");
+        EpisodeResult r;
+        r.outcome = Outcome::Success;
+        r.time = static_cast<double>(ran.size());
+        return r;
+    };
+    const auto record = [&](const GridEpisode& g) {
+        done.push_back(std::to_string(g.category) + " " + std::to_string(g.index) + " " +
+                       g.method + " " + g.world->name + " " + toString(g.result.outcome) +
+                       (g.error.empty() ? "" : " [" + g.error + "|" + g.result.reason + "]"));
+    };
+    const auto never = [] { return false; };
+    EXPECT_EQ(runEpisodeGrid(cats, 2, 1, methods, {}, episode, record, never), 8u);
+    EXPECT_EQ(ran, (std::vector<std::string>{"open_clutter_1/A", "open_clutter_1/B",
+                                             "open_clutter_2/A", "open_clutter_2/B", "office_1/A",
+                                             "office_1/B", "office_2/A", "office_2/B"}));
+    ASSERT_EQ(done.size(), 8u);
+    EXPECT_EQ(done[0], "0 0 A open_clutter_1 success");
+    EXPECT_EQ(done[6], "1 1 A office_2 success");
+    EXPECT_EQ(done[7], "1 1 B office_2 error [bullet gave up|bullet gave up]");
+    // Stopped (Ctrl-C) before the 4th episode: 3 done.
+    ran.clear(), done.clear();
+    const auto after3 = [&] { return done.size() == 3; };
+    EXPECT_EQ(runEpisodeGrid(cats, 2, 1, methods, {}, episode, record, after3), 3u);
+    EXPECT_EQ(done.size(), 3u);
+    // A method that cannot run at all: its first episode ends the runs, named.
+    ran.clear(), done.clear();
+    const auto no_b = [&](const WorldSpec& w, const std::string& m) {
+        if (m == "B") throw std::runtime_error("no such method");
+        return episode(w, m);
+    };
+    try {
+        (void)runEpisodeGrid(cats, 2, 7, methods, {}, no_b, record, never);
+        ADD_FAILURE() << "ran on after the first episode of B failed";
+    } catch (const std::runtime_error& e) {
+        EXPECT_EQ(std::string(e.what()),
+                  "open_clutter world of seed 7, B (its first episode): no such method");
+    }
+    EXPECT_EQ(done.size(), 1u);
+}
+
 TEST(RandomWorlds, SameSeedSameWorldAndAlwaysSolvable) {
     for (auto c : allCategories())
         for (uint32_t s = 1; s <= 3; s++) {

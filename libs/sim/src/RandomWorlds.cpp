@@ -238,4 +238,47 @@ WorldSpec randomWorld(Category c, uint32_t seed, const nav::GridPlannerOptions& 
                              " world for seed " + std::to_string(seed));
 }
 
+std::size_t runEpisodeGrid(
+    const std::vector<Category>& categories, int per_category, uint32_t first_seed,
+    const std::vector<std::string>& methods, const nav::GridPlannerOptions& planner,
+    const std::function<EpisodeResult(const WorldSpec&, const std::string&)>& episode,
+    const std::function<void(const GridEpisode&)>& done, const std::function<bool()>& stop) {
+    std::size_t n = 0;
+    for (std::size_t c = 0; c < categories.size(); c++) {
+        for (int i = 0; i < per_category; i++) {
+            const uint32_t seed = first_seed + static_cast<uint32_t>(i);
+            const std::string where =
+                std::string(toString(categories[c])) + " world of seed " + std::to_string(seed);
+            WorldSpec world;
+            std::string world_error;
+            try {
+                world = randomWorld(categories[c], seed, planner);
+            } catch (const std::exception& e) {
+                if (i == 0) throw std::runtime_error(where + ": " + e.what());
+                world_error = e.what();
+            }
+            for (const auto& m : methods) {
+                if (stop()) return n;
+                GridEpisode g{c, i, m, &world, {}, {}};
+                try {
+                    if (!world_error.empty()) throw std::runtime_error(world_error);
+                    g.result = episode(world, m);
+                } catch (const std::exception& e) {
+                    if (c == 0 && i == 0)
+                        throw std::runtime_error(where + ", " + m +
+                                                 " (its first episode): " + e.what());
+                    g.error = e.what();
+                    g.result = EpisodeResult{};
+                    g.result.outcome = Outcome::Error;
+                    g.result.reason = g.error;
+                    g.result.holonomic_method = m;
+                }
+                done(g);
+                ++n;
+            }
+        }
+    }
+    return n;
+}
+
 }  // namespace devslam::sim
