@@ -189,12 +189,17 @@ static int appMain(int argc, char** argv) {
             r.time, r.path_length, r.astar_length, r.min_clearance_static,
             world.pedestrians.empty() ? -1.0 : r.min_clearance_people, r.static_collisions,
             r.person_collisions, r.replans, png.c_str(),
-            navlog.empty() ? "" : " navlog=", navlog.c_str());
+            r.navlog.empty() ? "" : " navlog=", r.navlog.c_str());
         if (!r.reason.empty()) std::printf("reason: %s\n", r.reason.c_str());
         std::fflush(stdout);
         writePicture(png, [&] {
             devslam::sim::writeEpisodePng(world, r, png, world.name + " / " + r.holonomic_method);
         });
+        // A navlog asked for and cut short: the run is whole, its log is not.
+        if (!r.navlog_error.empty()) {
+            std::fprintf(stderr, "devslam-nav: %s\n", r.navlog_error.c_str());
+            return 1;
+        }
         return r.outcome == devslam::sim::Outcome::Success ? 0 : 1;
     } catch (const std::exception& e) {
         // MRPT's exceptions carry banners and a stack trace around their message.

@@ -21,6 +21,7 @@
 #include <fstream>
 #include <functional>
 #include <limits>
+#include <random>
 #include <thread>
 #include <typeinfo>
 
@@ -811,6 +812,40 @@ TEST(GzFile, InnermostMessageSkipsEmptyMessages) {
     EXPECT_EQ(innermostMessage(nested + "Message:"), "inner text");
     EXPECT_EQ(innermostMessage(nested + "Message:   \nmore"), "inner text");
     EXPECT_EQ(innermostMessage("Message:"), "Message:");
+}
+
+// A gzip file written through MRPT's stream interface: read back whole, and a full disk is
+// an error naming the file and why, at the write that hit it or at the close.
+TEST(GzFile, OutputStreamWritesAGzipFileAndSaysWhyAWriteFailed) {
+    const devslam::test::TempDir d("devslam_gz_");
+    const std::string path = d.str("a.gz");
+    std::string bytes(300000, '\0');
+    std::mt19937 g(1);
+    for (auto& c : bytes) c = static_cast<char>(g() & 0xff);  // does not compress
+    {
+        GzOutputStream s(path, 1, "thing");
+        EXPECT_EQ(s.Write(bytes.data(), bytes.size()), bytes.size());
+        EXPECT_EQ(s.getPosition(), bytes.size());
+        EXPECT_NO_THROW(s.close());
+        EXPECT_EQ(s.lastError(), "");
+    }
+    EXPECT_EQ(gzipDamage(path), "");
+    EXPECT_THROW(GzOutputStream(d.str("no/such/dir/a.gz"), 1, "thing"), std::runtime_error);
+    ASSERT_TRUE(std::filesystem::exists("/dev/full")) << "Linux has /dev/full";
+    GzOutputStream full("/dev/full", 1, "thing");
+    std::size_t taken = 0;
+    for (int k = 0; k < 10 && taken == bytes.size() * static_cast<std::size_t>(k); ++k)
+        taken += full.Write(bytes.data(), bytes.size());
+    EXPECT_LT(taken, 10 * bytes.size()) << "3 MB into /dev/full, no error";
+    EXPECT_EQ(full.lastError(), "No space left on device");
+    try {
+        full.close();
+        ADD_FAILURE() << "closed /dev/full without an error";
+    } catch (const std::runtime_error& e) {
+        EXPECT_EQ(std::string(e.what()),
+                  "error writing thing '/dev/full': its end was not written (disk full?), the "
+                  "file is cut short");
+    }
 }
 
 TEST(Stats, MatchesNumpy) {

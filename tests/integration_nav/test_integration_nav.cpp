@@ -28,6 +28,7 @@
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -237,6 +238,38 @@ TEST(IntegrationNav, TheIniChoosesTheHolonomicMethod) {
     eo.holonomic_method = "CHolonomicFullEval";
     EXPECT_EQ(devslam::sim::runEpisode(world, *ini, opts, eo).holonomic_method,
               "CHolonomicFullEval");
+}
+
+// A navlog on a full disk (a file-size limit stands in for one: CI cannot mount a small
+// disk): MRPT writes the log inside navigationStep(), and its handler of its own stream's
+// exception stopped the robot at every step (a 60 s timeout standing at the start, 12000
+// lines of stack traces). Now the log ends there and the robot drives on; the run says so
+// and exits 1. The navlog's folder is made with its parents.
+TEST(IntegrationNav, NavlogOnAFullDiskEndsTheLogNotTheRun) {
+    const devslam::test::TempDir dir("devslam_");
+    const std::string out = dir.str();
+    // 2048 blocks: 1 MiB in dash's 512-byte blocks, 2 MiB in bash's; the picture (~120 kB)
+    // and the PTG cache files (~230 kB) fit, the navlog (~2.9 MB) does not. SIGXFSZ ignored,
+    // as the write then fails with EFBIG instead of killing the program.
+    const std::string log = out + "/a/b/log_000.reactivenavlog";
+    const std::string cmd = "trap '' XFSZ; ulimit -f 2048; exec " + std::string(DEVSLAM_BIN_DIR) +
+                            "/devslam-nav " + kSrc + "/sim_worlds/paper_fig6.ini --png " + out +
+                            "/f.png --navlog " + out + "/a/b > " + out + "/o.txt 2>&1";
+    const int st = std::system(cmd.c_str());
+    std::ifstream in(out + "/o.txt");
+    const std::string said((std::istreambuf_iterator<char>(in)), {});
+    EXPECT_EQ(WEXITSTATUS(st), 1) << said;
+    EXPECT_NE(said.find("result=success"), std::string::npos) << said;
+    EXPECT_NE(said.find(" navlog=" + log + "\n"), std::string::npos) << said;
+    EXPECT_NE(said.find("devslam-nav: cannot write navlog '" + log +
+                        "': File too large; it ends there, the run went on without it\n"),
+              std::string::npos)
+        << said;
+    EXPECT_EQ(said.find("Stopping robot"), std::string::npos) << said;
+    EXPECT_EQ(std::count(said.begin(), said.end(), '\n'), 2) << said;
+    ASSERT_TRUE(std::filesystem::exists(log));
+    EXPECT_LT(std::filesystem::file_size(log), 2500000u);
+    EXPECT_GT(std::filesystem::file_size(out + "/f.png"), 10000u);
 }
 
 TEST(IntegrationNav, AppsSmokeTest) {

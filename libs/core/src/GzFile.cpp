@@ -2,9 +2,66 @@
 
 #include <zlib.h>
 
+#include <algorithm>
+#include <cerrno>
+#include <cstring>
+#include <stdexcept>
+#include <utility>
 #include <vector>
 
 namespace devslam::core {
+
+GzOutputStream::GzOutputStream(const std::string& path, int level, std::string kind)
+    : path_(path), kind_(std::move(kind)) {
+    gz_ = gzopen(path.c_str(), ("wb" + std::to_string(level)).c_str());
+    if (gz_ == nullptr) throw std::runtime_error("cannot write " + kind_ + " '" + path + "'");
+}
+
+GzOutputStream::~GzOutputStream() {
+    if (gz_ != nullptr) gzclose(static_cast<gzFile>(gz_));
+}
+
+size_t GzOutputStream::Read(void*, size_t) {
+    throw std::logic_error(kind_ + " '" + path_ + "' is open for writing");
+}
+
+size_t GzOutputStream::Write(const void* buf, size_t count) {
+    if (gz_ == nullptr) return 0;
+    const auto* p = static_cast<const char*>(buf);
+    size_t done = 0;
+    while (done < count) {
+        const auto chunk = static_cast<unsigned>(std::min<size_t>(count - done, 1u << 30));
+        errno = 0;
+        const int n = gzwrite(static_cast<gzFile>(gz_), p + done, chunk);
+        if (n <= 0) {
+            noteError();
+            break;
+        }
+        done += static_cast<size_t>(n);
+    }
+    written_ += done;
+    return done;
+}
+
+uint64_t GzOutputStream::Seek(int64_t, TSeekOrigin) {
+    throw std::logic_error(kind_ + " '" + path_ + "': a gzip stream cannot seek");
+}
+
+void GzOutputStream::noteError() {
+    int err = Z_OK;
+    const char* msg = gzerror(static_cast<gzFile>(gz_), &err);
+    error_ = err == Z_ERRNO ? std::strerror(errno) : (msg != nullptr ? msg : "write error");
+}
+
+void GzOutputStream::close() {
+    if (gz_ == nullptr) return;
+    errno = 0;
+    const int rc = gzclose(static_cast<gzFile>(std::exchange(gz_, nullptr)));
+    if (rc == Z_OK) return;
+    if (error_.empty()) error_ = rc == Z_ERRNO && errno != 0 ? std::strerror(errno) : "write error";
+    throw std::runtime_error("error writing " + kind_ + " '" + path_ +
+                             "': its end was not written (disk full?), the file is cut short");
+}
 
 std::string gzipDamage(const std::string& path) {
     gzFile f = gzopen(path.c_str(), "rb");

@@ -486,55 +486,10 @@ std::string RawlogReader::describe() const {
 }
 
 // ---------------------------------------------------------------------------------------
-// Written by hand instead of mrpt::io::CFileGZOutputStream, whose close() ignores what
-// gzclose() returns: the last compressed block and the gzip trailer leave zlib's buffers only
-// there, so a disk that fills at the end gave a cut rawlog without a word (found when read).
-// The same gzip stream otherwise (gzopen "wb<level>", as MRPT opens it).
-struct RawlogWriter::Stream : public mrpt::io::CStream {
-    Stream(const std::string& path, int level) : path_(path) {
-        gz_ = gzopen(path.c_str(), ("wb" + std::to_string(level)).c_str());
-        if (gz_ == nullptr) throw std::runtime_error("cannot write rawlog '" + path + "'");
-    }
-    ~Stream() override {
-        if (gz_ != nullptr) gzclose(gz_);
-    }
-    Stream(const Stream&) = delete;
-    Stream& operator=(const Stream&) = delete;
-    size_t Read(void*, size_t) override {
-        throw std::logic_error("rawlog '" + path_ + "' is open for writing");
-    }
-    // Whole or nothing: MRPT's archive throws when fewer bytes than asked were written.
-    size_t Write(const void* buf, size_t count) override {
-        if (gz_ == nullptr) return 0;
-        const auto* p = static_cast<const char*>(buf);
-        size_t done = 0;
-        while (done < count) {
-            const auto chunk = static_cast<unsigned>(std::min<size_t>(count - done, 1u << 30));
-            const int n = gzwrite(gz_, p + done, chunk);
-            if (n <= 0) return done;
-            done += static_cast<size_t>(n);
-        }
-        written_ += done;
-        return done;
-    }
-    uint64_t Seek(int64_t, TSeekOrigin) override {
-        throw std::logic_error("rawlog '" + path_ + "': a gzip stream cannot seek");
-    }
-    uint64_t getTotalBytesCount() const override { return written_; }
-    uint64_t getPosition() const override { return written_; }
-    /// Flushes zlib's buffers and the trailer; throws if they could not be written.
-    void close() {
-        if (gz_ == nullptr) return;
-        const int rc = gzclose(std::exchange(gz_, nullptr));
-        if (rc != Z_OK)
-            throw std::runtime_error("error writing rawlog '" + path_ + "': its end was not " +
-                                     "written (disk full?), the file is cut short");
-    }
-
-  private:
-    std::string path_;
-    gzFile gz_ = nullptr;
-    uint64_t written_ = 0;
+// core::GzOutputStream, not mrpt::io::CFileGZOutputStream: that one's close() ignores a
+// disk that filled at the end (see GzOutputStream).
+struct RawlogWriter::Stream : public core::GzOutputStream {
+    Stream(const std::string& path, int level) : GzOutputStream(path, level, "rawlog") {}
 };
 
 RawlogWriter::RawlogWriter(std::string path, RawlogWriterOptions opts)

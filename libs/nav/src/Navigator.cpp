@@ -1,4 +1,5 @@
 #include <devslam/core/Config.h>
+#include <devslam/core/GzFile.h>
 #include <devslam/nav/CHolonomicVFHPlus.h>
 #include <devslam/nav/Navigator.h>
 
@@ -59,6 +60,8 @@ class ReactiveNav : public mrpt::nav::CReactiveNavigationSystem {
         }
         return d;
     }
+    /// Writes the navlog into `s` (m_logFile, MRPT's own; a stream of MRPT's closed first).
+    void useLogStream(std::unique_ptr<mrpt::io::CStream> s) { m_logFile = std::move(s); }
     /// As the INI names it: "mrpt::nav::CHolonomicND" -> "CHolonomicND".
     std::string holonomicClass() const {
         if (m_holonomicMethod.empty() || !m_holonomicMethod.front()) return {};
@@ -71,6 +74,52 @@ class ReactiveNav : public mrpt::nav::CReactiveNavigationSystem {
     std::vector<std::uint64_t> vfh_steps_;  // per PTG, at markVfhSteps()
 };
 
+/// The first free "DIR/log_NNN.reactivenavlog", NNN from 000: MRPT's own names.
+std::string freeNavlogName(const std::string& dir) {
+    for (unsigned k = 0;; ++k) {
+        char name[64];
+        std::snprintf(name, sizeof name, "log_%03u.reactivenavlog", k);
+        const auto path = std::filesystem::path(dir) / name;
+        std::error_code ec;
+        if (!std::filesystem::exists(std::filesystem::symlink_status(path, ec))) return path.string();
+    }
+}
+}  // namespace
+
+/// MRPT's navlog through core::GzOutputStream (a gzip stream like MRPT's own, so
+/// navlog-viewer reads it), whose failed write ends the log instead of throwing: MRPT writes
+/// the log inside navigationStep(), and its handler of the exception its own stream threw on a
+/// full disk stopped the robot, at every step, with a stack trace each.
+class Navigator::NavlogStream : public mrpt::io::CStream {
+  public:
+    explicit NavlogStream(const std::string& path) : gz_(path, 1, "navlog") {}
+    size_t Read(void* buf, size_t n) override { return gz_.Read(buf, n); }
+    /// All taken, as MRPT's archive needs: after a failure the rest is dropped.
+    size_t Write(const void* buf, size_t n) override {
+        if (error_.empty() && gz_.Write(buf, n) != n)
+            error_ = "cannot write navlog '" + gz_.path() + "': " + gz_.lastError() +
+                     "; it ends there, the run went on without it";
+        return n;
+    }
+    uint64_t Seek(int64_t off, TSeekOrigin o) override { return gz_.Seek(off, o); }
+    uint64_t getTotalBytesCount() const override { return gz_.getTotalBytesCount(); }
+    uint64_t getPosition() const override { return gz_.getPosition(); }
+    /// Closes the file; what went wrong writing it, "" when nothing did.
+    std::string close() {
+        try {
+            gz_.close();
+        } catch (const std::exception& e) {
+            if (error_.empty()) error_ = std::string(e.what()) + ": " + gz_.lastError();
+        }
+        return error_;
+    }
+
+  private:
+    core::GzOutputStream gz_;
+    std::string error_;
+};
+
+namespace {
 void copyConfig(const mrpt::config::CConfigFileBase& from, mrpt::config::CConfigFileMemory& to) {
     std::vector<std::string> sections;
     from.getAllSections(sections);
@@ -179,11 +228,17 @@ Navigator::Navigator(mrpt::nav::CRobot2NavInterface& robot,
     nav_ = std::make_unique<ReactiveNav>(robot_, opts_.log_directory);
     nav_->setMinLoggingLevel(opts_.verbose ? mrpt::system::LVL_DEBUG : mrpt::system::LVL_ERROR);
     if (opts_.log_file) {
-        if (!mrpt::system::directoryExists(opts_.log_directory) &&
-            !mrpt::system::createDirectory(opts_.log_directory))
+        // Its parents too (a missing one was a std::filesystem error naming no option).
+        std::error_code ec;
+        std::filesystem::create_directories(opts_.log_directory, ec);
+        if (!std::filesystem::is_directory(opts_.log_directory))
             throw std::runtime_error("[navigator] log_directory: cannot create '" +
-                                     opts_.log_directory + "'");
-        nav_->enableLogFile(true);
+                                     opts_.log_directory + "'" +
+                                     (ec ? ": " + ec.message() : std::string()));
+        log_path_ = freeNavlogName(opts_.log_directory);
+        auto log = std::make_unique<NavlogStream>(log_path_);
+        navlog_ = log.get();
+        static_cast<ReactiveNav&>(*nav_).useLogStream(std::move(log));
     }
     std::string cache = opts_.ptg_cache_directory;
     if (cache.empty()) {
@@ -205,6 +260,14 @@ Navigator::Navigator(mrpt::nav::CRobot2NavInterface& robot,
 }
 
 Navigator::~Navigator() = default;
+
+std::string Navigator::closeLog() {
+    if (navlog_ == nullptr) return "";
+    std::string why = navlog_->close();
+    navlog_ = nullptr;
+    nav_->enableLogFile(false);  // MRPT's reference to the closed stream goes too
+    return why;
+}
 
 std::string Navigator::holonomicMethod() const {
     return static_cast<const ReactiveNav&>(*nav_).holonomicClass();

@@ -65,17 +65,22 @@ EpisodeResult runEpisode(const WorldSpec& world, const mrpt::config::CConfigFile
     const auto statics = staticObstacles(world);
     nav::Navigator navigator(robot, nav_ini, nav_opts);
     res.holonomic_method = navigator.holonomicMethod();
+    res.navlog = navigator.logPath();
+    // Closed at every return: a navlog cut short is said, with the run.
+    const auto closeLog = [&] { res.navlog_error = navigator.closeLog(); };
     bool started = false;
     try {
         started = navigator.start(grid, world.robot.start, world.goal, world.goal_tolerance);
     } catch (const nav::PlanningError& e) {  // a start or goal the planner cannot stand on
         res.outcome = Outcome::NoPath;
         res.reason = (world.source.empty() ? world.name : world.source) + ": " + e.what();
+        closeLog();
         return res;
     }
     if (!started) {
         res.outcome = Outcome::NoPath;
         res.reason = navigator.lastError();
+        closeLog();
         return res;
     }
     res.global_path = navigator.globalPath();
@@ -146,6 +151,7 @@ EpisodeResult runEpisode(const WorldSpec& world, const mrpt::config::CConfigFile
     res.person_collisions = sim.collisions().person_events;
     res.replans = navigator.replanCount();
     res.trajectory.push_back(sim.robotPose());
+    closeLog();
     return res;
 }
 

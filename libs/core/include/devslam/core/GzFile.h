@@ -6,9 +6,48 @@
 /// Usage:
 ///   if (auto d = devslam::core::gzipDamage(path); !d.empty()) throw ...(path + ": " + d);
 ///   catch (const std::exception& e) { ... devslam::core::innermostMessage(e.what()) ... }
+#include <mrpt/io/CStream.h>
+
+#include <cstdint>
 #include <string>
 
 namespace devslam::core {
+
+/// A gzip file written through MRPT's CStream interface (an archive's `<<`), as MRPT's
+/// CFileGZOutputStream writes it (gzopen "wb<level>"), but whose errors are not lost: that
+/// one's close() ignores what gzclose() returns, and the last compressed block and the gzip
+/// trailer leave zlib's buffers only there, so a disk that filled at the end gave a file cut
+/// short without a word. `kind` names the file in messages ("rawlog" -> "cannot write rawlog
+/// 'PATH'").
+class GzOutputStream : public mrpt::io::CStream {
+  public:
+    /// Throws std::runtime_error "cannot write <kind> '<path>'" when it cannot be made.
+    GzOutputStream(const std::string& path, int level, std::string kind);
+    ~GzOutputStream() override;
+    GzOutputStream(const GzOutputStream&) = delete;
+    GzOutputStream& operator=(const GzOutputStream&) = delete;
+    size_t Read(void*, size_t) override;  ///< throws std::logic_error: open for writing
+    /// Whole or the bytes before the error (MRPT's archive throws when fewer bytes than asked
+    /// were written); lastError() says why.
+    size_t Write(const void* buf, size_t count) override;
+    uint64_t Seek(int64_t, TSeekOrigin) override;  ///< throws std::logic_error
+    uint64_t getTotalBytesCount() const override { return written_; }
+    uint64_t getPosition() const override { return written_; }
+    /// Flushes zlib's buffers and the trailer; throws std::runtime_error "error writing
+    /// <kind> '<path>': its end was not written (disk full?), the file is cut short" if they
+    /// could not be written. Once only; the destructor closes it otherwise (silently).
+    void close();
+    /// Why the last write or close failed, as zlib or the system says ("No space left on
+    /// device"); "" when none did.
+    [[nodiscard]] const std::string& lastError() const { return error_; }
+    [[nodiscard]] const std::string& path() const { return path_; }
+
+  private:
+    void noteError();
+    std::string path_, kind_, error_;
+    void* gz_ = nullptr;  // gzFile, kept out of this header with <zlib.h>
+    uint64_t written_ = 0;
+};
 
 /// A gzip stream cut short decodes cleanly up to the cut, and MRPT's stream reports a plain
 /// end of file there (or, reading an archive, nothing at all); only zlib knows the trailer

@@ -83,6 +83,13 @@ class Navigator {
     /// The class of the holonomic method MRPT's navigator made (e.g. "CHolonomicVFHPlus").
     [[nodiscard]] std::string holonomicMethod() const;
     [[nodiscard]] mrpt::nav::CReactiveNavigationSystem& reactive();
+    /// The navlog being written (NavigatorOptions::log_file), "" when none is.
+    [[nodiscard]] const std::string& logPath() const { return log_path_; }
+    /// Closes the navlog and returns what went wrong writing it ("cannot write navlog
+    /// 'PATH': No space left on device; ..."), "" when nothing did or none is written. A write
+    /// that fails during the run ends the log there and the robot drives on (MRPT writes it
+    /// inside navigationStep(), whose error handler stopped the robot at every step).
+    std::string closeLog();
 
   private:
     bool replan(const mrpt::math::TPose2D& pose, const std::vector<mrpt::math::TPoint2D>& sensed);
@@ -93,6 +100,9 @@ class Navigator {
     mrpt::nav::CRobot2NavInterface& robot_;
     NavigatorOptions opts_;
     std::unique_ptr<mrpt::nav::CReactiveNavigationSystem> nav_;
+    class NavlogStream;
+    NavlogStream* navlog_ = nullptr;  ///< owned by nav_ (its log stream); null when none
+    std::string log_path_;
     GridPlanner planner_;
     mrpt::maps::COccupancyGridMap2D static_map_;
     ReplanTrigger trigger_;

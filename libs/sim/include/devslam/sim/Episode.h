@@ -49,6 +49,8 @@ struct EpisodeResult {
     std::vector<std::vector<mrpt::math::TPoint2D>> pedestrian_tracks;
     nav::GridPath global_path;
     std::vector<mrpt::math::TPoint2D> waypoints;
+    std::string navlog;        ///< the navlog written (NavigatorOptions::log_file), else ""
+    std::string navlog_error;  ///< why the navlog is cut short (nav::Navigator::closeLog)
 };
 
 /// Runs one episode. Throws nav::PlanningError if start/goal are invalid for the planner.
