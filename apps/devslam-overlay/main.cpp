@@ -26,9 +26,9 @@
 #include <opencv2/imgproc.hpp>
 
 #include <cstdio>
-#include <optional>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 #include <string>
 #include <variant>
 
@@ -213,7 +213,8 @@ std::string overlayName(std::size_t k) {
 std::optional<std::size_t> overlayIndex(const std::string& name) {
     const std::size_t first = name.find_first_of("0123456789");
     if (first == std::string::npos) return std::nullopt;
-    const std::string digits = name.substr(first, name.find_first_not_of("0123456789", first) - first);
+    const std::string digits =
+        name.substr(first, name.find_first_not_of("0123456789", first) - first);
     if (digits.size() > 18) return std::nullopt;  // no frame count has as many (nor std::stoull)
     const std::size_t k = std::stoull(digits);
     if (overlayName(k) != name) return std::nullopt;

@@ -523,7 +523,8 @@ TEST(DevslamBench, CompareSetsEachRunBesideTheSameRenderBefore) {
     // The comparison is printed only: onto a full disk it is lost, which is an error.
     const auto full = devslam::test::runAppOntoFullDisk("devslam-bench", args);
     EXPECT_EQ(full.rc, 1) << full.out;
-    EXPECT_EQ(full.out, "devslam-bench: cannot write the standard output (No space left on device)\n");
+    EXPECT_EQ(full.out,
+              "devslam-bench: cannot write the standard output (No space left on device)\n");
     // A run one side lacks is left out, and said so.
     fs::remove_all(after / "short/none/seed6_r0");
     r = devslam::test::runApp("devslam-bench", args);

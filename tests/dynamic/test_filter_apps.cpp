@@ -58,7 +58,10 @@ TEST(DevslamOverlay, WritesOneOverlayPerFrame) {
     r = devslam::test::runAppOntoFullDisk(
         "devslam-overlay", "--input synthetic:walking --frames 2 --out " + d.str("c"));
     EXPECT_EQ(r.rc, 1) << r.out;
-    EXPECT_NE(r.out.find("devslam-overlay: cannot write the standard output (No space left on device)\n"), std::string::npos) << r.out;
+    EXPECT_NE(
+        r.out.find("devslam-overlay: cannot write the standard output (No space left on device)\n"),
+        std::string::npos)
+        << r.out;
     EXPECT_EQ(pngsIn(d.str("c")), 2);
 }
 
@@ -227,5 +230,7 @@ TEST(DevslamFilterBench, BadConfigStopsItBeforeAnyWork) {
     // the tables take half a minute).
     r = devslam::test::runAppOntoFullDisk("devslam-filter-bench", "--help");
     EXPECT_EQ(r.rc, 1) << r.out;
-    EXPECT_EQ(r.out, "devslam-filter-bench: cannot write the standard output (No space left on device)\n") << r.out;
+    EXPECT_EQ(r.out,
+              "devslam-filter-bench: cannot write the standard output (No space left on device)\n")
+        << r.out;
 }

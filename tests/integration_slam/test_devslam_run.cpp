@@ -264,7 +264,10 @@ TEST(DevslamConvert, RefusesToWriteOverAnExistingRawlog) {
     c = devslam::test::runAppOntoFullDisk("devslam-convert",
                                           keep.string() + " " + (dir / "y").string());
     EXPECT_EQ(c.rc, 1) << c.out;
-    EXPECT_NE(c.out.find("devslam-convert: cannot write the standard output (No space left on device)\n"), std::string::npos) << c.out;
+    EXPECT_NE(
+        c.out.find("devslam-convert: cannot write the standard output (No space left on device)\n"),
+        std::string::npos)
+        << c.out;
 }
 
 // --max-frames 0 wrote a rawlog of no frames, which no reader opens.

@@ -1029,6 +1029,9 @@ TEST(VideoReader, BadFilesAndOptionsNameTheFile) {
     expectError([&] { io::VideoReader v(tmp.str("missing.avi"), {}); }, R"(missing\.avi: no such)");
     { std::ofstream(tmp.str("text.avi")) << "not a video\n"; }
     expectError([&] { io::VideoReader v(tmp.str("text.avi"), {}); }, R"(text\.avi)");
+    // A text file named .txt: FFmpeg decodes it (its tty demuxer draws the text as frames).
+    expectError([&] { io::VideoReader v(kTum + "/rgb.txt", {}); },
+                R"(rgb\.txt: a text file, not a video \(FFmpeg would draw its text as frames\))");
     expectError<std::invalid_argument>(
         [&] {
             io::VideoReader v(kTum + "/rgb.txt", {0.0, 0.0});

@@ -503,8 +503,8 @@ TEST(RandomWorlds, EpisodeGridKeepsGoingPastAnErrorButNotPastAMethodThatCannotRu
         return r;
     };
     const auto record = [&](const GridEpisode& g) {
-        done.push_back(std::to_string(g.category) + " " + std::to_string(g.index) + " " +
-                       g.method + " " + g.world->name + " " + toString(g.result.outcome) +
+        done.push_back(std::to_string(g.category) + " " + std::to_string(g.index) + " " + g.method +
+                       " " + g.world->name + " " + toString(g.result.outcome) +
                        (g.error.empty() ? "" : " [" + g.error + "|" + g.result.reason + "]"));
     };
     const auto never = [] { return false; };

@@ -21,6 +21,12 @@ VideoReader::VideoReader(std::string path, Options opts)
     if (!cap_->open(path_, cv::CAP_FFMPEG) || !cap_->isOpened())
         throw std::runtime_error(
             path_ + ": cannot open as a video (OpenCV's FFmpeg backend does not decode it)");
+    // FFmpeg's tty demuxer takes any text file named .txt, .nfo, .asc, ... and its "ansi"
+    // decoder draws the text as 640x400 frames: a list of images given as a video ran.
+    const int ansi = cv::VideoWriter::fourcc('a', 'n', 's', 'i');
+    if (static_cast<int>(cap_->get(cv::CAP_PROP_FOURCC)) == ansi)
+        throw std::runtime_error(
+            path_ + ": a text file, not a video (FFmpeg would draw its text as frames)");
     const double fps = cap_->get(cv::CAP_PROP_FPS);
     if (fps > 0) fps_ = fps;
     const double count = cap_->get(cv::CAP_PROP_FRAME_COUNT);

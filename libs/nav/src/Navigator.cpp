@@ -81,7 +81,8 @@ std::string freeNavlogName(const std::string& dir) {
         std::snprintf(name, sizeof name, "log_%03u.reactivenavlog", k);
         const auto path = std::filesystem::path(dir) / name;
         std::error_code ec;
-        if (!std::filesystem::exists(std::filesystem::symlink_status(path, ec))) return path.string();
+        if (!std::filesystem::exists(std::filesystem::symlink_status(path, ec)))
+            return path.string();
     }
 }
 }  // namespace
