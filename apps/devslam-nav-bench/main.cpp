@@ -259,6 +259,8 @@ struct Episodes {
     double sim_seconds = 0, wall = 0;  ///< [s]
     int stopped = 0;                   ///< the signal that stopped them (Ctrl-C), else 0
     std::vector<std::string> errors;   ///< "world / method: message" of each episode that threw
+    std::size_t navlogs_cut = 0;       ///< episodes whose navlog ([navigator] log_file) is cut
+    std::string first_navlog_error;    ///< the first of them's (nav::Navigator::closeLog)
     /// (category c, method m)'s tally; an empty one where none ran.
     [[nodiscard]] const Tally& of(std::size_t c, const std::string& m) const {
         static const Tally none;
@@ -331,6 +333,8 @@ Episodes runEpisodes(const Args& a, const mrpt::config::CConfigFileBase& ini,
                 ep.errors.push_back(std::string(devslam::sim::toString(cats[g.category])) +
                                     " world " + std::to_string(a.seed + g.index) + " / " +
                                     shortName(g.method) + ": " + g.error);
+            if (!r.navlog_error.empty() && ep.navlogs_cut++ == 0)
+                ep.first_navlog_error = r.navlog_error;
             bar.update(++ep.done, std::string(devslam::sim::toString(cats[g.category])) + " " +
                                       shortName(g.method));
         },
@@ -513,9 +517,14 @@ int appMain(int argc, char** argv) {
         }
         writePictures(a, cats, ep);
         std::cerr << "devslam-nav-bench: pictures in " << a.png_dir << "\n";
+        // The INI's log_file asked for navlogs: ones cut short (a full disk) fail the command,
+        // after the results, which do not depend on them.
+        if (ep.navlogs_cut > 0)
+            std::cerr << "devslam-nav-bench: the navlogs of " << ep.navlogs_cut << " of " << ep.done
+                      << " episodes are cut short; the first: " << ep.first_navlog_error << "\n";
         // Ctrl-C during the timings: all was written; end by the signal, as a script expects.
         if (const int sig = devslam::core::stopSignal()) devslam::core::exitBySignal(sig);
-        return 0;
+        return ep.navlogs_cut > 0 ? 1 : 0;
     } catch (const std::exception& e) {
         std::cerr << "devslam-nav-bench: " << e.what() << "\n";
         return 2;

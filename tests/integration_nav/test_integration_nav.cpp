@@ -270,6 +270,43 @@ TEST(IntegrationNav, NavlogOnAFullDiskEndsTheLogNotTheRun) {
     ASSERT_TRUE(std::filesystem::exists(log));
     EXPECT_LT(std::filesystem::file_size(log), 2500000u);
     EXPECT_GT(std::filesystem::file_size(out + "/f.png"), 10000u);
+
+    // devslam-nav-bench with the INI's log_file: the same tables, and the command fails
+    // saying how many navlogs are cut. Run whole first: it makes the PTG caches (~230 kB
+    // each), which the limited run then only reads.
+    std::ifstream ini_in(kIni);
+    std::string ini((std::istreambuf_iterator<char>(ini_in)), {});
+    const std::regex log_file("\nlog_file( *)=[^\n]*"), log_dir("\nlog_directory( *)=[^\n]*");
+    ASSERT_TRUE(std::regex_search(ini, log_file) && std::regex_search(ini, log_dir));
+    ini = std::regex_replace(ini, log_file, "\nlog_file = true");
+    const auto bench = [&](const std::string& logs, const std::string& limit) {
+        std::ofstream(out + "/" + logs + ".ini")
+            << std::regex_replace(ini, log_dir, "\nlog_directory = " + out + "/" + logs);
+        const std::string c = limit + "exec " + std::string(DEVSLAM_BIN_DIR) +
+                              "/devslam-nav-bench --per-category 1 --methods CHolonomicVFHPlus "
+                              "--results none --png-dir " +
+                              out + "/p_" + logs + " --config " + out + "/" + logs + ".ini > " +
+                              out + "/" + logs + ".md 2> " + out + "/" + logs + ".err";
+        const int rc = WEXITSTATUS(std::system(c.c_str()));
+        std::ifstream md(out + "/" + logs + ".md"), err(out + "/" + logs + ".err");
+        std::string rows, line;
+        while (std::getline(md, line))
+            if (line.rfind("| VFHPlus |", 0) == 0) rows += line + "\n";
+        return std::tuple(rc, rows, std::string((std::istreambuf_iterator<char>(err)), {}));
+    };
+    const auto [rc_whole, rows_whole, err_whole] = bench("logs1", "");
+    EXPECT_EQ(rc_whole, 0) << err_whole;
+    EXPECT_EQ(std::count(rows_whole.begin(), rows_whole.end(), '\n'), 4) << rows_whole;
+    // 400 blocks: 200 kB (dash) or 400 kB (bash); each navlog is over 2 MB, each picture under
+    // 130 kB.
+    const auto [rc_cut, rows_cut, err_cut] = bench("logs2", "trap '' XFSZ; ulimit -f 400; ");
+    EXPECT_EQ(rc_cut, 1) << err_cut;
+    EXPECT_EQ(rows_cut, rows_whole);
+    EXPECT_NE(err_cut.find("devslam-nav-bench: the navlogs of 4 of 4 episodes are cut short; "
+                           "the first: cannot write navlog '" +
+                           out + "/logs2/log_000.reactivenavlog': File too large"),
+              std::string::npos)
+        << err_cut;
 }
 
 TEST(IntegrationNav, AppsSmokeTest) {
