@@ -23,12 +23,8 @@ struct CommandResult {
     bool signalled = false;  ///< signalAppWhen: the signal was sent (it had not ended before)
 };
 
-/// `<DEVSLAM_BIN_DIR>/<app> <args> <redirect>` through the shell (quote arguments with
-/// spaces); its stderr, and its stdout where `redirect` does not send it elsewhere, are read.
-inline CommandResult runAppRedirected(const std::string& app, const std::string& args,
-                                      const std::string& redirect) {
-    const std::string cmd =
-        std::string(DEVSLAM_BIN_DIR) + "/" + app + " " + args + " 2>&1 " + redirect;
+/// The shell command `cmd`: what it writes on stdout, and how it exited.
+inline CommandResult runShell(const std::string& cmd) {
     CommandResult r;
     FILE* p = popen(cmd.c_str(), "r");
     if (!p) return r;
@@ -39,9 +35,25 @@ inline CommandResult runAppRedirected(const std::string& app, const std::string&
     return r;
 }
 
+/// `<DEVSLAM_BIN_DIR>/<app> <args> <redirect>` through the shell (quote arguments with
+/// spaces); its stderr, and its stdout where `redirect` does not send it elsewhere, are read.
+inline CommandResult runAppRedirected(const std::string& app, const std::string& args,
+                                      const std::string& redirect) {
+    return runShell(std::string(DEVSLAM_BIN_DIR) + "/" + app + " " + args + " 2>&1 " + redirect);
+}
+
 /// `<DEVSLAM_BIN_DIR>/<app> <args>` through the shell (quote arguments with spaces).
 inline CommandResult runApp(const std::string& app, const std::string& args) {
     return runAppRedirected(app, args, "");
+}
+
+/// `<app> <args>` with no file it writes allowed past `bytes` (RLIMIT_FSIZE, with SIGXFSZ
+/// ignored, so the write past it fails with EFBIG, "File too large"): a disk that fills, where
+/// CI cannot mount a small one. r.out: its stdout and stderr.
+inline CommandResult runAppWithFileLimit(const std::string& app, const std::string& args,
+                                         unsigned long bytes) {
+    return runShell("trap '' XFSZ; exec prlimit --fsize=" + std::to_string(bytes) + " " +
+                    std::string(DEVSLAM_BIN_DIR) + "/" + app + " " + args + " 2>&1");
 }
 
 /// `<app> <args>` with its standard output on /dev/full, as behind a '>' on a full disk: r.out

@@ -248,17 +248,15 @@ TEST(IntegrationNav, TheIniChoosesTheHolonomicMethod) {
 TEST(IntegrationNav, NavlogOnAFullDiskEndsTheLogNotTheRun) {
     const devslam::test::TempDir dir("devslam_");
     const std::string out = dir.str();
-    // 2048 blocks: 1 MiB in dash's 512-byte blocks, 2 MiB in bash's; the picture (~120 kB)
-    // and the PTG cache files (~230 kB) fit, the navlog (~2.9 MB) does not. SIGXFSZ ignored,
-    // as the write then fails with EFBIG instead of killing the program.
+    // 1 MB: the picture (~120 kB) and the PTG cache files (~230 kB) fit, the navlog (~2.9 MB)
+    // does not.
     const std::string log = out + "/a/b/log_000.reactivenavlog";
-    const std::string cmd = "trap '' XFSZ; ulimit -f 2048; exec " + std::string(DEVSLAM_BIN_DIR) +
-                            "/devslam-nav " + kSrc + "/sim_worlds/paper_fig6.ini --png " + out +
-                            "/f.png --navlog " + out + "/a/b > " + out + "/o.txt 2>&1";
-    const int st = std::system(cmd.c_str());
-    std::ifstream in(out + "/o.txt");
-    const std::string said((std::istreambuf_iterator<char>(in)), {});
-    EXPECT_EQ(WEXITSTATUS(st), 1) << said;
+    const auto r = devslam::test::runAppWithFileLimit(
+        "devslam-nav",
+        kSrc + "/sim_worlds/paper_fig6.ini --png " + out + "/f.png --navlog " + out + "/a/b",
+        1000000);
+    const std::string& said = r.out;
+    EXPECT_EQ(r.rc, 1) << said;
     EXPECT_NE(said.find("result=success"), std::string::npos) << said;
     EXPECT_NE(said.find(" navlog=" + log + "\n"), std::string::npos) << said;
     EXPECT_NE(said.find("devslam-nav: cannot write navlog '" + log +
@@ -282,7 +280,7 @@ TEST(IntegrationNav, NavlogOnAFullDiskEndsTheLogNotTheRun) {
     const auto bench = [&](const std::string& logs, const std::string& limit) {
         std::ofstream(out + "/" + logs + ".ini")
             << std::regex_replace(ini, log_dir, "\nlog_directory = " + out + "/" + logs);
-        const std::string c = limit + "exec " + std::string(DEVSLAM_BIN_DIR) +
+        const std::string c = limit + std::string(DEVSLAM_BIN_DIR) +
                               "/devslam-nav-bench --per-category 1 --methods CHolonomicVFHPlus "
                               "--results none --png-dir " +
                               out + "/p_" + logs + " --config " + out + "/" + logs + ".ini > " +
@@ -294,12 +292,13 @@ TEST(IntegrationNav, NavlogOnAFullDiskEndsTheLogNotTheRun) {
             if (line.rfind("| VFHPlus |", 0) == 0) rows += line + "\n";
         return std::tuple(rc, rows, std::string((std::istreambuf_iterator<char>(err)), {}));
     };
-    const auto [rc_whole, rows_whole, err_whole] = bench("logs1", "");
+    const auto [rc_whole, rows_whole, err_whole] = bench("logs1", "exec ");
     EXPECT_EQ(rc_whole, 0) << err_whole;
     EXPECT_EQ(std::count(rows_whole.begin(), rows_whole.end(), '\n'), 4) << rows_whole;
-    // 400 blocks: 200 kB (dash) or 400 kB (bash); each navlog is over 2 MB, each picture under
-    // 130 kB.
-    const auto [rc_cut, rows_cut, err_cut] = bench("logs2", "trap '' XFSZ; ulimit -f 400; ");
+    // (Its tables on stdout, apart: runAppWithFileLimit mixes stderr into them.) 300 kB: each
+    // navlog is over 2 MB, each picture under 130 kB.
+    const auto [rc_cut, rows_cut, err_cut] =
+        bench("logs2", "trap '' XFSZ; exec prlimit --fsize=300000 ");
     EXPECT_EQ(rc_cut, 1) << err_cut;
     EXPECT_EQ(rows_cut, rows_whole);
     EXPECT_NE(err_cut.find("devslam-nav-bench: the navlogs of 4 of 4 episodes are cut short; "

@@ -270,6 +270,41 @@ TEST(DevslamConvert, RefusesToWriteOverAnExistingRawlog) {
         << c.out;
 }
 
+// A disk that fills during a conversion (a file-size limit stands in for one): the frame it
+// stopped at and the system's reason are named, and the frames before it are kept, said to be
+// cut short; a TUM folder written from a rawlog stops the same way.
+TEST(DevslamConvert, ADiskThatFillsStopsItSayingWhereAndWhy) {
+    const devslam::test::TempDir d("devslam_");
+    const fs::path dir = d.str();
+    const std::string tum = std::string(DEVSLAM_SOURCE_DIR) + "/data/tum/fr1_xyz_first37";
+    // ~600 kB per frame: the second one does not fit in 1 MB.
+    const std::string cut = (dir / "cut.rawlog").string();
+    auto c = devslam::test::runAppWithFileLimit("devslam-convert", tum + " " + cut, 1000000);
+    EXPECT_EQ(c.rc, 1) << c.out;
+    EXPECT_NE(c.out.find("devslam-convert: cannot write rawlog '" + cut + "' at " + tum +
+                         "/rgb/1305031102.211214.png: File too large\n"),
+              std::string::npos)
+        << c.out;
+    EXPECT_NE(c.out.find("devslam-convert: stopped there; " + cut +
+                         " holds the 1 frames before it, but not whole"),
+              std::string::npos)
+        << c.out;
+    EXPECT_TRUE(fs::exists(cut));
+    // The other way: a rawlog into a TUM folder whose images do not fit.
+    const std::string whole = (dir / "whole.rawlog").string();
+    c = devslam::test::runApp("devslam-convert", tum + " " + whole + " --max-frames 3");
+    ASSERT_EQ(c.rc, 0) << c.out;
+    c = devslam::test::runAppWithFileLimit("devslam-convert",
+                                           whole + " " + (dir / "folder").string(), 100000);
+    EXPECT_EQ(c.rc, 1) << c.out;
+    EXPECT_NE(c.out.find("devslam-convert: cannot write '" + (dir / "folder/rgb/").string()),
+              std::string::npos)
+        << c.out;
+    EXPECT_NE(c.out.find(".png': File too large\n"), std::string::npos) << c.out;
+    EXPECT_NE(c.out.find("nothing was written"), std::string::npos) << c.out;
+    EXPECT_FALSE(fs::exists(dir / "folder"));
+}
+
 // --max-frames 0 wrote a rawlog of no frames, which no reader opens.
 TEST(DevslamConvert, MaxFramesMustBeAtLeastOne) {
     const devslam::test::TempDir d("devslam_");

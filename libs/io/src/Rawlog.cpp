@@ -561,10 +561,13 @@ void RawlogWriter::write(const core::Frame& f) {
             arch << *obs;
         }
     } catch (const std::exception& e) {
-        // MRPT's message is a stack trace ("Cannot write bytes to stream!"): its first line,
+        // MRPT's message is a stack trace ("Cannot write bytes to stream!"): the system's
+        // reason where the stream has one ("No space left on device"), else MRPT's first line,
         // with the file and frame.
-        throw std::runtime_error("cannot write rawlog '" + path_ + "' at " + what + ": " +
-                                 core::innermostMessage(e.what()) + " (disk full?)");
+        const std::string why = stream_->lastError().empty()
+                                    ? core::innermostMessage(e.what()) + " (disk full?)"
+                                    : stream_->lastError();
+        throw std::runtime_error("cannot write rawlog '" + path_ + "' at " + what + ": " + why);
     }
     ++count_;
 }

@@ -5,7 +5,9 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -83,7 +85,12 @@ void requireWholePng(const std::string& path) {
 }  // namespace
 
 void writePng(const std::string& path, const cv::Mat& image) {
-    if (!cv::imwrite(path, image)) throw std::runtime_error("cannot write '" + path + "'");
+    errno = 0;
+    if (!cv::imwrite(path, image))
+        // The system's reason where the write set one ("File too large", "No space left on
+        // device"; OpenCV's PNG encoder writes through stdio), which cv::imwrite does not say.
+        throw std::runtime_error("cannot write '" + path + "'" +
+                                 (errno != 0 ? std::string(": ") + std::strerror(errno) : ""));
     requireWholePng(path);
 }
 
