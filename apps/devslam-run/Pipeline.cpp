@@ -3,6 +3,7 @@
 #include "MaskSource.h"
 
 #include <devslam/core/Config.h>
+#include <devslam/core/GzFile.h>
 #include <devslam/core/Interrupt.h>
 #include <devslam/core/Pose.h>
 #include <devslam/core/Progress.h>
@@ -18,8 +19,9 @@
 #include <ctime>
 #include <filesystem>
 #include <fstream>
-#include <iostream>
+#include <functional>
 #include <future>
+#include <iostream>
 #include <sstream>
 
 namespace devslam::run {
@@ -317,22 +319,34 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
               "loops.txt", "map.ply", "map.3Dscene", "map_grid.png", "map_grid.gridmap",
               "trajectory.png", "mask_errors.csv"})
             fs::remove(fs::path(rc.out_dir) / f);
-        auto out = [&](const std::string& name) {
-            std::string p = (fs::path(rc.out_dir) / name).string();
-            rep.outputs.push_back(p);
-            return p;
+        auto out = [&](const std::string& name) { return (fs::path(rc.out_dir) / name).string(); };
+        // Each output on its own: one that cannot be written (a full disk) is named in
+        // output_errors, and the others are still tried; the figures are printed whatever.
+        const auto write = [&](const std::string& path, const std::function<void()>& fn) {
+            try {
+                fn();
+                rep.outputs.push_back(path);
+            } catch (const std::exception& e) {
+                rep.output_errors.push_back(core::innermostMessage(e.what()));
+            }
         };
         std::string lost_note =
             "lost frames (motion-model pose): " + std::to_string(rep.lost.size());
-        io::writeTumTrajectory(out("trajectory.txt"), rep.trajectory,
-                               "DEV-SLAM per-frame trajectory, mode " + rc.mode + "; " + lost_note);
-        io::writeTumTrajectory(out("keyframes.txt"), rep.keyframe_trajectory,
-                               "DEV-SLAM keyframe trajectory, mode " + rc.mode);
+        write(out("trajectory.txt"), [&] {
+            io::writeTumTrajectory(
+                out("trajectory.txt"), rep.trajectory,
+                "DEV-SLAM per-frame trajectory, mode " + rc.mode + "; " + lost_note);
+        });
+        write(out("keyframes.txt"), [&] {
+            io::writeTumTrajectory(out("keyframes.txt"), rep.keyframe_trajectory,
+                                   "DEV-SLAM keyframe trajectory, mode " + rc.mode);
+        });
         {
             std::ostringstream lf;  // each file written whole, or an error
             lf << "# index timestamp (frames without a tracked pose)\n";
             for (std::size_t i : rep.lost) lf << i << " " << num(rep.trajectory[i].t, 6) << "\n";
-            core::writeFileWhole(out("lost_frames.txt"), lf.str());
+            write(out("lost_frames.txt"),
+                  [&] { core::writeFileWhole(out("lost_frames.txt"), lf.str()); });
         }
         {
             std::ostringstream lp;
@@ -347,9 +361,9 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
                    << num(q.w(), 7) << " " << (l.error_m ? num(*l.error_m) : "-") << " "
                    << (l.error_deg ? num(*l.error_deg, 3) : "-") << "\n";
             }
-            core::writeFileWhole(out("loops.txt"), lp.str());
+            write(out("loops.txt"), [&] { core::writeFileWhole(out("loops.txt"), lp.str()); });
         }
-        slam::writePly(out("map.ply"), slam.map());
+        write(out("map.ply"), [&] { slam::writePly(out("map.ply"), slam.map()); });
         std::optional<core::Trajectory> gt_in_est;
         if (rep.ate && rep.ground_truth) {
             // Ground truth brought into the SLAM frame for the 3D view.
@@ -362,7 +376,9 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
             }
             gt_in_est = g;
         }
-        slam::write3DScene(out("map.3Dscene"), slam.map(), rep.trajectory, gt_in_est);
+        write(out("map.3Dscene"), [&] {
+            slam::write3DScene(out("map.3Dscene"), slam.map(), rep.trajectory, gt_in_est);
+        });
         // A grid too large for its [grid_map] resolution is left out, not the run's other
         // outputs.
         std::optional<mrpt::maps::COccupancyGridMap2D> grid;
@@ -373,13 +389,15 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
         }
         if (grid) {
             const std::string stem = (fs::path(rc.out_dir) / "map_grid").string();
-            slam::saveGrid(*grid, stem);
-            rep.outputs.push_back(stem + ".png");
-            rep.outputs.push_back(stem + ".gridmap");
+            const std::size_t errors = rep.output_errors.size();
+            write(stem + ".png", [&] { slam::saveGrid(*grid, stem); });
+            if (rep.output_errors.size() == errors) rep.outputs.push_back(stem + ".gridmap");
         }
         if (rep.ate)
-            eval::plotAte(out("trajectory.png"), *rep.ate,
-                          fs::path(rc.input).filename().string() + ", mode " + rc.mode);
+            write(out("trajectory.png"), [&] {
+                eval::plotAte(out("trajectory.png"), *rep.ate,
+                              fs::path(rc.input).filename().string() + ", mode " + rc.mode);
+            });
         if (rep.mask_score) {
             std::ostringstream mf;
             mf << "# person instances the masks got wrong (renderer truth): walkers not masked, "
@@ -397,10 +415,14 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
                    << num(e.masked_fraction, 3) << "," << e.filter_box << "," << num(e.box_cover, 2)
                    << "\n";
             }
-            core::writeFileWhole(out("mask_errors.csv"), mf.str());
+            write(out("mask_errors.csv"),
+                  [&] { core::writeFileWhole(out("mask_errors.csv"), mf.str()); });
         }
         rep.peak_rss_mb = peakRssMb();
-        core::writeFileWhole(out("run.json"), toJson(rep));
+        // run.json says the outputs are whole: not written beside ones that are not (it would
+        // pass the run for a whole one, to devslam-bench too).
+        if (rep.output_errors.empty())
+            write(out("run.json"), [&] { core::writeFileWhole(out("run.json"), toJson(rep)); });
     }
     rep.peak_rss_mb = peakRssMb();
     return rep;

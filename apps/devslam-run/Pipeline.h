@@ -96,6 +96,10 @@ struct RunReport {
     double map_mb = 0;       ///< approximate map heap
     double bytes_per_keyframe = 0;
     std::vector<std::string> outputs;  ///< files written
+    /// Outputs that could not be written ("cannot write 'PATH': No space left on device"):
+    /// each output is tried on its own, so one that fails loses neither the others nor the
+    /// figures.
+    std::vector<std::string> output_errors;
     /// The masks scored against the person truth (rendered inputs only).
     std::optional<eval::MaskScore> mask_score;
     std::vector<LoopReport> loop_reports;  ///< every closed loop (loops.txt)

@@ -250,6 +250,12 @@ int runOnce(const Args& a) {
         return 1;
     }
     std::cout << run::formatSummary(rep);
+    // Outputs the disk did not take: named, after the figures (whole, above).
+    for (const auto& e : rep.output_errors) std::cerr << "devslam-run: " << e << "\n";
+    if (!rep.output_errors.empty())
+        std::cerr << "devslam-run: " << rep.output_errors.size() << " of the run's outputs in "
+                  << a.out << " were not written, nor run.json (which says they are whole); "
+                  << "the figures above are whole\n";
     const std::string kept = a.out.empty() ? std::string() : "; " + a.out + " holds their results";
     if (!rep.read_error.empty()) {
         std::cerr << "devslam-run: " << rep.read_error << "\ndevslam-run: stopped after "
@@ -264,7 +270,7 @@ int runOnce(const Args& a) {
     if (core::stopSignal())  // it came after the last frame was read (finalize, outputs)
         std::cerr << "devslam-run: " << core::signalName(core::stopSignal())
                   << " came after the last frame; the run is whole\n";
-    return 0;
+    return rep.output_errors.empty() ? 0 : 1;
 }
 
 std::string fmt(double v, int p) {

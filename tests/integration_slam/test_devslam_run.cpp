@@ -75,6 +75,33 @@ TEST(DevslamRun, WritesEveryOutputAndPrintsTheSummary) {
     fs::remove_all(out);
 }
 
+// A disk that fills while the outputs are written (a file-size limit stands in for one): the
+// first output it refused ended the run before its summary, the figures lost, and left that
+// output cut. Now each output is tried on its own, the ones refused are named with the
+// system's reason, the summary is printed whole, and no run.json passes the folder for whole.
+TEST(DevslamRun, ADiskThatFillsLosesNeitherTheFiguresNorTheOtherOutputs) {
+    const devslam::test::TempDir d("devslam_");
+    const fs::path out = d.str("run");
+    // 50 kB: the trajectories fit, the ATE plot (~200 kB) does not.
+    const auto r = devslam::test::runAppWithFileLimit(
+        "devslam-run", "--max-frames 10 --quiet --out " + out.string(), 50000);
+    EXPECT_EQ(r.rc, 1) << r.out;
+    EXPECT_NE(r.out.find("ATE        : RMSE"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("devslam-run: cannot write plot '" + (out / "trajectory.png").string() +
+                         "': File too large\n"),
+              std::string::npos)
+        << r.out;
+    EXPECT_NE(r.out.find(" of the run's outputs in " + out.string() +
+                         " were not written, nor run.json (which says they are whole); the "
+                         "figures above are whole\n"),
+              std::string::npos)
+        << r.out;
+    EXPECT_FALSE(fs::exists(out / "run.json"));
+    EXPECT_EQ(lines(out / "trajectory.txt"), 10u);
+    for (const auto& e : fs::directory_iterator(out))  // none left cut, under its name or .part
+        EXPECT_LT(fs::file_size(e.path()), 50000u) << e.path();
+}
+
 TEST(DevslamRun, BadInputIsReported) {
     auto r = run("--mode flying --quiet --out ''");
     EXPECT_EQ(r.rc, 1);

@@ -1,5 +1,6 @@
 // Unit tests of devslam::slam with known answers (synthetic geometry, fixed seeds).
 #include <devslam/core/Config.h>
+#include <devslam/core/GzFile.h>
 #include <devslam/slam/KeyframeSelector.h>
 #include <devslam/slam/LocalBundleAdjuster.h>
 #include <devslam/slam/LoopDetector.h>
@@ -13,6 +14,7 @@
 #include <devslam/slam/Tracker.h>
 
 #include "ConfigRoundTrip.h"
+#include "Scratch.h"
 
 #include <gtest/gtest.h>
 #include <mrpt/config/CConfigFileMemory.h>
@@ -21,6 +23,7 @@
 #include <cmath>
 #include <cstdint>
 #include <filesystem>
+#include <fstream>
 #include <random>
 
 using namespace devslam;
@@ -677,14 +680,29 @@ TEST(Matching, HammingAndBruteForce) {
 TEST(MapExporter, AFullDiskIsAnError) {
     // The header of an empty map fits the stream's buffer, which goes out (and fails) only at
     // the close: the lost file passed for written.
-    if (!std::filesystem::exists("/dev/full")) GTEST_SKIP() << "no /dev/full";
+    ASSERT_TRUE(std::filesystem::exists("/dev/full")) << "Linux has /dev/full";
     try {
         writePly("/dev/full", Map{});
         ADD_FAILURE() << "no error on a full disk";
     } catch (const std::runtime_error& e) {
-        EXPECT_NE(std::string(e.what()).find("error writing PLY '/dev/full'"), std::string::npos)
-            << e.what();
+        EXPECT_EQ(std::string(e.what()), "PLY: cannot write '/dev/full': No space left on device");
     }
+    // The gzip archives (.3Dscene, .gridmap) name the file and why; no .part is left, and an
+    // earlier file stays as it was.
+    const devslam::test::TempDir d("devslam_");
+    const std::string scene = d.str("map.3Dscene");
+    std::ofstream(scene) << "earlier";
+    try {
+        write3DScene(d.str("no/such/map.3Dscene"), Map{}, {}, std::nullopt);
+        ADD_FAILURE() << "wrote into a folder that is not there";
+    } catch (const std::runtime_error& e) {
+        EXPECT_EQ(std::string(e.what()), "cannot write 3D scene '" + d.str("no/such/map.3Dscene") +
+                                             "': No such file or directory");
+    }
+    EXPECT_NO_THROW(write3DScene(scene, Map{}, {}, std::nullopt));
+    EXPECT_EQ(devslam::core::gzipDamage(scene), "");
+    EXPECT_GT(std::filesystem::file_size(scene), 100u);
+    EXPECT_FALSE(std::filesystem::exists(scene + ".part"));
 }
 
 TEST(Map, ObservationsAndRemovalStayConsistent) {

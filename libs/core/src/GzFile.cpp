@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstring>
+#include <filesystem>
 #include <stdexcept>
 #include <utility>
 #include <vector>
@@ -61,6 +62,31 @@ void GzOutputStream::close() {
     if (error_.empty()) error_ = rc == Z_ERRNO && errno != 0 ? std::strerror(errno) : "write error";
     throw std::runtime_error("error writing " + kind_ + " '" + path_ +
                              "': its end was not written (disk full?), the file is cut short");
+}
+
+void writeGzFileWhole(const std::string& path, const std::string& kind,
+                      const std::function<void(mrpt::io::CStream&)>& write) {
+    const std::string part = path + ".part";
+    std::string why;
+    try {
+        GzOutputStream s(part, 1, kind);
+        try {
+            write(s);
+            s.close();
+        } catch (const std::exception& e) {
+            why = !s.lastError().empty() ? s.lastError() : innermostMessage(e.what());
+        }
+    } catch (const std::exception& e) {  // not made (its folder is not there, ...)
+        why = std::strerror(errno != 0 ? errno : EIO);
+    }
+    std::error_code ec;
+    if (why.empty()) {
+        std::filesystem::rename(part, path, ec);
+        if (!ec) return;
+        why = ec.message();
+    }
+    std::filesystem::remove(part, ec);
+    throw std::runtime_error("cannot write " + kind + " '" + path + "': " + why);
 }
 
 std::string gzipDamage(const std::string& path) {

@@ -196,7 +196,7 @@ void writeFileWhole(const std::string& link, const std::string& text) {
     const std::string part = path + ".part";
     if (const std::string why = writeText(part, text); !why.empty()) {
         std::filesystem::remove(part, ec);
-        throw std::runtime_error("cannot write '" + part + "': " + why);
+        throw std::runtime_error("cannot write '" + path + "': " + why);  // (the .part is gone)
     }
     // The file keeps its permissions (the .part got the default ones).
     if (exists) fs::permissions(part, st.permissions(), ec);

@@ -6,8 +6,10 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -149,7 +151,10 @@ void plotAte(const std::string& path, const AteResult& ate, const std::string& t
         p.line(canvas, t, g, cv::Scalar(0, 0, 0), 2);
         p.line(canvas, t, e, cv::Scalar(30, 120, 255), 1);
     }
-    if (!cv::imwrite(path, canvas)) throw std::runtime_error("cannot write plot '" + path + "'");
+    errno = 0;  // cv::imwrite does not say why; the system's reason, where the write set one
+    if (!cv::imwrite(path, canvas))
+        throw std::runtime_error("cannot write plot '" + path + "'" +
+                                 (errno != 0 ? std::string(": ") + std::strerror(errno) : ""));
 }
 
 }  // namespace devslam::eval

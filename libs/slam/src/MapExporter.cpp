@@ -1,9 +1,10 @@
 #include <devslam/core/Config.h>
+#include <devslam/core/GzFile.h>
 #include <devslam/core/Pose.h>
+#include <devslam/core/Results.h>
 #include <devslam/slam/MapExporter.h>
 
 #include <mrpt/config/CConfigFileBase.h>
-#include <mrpt/io/CFileGZOutputStream.h>
 #include <mrpt/opengl/CGridPlaneXY.h>
 #include <mrpt/opengl/COpenGLScene.h>
 #include <mrpt/opengl/CPointCloudColoured.h>
@@ -22,8 +23,7 @@
 namespace devslam::slam {
 
 void writePly(const std::string& path, const Map& map) {
-    std::ofstream out(path);
-    if (!out) throw std::runtime_error("cannot write PLY '" + path + "'");
+    std::ostringstream out;  // written whole or not at all, and a failure says why
     out << "ply\nformat ascii 1.0\ncomment DEV-SLAM landmarks, SLAM world frame (first camera "
            "optical frame), metres\nelement vertex "
         << map.landmarks().size()
@@ -41,8 +41,11 @@ void writePly(const std::string& path, const Map& map) {
                       l.p_w.z(), l.color[2], l.color[1], l.color[0]);
         out << line;
     }
-    out.close();  // flushed here: a full disk is found now, not lost in the destructor
-    if (!out) throw std::runtime_error("error writing PLY '" + path + "'");
+    try {
+        core::writeFileWhole(path, out.str());
+    } catch (const std::exception& e) {  // "cannot write 'PATH': why"
+        throw std::runtime_error(std::string("PLY: ") + e.what());
+    }
 }
 
 namespace {
@@ -89,7 +92,11 @@ void write3DScene(const std::string& path, const Map& map, const core::Trajector
     scene.insert(polyline(estimate, 1.f, 0.f, 0.f));
     if (ground_truth) scene.insert(polyline(*ground_truth, 0.f, 0.8f, 0.f));
     scene.insert(mrpt::opengl::CGridPlaneXY::Create(-2, 2, -2, 2, -1.0, 0.5));
-    if (!scene.saveToFile(path)) throw std::runtime_error("cannot write 3D scene '" + path + "'");
+    // (COpenGLScene::saveToFile's gzip stream cut the file short on a full disk, saying
+    // nothing: the same archive through core::writeGzFileWhole.)
+    core::writeGzFileWhole(path, "3D scene", [&](mrpt::io::CStream& s) {
+        mrpt::serialization::archiveFrom(s) << scene;
+    });
 }
 
 void GridMapOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, const std::string& s) {
@@ -187,11 +194,9 @@ std::optional<mrpt::maps::COccupancyGridMap2D> buildOccupancyGrid(const Map& map
 void saveGrid(const mrpt::maps::COccupancyGridMap2D& grid, const std::string& stem) {
     if (!grid.saveAsBitmapFile(stem + ".png"))
         throw std::runtime_error("cannot write grid image '" + stem + ".png'");
-    mrpt::io::CFileGZOutputStream f;
-    if (!f.open(stem + ".gridmap"))
-        throw std::runtime_error("cannot write grid map '" + stem + ".gridmap'");
-    auto arch = mrpt::serialization::archiveFrom(f);
-    arch << grid;
+    core::writeGzFileWhole(stem + ".gridmap", "grid map", [&](mrpt::io::CStream& s) {
+        mrpt::serialization::archiveFrom(s) << grid;
+    });
 }
 
 }  // namespace devslam::slam

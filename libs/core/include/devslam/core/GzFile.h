@@ -9,6 +9,7 @@
 #include <mrpt/io/CStream.h>
 
 #include <cstdint>
+#include <functional>
 #include <string>
 
 namespace devslam::core {
@@ -48,6 +49,14 @@ class GzOutputStream : public mrpt::io::CStream {
     void* gz_ = nullptr;  // gzFile, kept out of this header with <zlib.h>
     uint64_t written_ = 0;
 };
+
+/// Writes a gzip file whole or not at all: `write` fills a GzOutputStream into `path`.part,
+/// which is closed and renamed over `path`. Throws std::runtime_error "cannot write <kind>
+/// '<path>': <why>" (the .part removed, `path` left as it was) when any of it fails. For
+/// MRPT's archives (`archiveFrom(s) << object`), which CFileGZOutputStream cut short on a
+/// full disk without a word.
+void writeGzFileWhole(const std::string& path, const std::string& kind,
+                      const std::function<void(mrpt::io::CStream&)>& write);
 
 /// A gzip stream cut short decodes cleanly up to the cut, and MRPT's stream reports a plain
 /// end of file there (or, reading an archive, nothing at all); only zlib knows the trailer
