@@ -450,6 +450,16 @@ TEST(Config, NulByteIsRefusedWithItsLine) {
     }
 }
 
+// A UTF-8 byte-order mark (Windows editors write one) made line 1 "neither a [section] nor
+// a key = value".
+TEST(Config, AByteOrderMarkIsNotPartOfTheFirstLine) {
+    devslam::test::TempDir d("devslam_core_");
+    const std::string path = d.str("bom.ini");
+    std::ofstream(path, std::ios::binary) << "\xEF\xBB\xBF[run]\r\nmode = none\r\n";
+    const auto ini = loadIni(path);
+    EXPECT_EQ(ini->read_string("run", "mode", "", true), "none");
+}
+
 TEST(Config, UnknownSectionsAndKeysBeforeAnySectionAreErrors) {
     const std::vector<std::string> known{"room", "box_*"};
     mrpt::config::CConfigFileMemory ok("[room]\nsize = 1\n[box_desk]\nx = 2\n[box_]\n");

@@ -181,6 +181,49 @@ TEST(TumReader, MalformedListsNameFileAndLine) {
     expectError([&] { (void)io::openRgbd(d.str("nothing_here")); }, "no such TUM folder or rawlog");
 }
 
+// Lists as other tools write them: a byte-order mark and CRLF (Windows editors), an image
+// given by its absolute path (it was looked for under the folder), a '#' inside a file name
+// (it was cut there as a comment; TUM's associate.py keeps it), a comment after the values.
+TEST(TumReader, ListsFromOtherToolsReadAsTheTumToolsReadThem) {
+    TempDir d;
+    copyTumSubset(d.str("s"), 2);
+    std::vector<core::Frame> plain;
+    {
+        io::TumReader r(d.str("s"));
+        for (std::size_t i = 0; i < r.size(); ++i) plain.push_back(r.read(i));
+    }
+    std::vector<std::string> rgb_lines;
+    {
+        std::ifstream in(d.str("s/rgb.txt"));
+        for (std::string line; std::getline(in, line);)
+            if (!line.empty() && line[0] != '#') rgb_lines.push_back(line);
+    }
+    ASSERT_EQ(rgb_lines.size(), 2u);
+    const auto name = [](const std::string& l) { return l.substr(l.find(' ') + 1); };
+    const auto stamp = [](const std::string& l) { return l.substr(0, l.find(' ')); };
+    fs::rename(d.str("s/" + name(rgb_lines[1])), d.str("s/rgb/take#2.png"));
+    writeText(d.str("s/rgb.txt"), "\xEF\xBB\xBF# colour images\r\n" + stamp(rgb_lines[0]) + " " +
+                                      d.str("s/" + name(rgb_lines[0])) + "  # absolute\r\n" +
+                                      stamp(rgb_lines[1]) + " rgb/take#2.png\r\n");
+    std::string depth;
+    {
+        std::ifstream in(d.str("s/depth.txt"));
+        std::stringstream ss;
+        ss << in.rdbuf();
+        depth = ss.str();
+    }
+    writeText(d.str("s/depth.txt"), "\xEF\xBB\xBF" + depth);
+    io::TumReader odd(d.str("s"));
+    ASSERT_EQ(odd.size(), plain.size());
+    for (std::size_t i = 0; i < odd.size(); ++i) {
+        const auto &a = plain[i], b = odd.read(i);
+        EXPECT_EQ(a.timestamp, b.timestamp) << i;
+        EXPECT_EQ(cv::norm(a.bgr, b.bgr, cv::NORM_INF), 0.0) << i;
+        EXPECT_EQ(cv::norm(a.depth, b.depth, cv::NORM_INF), 0.0) << i;
+    }
+    EXPECT_EQ(odd.read(1).rgb_source, d.str("s") + "/rgb/take#2.png");
+}
+
 TEST(TumReader, BadImagesNameTheFile) {
     TempDir d;
     copyTumSubset(d.str("s"), 3);

@@ -125,9 +125,13 @@ std::unique_ptr<mrpt::config::CConfigFileMemory> loadIni(const std::string& path
     std::stringstream ss;
     ss << in.rdbuf();
     if (in.bad()) throw std::runtime_error("cannot read INI file '" + path + "'");
-    refuseMisreadLines(ss.str(), path);
+    // A UTF-8 byte-order mark (Windows editors write one) made the first line "neither a
+    // [section] nor a key = value", and MRPT lost the first section to it.
+    std::string text = ss.str();
+    if (text.rfind("\xEF\xBB\xBF", 0) == 0) text.erase(0, 3);
+    refuseMisreadLines(text, path);
     try {
-        return std::make_unique<mrpt::config::CConfigFileMemory>(ss.str());
+        return std::make_unique<mrpt::config::CConfigFileMemory>(text);
     } catch (const std::exception& e) {
         // MRPT's parser says "Line 73: Unknown variable ${REF_DIST}" (an @define missing or
         // misspelt) and names no file.

@@ -5,6 +5,7 @@
 #include <opencv2/imgcodecs.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -22,8 +23,16 @@ void forEachDataLine(const std::string& path,
     int n = 0;
     while (std::getline(in, line)) {
         ++n;
-        const auto hash = line.find('#');
-        if (hash != std::string::npos) line.resize(hash);
+        // A UTF-8 byte-order mark (Windows editors write one) is not part of the first line.
+        if (n == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);
+        // A comment: from a '#' that starts the line or a word ("# note" after the values), not
+        // one inside a file name ("take#2.png"), which the TUM tools read as part of it.
+        for (std::size_t hash = line.find('#'); hash != std::string::npos;
+             hash = line.find('#', hash + 1))
+            if (hash == 0 || std::isspace(static_cast<unsigned char>(line[hash - 1]))) {
+                line.resize(hash);
+                break;
+            }
         std::istringstream ss(line);
         std::vector<std::string> tokens;
         for (std::string t; ss >> t;) tokens.push_back(t);

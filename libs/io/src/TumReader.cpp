@@ -92,7 +92,7 @@ TumReader::TumReader(std::string folder, ReaderOptions opts)
         bool complete = true;
         for (const auto* e : {&rgb[i], &depth[j]}) {
             const std::string list = e == &rgb[i] ? "/rgb.txt" : "/depth.txt";
-            if (fs::exists(folder_ + "/" + e->file)) continue;
+            if (fs::exists(imagePath(e->file))) continue;
             missing.push_back(
                 detail::lineError(folder_ + list, e->line, "image '" + e->file + "' not found"));
             complete = false;
@@ -144,6 +144,10 @@ TumReader::TumReader(std::string folder, ReaderOptions opts)
     }
 }
 
+std::string TumReader::imagePath(const std::string& listed) const {
+    return fs::path(listed).is_absolute() ? listed : folder_ + "/" + listed;
+}
+
 core::Frame TumReader::read(std::size_t i) const {
     if (i >= pairs_.size())
         throw std::out_of_range(folder_ + ": frame " + std::to_string(i) + " of " +
@@ -154,7 +158,7 @@ core::Frame TumReader::read(std::size_t i) const {
     f.timestamp = r.t;
     f.depth_timestamp = d.t;
     f.K = K_;
-    loadTumImages(folder_ + "/" + r.file, folder_ + "/" + d.file, opts_.tum_depth_scale, f);
+    loadTumImages(imagePath(r.file), imagePath(d.file), opts_.tum_depth_scale, f);
     if (f.K.width != f.bgr.cols || f.K.height != f.bgr.rows) {
         // Presets are for 640x480; other sizes need explicit intrinsics.
         throw std::runtime_error(f.rgb_source + ": image is " + std::to_string(f.bgr.cols) + "x" +

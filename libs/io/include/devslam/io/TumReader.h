@@ -52,6 +52,8 @@ class TumReader final : public RgbdReader {
     [[nodiscard]] core::Frame read(std::size_t i) const;
 
   private:
+    /// A listed image's file: as listed where that is absolute, else in the folder.
+    [[nodiscard]] std::string imagePath(const std::string& listed) const;
     std::string folder_;
     ReaderOptions opts_;
     core::CameraIntrinsics K_;
