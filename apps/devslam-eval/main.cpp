@@ -99,6 +99,12 @@ static int appMain(int argc, char** argv) {
                                                 "' is the input '" + in +
                                                 "': writing it would destroy it; name another");
             }
+        // Both outputs in one file: the plot replaced the JSON, and the command said 0.
+        if (!json.empty() && !plot.empty() &&
+            (std::filesystem::weakly_canonical(json) == std::filesystem::weakly_canonical(plot) ||
+             devslam::core::sameFile(json, plot)))
+            throw std::invalid_argument("--json and --plot are the same file '" + plot +
+                                        "': the plot would replace the figures; name two");
         const auto gt = devslam::io::readTumTrajectory(pos[0]);
         auto est = devslam::io::readTumTrajectory(pos[1]);
         const auto ate = devslam::eval::computeAte(gt, est, ao);

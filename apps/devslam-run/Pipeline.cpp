@@ -395,8 +395,11 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
         }
         if (rep.ate)
             write(out("trajectory.png"), [&] {
-                eval::plotAte(out("trajectory.png"), *rep.ate,
-                              fs::path(rc.input).filename().string() + ", mode " + rc.mode);
+                // The input's name, also when given with a trailing '/' (the title was empty).
+                const fs::path in = fs::path(rc.input).lexically_normal();
+                const std::string name =
+                    (in.has_filename() ? in.filename() : in.parent_path().filename()).string();
+                eval::plotAte(out("trajectory.png"), *rep.ate, name + ", mode " + rc.mode);
             });
         if (rep.mask_score) {
             std::ostringstream mf;

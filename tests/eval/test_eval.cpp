@@ -460,7 +460,10 @@ TEST(Report, RefusesOverflowNonFiniteJsonAndOutputsThatAreInputs) {
              {g + " " + far + " --json " + d.str("j.json"), "far.txt line 2: tx 1e200"},
              {g + " " + e + " --json " + e, "--json '" + e + "' is the input '" + e + "'"},
              {g + " " + e + " --json " + g, "--json '" + g + "' is the input '" + g + "'"},
-             {g + " " + e + " --json --plot " + d.str("p.png"), "--json needs a value"}}) {
+             {g + " " + e + " --json --plot " + d.str("p.png"), "--json needs a value"},
+             {g + " " + e + " --json " + d.str("p.png") + " --plot " + d.str("x/../p.png"),
+              "--json and --plot are the same file '" + d.str("x/../p.png") +
+                  "': the plot would replace the figures; name two"}}) {
         const auto r = devslam::test::runApp("devslam-eval", args);
         EXPECT_EQ(r.rc, 1) << args << "\n" << r.out;
         EXPECT_NE(r.out.find(says), std::string::npos) << args << "\n" << r.out;
