@@ -238,12 +238,14 @@ int convert(int argc, char** argv) {
             }
         };
         if (isRawlog(args.output)) {
-            devslam::io::RawlogWriter out(args.output, args.wo);
+            auto wo = args.wo;
+            wo.fresh = true;  // (refused above if it is there; this catches one made since)
+            devslam::io::RawlogWriter out(args.output, wo);
             c.copy(*reader, out, args, bar);
             finish([&] { out.close(); });
         } else {
             devslam::io::TumWriter out(args.output,
-                                       "converted by devslam-convert from " + args.input);
+                                       "converted by devslam-convert from " + args.input, true);
             c.copy(*reader, out, args, bar);
             finish([&] {
                 if (auto gt = reader->groundTruth()) out.writeGroundTruth(*gt);

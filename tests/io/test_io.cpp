@@ -224,6 +224,27 @@ TEST(TumReader, ListsFromOtherToolsReadAsTheTumToolsReadThem) {
     EXPECT_EQ(odd.read(1).rgb_source, d.str("s") + "/rgb/take#2.png");
 }
 
+// devslam-convert's writers make their output exclusively: of two conversions into one
+// output started at once, one was refused only by a check both passed, and both wrote it
+// (a rawlog that did not decode, both saying "wrote 5 frames").
+TEST(Writers, FreshOutputsRefuseOneThatIsThere) {
+    TempDir d;
+    const std::string rawlog = d.str("a.rawlog");
+    writeText(rawlog, "made by another run");
+    io::RawlogWriterOptions wo;
+    wo.fresh = true;
+    expectError([&] { io::RawlogWriter w(rawlog, wo); },
+                "^cannot write rawlog '.*a\\.rawlog': File exists$");
+    wo.fresh = false;
+    EXPECT_NO_THROW(io::RawlogWriter(rawlog, wo).close());
+    copyTumSubset(d.str("tum"), 1);
+    expectError(
+        [&] { io::TumWriter w(d.str("tum"), "x", true); },
+        "^cannot write TUM folder '.*tum': it already holds a TUM sequence \\(rgb\\.txt\\)$");
+    EXPECT_NO_THROW(io::TumWriter(d.str("tum"), "x", false).close());
+    EXPECT_NO_THROW(io::TumWriter(d.str("new"), "x", true).close());
+}
+
 TEST(TumReader, BadImagesNameTheFile) {
     TempDir d;
     copyTumSubset(d.str("s"), 3);

@@ -12,10 +12,13 @@
 
 namespace devslam::core {
 
-GzOutputStream::GzOutputStream(const std::string& path, int level, std::string kind)
+GzOutputStream::GzOutputStream(const std::string& path, int level, std::string kind, bool exclusive)
     : path_(path), kind_(std::move(kind)) {
-    gz_ = gzopen(path.c_str(), ("wb" + std::to_string(level)).c_str());
-    if (gz_ == nullptr) throw std::runtime_error("cannot write " + kind_ + " '" + path + "'");
+    errno = 0;
+    gz_ = gzopen(path.c_str(), ("wb" + std::to_string(level) + (exclusive ? "x" : "")).c_str());
+    if (gz_ == nullptr)
+        throw std::runtime_error("cannot write " + kind_ + " '" + path + "'" +
+                                 (errno != 0 ? std::string(": ") + std::strerror(errno) : ""));
 }
 
 GzOutputStream::~GzOutputStream() {

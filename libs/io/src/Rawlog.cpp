@@ -489,7 +489,8 @@ std::string RawlogReader::describe() const {
 // core::GzOutputStream, not mrpt::io::CFileGZOutputStream: that one's close() ignores a
 // disk that filled at the end (see GzOutputStream).
 struct RawlogWriter::Stream : public core::GzOutputStream {
-    Stream(const std::string& path, int level) : GzOutputStream(path, level, "rawlog") {}
+    Stream(const std::string& path, int level, bool fresh)
+        : GzOutputStream(path, level, "rawlog", fresh) {}
 };
 
 RawlogWriter::RawlogWriter(std::string path, RawlogWriterOptions opts)
@@ -497,7 +498,7 @@ RawlogWriter::RawlogWriter(std::string path, RawlogWriterOptions opts)
     if (opts_.compression < 0 || opts_.compression > 9)
         throw std::invalid_argument("rawlog compression must be 0..9, got " +
                                     std::to_string(opts_.compression));
-    stream_ = std::make_unique<Stream>(path_, opts_.compression);
+    stream_ = std::make_unique<Stream>(path_, opts_.compression, opts_.fresh);
     if (opts_.external_images) {
         images_dir_ = rawlogImagesDir(path_);
         fs::create_directories(images_dir_);

@@ -5,11 +5,16 @@
 
 #include <mrpt/config/CConfigFileMemory.h>
 
+#include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
+
+#include <fcntl.h>
+#include <unistd.h>
 
 namespace fs = std::filesystem;
 
@@ -25,7 +30,7 @@ detail::WrittenFile openList(const std::string& path, const std::string& kind,
 }
 }  // namespace
 
-TumWriter::TumWriter(std::string folder, const std::string& description)
+TumWriter::TumWriter(std::string folder, const std::string& description, bool fresh)
     : folder_(std::move(folder)),
       rgb_list_(nullptr, &std::fclose),
       depth_list_(nullptr, &std::fclose) {
@@ -34,6 +39,16 @@ TumWriter::TumWriter(std::string folder, const std::string& description)
     fs::create_directories(folder_ + "/depth", ec);
     if (ec || !fs::is_directory(folder_ + "/depth"))
         throw std::runtime_error("cannot create TUM folder '" + folder_ + "': " + ec.message());
+    if (fresh) {
+        // Made here, exclusively: the list marks a folder as holding a sequence.
+        const int fd = ::open((folder_ + "/rgb.txt").c_str(), O_WRONLY | O_CREAT | O_EXCL, 0644);
+        if (fd < 0)
+            throw std::runtime_error("cannot write TUM folder '" + folder_ + "': " +
+                                     (errno == EEXIST ? std::string("it already holds a TUM "
+                                                                    "sequence (rgb.txt)")
+                                                      : std::strerror(errno)));
+        ::close(fd);
+    }
     rgb_list_ = openList(folder_ + "/rgb.txt", "color", description);
     depth_list_ = openList(folder_ + "/depth.txt", "depth", description);
 }

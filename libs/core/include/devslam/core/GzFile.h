@@ -22,8 +22,10 @@ namespace devslam::core {
 /// 'PATH'").
 class GzOutputStream : public mrpt::io::CStream {
   public:
-    /// Throws std::runtime_error "cannot write <kind> '<path>'" when it cannot be made.
-    GzOutputStream(const std::string& path, int level, std::string kind);
+    /// Throws std::runtime_error "cannot write <kind> '<path>': <why>" when it cannot be made;
+    /// `exclusive`: also when the file is there (made with O_EXCL, so of two writers starting
+    /// at once only one gets it: "File exists").
+    GzOutputStream(const std::string& path, int level, std::string kind, bool exclusive = false);
     ~GzOutputStream() override;
     GzOutputStream(const GzOutputStream&) = delete;
     GzOutputStream& operator=(const GzOutputStream&) = delete;

@@ -70,6 +70,9 @@ struct RawlogWriterOptions {
     bool external_images = false;
     int compression = 1;                ///< gzip level 0..9
     std::string sensor_label = "RGBD";  ///< CObservation::sensorLabel
+    /// true: the rawlog must not be there yet ("File exists" otherwise): of two conversions
+    /// into one file started at once, one is refused instead of both writing it.
+    bool fresh = false;
 };
 
 class RawlogWriter {

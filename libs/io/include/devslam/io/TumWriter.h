@@ -19,8 +19,12 @@ namespace devslam::io {
 
 class TumWriter {
   public:
-    /// Creates the folder (and rgb/, depth/); throws if it cannot.
-    explicit TumWriter(std::string folder, const std::string& description = "devslam");
+    /// Creates the folder (and rgb/, depth/); throws if it cannot. `fresh`: the folder must
+    /// not hold a sequence yet (rgb.txt made with O_EXCL: of two writers into one folder
+    /// started at once, one is refused, "already holds a TUM sequence", instead of both
+    /// writing it).
+    explicit TumWriter(std::string folder, const std::string& description = "devslam",
+                       bool fresh = false);
     ~TumWriter();
     TumWriter(const TumWriter&) = delete;
     TumWriter& operator=(const TumWriter&) = delete;
