@@ -261,7 +261,7 @@ int appMain(int argc, char** argv) {
         }
         auto filter = core::namingSource(
             filter_source, [&] { return dynamic::makeFilterFromConfig(*cfg, mode_override); });
-        fs::create_directories(a.out_dir);
+        const core::FolderClaim claim(a.out_dir);  // (two runs into it at once mixed overlays)
 
         Input in = openInput(a);
         core::ProgressBar bar("overlay", in.total);

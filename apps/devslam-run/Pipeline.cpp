@@ -98,6 +98,19 @@ double peakRssMb() {
     return 0.0;
 }
 
+void checkOutputFolder(const std::string& dir) {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    for (const char* f : kOutputFiles) {
+        const fs::path p = fs::path(dir) / f;
+        if (fs::exists(fs::symlink_status(p, ec)) &&
+            !fs::is_regular_file(fs::symlink_status(p, ec)))
+            throw std::runtime_error("'" + p.string() +
+                                     "' is not a file: the run writes its output of that name "
+                                     "there; move it or name another --out");
+    }
+}
+
 RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
                       const mrpt::config::CConfigFileBase& cfg,
                       const mrpt::config::CConfigFileBase& filter_cfg) {
@@ -314,11 +327,7 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
         // An earlier run's outputs go first: a run that writes fewer (no ATE plot without
         // ground truth, no mask errors without person truth) or is killed while writing
         // leaves none of them beside its own. run.json comes last and says they are whole.
-        for (const char* f :
-             {"run.json", "run.json.part", "trajectory.txt", "keyframes.txt", "lost_frames.txt",
-              "loops.txt", "map.ply", "map.3Dscene", "map_grid.png", "map_grid.gridmap",
-              "trajectory.png", "mask_errors.csv"})
-            fs::remove(fs::path(rc.out_dir) / f);
+        for (const char* f : kOutputFiles) fs::remove(fs::path(rc.out_dir) / f);
         auto out = [&](const std::string& name) { return (fs::path(rc.out_dir) / name).string(); };
         // Each output on its own: one that cannot be written (a full disk) is named in
         // output_errors, and the others are still tried; the figures are printed whatever.

@@ -107,6 +107,17 @@ struct RunReport {
 
 /// Runs the pipeline over `reader` with the INI `cfg` (SLAM sections) and `filter_cfg`
 /// ([detector], [dynamic_filter]). Throws on setup errors (bad INI, unknown mode).
+/// The files a run writes into its --out folder (an earlier run's are removed first).
+inline constexpr const char* kOutputFiles[] = {
+    "run.json",        "run.json.part",    "trajectory.txt", "keyframes.txt",
+    "lost_frames.txt", "loops.txt",        "map.ply",        "map.3Dscene",
+    "map_grid.png",    "map_grid.gridmap", "trajectory.png", "mask_errors.csv"};
+
+/// Throws unless each of kOutputFiles in `dir` is a file or not there: found before the run,
+/// not after it (a folder named trajectory.png stopped the run's outputs, the earlier run's
+/// all removed).
+void checkOutputFolder(const std::string& dir);
+
 [[nodiscard]] RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
                                     const mrpt::config::CConfigFileBase& cfg,
                                     const mrpt::config::CConfigFileBase& filter_cfg);

@@ -17,6 +17,7 @@
 
 #include <filesystem>
 #include <iostream>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -243,6 +244,13 @@ int runOnce(const Args& a) {
     rc.out_dir = a.out;
     rc.progress = !a.quiet;
     rc.score_masks = a.replay <= 0;
+    // The folder is this run's until it ends: a second run into it at once is refused (the
+    // two mixed their files). Taken before the frames, as are its outputs' names.
+    std::optional<core::FolderClaim> claim;
+    if (!a.out.empty()) {
+        claim.emplace(a.out);
+        run::checkOutputFolder(a.out);
+    }
     const auto rep = run::runSequence(*reader, rc, *l.cfg, *l.filter_cfg);
     if (!rep.interrupted.empty() && rep.frames == 0) {
         std::cerr << "devslam-run: interrupted (" << rep.interrupted

@@ -163,6 +163,9 @@ int run(int argc, char** argv) {
     o.rawlog_path = rawlog;
     o.write_labels = labels;
     o.max_frames = frames;
+    // The folder is this render's until it ends: a second render into it at once is refused
+    // (the two mixed their images, labels and ground truth, both saying 0).
+    const core::FolderClaim claim(out_dir);
     render::checkOutputs(sc, o);  // before the preview: a real TUM folder is left as it was
     if (if_changed && render::isRenderCurrent(sc, o)) {
         std::cout << "scenario " << sc.name << ": " << out_dir

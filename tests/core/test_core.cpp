@@ -858,6 +858,42 @@ TEST(GzFile, OutputStreamWritesAGzipFileAndSaysWhyAWriteFailed) {
     }
 }
 
+// An output folder held for a run: a second claim (a second run into it at once) is refused;
+// a folder the claim made and nothing was written into goes with it.
+TEST(Results, FolderClaimRefusesASecondWriterAndTakesBackAnEmptyFolderItMade) {
+    const devslam::test::TempDir d("devslam_core_");
+    const std::string dir = d.str("a/b");
+    {
+        const FolderClaim first(dir);
+        EXPECT_TRUE(std::filesystem::is_directory(dir));
+        try {
+            const FolderClaim second(dir);
+            ADD_FAILURE() << "two claims on one folder";
+        } catch (const std::runtime_error& e) {
+            EXPECT_EQ(std::string(e.what()), "'" + dir +
+                                                 "' is being written by another run at the "
+                                                 "moment; wait for it or name another folder");
+        }
+    }
+    EXPECT_FALSE(std::filesystem::exists(dir)) << "made, empty, and left";
+    {
+        const FolderClaim again(dir);
+        std::ofstream(dir + "/out.txt") << "x";
+    }
+    EXPECT_TRUE(std::filesystem::exists(dir + "/out.txt"));
+    { const FolderClaim kept(dir); }  // there before: stays, even if it were empty
+    EXPECT_TRUE(std::filesystem::is_directory(dir));
+    std::filesystem::create_symlink(d.str("nowhere"), d.str("link"));
+    try {
+        const FolderClaim broken(d.str("link"));
+        ADD_FAILURE() << "claimed a link to nothing";
+    } catch (const std::runtime_error& e) {
+        EXPECT_EQ(std::string(e.what()), "cannot make folder '" + d.str("link") +
+                                             "': it is a link to '" + d.str("nowhere") +
+                                             "', which is not there");
+    }
+}
+
 TEST(Stats, MatchesNumpy) {
     const auto s = summarize({1, 2, 3, 4});
     EXPECT_DOUBLE_EQ(s.mean, 2.5);

@@ -1,4 +1,5 @@
 // Smoke tests of the devslam-run app: outputs written and loadable, bad input reported.
+#include <devslam/core/Results.h>
 #include <devslam/io/Rawlog.h>
 #include <devslam/io/TumReader.h>
 
@@ -100,6 +101,35 @@ TEST(DevslamRun, ADiskThatFillsLosesNeitherTheFiguresNorTheOtherOutputs) {
     EXPECT_EQ(lines(out / "trajectory.txt"), 10u);
     for (const auto& e : fs::directory_iterator(out))  // none left cut, under its name or .part
         EXPECT_LT(fs::file_size(e.path()), 50000u) << e.path();
+}
+
+// Found before the run, not after it: a second run into the folder of one in progress (the
+// two mixed their files), and an output name taken by a folder (it stopped the outputs after
+// the earlier run's were all removed).
+TEST(DevslamRun, AFolderInUseOrAnOutputNameThatIsAFolderIsRefusedFirst) {
+    const devslam::test::TempDir d("devslam_");
+    const std::string out = d.str("run");
+    {
+        const devslam::core::FolderClaim busy(out);  // as a run in progress holds it
+        const auto r = run("--max-frames 3 --quiet --out " + out);
+        EXPECT_EQ(r.rc, 1) << r.out;
+        EXPECT_NE(
+            r.out.find("devslam-run: '" + out + "' is being written by another run at the moment"),
+            std::string::npos)
+            << r.out;
+        std::ofstream(out + "/trajectory.txt") << "the other run's\n";
+    }
+    EXPECT_EQ(lines(fs::path(out) / "trajectory.txt"), 1u) << "the run wrote into it";
+    fs::create_directories(out + "/map.ply/x");
+    const auto r = run("--max-frames 3 --quiet --out " + out);
+    EXPECT_EQ(r.rc, 1) << r.out;
+    EXPECT_NE(r.out.find("devslam-run: '" + out +
+                         "/map.ply' is not a file: the run writes its output of that name "
+                         "there; move it or name another --out"),
+              std::string::npos)
+        << r.out;
+    EXPECT_EQ(r.out.find("frames     :"), std::string::npos) << "ran first: " << r.out;
+    EXPECT_EQ(lines(fs::path(out) / "trajectory.txt"), 1u) << "an earlier output removed";
 }
 
 TEST(DevslamRun, BadInputIsReported) {

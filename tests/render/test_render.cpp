@@ -3,6 +3,7 @@
 // person truth, depth noise, trajectories and scenario files.
 #include <devslam/core/Config.h>
 #include <devslam/core/Pose.h>
+#include <devslam/core/Results.h>
 #include <devslam/io/Rawlog.h>
 #include <devslam/io/RgbdReader.h>
 #include <devslam/io/TrajectoryIO.h>
@@ -598,6 +599,18 @@ TEST(DevslamSynth, RefusesOutputsThatAreNotItsOwnAndMissingValues) {
         EXPECT_NE(r.out.find(says), std::string::npos) << args << "\n" << r.out;
     }
     EXPECT_EQ(readFile(tum + "/rgb.txt"), list);
+    {
+        // A folder another render is writing (two at once mixed their images and truth).
+        const devslam::core::FolderClaim busy(tmp.str("busy"));
+        const auto r = devslam::test::runApp("devslam-synth",
+                                             "short_walking -o " + tmp.str("busy") + " --frames 2");
+        EXPECT_EQ(r.rc, 1) << r.out;
+        EXPECT_NE(r.out.find("devslam-synth: '" + tmp.str("busy") +
+                             "' is being written by another run at the moment"),
+                  std::string::npos)
+            << r.out;
+        EXPECT_TRUE(std::filesystem::is_empty(tmp.str("busy")));
+    }
     EXPECT_FALSE(fs::exists(tum + "/preview.png"));
     EXPECT_EQ(readFile(ini), "[scenario]\n");
     EXPECT_FALSE(fs::exists(tmp.str("so")));

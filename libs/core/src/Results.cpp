@@ -15,6 +15,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <thread>
+#include <utility>
 
 #include <fcntl.h>
 #include <sys/file.h>
@@ -206,6 +207,37 @@ void writeFileWhole(const std::string& link, const std::string& text) {
         std::filesystem::remove(part, ec);
         throw std::runtime_error("cannot write '" + path + "': " + why);
     }
+}
+
+FolderClaim::FolderClaim(const std::string& dir) : dir_(dir) {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    if (fs::is_symlink(dir, ec) && !fs::exists(dir, ec))
+        throw std::runtime_error("cannot make folder '" + dir + "': it is a link to '" +
+                                 fs::read_symlink(dir, ec).string() + "', which is not there");
+    made_ = !fs::exists(dir, ec);
+    fs::create_directories(dir, ec);
+    if (!fs::is_directory(dir))
+        throw std::runtime_error("cannot make folder '" + dir +
+                                 "': " + (ec ? ec.message() : std::string("a file is there")));
+    fd_ = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (fd_ < 0) return;  // not held (the writes then name what is wrong)
+    int rc = 0;
+    while ((rc = ::flock(fd_, LOCK_EX | LOCK_NB)) != 0 && errno == EINTR) {
+    }
+    if (rc != 0 && errno == EWOULDBLOCK) {
+        ::close(std::exchange(fd_, -1));
+        made_ = false;  // the other run's now
+        throw std::runtime_error("'" + dir +
+                                 "' is being written by another run at the moment; wait for it "
+                                 "or name another folder");
+    }
+}
+
+FolderClaim::~FolderClaim() {
+    std::error_code ec;
+    if (made_ && std::filesystem::is_empty(dir_, ec) && !ec) std::filesystem::remove(dir_, ec);
+    if (fd_ >= 0) ::close(fd_);  // releases the claim
 }
 
 int withStandardOutput(const char* program, int rc) {

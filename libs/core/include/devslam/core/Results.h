@@ -29,6 +29,27 @@ void replaceResultsSection(const std::string& path, const std::string& name,
 /// replaced, or made). Throws std::runtime_error naming the file when it cannot be written.
 void writeFileWhole(const std::string& path, const std::string& text);
 
+/// An output folder held by this process for as long as the object lives (an exclusive
+/// flock on the folder, taken without waiting), so that a second run writing the same folder
+/// at once is refused instead of mixing its files with this one's. The folder is made with
+/// its parents if it is not there, and removed again at the end if this made it and it is
+/// still empty (a run stopped before its first output). Advisory: devslam-run --out,
+/// devslam-synth -o and devslam-overlay --out take it.
+class FolderClaim {
+  public:
+    /// Throws std::runtime_error "'DIR' is being written by another run at the moment; wait
+    /// for it or name another folder", or "cannot make folder 'DIR': <why>".
+    explicit FolderClaim(const std::string& dir);
+    ~FolderClaim();
+    FolderClaim(const FolderClaim&) = delete;
+    FolderClaim& operator=(const FolderClaim&) = delete;
+
+  private:
+    std::string dir_;
+    int fd_ = -1;
+    bool made_ = false;
+};
+
 /// Flushes std::cout and returns `rc`, or 1 where `rc` is 0 and the standard output could not
 /// be written (a full disk behind '>': the figures were lost, and the program said 0), saying
 /// so on std::cerr as "<program>: cannot write the standard output".
