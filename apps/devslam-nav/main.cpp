@@ -163,9 +163,17 @@ static int appMain(int argc, char** argv) {
         return 2;
     }
     try {
-        // Known before minutes of work: the picture's format (OpenCV picks it by the name).
+        // Known before minutes of work: the picture's format (OpenCV picks it by the name), and
+        // a folder it cannot go in (found after the run, its result line naming it).
         if (!png.empty() && !devslam::core::endsWithNoCase(png, ".png"))
             throw std::invalid_argument("--png '" + png + "': the picture's name must end in .png");
+        if (!png.empty()) {
+            const auto parent = std::filesystem::absolute(png).parent_path();
+            const auto up = devslam::core::nearestExisting(parent.string());
+            if (!std::filesystem::is_directory(up) || !devslam::core::canMakeFilesIn(up))
+                throw std::invalid_argument("--png '" + png + "': cannot write in '" + up.string() +
+                                            "'");
+        }
         if (!map.empty()) return planOnSlamMap(map, from, to, config, png);
         if (!method.empty()) devslam::nav::requireHolonomicMethod(method, "--method");
         const auto world = loadOrGenerate(world_path);

@@ -308,6 +308,21 @@ TEST(IntegrationNav, NavlogOnAFullDiskEndsTheLogNotTheRun) {
         << err_cut;
 }
 
+// A --png that cannot be written is found before the run (it was found after it, with the
+// result line naming the picture).
+TEST(IntegrationNav, APngThatCannotBeWrittenIsRefusedFirst) {
+    const devslam::test::TempDir dir("devslam_");
+    std::ofstream(dir.str("a_file")) << "x";
+    const auto r = devslam::test::runApp(
+        "devslam-nav", kSrc + "/sim_worlds/paper_fig6.ini --png " + dir.str("a_file/x.png"));
+    EXPECT_EQ(r.rc, 2) << r.out;
+    EXPECT_NE(r.out.find("devslam-nav: --png '" + dir.str("a_file/x.png") + "': cannot write in '" +
+                         dir.str("a_file") + "'"),
+              std::string::npos)
+        << r.out;
+    EXPECT_EQ(r.out.find("result="), std::string::npos) << "ran first: " << r.out;
+}
+
 TEST(IntegrationNav, AppsSmokeTest) {
     const std::string bin = DEVSLAM_BIN_DIR;
     // Emptied first (an earlier failed run's files would pass the checks below), removed

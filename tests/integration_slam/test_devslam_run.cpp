@@ -88,7 +88,7 @@ TEST(DevslamRun, ADiskThatFillsLosesNeitherTheFiguresNorTheOtherOutputs) {
         "devslam-run", "--max-frames 10 --quiet --out " + out.string(), 50000);
     EXPECT_EQ(r.rc, 1) << r.out;
     EXPECT_NE(r.out.find("ATE        : RMSE"), std::string::npos) << r.out;
-    EXPECT_NE(r.out.find("devslam-run: cannot write plot '" + (out / "trajectory.png").string() +
+    EXPECT_NE(r.out.find("devslam-run: plot: cannot write '" + (out / "trajectory.png").string() +
                          "': File too large\n"),
               std::string::npos)
         << r.out;

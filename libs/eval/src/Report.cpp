@@ -13,6 +13,7 @@
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
+#include <vector>
 
 namespace devslam::eval {
 
@@ -151,10 +152,16 @@ void plotAte(const std::string& path, const AteResult& ate, const std::string& t
         p.line(canvas, t, g, cv::Scalar(0, 0, 0), 2);
         p.line(canvas, t, e, cv::Scalar(30, 120, 255), 1);
     }
-    errno = 0;  // cv::imwrite does not say why; the system's reason, where the write set one
-    if (!cv::imwrite(path, canvas))
-        throw std::runtime_error("cannot write plot '" + path + "'" +
-                                 (errno != 0 ? std::string(": ") + std::strerror(errno) : ""));
+    // Whole or not at all (two runs writing one plot at once spliced their PNGs), and an
+    // error says why (cv::imwrite did not).
+    std::vector<uchar> png;
+    if (!cv::imencode(".png", canvas, png))
+        throw std::runtime_error("cannot write plot '" + path + "': the PNG did not encode");
+    try {
+        core::writeFileWhole(path, std::string(png.begin(), png.end()));
+    } catch (const std::exception& e) {  // "cannot write 'PATH': why"
+        throw std::runtime_error(std::string("plot: ") + e.what());
+    }
 }
 
 }  // namespace devslam::eval
