@@ -150,7 +150,21 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
             std::async(std::launch::async, [&masks, f, prior] { return masks->step(f, prior); });
     };
     auto within = [&](std::size_t i) { return rc.max_frames == 0 || i < rc.max_frames; };
-    std::optional<core::Frame> cur = reader.next();
+    // The next frame; one that does not decode is left out with allow_damaged (the readers
+    // pass it), else its error ends the run there. Nothing after a broken stream can be read.
+    const auto readNext = [&]() -> std::optional<core::Frame> {
+        while (true) {
+            try {
+                return reader.next();
+            } catch (const io::InputBroken&) {
+                throw;
+            } catch (const std::exception& e) {
+                if (!rc.allow_damaged) throw;
+                rep.undecodable.push_back(e.what());
+            }
+        }
+    };
+    std::optional<core::Frame> cur = readNext();
     if (cur) cur->index = 0;
     // A Ctrl-C before the first frame (while the detector loads): no frame done, nothing
     // written (an earlier run's results in the output folder stay as they are).
@@ -181,7 +195,7 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
         const double cpu_read = processCpuMs();
         std::optional<core::Frame> nxt;
         try {
-            if (within(n + 1)) nxt = reader.next();
+            if (within(n + 1)) nxt = readNext();
         } catch (const std::exception& e) {
             // A frame damaged in a way the reader cannot see at open (an image that does not
             // decode): stop here and keep what was computed, instead of losing the whole run.
@@ -444,6 +458,10 @@ std::string formatSummary(const RunReport& r) {
     std::ostringstream o;
     o << "input      : " << r.input << "\n";
     if (!r.input_damage.empty()) o << "left out   : " << r.input_damage << "\n";
+    if (!r.undecodable.empty())
+        o << "left out   : " << r.undecodable.size()
+          << " frames that do not decode (--allow-damaged), the first: " << r.undecodable.front()
+          << "\n";
     if (!r.read_error.empty())
         o << "STOPPED    : after " << r.frames << " frames: " << r.read_error << "\n";
     if (!r.interrupted.empty())

@@ -23,6 +23,9 @@ struct RunConfig {
     std::string config_source = "SLAM INI", filter_source = "filter INI";
     std::string out_dir;         ///< empty: write nothing
     bool progress = true;        ///< progress bar on stderr
+    /// A frame that does not decode (an image that is there but damaged) is left out and the
+    /// run goes on (--allow-damaged, as devslam-convert does); else the run stops before it.
+    bool allow_damaged = false;
     std::size_t max_frames = 0;  ///< 0 = all
     /// Run the dynamic filter for frame k+1 in a second thread while the SLAM processes
     /// frame k (INI [run] async_filter). Results do not depend on timing.
@@ -96,6 +99,8 @@ struct RunReport {
     double map_mb = 0;       ///< approximate map heap
     double bytes_per_keyframe = 0;
     std::vector<std::string> outputs;  ///< files written
+    /// Frames left out because they do not decode (RunConfig::allow_damaged): why, each.
+    std::vector<std::string> undecodable;
     /// Outputs that could not be written ("cannot write 'PATH': No space left on device"):
     /// each output is tried on its own, so one that fails loses neither the others nor the
     /// figures.

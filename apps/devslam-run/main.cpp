@@ -31,8 +31,8 @@ const char* kUsage =
     "usage: devslam-run [--input PATH] [--mode none|all_persons|dynamic|truth] [--config INI]\n"
     "                   [--out DIR] [--max-frames N] [--quiet] [--set SECTION.KEY=VALUE]...\n"
     "                   [--replay N]  (play the input forward/backward N times)\n"
-    "                   [--allow-damaged]  (a rawlog cut short, a TUM folder missing images:\n"
-    "                                       run on what is intact)\n"
+    "                   [--allow-damaged]  (a rawlog cut short, a TUM folder missing images,\n"
+    "                                       frames that do not decode: run on what is intact)\n"
     "       devslam-run --bench N [--input PATH] [--config INI] [--results FILE]\n"
     "                   [--section NAME] [--modes-only]\n"
     "defaults: --input " DEVSLAM_SOURCE_DIR
@@ -243,6 +243,7 @@ int runOnce(const Args& a) {
     auto rc = runConfig(a, l, l.mode);
     rc.out_dir = a.out;
     rc.progress = !a.quiet;
+    rc.allow_damaged = a.allow_damaged;
     rc.score_masks = a.replay <= 0;
     // The folder is this run's until it ends: a second run into it at once is refused (the
     // two mixed their files). Taken before the frames, as are its outputs' names.

@@ -565,6 +565,16 @@ TEST(DevslamRun, AnUndecodableFrameMidRunKeepsTheFramesBeforeIt) {
     EXPECT_NE(ss.str().find("\"read_error\": \"" + (dir / "seq" / image).string()),
               std::string::npos)
         << ss.str().substr(0, 400);
+    // With --allow-damaged, as devslam-convert: that frame left out, the others run.
+    const auto all = run("--input " + (dir / "seq").string() +
+                         " --mode dynamic --quiet --allow-damaged --out " + (dir / "all").string());
+    EXPECT_EQ(all.rc, 0) << all.out;
+    EXPECT_NE(all.out.find("left out   : 1 frames that do not decode (--allow-damaged), the "
+                           "first: " +
+                           (dir / "seq" / image).string() + ": cannot decode colour image"),
+              std::string::npos)
+        << all.out;
+    EXPECT_EQ(lines(dir / "all" / "trajectory.txt"), 7u);
 
     // devslam-convert keeps the frames before it, or with --allow-damaged all but that one.
     auto c = devslam::test::runApp("devslam-convert",
