@@ -7,6 +7,7 @@
 #include <devslam/core/Config.h>
 #include <devslam/core/Interrupt.h>
 #include <devslam/core/Parse.h>
+#include <devslam/core/Picture.h>
 #include <devslam/core/Progress.h>
 #include <devslam/core/Results.h>
 #include <devslam/core/Stats.h>
@@ -18,7 +19,6 @@
 #include <devslam/sim/RandomWorlds.h>
 
 #include <mrpt/system/filesystem.h>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
@@ -168,7 +168,7 @@ void writeChart(const std::string& path, const std::vector<devslam::sim::Categor
     }
     cv::putText(img, "success rate per category (devslam-nav-bench)", {left, 25},
                 cv::FONT_HERSHEY_SIMPLEX, 0.55, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
-    if (!cv::imwrite(path, img)) throw std::runtime_error("cannot write " + path);
+    devslam::core::writePngWhole(path, img);
 }
 /// Reads the command line into `a`; the exit code when the program should end here (0 after
 /// --help, 2 for a bad argument, said on stderr with the usage).

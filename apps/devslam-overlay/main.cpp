@@ -13,6 +13,7 @@
 #include <devslam/core/Config.h>
 #include <devslam/core/Interrupt.h>
 #include <devslam/core/Parse.h>
+#include <devslam/core/Picture.h>
 #include <devslam/core/Progress.h>
 #include <devslam/core/Results.h>
 #include <devslam/dynamic/DynamicObjectFilter.h>
@@ -227,15 +228,14 @@ void writeOverlay(const std::string& out_dir, std::size_t k, const core::Frame& 
     const std::string file = (fs::path(out_dir) / overlayName(k)).string();
     // Drawn outside the write's try: a drawing error is not a write error.
     const cv::Mat picture = drawOverlay(f, out);
-    std::string why;
+    // Whole or not at all: a disk that fills or a Ctrl-C leaves no cut overlay among the
+    // ones written.
     try {
-        if (!cv::imwrite(file, picture)) why = "imwrite failed";
-    } catch (const cv::Exception& e) {
-        why = e.what();
+        core::writePngWhole(file, picture);
+    } catch (const std::runtime_error& e) {  // "cannot write 'FILE': why"
+        throw std::runtime_error(e.what() + (" (" + std::to_string(written) +
+                                             " overlays written before it)"));
     }
-    if (!why.empty())
-        throw std::runtime_error("cannot write " + file + " (" + std::to_string(written) +
-                                 " overlays written before it): " + why);
 }
 
 int appMain(int argc, char** argv) {

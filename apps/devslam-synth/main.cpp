@@ -9,6 +9,7 @@
 // folder, without render.txt (so --if-changed renders it again).
 #include <devslam/core/Interrupt.h>
 #include <devslam/core/Parse.h>
+#include <devslam/core/Picture.h>
 #include <devslam/core/Progress.h>
 #include <devslam/core/Results.h>
 #include <devslam/render/PersonTexture.h>
@@ -90,7 +91,7 @@ int cutTexture(const std::vector<std::string>& a) {
     const auto v = core::parseNumberList(a[2], "--cut-texture box", 4);
     const cv::Rect box{int(v[0]), int(v[1]), int(v[2]), int(v[3])};
     const cv::Mat rgba = render::cutPersonTexture(img, box);
-    if (!cv::imwrite(a[3], rgba)) throw std::runtime_error("cannot write '" + a[3] + "'");
+    core::writePngWhole(a[3], rgba);
     std::vector<cv::Mat> ch;
     cv::split(rgba, ch);
     std::cout << "wrote " << a[3] << " (" << rgba.cols << "x" << rgba.rows << ", "
@@ -179,8 +180,7 @@ int run(int argc, char** argv) {
     const std::string prev = (fs::path(out_dir) / "preview.png").string();
     o.on_frame = [&](std::size_t i, const render::RenderedFrame& f) {
         if (i == 0) fs::remove(prev);
-        if (i == n / 2 && !cv::imwrite(prev, preview(f)))
-            throw std::runtime_error("cannot write '" + prev + "'");
+        if (i == n / 2) core::writePngWhole(prev, preview(f));
     };
     core::ProgressBar bar("render " + sc.name, n);
     o.stop = [] { return core::stopSignal() != 0; };

@@ -5,6 +5,7 @@
 #include <devslam/core/GzFile.h>
 #include <devslam/core/Interrupt.h>
 #include <devslam/core/Parse.h>
+#include <devslam/core/Picture.h>
 #include <devslam/core/Pose.h>
 #include <devslam/core/Results.h>
 #include <devslam/core/Stats.h>
@@ -12,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include <opencv2/core/utility.hpp>
+#include <opencv2/imgcodecs.hpp>
 
 #include "ConfigRoundTrip.h"
 #include "Scratch.h"
@@ -350,6 +352,16 @@ TEST(Config, OverrideListsKeepBracketedValuesWhole) {
     mrpt::config::CConfigFileMemory mem;
     applyOverrides(mem, overrideItems("p.path=[3.5 2.1]"));
     EXPECT_EQ(mem.read_string("p", "path", ""), "[3.5 2.1]");
+    // Blanks around the names and the value, as an INI line has them (a --set in quotes).
+    applyOverrides(mem, {" orb . n_features = 300 "});
+    std::vector<std::string> keys;
+    mem.getAllKeys("orb", keys);
+    EXPECT_EQ(keys, (std::vector<std::string>{"n_features"}));
+    EXPECT_EQ(mem.read_string("orb", "n_features", ""), "300");
+    for (const std::string bad : {" .k=1", "s. =1", "s.k", ".=", "s=k.1"})
+        EXPECT_EQ(invalidArgument([&] { applyOverrides(mem, {bad}, "--set"); }),
+                  "--set '" + bad + "': expected SECTION.KEY=VALUE")
+            << bad;
     const std::string msg =
         invalidArgument([] { (void)overrideItems("p.path=[3.5 2.1", "x.ini set"); });
     EXPECT_EQ(msg, "x.ini set 'p.path=[3.5 2.1': a '[' is not closed");
@@ -772,6 +784,35 @@ TEST(Results, FilesAreWrittenWholeAndHashedByContent) {
     std::ifstream later(dir / "later.txt");
     std::getline(later, line);
     EXPECT_EQ(line, "five");
+    std::filesystem::remove_all(dir);
+}
+
+TEST(Results, PicturesAreWrittenWholeOrSayWhyNot) {
+    const auto dir = devslam::test::scratchPath("results_png");
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    const std::string f = (dir / "p.png").string();
+    cv::Mat img(40, 60, CV_8UC3, cv::Scalar(10, 200, 30));
+    img(cv::Rect(5, 5, 10, 10)).setTo(cv::Scalar(255, 0, 0));
+    devslam::core::writePngWhole(f, img);
+    const cv::Mat back = cv::imread(f, cv::IMREAD_UNCHANGED);
+    ASSERT_EQ(back.size(), img.size());
+    EXPECT_EQ(cv::norm(back, img, cv::NORM_INF), 0.0);  // lossless, the same pixels
+    EXPECT_FALSE(std::filesystem::exists(f + ".part"));
+    // An image PNG cannot hold, an empty one, a folder: named errors, the old picture kept.
+    const auto error = [&](const std::string& path, const cv::Mat& m) -> std::string {
+        try {
+            devslam::core::writePngWhole(path, m);
+        } catch (const std::runtime_error& e) {
+            return e.what();
+        }
+        return "written";
+    };
+    EXPECT_EQ(error(f, cv::Mat(4, 4, CV_8UC2, cv::Scalar(1, 2))),
+              "cannot write '" + f + "': the PNG did not encode");
+    EXPECT_EQ(error(f, cv::Mat()), "cannot write '" + f + "': the PNG did not encode");
+    EXPECT_EQ(error(dir.string(), img), "cannot write '" + dir.string() + "': a folder");
+    EXPECT_EQ(cv::norm(cv::imread(f, cv::IMREAD_UNCHANGED), img, cv::NORM_INF), 0.0);
     std::filesystem::remove_all(dir);
 }
 

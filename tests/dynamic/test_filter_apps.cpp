@@ -63,6 +63,16 @@ TEST(DevslamOverlay, WritesOneOverlayPerFrame) {
         std::string::npos)
         << r.out;
     EXPECT_EQ(pngsIn(d.str("c")), 2);
+    // A disk that fills under an overlay: the error names it and why, and no cut PNG is left.
+    r = devslam::test::runAppWithFileLimit(
+        "devslam-overlay", "--input synthetic:walking --frames 2 --out " + d.str("e"), 4096);
+    EXPECT_NE(r.rc, 0) << r.out;
+    EXPECT_NE(r.out.find("devslam-overlay: cannot write '" + d.str("e/overlay_00000.png") +
+                         "': File too large (0 overlays written before it)"),
+              std::string::npos)
+        << r.out;
+    EXPECT_FALSE(fs::exists(d.str("e/overlay_00000.png")));
+    EXPECT_FALSE(fs::exists(d.str("e/overlay_00000.png.part")));
 }
 
 // The shipped real frames through a SLAM INI, whose [run] filter_config names the filter INI.
@@ -150,9 +160,8 @@ TEST(DevslamOverlay, BadInputIsNamed) {
     std::filesystem::create_directories(d.str("o") + "/overlay_00002.png");
     r = runApp("devslam-overlay", "--input synthetic:walking --frames 4" + out);
     EXPECT_EQ(r.rc, 1) << r.out;
-    EXPECT_NE(r.out.find("cannot write " + d.str("o") +
-                         "/overlay_00002.png (2 overlays written "
-                         "before it)"),
+    EXPECT_NE(r.out.find("cannot write '" + d.str("o") +
+                         "/overlay_00002.png': a folder (2 overlays written before it)"),
               std::string::npos)
         << r.out;
 

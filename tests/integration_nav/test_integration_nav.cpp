@@ -396,8 +396,7 @@ TEST(IntegrationNav, AppsSmokeTest) {
                   std::string::npos)
             << said;
     }
-    // An unknown method or a picture of another format: refused before the run. A picture
-    // that cannot be written is an error after the result line, which is kept.
+    // An unknown method or a picture of another format: refused before the run.
     const auto nav = [&](const std::string& args) {
         return devslam::test::runApp("devslam-nav", kSrc + "/sim_worlds/paper_fig6.ini " + args);
     };
@@ -409,12 +408,18 @@ TEST(IntegrationNav, AppsSmokeTest) {
     EXPECT_EQ(r.rc, 2);
     EXPECT_NE(r.out.find("the picture's name must end in .png"), std::string::npos) << r.out;
     EXPECT_EQ(r.out.find("result="), std::string::npos) << r.out;
-    r = nav("--png /proc/devslam_no/fig6.png");
+    // (A folder it cannot go in is refused first: APngThatCannotBeWrittenIsRefusedFirst.) A
+    // disk that fills under the picture: the result line stays, the error names the picture
+    // and why, and no cut PNG is left.
+    r = devslam::test::runAppWithFileLimit(
+        "devslam-nav", kSrc + "/sim_worlds/paper_fig6.ini --png " + out + "/cut/fig6.png", 4096);
     EXPECT_EQ(r.rc, 2);
     EXPECT_NE(r.out.find("result=success"), std::string::npos) << r.out;
-    EXPECT_NE(r.out.find("--png '/proc/devslam_no/fig6.png': cannot write the picture"),
+    EXPECT_NE(r.out.find("--png '" + out + "/cut/fig6.png': cannot write the picture: cannot write '" +
+                         out + "/cut/fig6.png': File too large"),
               std::string::npos)
         << r.out;
+    EXPECT_FALSE(std::filesystem::exists(out + "/cut/fig6.png"));
     // bench smoke test: one method, one world per category, RESULTS.md untouched
     const std::string bench =
         bin + "/devslam-nav-bench --per-category 1 --methods CHolonomicVFHPlus --png-dir " + out +

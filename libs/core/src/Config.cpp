@@ -145,15 +145,20 @@ void applyOverrides(mrpt::config::CConfigFileMemory& cfg, const std::vector<std:
     std::map<std::pair<std::string, std::string>, std::string> given;
     for (const auto& s : items) {
         const auto dot = s.find('.'), eq = s.find('=');
-        if (dot == std::string::npos || eq == std::string::npos || dot > eq || dot == 0 ||
-            eq == dot + 1)
+        // Blanks around the names and the value go, as in an INI line ("orb.n_features = 300"
+        // as the file's "n_features = 300"; the names were kept with their blanks and refused).
+        const std::string section = dot == std::string::npos ? "" : trimmed(s.substr(0, dot));
+        const std::string key =
+            dot == std::string::npos || eq == std::string::npos || dot > eq
+                ? ""
+                : trimmed(s.substr(dot + 1, eq - dot - 1));
+        if (section.empty() || key.empty())
             throw std::invalid_argument(what + " '" + s + "': expected SECTION.KEY=VALUE");
-        const std::string section = s.substr(0, dot), key = s.substr(dot + 1, eq - dot - 1);
         const auto [at, fresh] = given.emplace(std::pair{lowercase(section), lowercase(key)}, s);
         if (!fresh)
             throw std::invalid_argument(what + " '" + s + "': [" + section + "] " + key +
                                         " is set twice (also '" + at->second + "')");
-        cfg.write(section, key, s.substr(eq + 1));
+        cfg.write(section, key, trimmed(s.substr(eq + 1)));
     }
 }
 

@@ -1,16 +1,13 @@
 #include <devslam/eval/Plot.h>
 #include <devslam/eval/Report.h>
 
+#include <devslam/core/Picture.h>
 #include <devslam/core/Results.h>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include <cerrno>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
-#include <fstream>
 #include <sstream>
 #include <stdexcept>
 #include <vector>
@@ -154,11 +151,8 @@ void plotAte(const std::string& path, const AteResult& ate, const std::string& t
     }
     // Whole or not at all (two runs writing one plot at once spliced their PNGs), and an
     // error says why (cv::imwrite did not).
-    std::vector<uchar> png;
-    if (!cv::imencode(".png", canvas, png))
-        throw std::runtime_error("cannot write plot '" + path + "': the PNG did not encode");
     try {
-        core::writeFileWhole(path, std::string(png.begin(), png.end()));
+        core::writePngWhole(path, canvas);
     } catch (const std::exception& e) {  // "cannot write 'PATH': why"
         throw std::runtime_error(std::string("plot: ") + e.what());
     }

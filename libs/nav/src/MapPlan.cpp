@@ -1,12 +1,12 @@
 #include <devslam/nav/MapPlan.h>
 
 #include <devslam/core/GzFile.h>
+#include <devslam/core/Picture.h>
 #include <devslam/nav/RoutePicture.h>
 
 #include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/serialization/CArchive.h>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
@@ -97,7 +97,7 @@ void writeMapPlanPng(const mrpt::maps::COccupancyGridMap2D& grid, const MapPlan&
     drawTitleBand(img, os.str(),
                   "white free, black occupied, grey unknown; blue: A* + waypoints; green: "
                   "start; star: goal; 1 m grid");
-    if (!cv::imwrite(path, img)) throw std::runtime_error(path + ": cannot write the picture");
+    core::writePngWhole(path, img);
 }
 
 }  // namespace devslam::nav

@@ -2,12 +2,12 @@
 #include <devslam/sim/SimRobot.h>
 #include <devslam/sim/Simulator.h>
 
+#include <devslam/core/Picture.h>
 #include <devslam/nav/GridPlanner.h>
 #include <devslam/nav/RoutePicture.h>
 
 #include <mrpt/core/Clock.h>
 
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include <cmath>
@@ -215,7 +215,7 @@ void writeEpisodePng(const WorldSpec& w, const EpisodeResult& r, const std::stri
     nav::drawTitleBand(
         img, os.str(),
         "blue: A* + waypoints   red: robot   orange: people   green: start   star: goal");
-    if (!cv::imwrite(path, img)) throw std::runtime_error("writeEpisodePng: cannot write " + path);
+    core::writePngWhole(path, img);
 }
 
 }  // namespace devslam::sim

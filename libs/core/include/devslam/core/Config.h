@@ -44,8 +44,9 @@ void requireKnownKeys(const mrpt::config::CConfigFileBase& cfg, const std::strin
 void requireKnownSections(const mrpt::config::CConfigFileBase& cfg,
                           const std::vector<std::string>& known, const std::string& source = "");
 
-/// Applies "section.key=value" items to an INI held in memory. Throws std::invalid_argument
-/// naming `what` and the item when one is malformed.
+/// Applies "section.key=value" items to an INI held in memory, blanks around the names and
+/// the value dropped as in an INI line. Throws std::invalid_argument naming `what` and the
+/// item when one is malformed.
 void applyOverrides(mrpt::config::CConfigFileMemory& cfg, const std::vector<std::string>& items,
                     const std::string& what = "override");
 

@@ -1,0 +1,23 @@
+#include "devslam/core/Picture.h"
+
+#include "devslam/core/Results.h"
+
+#include <opencv2/imgcodecs.hpp>
+
+#include <stdexcept>
+#include <vector>
+
+namespace devslam::core {
+
+void writePngWhole(const std::string& path, const cv::Mat& image) {
+    std::vector<uchar> png;
+    bool encoded = false;
+    try {
+        encoded = !image.empty() && cv::imencode(".png", image, png);
+    } catch (const cv::Exception&) {  // a channel count PNG does not hold (2, or over 4)
+    }
+    if (!encoded) throw std::runtime_error("cannot write '" + path + "': the PNG did not encode");
+    writeFileWhole(path, std::string(png.begin(), png.end()));
+}
+
+}  // namespace devslam::core
