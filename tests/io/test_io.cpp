@@ -947,8 +947,10 @@ TEST(Writers, AnImageFileCutAtItsEndIsAnError) {
         io::TumWriter cut(d.str("cut"));
         FileSizeLimit limit(rgb_size - 1);
         expectError([&] { cut.write(f); },
-                    "cannot write '.*cut/rgb/[0-9.]+\\.png': the file is cut short");
+                    "cannot write '.*cut/rgb/[0-9.]+\\.png': File too large");
     }
+    // Whole or not at all: no cut picture, no .part left.
+    EXPECT_TRUE(fs::is_empty(d.str("cut/rgb")));
 
     // A rawlog with external images: a black colour image (a small PNG), then the depth.
     core::Frame b = f;
@@ -973,8 +975,9 @@ TEST(Writers, AnImageFileCutAtItsEndIsAnError) {
         io::RawlogWriter cut(d.str("cut2.rawlog"), wo);
         FileSizeLimit limit(fs::file_size(d.str("ok_Images/frame_0_rgb.png")) - 1);
         expectError([&] { cut.write(b); },
-                    "cannot write '.*cut2_Images/frame_0_rgb\\.png': the file is cut short");
+                    "cannot write '.*cut2_Images/frame_0_rgb\\.png': File too large");
     }
+    EXPECT_FALSE(fs::exists(d.str("cut2_Images/frame_0_rgb.png")));
 }
 
 // Binary garbage read as an object's class name was echoed to the terminal in the error.

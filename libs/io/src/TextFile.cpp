@@ -2,13 +2,10 @@
 
 #include <devslam/core/Parse.h>
 
-#include <opencv2/imgcodecs.hpp>
+#include <devslam/core/Picture.h>
 
-#include <algorithm>
 #include <cctype>
-#include <cerrno>
 #include <cmath>
-#include <cstring>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -77,30 +74,6 @@ void closeWritten(WrittenFile& f, const std::string& error) {
     if (std::fclose(f.release()) != 0 || failed) throw std::runtime_error(error);
 }
 
-namespace {
-
-// Throws unless the file ends with a PNG's IEND chunk (an image cut short does not).
-void requireWholePng(const std::string& path) {
-    // The IEND chunk: length 0, type "IEND", CRC AE 42 60 82.
-    static const char kEnd[12] = {0, 0, 0, 0, 'I', 'E', 'N', 'D', '\xAE', '\x42', '\x60', '\x82'};
-    std::ifstream in(path, std::ios::binary | std::ios::ate);
-    char tail[12] = {};
-    const bool whole = in && in.tellg() >= 12 && in.seekg(-12, std::ios::end) &&
-                       in.read(tail, 12) && std::equal(tail, tail + 12, kEnd);
-    if (!whole)
-        throw std::runtime_error("cannot write '" + path + "': the file is cut short (disk full?)");
-}
-
-}  // namespace
-
-void writePng(const std::string& path, const cv::Mat& image) {
-    errno = 0;
-    if (!cv::imwrite(path, image))
-        // The system's reason where the write set one ("File too large", "No space left on
-        // device"; OpenCV's PNG encoder writes through stdio), which cv::imwrite does not say.
-        throw std::runtime_error("cannot write '" + path + "'" +
-                                 (errno != 0 ? std::string(": ") + std::strerror(errno) : ""));
-    requireWholePng(path);
-}
+void writePng(const std::string& path, const cv::Mat& image) { core::writePngWhole(path, image); }
 
 }  // namespace devslam::io::detail

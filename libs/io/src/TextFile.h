@@ -43,10 +43,9 @@ using WrittenFile = std::unique_ptr<std::FILE, int (*)(std::FILE*)>;
 /// before.
 void closeWritten(WrittenFile& f, const std::string& error);
 
-/// Writes an image with cv::imwrite and checks that the whole file reached the disk;
-/// throws std::runtime_error "cannot write '<path>'" (and why, when known). OpenCV's PNG
-/// encoder does not check fclose(), where stdio's last buffer goes out: a disk that filled
-/// there left a cut PNG behind a success. (PNG only: its last chunk, IEND, is checked.)
+/// Writes a frame's PNG whole or not at all (core::writePngWhole); throws std::runtime_error
+/// "cannot write '<path>': <why>". (cv::imwrite did not check fclose(), where stdio's last
+/// buffer goes out: a disk that filled there left a cut PNG behind a success.)
 void writePng(const std::string& path, const cv::Mat& image);
 
 }  // namespace devslam::io::detail

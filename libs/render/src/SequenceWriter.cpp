@@ -1,4 +1,5 @@
 #include <devslam/core/Parse.h>
+#include <devslam/core/Picture.h>
 #include <devslam/core/Results.h>
 #include <devslam/core/Stats.h>
 #include <devslam/io/Rawlog.h>
@@ -7,8 +8,6 @@
 #include <devslam/render/SequenceWriter.h>
 
 #include <mrpt/config/CConfigFileMemory.h>
-
-#include <opencv2/imgcodecs.hpp>
 
 #include <chrono>
 #include <cstdio>
@@ -232,7 +231,7 @@ WriteSummary writeSequence(const Scenario& sc, const WriteOptions& o,
         if (o.write_labels) {
             const std::string lp =
                 (fs::path(o.out_dir) / "labels" / (std::string(stamp) + ".png")).string();
-            if (!cv::imwrite(lp, rf.labels)) throw std::runtime_error("cannot write '" + lp + "'");
+            core::writePngWhole(lp, rf.labels);
         }
         if (o.on_frame) o.on_frame(i, rf);
         if (progress) progress(i + 1, n);
