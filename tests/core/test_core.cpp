@@ -787,6 +787,59 @@ TEST(Results, FilesAreWrittenWholeAndHashedByContent) {
     std::filesystem::remove_all(dir);
 }
 
+// Writers of one file at once wrote one .part together and renamed a splice of both (two
+// runs writing one plot). Each text is one letter repeated: a splice has two letters, a
+// reader between renames sees one whole text.
+TEST(Results, WritersOfOneFileAtOnceNeverSpliceIt) {
+    const auto dir = devslam::test::scratchPath("results_splice");
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    const std::string f = (dir / "plot.png").string();
+    constexpr std::size_t kSize = 1 << 20;
+    const auto whole = [&](const std::string& text) {
+        return text.size() == kSize && text.find_first_not_of(text[0]) == std::string::npos;
+    };
+    std::atomic<bool> done{false};
+    std::atomic<int> bad_reads{0}, reads{0};
+    std::thread reader([&] {
+        while (!done) {
+            std::ifstream in(f, std::ios::binary);
+            if (!in) continue;
+            const std::string got((std::istreambuf_iterator<char>(in)), {});
+            ++reads;
+            if (!whole(got)) ++bad_reads;
+        }
+    });
+    std::vector<std::thread> writers;
+    std::atomic<int> errors{0};
+    for (int w = 0; w < 4; ++w)
+        writers.emplace_back([&, w] {
+            const std::string text(kSize, static_cast<char>('a' + w));
+            for (int i = 0; i < 15; ++i) try {
+                    devslam::core::writeFileWhole(f, text);
+                } catch (const std::exception&) {
+                    ++errors;
+                }
+        });
+    for (auto& t : writers) t.join();
+    done = true;
+    reader.join();
+    EXPECT_EQ(errors, 0);
+    EXPECT_EQ(bad_reads, 0) << "of " << reads << " reads";
+    std::ifstream in(f, std::ios::binary);
+    EXPECT_TRUE(whole(std::string((std::istreambuf_iterator<char>(in)), {})));
+    EXPECT_FALSE(std::filesystem::exists(f + ".part"));
+    // A .part a killed writer left is taken over, not a reason to fail.
+    std::ofstream(f + ".part") << "left by a writer killed on the way, longer than the text";
+    devslam::core::writeFileWhole(f, "new\n");
+    std::ifstream again(f);
+    std::string line;
+    std::getline(again, line);
+    EXPECT_EQ(line, "new");
+    EXPECT_FALSE(std::filesystem::exists(f + ".part"));
+    std::filesystem::remove_all(dir);
+}
+
 TEST(Results, PicturesAreWrittenWholeOrSayWhyNot) {
     const auto dir = devslam::test::scratchPath("results_png");
     std::filesystem::remove_all(dir);

@@ -19,6 +19,7 @@
 
 #include <fcntl.h>
 #include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 namespace devslam::core {
@@ -166,6 +167,50 @@ void replaceResultsSection(const std::string& path, const std::string& name,
 }
 
 namespace {
+/// `<path>.part`, opened and held (an exclusive flock, waited for) by one writer at a time:
+/// two programs writing one file at once wrote into one .part together and renamed a splice
+/// of both. The one that waited finds the .part renamed away (or another one made at the
+/// name) and opens the name again. Emptied once held: a .part a killed writer left is taken
+/// over. `why` is set, and `fd` -1, when it cannot be made.
+struct PartFile {
+    int fd = -1;
+    std::string why;
+    explicit PartFile(const std::string& part) {
+        for (;;) {
+            fd = ::open(part.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC, 0666);
+            if (fd < 0) {
+                why = std::strerror(errno);
+                return;
+            }
+            while (::flock(fd, LOCK_EX) != 0 && errno == EINTR) {
+            }
+            struct stat held{}, named{};
+            if (::fstat(fd, &held) == 0 && ::stat(part.c_str(), &named) == 0 &&
+                held.st_dev == named.st_dev && held.st_ino == named.st_ino)
+                break;  // the .part at the name is the one held
+            ::close(fd);
+        }
+        if (::ftruncate(fd, 0) != 0) why = std::strerror(errno);
+    }
+    ~PartFile() {
+        if (fd >= 0) ::close(fd);  // after the rename: the next writer then opens afresh
+    }
+    PartFile(const PartFile&) = delete;
+    PartFile& operator=(const PartFile&) = delete;
+};
+
+/// Writes all of `text` at `fd`: "" when it went, else the system's reason.
+std::string writeAll(int fd, const std::string& text) {
+    std::size_t done = 0;
+    while (done < text.size()) {
+        const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
+        if (n < 0 && errno == EINTR) continue;
+        if (n <= 0) return n < 0 ? std::strerror(errno) : "write failed";
+        done += static_cast<std::size_t>(n);
+    }
+    return "";
+}
+
 /// Writes `text` into `file` (made, or emptied first): "" when it went, else why not.
 std::string writeText(const std::string& file, const std::string& text) {
     errno = 0;
@@ -195,16 +240,17 @@ void writeFileWhole(const std::string& link, const std::string& text) {
         return;
     }
     const std::string part = path + ".part";
-    if (const std::string why = writeText(part, text); !why.empty()) {
-        std::filesystem::remove(part, ec);
-        throw std::runtime_error("cannot write '" + path + "': " + why);  // (the .part is gone)
-    }
+    const PartFile f(part);  // held from its first byte to its rename
+    std::string why = f.why;
+    if (why.empty()) why = writeAll(f.fd, text);
     // The file keeps its permissions (the .part got the default ones).
-    if (exists) fs::permissions(part, st.permissions(), ec);
-    std::filesystem::rename(part, path, ec);
-    if (ec) {
-        const std::string why = ec.message();
-        std::filesystem::remove(part, ec);
+    if (why.empty() && exists) fs::permissions(part, st.permissions(), ec);
+    if (why.empty()) {
+        fs::rename(part, path, ec);
+        if (ec) why = ec.message();
+    }
+    if (!why.empty()) {
+        if (f.fd >= 0) fs::remove(part, ec);  // ours: held (the lock is left on the fd alone)
         throw std::runtime_error("cannot write '" + path + "': " + why);
     }
 }
