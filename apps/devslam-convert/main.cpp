@@ -240,6 +240,16 @@ int convert(int argc, char** argv) {
         if (isRawlog(args.output)) {
             auto wo = args.wo;
             wo.fresh = true;  // (refused above if it is there; this catches one made since)
+            // Its folder is made, as a TUM output's folder is (with its parents).
+            if (const auto parent = std::filesystem::path(args.output).parent_path();
+                !parent.empty()) {
+                std::error_code ec;
+                std::filesystem::create_directories(parent, ec);
+                if (!std::filesystem::is_directory(parent))
+                    throw std::runtime_error(
+                        "cannot write rawlog '" + args.output + "': cannot make folder '" +
+                        parent.string() + "': " + (ec ? ec.message() : "a file is there"));
+            }
             devslam::io::RawlogWriter out(args.output, wo);
             c.copy(*reader, out, args, bar);
             finish([&] { out.close(); });

@@ -283,6 +283,19 @@ TEST(DevslamConvert, SaysWhatARawlogDoesNotKeep) {
     EXPECT_NE(r.out.find("not kept: groundtruth.txt (a rawlog holds no ground truth)"),
               std::string::npos)
         << r.out;
+    // A rawlog's folder is made, as a TUM output's is; a file in its way is named.
+    const std::string in = std::string(DEVSLAM_SOURCE_DIR) + "/data/tum/fr1_xyz_first37 ";
+    auto made = devslam::test::runApp(
+        "devslam-convert", in + (dir / "new/sub/y.rawlog").string() + " --max-frames 2");
+    EXPECT_EQ(made.rc, 0) << made.out;
+    EXPECT_TRUE(fs::is_regular_file(dir / "new/sub/y.rawlog")) << made.out;
+    made = devslam::test::runApp("devslam-convert",
+                                 in + (dir / "x.rawlog/z.rawlog").string() + " --max-frames 2");
+    EXPECT_EQ(made.rc, 1) << made.out;
+    EXPECT_NE(made.out.find("cannot write rawlog '" + (dir / "x.rawlog/z.rawlog").string() +
+                            "': cannot make folder '" + (dir / "x.rawlog").string() + "': "),
+              std::string::npos)
+        << made.out;
     fs::remove_all(dir);
 }
 
