@@ -980,6 +980,25 @@ TEST(Writers, AnImageFileCutAtItsEndIsAnError) {
     EXPECT_FALSE(fs::exists(d.str("cut2_Images/frame_0_rgb.png")));
 }
 
+// A text file given as a rawlog got MRPT's "Expecting 0x00 00 00 while parsing old streaming
+// header" alone: the error now says what the file starts with.
+TEST(Rawlog, ATextFileIsNamedForWhatItStartsWith) {
+    TempDir d;
+    const std::string path = d.str("notes.rawlog");
+    std::ofstream(path) << "hello\tworld\nsecond line\n";
+    try {
+        io::RawlogReader r(path);
+        ADD_FAILURE() << "a text file opened as a rawlog";
+    } catch (const std::runtime_error& e) {
+        const std::string m = e.what();
+        EXPECT_NE(m.find("notes.rawlog: cannot decode object 0 at byte 0 of the uncompressed "
+                         "stream: not a rawlog? It starts with 'hello?world?second line?' where a "
+                         "rawlog starts with an MRPT class name"),
+                  std::string::npos)
+            << m;
+    }
+}
+
 // Binary garbage read as an object's class name was echoed to the terminal in the error.
 TEST(Rawlog, AGarbageClassNameIsNotEchoed) {
     TempDir d;

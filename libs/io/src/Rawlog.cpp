@@ -268,11 +268,29 @@ core::Frame frameFromObservation(const CObservation3DRangeScan& o, const std::st
 // ---------------------------------------------------------------------------------------
 struct RawlogReader::Stream {
     explicit Stream(const std::string& path)
-        : file(path), arch(mrpt::serialization::archiveFrom(file)) {}
+        : path(path), file(path), arch(mrpt::serialization::archiveFrom(file)) {}
+    std::string path;
     mrpt::io::CFileGZInputStream file;
     mrpt::serialization::CArchiveStreamBase<mrpt::io::CFileGZInputStream> arch;
     std::vector<CObservation3DRangeScan::Ptr> pending;  // from the current sensory frame
     std::size_t objects = 0;
+
+    /// For a first object that does not decode: what the file starts with (a text file given
+    /// as a rawlog got MRPT's "old streaming header" alone).
+    std::string notARawlog() const {
+        char head[24] = {};
+        std::size_t n = 0;
+        try {
+            mrpt::io::CFileGZInputStream again(path);
+            n = again.Read(head, sizeof head);
+        } catch (const std::exception&) {
+        }
+        // MRPT's objects start with 0x80 + the class name's length, then the name.
+        if (n >= 2 && (static_cast<unsigned char>(head[0]) & 0x80) && head[1] == 'C') return "";
+        return ": not a rawlog? It starts with '" + printable(std::string(head, n)) +
+               "' where a rawlog starts with an MRPT class name (CSensoryFrame, "
+               "CObservation3DRangeScan...)";
+    }
 
     // Next 3D scan (optionally of one sensor label); nullptr at a clean end. Counts other
     // observations in `skipped`. Throws on damage.
@@ -295,7 +313,8 @@ struct RawlogReader::Stream {
             } catch (const std::exception& e) {
                 throw std::runtime_error("cannot decode object " + std::to_string(objects) +
                                          " at byte " + std::to_string(pos) +
-                                         " of the uncompressed stream (" +
+                                         " of the uncompressed stream" +
+                                         (objects == 0 && pos == 0 ? notARawlog() : "") + " (" +
                                          printable(core::innermostMessage(e.what())) + ")");
             }
             ++objects;
