@@ -179,6 +179,12 @@ TEST(TumReader, MalformedListsNameFileAndLine) {
     expectError([&] { (void)io::openRgbd(d.str("s")); }, "no rgb\\.txt");
     expectError([&] { io::TumReader r(d.str("s")); }, "rgb\\.txt: file not found");
     expectError([&] { (void)io::openRgbd(d.str("nothing_here")); }, "no such TUM folder or rawlog");
+    // The system's reason, after the path, where the path cannot be looked at (it was a bare
+    // "filesystem error: status: File name too long [...]").
+    const std::string long_name = d.str(std::string(300, 'a'));
+    expectError([&] { (void)io::openRgbd(long_name); }, "^" + long_name + ": File name too long$");
+    writeText(d.str("plain"), "x");  // a path through a file: not there, as ENOENT
+    expectError([&] { (void)io::openRgbd(d.str("plain/x")); }, "no such TUM folder or rawlog");
 }
 
 // Lists as other tools write them: a byte-order mark and CRLF (Windows editors), an image

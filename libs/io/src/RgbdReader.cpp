@@ -31,12 +31,18 @@ void ReaderOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, const
 }
 
 std::unique_ptr<RgbdReader> openRgbd(const std::string& path, const ReaderOptions& opts) {
-    if (fs::is_directory(path)) {
+    // (error codes: a name too long or a folder that cannot be entered threw a bare
+    // "filesystem error: status: ..." that named no option)
+    std::error_code ec;
+    const fs::file_status st = fs::status(path, ec);
+    if (ec && ec != std::errc::no_such_file_or_directory && ec != std::errc::not_a_directory)
+        throw std::runtime_error(path + ": " + ec.message());
+    if (fs::is_directory(st)) {
         if (!fs::exists(fs::path(path) / "rgb.txt"))
             throw std::runtime_error(path + ": folder has no rgb.txt (not a TUM RGB-D folder)");
         return std::make_unique<TumReader>(path, opts);
     }
-    if (fs::is_regular_file(path)) {
+    if (fs::is_regular_file(st)) {
         std::string ext = fs::path(path).extension().string();
         std::transform(ext.begin(), ext.end(), ext.begin(),
                        [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
