@@ -18,6 +18,9 @@
 
 #include <gtest/gtest.h>
 #include <mrpt/config/CConfigFileMemory.h>
+#include <mrpt/img/CImage.h>
+#include <mrpt/maps/COccupancyGridMap2D.h>
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include <cmath>
@@ -703,6 +706,24 @@ TEST(MapExporter, AFullDiskIsAnError) {
     EXPECT_EQ(devslam::core::gzipDamage(scene), "");
     EXPECT_GT(std::filesystem::file_size(scene), 100u);
     EXPECT_FALSE(std::filesystem::exists(scene + ".part"));
+    // The grid's picture too: written whole, the same pixels as MRPT's own image of it, and a
+    // failure names the file and why.
+    mrpt::maps::COccupancyGridMap2D grid(-1, 1, -1, 1, 0.1f);
+    grid.setCell(3, 4, 0.0f);
+    saveGrid(grid, d.str("grid"));
+    mrpt::img::CImage mrpts;
+    grid.getAsImage(mrpts);
+    const cv::Mat back = cv::imread(d.str("grid.png"), cv::IMREAD_UNCHANGED);
+    ASSERT_EQ(back.size(), mrpts.asCvMatRef().size());
+    EXPECT_EQ(cv::norm(back, mrpts.asCvMatRef(), cv::NORM_INF), 0.0);
+    EXPECT_FALSE(std::filesystem::exists(d.str("grid.png.part")));
+    try {
+        saveGrid(grid, d.str("no/such/grid"));
+        ADD_FAILURE() << "wrote into a folder that is not there";
+    } catch (const std::runtime_error& e) {
+        EXPECT_EQ(std::string(e.what()), "grid image: cannot write '" + d.str("no/such/grid.png") +
+                                             "': No such file or directory");
+    }
 }
 
 TEST(Map, ObservationsAndRemovalStayConsistent) {

@@ -1,10 +1,12 @@
 #include <devslam/core/Config.h>
 #include <devslam/core/GzFile.h>
+#include <devslam/core/Picture.h>
 #include <devslam/core/Pose.h>
 #include <devslam/core/Results.h>
 #include <devslam/slam/MapExporter.h>
 
 #include <mrpt/config/CConfigFileBase.h>
+#include <mrpt/img/CImage.h>
 #include <mrpt/opengl/CGridPlaneXY.h>
 #include <mrpt/opengl/COpenGLScene.h>
 #include <mrpt/opengl/CPointCloudColoured.h>
@@ -192,8 +194,14 @@ std::optional<mrpt::maps::COccupancyGridMap2D> buildOccupancyGrid(const Map& map
 }
 
 void saveGrid(const mrpt::maps::COccupancyGridMap2D& grid, const std::string& stem) {
-    if (!grid.saveAsBitmapFile(stem + ".png"))
-        throw std::runtime_error("cannot write grid image '" + stem + ".png'");
+    // (saveAsBitmapFile is getAsImage + cv::imwrite: a cut picture on a full disk, no reason)
+    mrpt::img::CImage img;
+    grid.getAsImage(img);
+    try {
+        core::writePngWhole(stem + ".png", img.asCvMatRef());
+    } catch (const std::exception& e) {  // "cannot write 'PATH': why"
+        throw std::runtime_error(std::string("grid image: ") + e.what());
+    }
     core::writeGzFileWhole(stem + ".gridmap", "grid map", [&](mrpt::io::CStream& s) {
         mrpt::serialization::archiveFrom(s) << grid;
     });
