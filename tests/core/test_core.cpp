@@ -29,6 +29,7 @@
 
 #include <fcntl.h>
 #include <sys/file.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 #include <chrono>
@@ -516,8 +517,7 @@ TEST(Config, StrictReadsNameSectionKeyAndValue) {
               "[a] typo_num: expected a number, got '0.5.1'");
     EXPECT_EQ(invalidArgument([&] { (void)readBool(mem, "a", "typo_bool", true); }),
               "[a] typo_bool: expected true or false, got 'ture'");
-    for (const auto& [key, read] :
-         std::vector<std::pair<std::string, std::function<void()>>>{
+    for (const auto& [key, read] : std::vector<std::pair<std::string, std::function<void()>>>{
              {"empty", [&] { (void)readInt(mem, "a", "empty", 3); }},
              {"neg_seed", [&] { (void)readUint64(mem, "a", "neg_seed", 0); }},
              {"huge", [&] { (void)readInt(mem, "a", "huge", 0); }}}) {  // huge: > int
@@ -829,6 +829,22 @@ TEST(Results, WritersOfOneFileAtOnceNeverSpliceIt) {
     std::ifstream in(f, std::ios::binary);
     EXPECT_TRUE(whole(std::string((std::istreambuf_iterator<char>(in)), {})));
     EXPECT_FALSE(std::filesystem::exists(f + ".part"));
+    // A .part that is a link or a FIFO is in the way (through the link, the rename would have
+    // put the link itself at the file's name; a FIFO blocked the write).
+    std::filesystem::create_symlink("elsewhere.txt", f + ".part");
+    try {
+        devslam::core::writeFileWhole(f, "through a link\n");
+        ADD_FAILURE() << "written through the link";
+    } catch (const std::runtime_error& e) {
+        EXPECT_EQ(std::string(e.what()),
+                  "cannot write '" + f + "': '" + f + ".part' is in the way (not a plain file)");
+    }
+    EXPECT_FALSE(std::filesystem::exists(dir / "elsewhere.txt"));
+    EXPECT_FALSE(std::filesystem::is_symlink(f));
+    std::filesystem::remove(f + ".part");
+    ASSERT_EQ(::mkfifo((f + ".part").c_str(), 0600), 0);
+    EXPECT_THROW(devslam::core::writeFileWhole(f, "into a FIFO\n"), std::runtime_error);
+    std::filesystem::remove(f + ".part");
     // A .part a killed writer left is taken over, not a reason to fail.
     std::ofstream(f + ".part") << "left by a writer killed on the way, longer than the text";
     devslam::core::writeFileWhole(f, "new\n");

@@ -177,14 +177,26 @@ struct PartFile {
     std::string why;
     explicit PartFile(const std::string& part) {
         for (;;) {
-            fd = ::open(part.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC, 0666);
+            // Not through a link (the rename would then put the link itself at the file's
+            // name), nor blocking on a FIFO with no reader.
+            fd = ::open(part.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK,
+                        0666);
+            struct stat st {};
+            if (fd >= 0 && (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode))) {
+                ::close(fd);
+                fd = -1;
+                errno = ELOOP;
+            }
             if (fd < 0) {
-                why = std::strerror(errno);
+                why = errno == ELOOP || errno == ENXIO
+                          ? "'" + part + "' is in the way (not a plain file)"
+                          : std::strerror(errno);
                 return;
             }
             while (::flock(fd, LOCK_EX) != 0 && errno == EINTR) {
             }
-            struct stat held{}, named{};
+            struct stat held {
+            }, named{};
             if (::fstat(fd, &held) == 0 && ::stat(part.c_str(), &named) == 0 &&
                 held.st_dev == named.st_dev && held.st_ino == named.st_ino)
                 break;  // the .part at the name is the one held

@@ -74,6 +74,8 @@ void closeWritten(WrittenFile& f, const std::string& error) {
     if (std::fclose(f.release()) != 0 || failed) throw std::runtime_error(error);
 }
 
-void writePng(const std::string& path, const cv::Mat& image) { core::writePngWhole(path, image); }
+void writePng(const std::string& path, const cv::Mat& image) {
+    core::writePngWhole(path, image);
+}
 
 }  // namespace devslam::io::detail

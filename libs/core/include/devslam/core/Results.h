@@ -26,9 +26,10 @@ void replaceResultsSection(const std::string& path, const std::string& name,
 /// Writes `text` to `path` whole or not at all: into `path`.part, then renamed over `path`,
 /// so that a program killed on the way leaves the old file (and at most the .part beside it,
 /// which the next write takes over). Writers of one file at once take turns (each holds the
-/// .part, flocked, from its first byte to its rename): the last one's text is the file's, never
-/// a splice of two. The file keeps its permissions; a symbolic link stays one (the file it leads to is
-/// replaced, or made). Throws std::runtime_error naming the file when it cannot be written.
+/// .part, flocked, from its first byte to its rename): the last one's text is the file's,
+/// never a splice of two. The file keeps its permissions; a symbolic link stays one (the file
+/// it leads to is replaced, or made). Throws std::runtime_error naming the file when it
+/// cannot be written, or when its .part is a link or not a plain file.
 void writeFileWhole(const std::string& path, const std::string& text);
 
 /// An output folder held by this process for as long as the object lives (an exclusive
