@@ -71,7 +71,8 @@ const std::vector<std::string> kKeys{"mode",
                                      "depth_noise_z2",
                                      "new_track_score",
                                      "static_person_weight",
-                                     "static_person_gate"};
+                                     "static_person_gate",
+                                     "static_person_outline"};
 
 cv::Rect2f shrink(const cv::Rect2f& b, double f) {
     const auto dx = static_cast<float>(f * b.width), dy = static_cast<float>(f * b.height);
@@ -212,6 +213,7 @@ void DynamicObjectFilter::Options::loadFromConfig(const mrpt::config::CConfigFil
                            "must be wider, same or narrower (got '" + g + "')");
         static_person_gate = it->second;
     }
+    static_person_outline = core::readInt(c, s, "static_person_outline", static_person_outline);
     slow_frames = core::readInt(c, s, "slow_frames", slow_frames);
     slow_threshold = core::readDouble(c, s, "slow_threshold", slow_threshold);
     slow_speed = core::readDouble(c, s, "slow_speed", slow_speed);
@@ -270,6 +272,9 @@ void DynamicObjectFilter::Options::validate(const std::string& s) const {
                        "static_person_weight", "must be in (0, 1] (1 = like any keypoint)");
     core::requireValue(gateName(static_person_gate) != nullptr, s, "static_person_gate",
                        "must be 1, 0 or -1 (wider, same, narrower)");
+    // (a structuring element of (2 w + 1)^2 bytes per Static person and frame, as mask_margin)
+    core::requireValue(static_person_outline >= 0 && static_person_outline <= 500, s,
+                       "static_person_outline", "must be in [0, 500] [px] (0 = off)");
     core::requireValue(slow_frames >= 0, s, "slow_frames", "must be >= 0 (0 = off)");
     core::requireValue(slow_threshold > 0, s, "slow_threshold", "must be > 0");
     core::requireValue(slow_speed >= 0, s, "slow_speed", "must be >= 0 (0 = off)");
@@ -324,6 +329,7 @@ void DynamicObjectFilter::Options::saveToConfig(mrpt::config::CConfigFileBase& c
         core::writeKey(c, s, "static_person_gate", std::string(gate));
     else
         core::writeKey(c, s, "static_person_gate", static_person_gate);
+    core::writeKey(c, s, "static_person_outline", static_person_outline);
     core::writeKey(c, s, "slow_frames", slow_frames);
     core::writeKey(c, s, "slow_threshold", slow_threshold);
     core::writeKey(c, s, "slow_speed", slow_speed);
@@ -990,6 +996,8 @@ void DynamicObjectFilter::Impl::forgetUnseen(const Options& o) {
             tracks.end());
 }
 
+namespace {
+
 /// Clears the set pixels of `sil` not 8-connected to one inside `inner` (a rectangle in
 /// sil's coordinates). Pixels inside `inner` are all kept: their components reach it.
 void keepConnectedTo(cv::Mat& sil, const cv::Rect& inner) {
@@ -1011,6 +1019,56 @@ void keepConnectedTo(cv::Mat& sil, const cv::Rect& inner) {
     }
 }
 
+/// The person's silhouette as mask_silhouette draws it: the pixels of `outer` in the
+/// person's depth band (person depth zp) or without depth (the holes along a person's
+/// outline); outside `inner` (the box, inside outer) only those connected to the silhouette
+/// inside it (a head above the box, not a desk at the person's depth beside it). In outer's
+/// coordinates.
+cv::Mat silhouetteIn(const cv::Mat& depth, const cv::Rect& outer, const cv::Rect& inner, float zp,
+                     const DynamicObjectFilter::Options& o) {
+    const double band = o.silhouette_depth_band > 0 ? o.silhouette_depth_band
+                        : o.fg_depth_band > 0       ? o.fg_depth_band
+                                                    : 0.5;
+    const float h = depthBand(band, zp);
+    cv::Mat sil, holes;
+    cv::inRange(depth(outer), zp - h, zp + h, sil);
+    cv::compare(depth(outer), 0.f, holes, cv::CMP_LE);
+    sil |= holes;
+    if (outer != inner) keepConnectedTo(sil, inner - outer.tl());
+    return sil;
+}
+
+/// The box grown by silhouette_grow (the region the silhouette is sought in), clipped.
+cv::Rect grownBox(const cv::Rect& inner, const cv::Rect2f& box, const cv::Size& size,
+                  const DynamicObjectFilter::Options& o) {
+    const int gx = static_cast<int>(std::lround(o.silhouette_grow * box.width));
+    const int gy = static_cast<int>(std::lround(o.silhouette_grow * box.height));
+    return cv::Rect(inner.x - gx, inner.y - gy, inner.width + 2 * gx, inner.height + 2 * gy) &
+           cv::Rect({}, size);
+}
+
+/// Sets in `mask` the pixels within `w` px of the outline of a Static person's silhouette,
+/// on both sides (static_person_outline): the silhouette's dilation less its erosion.
+void drawOutline(const core::Frame& frame, const cv::Rect& inner, const cv::Rect2f& box, float zp,
+                 const DynamicObjectFilter::Options& o, cv::Mat& mask) {
+    const int w = o.static_person_outline;
+    const cv::Size size = mask.size();
+    const cv::Rect outer = grownBox(inner, box, size, o);
+    const cv::Rect region =
+        cv::Rect(outer.x - w, outer.y - w, outer.width + 2 * w, outer.height + 2 * w) &
+        cv::Rect({}, size);
+    cv::Mat big = cv::Mat::zeros(region.size(), CV_8UC1);
+    silhouetteIn(frame.depth, outer, inner, zp, o).copyTo(big(outer - region.tl()));
+    const cv::Mat k = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * w + 1, 2 * w + 1));
+    cv::Mat grown, shrunk;
+    cv::dilate(big, grown, k);
+    // (the image's border erodes nothing: a person cut by it has no outline there)
+    cv::erode(big, shrunk, k);
+    mask(region) |= grown & ~shrunk;
+}
+
+}  // namespace
+
 void DynamicObjectFilter::Impl::drawMask(const core::Frame& frame, bool have_prev, const Options& o,
                                          FilterOutput& out) const {
     // Whole boxes, dilated by the margin. On a frame with no previous one every box is
@@ -1021,6 +1079,7 @@ void DynamicObjectFilter::Impl::drawMask(const core::Frame& frame, bool have_pre
     // The people judged Static, for the SLAM's static_person_weight (mode Dynamic only:
     // all_persons masks them).
     const bool weigh_static = o.mode == MaskMode::Dynamic && o.static_person_weight < 1.0;
+    const bool outline_static = o.mode == MaskMode::Dynamic && o.static_person_outline > 0;
     if (weigh_static) out.static_people = cv::Mat::zeros(size, CV_8UC1);
     for (const auto& t : tracks) {
         if (t.hidden(o)) continue;
@@ -1028,11 +1087,14 @@ void DynamicObjectFilter::Impl::drawMask(const core::Frame& frame, bool have_pre
         const bool masked = o.mode == MaskMode::AllPersons || t.tb.state == BoxState::Moving ||
                             (mask_unknown && t.tb.state == BoxState::Unknown);
         if (!masked) {
+            if (t.tb.state != BoxState::Static) continue;
             // The whole box, not the silhouette (with or without the margin): on sitting_xyz
             // the silhouette's weights were worse (docs/dynamic.md, "Weighing seated people
             // down"); a gesturing hand leaves the person's depth band, not the box.
-            if (weigh_static && t.tb.state == BoxState::Static)
-                out.static_people(cv::Rect(t.tb.box) & cv::Rect({}, size)).setTo(255);
+            const cv::Rect inner = cv::Rect(t.tb.box) & cv::Rect({}, size);
+            if (weigh_static) out.static_people(inner).setTo(255);
+            if (outline_static && t.depth && !inner.empty())
+                drawOutline(frame, inner, t.tb.box, *t.depth, o, out.mask);
             continue;
         }
         const auto m = static_cast<float>(o.mask_margin);
@@ -1057,32 +1119,18 @@ void DynamicObjectFilter::Impl::drawMask(const core::Frame& frame, bool have_pre
         }
         // Silhouette: the box's pixels in the person's depth band or without depth (the
         // holes along a person's outline), dilated by the margin.
-        const float zp = *t.depth;
-        const double band = o.silhouette_depth_band > 0 ? o.silhouette_depth_band
-                            : o.fg_depth_band > 0       ? o.fg_depth_band
-                                                        : 0.5;
-        const float h = depthBand(band, zp);
         const cv::Rect inner = cv::Rect(t.tb.box) & cv::Rect({}, size);
         if (inner.empty()) continue;
         // The band is sought in the box grown by silhouette_grow; outside the box only the
-        // parts connected to the silhouette inside it are kept (a head above the box, not
-        // a desk at the person's depth beside it).
-        const int gx = static_cast<int>(std::lround(o.silhouette_grow * t.tb.box.width));
-        const int gy = static_cast<int>(std::lround(o.silhouette_grow * t.tb.box.height));
-        cv::Rect outer =
-            cv::Rect(inner.x - gx, inner.y - gy, inner.width + 2 * gx, inner.height + 2 * gy) &
-            cv::Rect({}, size);
+        // parts connected to the silhouette inside it are kept.
+        cv::Rect outer = grownBox(inner, t.tb.box, size, o);
         // mask_border_snap: on a side snapped to the border the silhouette may reach it, as
         // the whole box does (still only through the person's pixels, like silhouette_grow).
         if (snap_l) outer = cv::Rect(0, outer.y, outer.br().x, outer.height);
         if (snap_t) outer = cv::Rect(outer.x, 0, outer.width, outer.br().y);
         if (snap_r) outer.width = size.width - outer.x;
         if (snap_b) outer.height = size.height - outer.y;
-        cv::Mat sil, holes;
-        cv::inRange(frame.depth(outer), zp - h, zp + h, sil);
-        cv::compare(frame.depth(outer), 0.f, holes, cv::CMP_LE);
-        sil |= holes;
-        if (outer != inner) keepConnectedTo(sil, inner - outer.tl());
+        const cv::Mat sil = silhouetteIn(frame.depth, outer, inner, *t.depth, o);
         const cv::Rect region = r | outer;
         cv::Mat big = cv::Mat::zeros(region.size(), CV_8UC1);
         sil.copyTo(big(outer - region.tl()));

@@ -244,6 +244,13 @@ class DynamicObjectFilter {
         /// narrows it by sqrt(w): a sitter's corner that drifted with the sway is dropped
         /// sooner (docs/dynamic.md, "The weight in the chi2 tests"). Only -1, 0 and 1.
         double static_person_gate = 1.0;
+        /// [px] In mode Dynamic, the pixels within this distance of the outline of a person
+        /// judged Static are masked, on both sides (the silhouette as mask_silhouette finds
+        /// it, in the box grown by silhouette_grow; the person's inside stays unmasked). A
+        /// swaying sitter's outline is where their motion shows most and where the wall
+        /// behind them is covered and uncovered: corners there are not points of the scene.
+        /// Needs the person's depth (none: nothing masked). 0 = off.
+        int static_person_outline = 0;
 
         /// Reads `[section]`; unknown keys throw std::invalid_argument naming them.
         void loadFromConfig(const mrpt::config::CConfigFileBase& cfg,
