@@ -1048,7 +1048,9 @@ cv::Rect grownBox(const cv::Rect& inner, const cv::Rect2f& box, const cv::Size& 
 }
 
 /// Sets in `mask` the pixels within `w` px of the outline of a Static person's silhouette,
-/// on both sides (static_person_outline): the silhouette's dilation less its erosion.
+/// on both sides (static_person_outline): the silhouette's dilation less its erosion. Where
+/// the grown box cuts the silhouette (a box that stops at the knees), the cut counts as
+/// outline too.
 void drawOutline(const core::Frame& frame, const cv::Rect& inner, const cv::Rect2f& box, float zp,
                  const DynamicObjectFilter::Options& o, cv::Mat& mask) {
     const int w = o.static_person_outline;
