@@ -288,10 +288,17 @@ TEST(DynamicFilter, StaticPersonOutlineMasksABandAlongTheSilhouetteOnly) {
     const auto& seq = standingPerson();
     constexpr int kWidth = 4;
     // The masks of one run per mode and outline width, frame by frame.
-    const auto run = [&](MaskMode mode, int width, std::vector<BoxState>* states) {
+    // `depth_only_for_outline`: nothing else of the filter needs the person's depth.
+    const auto run = [&](MaskMode mode, int width, std::vector<BoxState>* states,
+                         bool depth_only_for_outline = false) {
         auto fo = testOptions();
         fo.mode = mode;
-        fo.mask_silhouette = true;
+        fo.mask_silhouette = !depth_only_for_outline;
+        if (depth_only_for_outline) {
+            fo.fg_depth_band = 0;
+            fo.depth_frames = 0;
+            fo.slow_frames = 0;
+        }
         fo.static_person_outline = width;
         auto det = std::make_unique<ScriptedDetector>();
         ScriptedDetector* script = det.get();
@@ -346,6 +353,16 @@ TEST(DynamicFilter, StaticPersonOutlineMasksABandAlongTheSilhouetteOnly) {
         EXPECT_EQ(cv::countNonZero(inside & outlined[k]), 0) << "frame " << k;
     }
     EXPECT_GE(checked, static_cast<int>(seq.size()) - 1);
+    // The outline finds the person's depth itself when nothing else needs it.
+    std::vector<BoxState> bare_states;
+    const auto bare = run(MaskMode::Dynamic, kWidth, &bare_states, true);
+    int bare_static = 0;
+    for (std::size_t k = 0; k < seq.size(); ++k) {
+        if (bare_states[k] != BoxState::Static) continue;
+        ++bare_static;
+        EXPECT_GT(cv::countNonZero(bare[k]), 0) << "frame " << k << ": no outline";
+    }
+    EXPECT_GE(bare_static, static_cast<int>(seq.size()) - 1);
     // all_persons masks the whole person whatever the width
     const auto all_outlined = run(MaskMode::AllPersons, kWidth, nullptr);
     const auto all_plain = run(MaskMode::AllPersons, 0, nullptr);

@@ -730,7 +730,7 @@ void DynamicObjectFilter::Impl::measureBoxes(const cv::Mat& depth, const Options
                                 [](const Track& t) { return t.tb.box.area() < 16.f; }),
                  tracks.end());
     const bool need_depth = o.fg_depth_band > 0 || o.mask_silhouette || o.depth_frames > 0 ||
-                            (o.slow_frames > 0 && o.slow_speed > 0);
+                            (o.slow_frames > 0 && o.slow_speed > 0) || o.static_person_outline > 0;
     for (auto& t : tracks)
         t.depth = need_depth ? personDepth(depth, t.tb.box, o.max_depth) : std::nullopt;
 }

@@ -249,7 +249,7 @@ class DynamicObjectFilter {
         /// it, in the box grown by silhouette_grow; the person's inside stays unmasked). A
         /// swaying sitter's outline is where their motion shows most and where the wall
         /// behind them is covered and uncovered: corners there are not points of the scene.
-        /// Needs the person's depth (none: nothing masked). 0 = off.
+        /// The person's depth is measured for it (a box without one: nothing masked). 0 = off.
         int static_person_outline = 0;
 
         /// Reads `[section]`; unknown keys throw std::invalid_argument naming them.
