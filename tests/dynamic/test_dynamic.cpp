@@ -370,6 +370,33 @@ TEST(DynamicFilter, StaticPersonOutlineMasksABandAlongTheSilhouetteOnly) {
         EXPECT_EQ(cv::norm(all_outlined[k], all_plain[k], cv::NORM_INF), 0) << "frame " << k;
 }
 
+// static_person_outline draws along depth edges only: a false detection on the flat wall,
+// held Static, has no outline (the silhouette is the whole box there; dilated less eroded it
+// gave a ring along the box's sides, all of it wall).
+TEST(DynamicFilter, StaticPersonOutlineLeavesABoxOnAFlatWallUnmasked) {
+    const auto& seq = standingPerson();
+    auto fo = testOptions();
+    fo.static_person_outline = 4;
+    auto det = std::make_unique<ScriptedDetector>();
+    ScriptedDetector* script = det.get();
+    DynamicObjectFilter filter(fo, std::move(det));
+    const cv::Rect2f on_wall(60, 150, 120, 200);  // left of the billboard, wall only
+    int checked = 0;
+    for (const auto& f : seq) {
+        ASSERT_FALSE((on_wall & f.person_box.value()).area() > 0) << "the box must miss the person";
+        script->next = {{on_wall, 0, "person", 0.9f}, {boxWithWall(f), 0, "person", 0.9f}};
+        const auto out = filter.step(f.frame, f.T_prev_cur);
+        ASSERT_EQ(out.boxes.size(), 2U);
+        if (out.boxes[0].state != BoxState::Static || out.boxes[1].state != BoxState::Static)
+            continue;
+        ++checked;
+        const cv::Rect around = cv::Rect(0, 100, 240, 300);  // the wall box and its surroundings
+        EXPECT_EQ(cv::countNonZero(out.mask(around)), 0) << "frame " << checked;
+        EXPECT_GT(cv::countNonZero(out.mask), 0) << "the person's outline is masked";
+    }
+    EXPECT_GE(checked, static_cast<int>(seq.size()) - 1);
+}
+
 TEST(DynamicFilter, PureCameraMotionFlagsNothing) {
     // No person; two boxes on the wall (false detections) must never be flagged, with or
     // without ego-motion prior. Raw displacement (no compensation) flags them: that is the

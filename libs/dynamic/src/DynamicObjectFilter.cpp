@@ -1019,6 +1019,14 @@ void keepConnectedTo(cv::Mat& sil, const cv::Rect& inner) {
     }
 }
 
+/// Half-width [m] of the depth band of a person at depth zp that their silhouette holds.
+float silhouetteBand(const DynamicObjectFilter::Options& o, float zp) {
+    const double band = o.silhouette_depth_band > 0 ? o.silhouette_depth_band
+                        : o.fg_depth_band > 0       ? o.fg_depth_band
+                                                    : 0.5;
+    return depthBand(band, zp);
+}
+
 /// The person's silhouette as mask_silhouette draws it: the pixels of `outer` in the
 /// person's depth band (person depth zp) or without depth (the holes along a person's
 /// outline); outside `inner` (the box, inside outer) only those connected to the silhouette
@@ -1026,10 +1034,7 @@ void keepConnectedTo(cv::Mat& sil, const cv::Rect& inner) {
 /// coordinates.
 cv::Mat silhouetteIn(const cv::Mat& depth, const cv::Rect& outer, const cv::Rect& inner, float zp,
                      const DynamicObjectFilter::Options& o) {
-    const double band = o.silhouette_depth_band > 0 ? o.silhouette_depth_band
-                        : o.fg_depth_band > 0       ? o.fg_depth_band
-                                                    : 0.5;
-    const float h = depthBand(band, zp);
+    const float h = silhouetteBand(o, zp);
     cv::Mat sil, holes;
     cv::inRange(depth(outer), zp - h, zp + h, sil);
     cv::compare(depth(outer), 0.f, holes, cv::CMP_LE);
@@ -1047,26 +1052,55 @@ cv::Rect grownBox(const cv::Rect& inner, const cv::Rect2f& box, const cv::Size& 
            cv::Rect({}, size);
 }
 
-/// Sets in `mask` the pixels within `w` px of the outline of a Static person's silhouette,
-/// on both sides (static_person_outline): the silhouette's dilation less its erosion. Where
-/// the grown box cuts the silhouette (a box that stops at the knees), the cut counts as
-/// outline too.
+/// Sets in `mask` the pixels within `w` px of a Static person's outline where it is a depth
+/// edge (static_person_outline), on both sides: where the person covers the wall behind them
+/// (or a desk covers them). The outline is the silhouette's boundary (its pixels with a
+/// 4-neighbour outside it); a boundary pixel is a depth edge when the valid depths within
+/// kEdgeReach px of it span more than the person's depth band. The reach spans the band of
+/// missing depth a depth camera leaves along a discontinuity (the silhouette holds those
+/// holes, so its boundary is on their far side); holes do not count as depths, so the
+/// scattered missing pixels of the person and the wall make no edges. A cut of the
+/// silhouette by the grown box (a box that stops at the knees) and a box on a flat wall (a
+/// false detection) have no outline, and the image's border none either: the first version
+/// of this band, the silhouette's dilation less its erosion, outlined the first two (docs/dynamic.md, "A band along the still
+/// person's outline").
 void drawOutline(const core::Frame& frame, const cv::Rect& inner, const cv::Rect2f& box, float zp,
                  const DynamicObjectFilter::Options& o, cv::Mat& mask) {
+    constexpr int kEdgeReach = 5;  // [px]
     const int w = o.static_person_outline;
     const cv::Size size = mask.size();
     const cv::Rect outer = grownBox(inner, box, size, o);
     const cv::Rect region =
         cv::Rect(outer.x - w, outer.y - w, outer.width + 2 * w, outer.height + 2 * w) &
         cv::Rect({}, size);
-    cv::Mat big = cv::Mat::zeros(region.size(), CV_8UC1);
-    silhouetteIn(frame.depth, outer, inner, zp, o).copyTo(big(outer - region.tl()));
-    const cv::Mat k = cv::getStructuringElement(cv::MORPH_ELLIPSE, cv::Size(2 * w + 1, 2 * w + 1));
-    cv::Mat grown, shrunk;
-    cv::dilate(big, grown, k);
-    // (the image's border erodes nothing: a person cut by it has no outline there)
-    cv::erode(big, shrunk, k);
-    mask(region) |= grown & ~shrunk;
+    // The span of the valid depths around each pixel, from the image beyond the grown box
+    // too (a head at the box's top, with the wall above it). Holes: 0, never the largest;
+    // set to +max, never the smallest.
+    const cv::Rect wide = cv::Rect(outer.x - kEdgeReach, outer.y - kEdgeReach,
+                                   outer.width + 2 * kEdgeReach, outer.height + 2 * kEdgeReach) &
+                          cv::Rect({}, size);
+    const cv::Mat depth = frame.depth(wide);
+    const cv::Mat reach = cv::getStructuringElement(
+        cv::MORPH_RECT, cv::Size(2 * kEdgeReach + 1, 2 * kEdgeReach + 1));
+    cv::Mat dmax, dmin, no_hole = depth.clone(), jump;
+    no_hole.setTo(std::numeric_limits<float>::max(), depth <= 0.f);
+    cv::dilate(depth, dmax, reach, {-1, -1}, 1, cv::BORDER_REPLICATE);
+    cv::erode(no_hole, dmin, reach, {-1, -1}, 1, cv::BORDER_REPLICATE);
+    cv::compare(dmax - dmin, silhouetteBand(o, zp), jump, cv::CMP_GT);
+    // The silhouette's boundary, the grown box's cut included (the depth span decides there:
+    // a head cut by it is an edge, legs or a flat wall are not)
+    const cv::Mat sil = silhouetteIn(frame.depth, outer, inner, zp, o);
+    cv::Mat eroded;
+    cv::erode(sil, eroded, cv::getStructuringElement(cv::MORPH_CROSS, cv::Size(3, 3)), {-1, -1},
+              1, cv::BORDER_CONSTANT, cv::Scalar(0));
+    const cv::Mat edge = sil & ~eroded & jump(outer - wide.tl());
+    // The band: every pixel within w px of an edge pixel (the zeros of `far`). A distance
+    // transform, not a dilation by a disc: linear in the region's pixels, whatever w.
+    cv::Mat far(region.size(), CV_8UC1, cv::Scalar(255)), dist, band;
+    far(outer - region.tl()).setTo(0, edge);
+    cv::distanceTransform(far, dist, cv::DIST_L2, cv::DIST_MASK_PRECISE);
+    cv::compare(dist, static_cast<double>(w), band, cv::CMP_LE);
+    mask(region) |= band;
 }
 
 }  // namespace

@@ -245,11 +245,12 @@ class DynamicObjectFilter {
         /// sooner (docs/dynamic.md, "The weight in the chi2 tests"). Only -1, 0 and 1.
         double static_person_gate = 1.0;
         /// [px] In mode Dynamic, the pixels within this distance of the outline of a person
-        /// judged Static are masked, on both sides (the silhouette as mask_silhouette finds
-        /// it, in the box grown by silhouette_grow; the person's inside stays unmasked). A
-        /// swaying sitter's outline is where their motion shows most and where the wall
-        /// behind them is covered and uncovered: corners there are not points of the scene.
-        /// The person's depth is measured for it (a box without one: nothing masked). 0 = off.
+        /// judged Static are masked, on both sides, where that outline is a depth edge (the
+        /// silhouette as mask_silhouette finds it, in the box grown by silhouette_grow; the
+        /// person's inside stays unmasked, and so does a box on a flat wall). A swaying
+        /// sitter's outline is where their motion shows most and where the wall behind them
+        /// is covered and uncovered: corners there are not points of the scene. The person's
+        /// depth is measured for it (a box without one: nothing masked). 0 = off.
         int static_person_outline = 0;
 
         /// Reads `[section]`; unknown keys throw std::invalid_argument naming them.
