@@ -397,6 +397,30 @@ TEST(DynamicFilter, StaticPersonOutlineLeavesABoxOnAFlatWallUnmasked) {
     EXPECT_GE(checked, static_cast<int>(seq.size()) - 1);
 }
 
+// static_person_outline_after: the band starts at a person's n-th consecutive Static step.
+TEST(DynamicFilter, StaticPersonOutlineStartsAfterTheGivenStaticSteps) {
+    const auto& seq = standingPerson();
+    for (const int after : {0, 3}) {
+        auto fo = testOptions();
+        fo.static_person_outline = 4;
+        fo.static_person_outline_after = after;
+        auto det = std::make_unique<ScriptedDetector>();
+        ScriptedDetector* script = det.get();
+        DynamicObjectFilter filter(fo, std::move(det));
+        int static_steps = 0, banded = 0;
+        for (const auto& f : seq) {
+            script->next = {{boxWithWall(f), 0, "person", 0.9f}};
+            const auto out = filter.step(f.frame, f.T_prev_cur);
+            static_steps = out.boxes.at(0).state == BoxState::Static ? static_steps + 1 : 0;
+            const bool band = static_steps > 0 && static_steps >= after;
+            banded += band ? 1 : 0;
+            EXPECT_EQ(cv::countNonZero(out.mask) > 0, band)
+                << "after " << after << ", Static step " << static_steps;
+        }
+        EXPECT_GE(banded, static_cast<int>(seq.size()) - (after == 0 ? 1 : after)) << after;
+    }
+}
+
 TEST(DynamicFilter, PureCameraMotionFlagsNothing) {
     // No person; two boxes on the wall (false detections) must never be flagged, with or
     // without ego-motion prior. Raw displacement (no compensation) flags them: that is the
@@ -623,6 +647,8 @@ TEST(DynamicFilter, OptionsSetInCodeAreChecked) {
              {"static_person_weight", [](auto& o) { o.static_person_weight = 1.5; }},
              {"static_person_outline", [](auto& o) { o.static_person_outline = -1; }},
              {"static_person_outline", [](auto& o) { o.static_person_outline = 501; }},
+             {"static_person_outline_after",
+              [](auto& o) { o.static_person_outline_after = -1; }},
              {"static_person_gate", [](auto& o) { o.static_person_gate = 0.5; }},
              // (a (2 m + 1)^2 dilation kernel per box and frame: 100000 asked for 40 GB)
              {"mask_margin", [](auto& o) { o.mask_margin = 100000; }}}) {
@@ -948,6 +974,15 @@ TEST(DynamicConfig, ShippedIniLoadsAndRoundTrips) {
     DynamicObjectFilter::Options o2;
     o2.loadFromConfig(saved);
     EXPECT_EQ(o2.static_person_outline, 5);
+    EXPECT_EQ(o2.static_person_outline_after, 0);  // from the first Static step, the default
+    quarter.write("dynamic_filter", "static_person_outline_after", 90);
+    DynamicObjectFilter::Options o3;
+    o3.loadFromConfig(quarter);
+    mrpt::config::CConfigFileMemory saved3;
+    o3.saveToConfig(saved3);
+    DynamicObjectFilter::Options o4;
+    o4.loadFromConfig(saved3);
+    EXPECT_EQ(o4.static_person_outline_after, 90);
     for (const auto& [name, p] : std::vector<std::pair<std::string, double>>{
              {"narrower", -1.0}, {"same", 0.0}, {"wider", 1.0}}) {
         quarter.write("dynamic_filter", "static_person_gate", name);

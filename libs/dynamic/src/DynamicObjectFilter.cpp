@@ -72,7 +72,8 @@ const std::vector<std::string> kKeys{"mode",
                                      "new_track_score",
                                      "static_person_weight",
                                      "static_person_gate",
-                                     "static_person_outline"};
+                                     "static_person_outline",
+                                     "static_person_outline_after"};
 
 cv::Rect2f shrink(const cv::Rect2f& b, double f) {
     const auto dx = static_cast<float>(f * b.width), dy = static_cast<float>(f * b.height);
@@ -214,6 +215,8 @@ void DynamicObjectFilter::Options::loadFromConfig(const mrpt::config::CConfigFil
         static_person_gate = it->second;
     }
     static_person_outline = core::readInt(c, s, "static_person_outline", static_person_outline);
+    static_person_outline_after =
+        core::readInt(c, s, "static_person_outline_after", static_person_outline_after);
     slow_frames = core::readInt(c, s, "slow_frames", slow_frames);
     slow_threshold = core::readDouble(c, s, "slow_threshold", slow_threshold);
     slow_speed = core::readDouble(c, s, "slow_speed", slow_speed);
@@ -272,9 +275,11 @@ void DynamicObjectFilter::Options::validate(const std::string& s) const {
                        "static_person_weight", "must be in (0, 1] (1 = like any keypoint)");
     core::requireValue(gateName(static_person_gate) != nullptr, s, "static_person_gate",
                        "must be 1, 0 or -1 (wider, same, narrower)");
-    // (a structuring element of (2 w + 1)^2 bytes per Static person and frame, as mask_margin)
+    // (the band's region grows by w on each side: 500 px spans the image)
     core::requireValue(static_person_outline >= 0 && static_person_outline <= 500, s,
                        "static_person_outline", "must be in [0, 500] [px] (0 = off)");
+    core::requireValue(static_person_outline_after >= 0, s, "static_person_outline_after",
+                       "must be >= 0 [steps] (0 = from the first step judged Static)");
     core::requireValue(slow_frames >= 0, s, "slow_frames", "must be >= 0 (0 = off)");
     core::requireValue(slow_threshold > 0, s, "slow_threshold", "must be > 0");
     core::requireValue(slow_speed >= 0, s, "slow_speed", "must be >= 0 (0 = off)");
@@ -330,6 +335,7 @@ void DynamicObjectFilter::Options::saveToConfig(mrpt::config::CConfigFileBase& c
     else
         core::writeKey(c, s, "static_person_gate", static_person_gate);
     core::writeKey(c, s, "static_person_outline", static_person_outline);
+    core::writeKey(c, s, "static_person_outline_after", static_person_outline_after);
     core::writeKey(c, s, "slow_frames", slow_frames);
     core::writeKey(c, s, "slow_threshold", slow_threshold);
     core::writeKey(c, s, "slow_speed", slow_speed);
@@ -388,6 +394,7 @@ struct DynamicObjectFilter::Impl {
     struct Track {
         TrackedBox tb;
         int quiet = 0;   ///< consecutive frames without moving evidence
+        int static_steps = 0;  ///< consecutive steps, this one included, in state Static
         int missed = 0;  ///< detector runs without a matching detection
         /// consecutive steps unmatched at the last detector run and with fewer than
         /// min_points points in the box: nothing shows the person is still there
@@ -552,6 +559,8 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
     }
     im.classifyBoxes(res, frame, have_prev ? frame.timestamp - im.prev_timestamp : 0.0, opts_, out);
     im.forgetUnseen(opts_);
+    for (auto& t : im.tracks)
+        t.static_steps = t.tb.state == BoxState::Static ? t.static_steps + 1 : 0;
     lap(times.evidence);
     im.drawMask(frame, have_prev, opts_, out);
     lap(times.mask);
@@ -1129,7 +1138,10 @@ void DynamicObjectFilter::Impl::drawMask(const core::Frame& frame, bool have_pre
             // down"); a gesturing hand leaves the person's depth band, not the box.
             const cv::Rect inner = cv::Rect(t.tb.box) & cv::Rect({}, size);
             if (weigh_static) out.static_people(inner).setTo(255);
-            if (outline_static && t.depth && !inner.empty())
+            // (a person Static for static_person_outline_after steps: walkers the filter
+            // holds Static for a while are left alone, docs/dynamic.md)
+            if (outline_static && t.depth && !inner.empty() &&
+                t.static_steps >= o.static_person_outline_after)
                 drawOutline(frame, inner, t.tb.box, *t.depth, o, out.mask);
             continue;
         }

@@ -252,6 +252,11 @@ class DynamicObjectFilter {
         /// is covered and uncovered: corners there are not points of the scene. The person's
         /// depth is measured for it (a box without one: nothing masked). 0 = off.
         int static_person_outline = 0;
+        /// [steps] static_person_outline acts on a person from their this-many-th
+        /// consecutive step in state Static on: a seated person, not a walker the filter
+        /// holds Static for a while (at a border, coming at the camera). 0 or 1 = from
+        /// their first Static step.
+        int static_person_outline_after = 0;
 
         /// Reads `[section]`; unknown keys throw std::invalid_argument naming them.
         void loadFromConfig(const mrpt::config::CConfigFileBase& cfg,
