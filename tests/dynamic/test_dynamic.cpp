@@ -647,8 +647,7 @@ TEST(DynamicFilter, OptionsSetInCodeAreChecked) {
              {"static_person_weight", [](auto& o) { o.static_person_weight = 1.5; }},
              {"static_person_outline", [](auto& o) { o.static_person_outline = -1; }},
              {"static_person_outline", [](auto& o) { o.static_person_outline = 501; }},
-             {"static_person_outline_after",
-              [](auto& o) { o.static_person_outline_after = -1; }},
+             {"static_person_outline_after", [](auto& o) { o.static_person_outline_after = -1; }},
              {"static_person_gate", [](auto& o) { o.static_person_gate = 0.5; }},
              // (a (2 m + 1)^2 dilation kernel per box and frame: 100000 asked for 40 GB)
              {"mask_margin", [](auto& o) { o.mask_margin = 100000; }}}) {
@@ -963,26 +962,21 @@ TEST(DynamicConfig, ShippedIniLoadsAndRoundTrips) {
     DynamicObjectFilter::Options c;
     c.loadFromConfig(quarter);
     EXPECT_EQ(c.static_person_weight, 0.25);
-    EXPECT_EQ(c.static_person_gate, 1.0);   // wider, the default
-    EXPECT_EQ(c.static_person_outline, 0);  // off, the default
+    EXPECT_EQ(c.static_person_gate, 1.0);         // wider, the default
+    EXPECT_EQ(c.static_person_outline, 0);        // off, the default
+    EXPECT_EQ(c.static_person_outline_after, 0);  // from the first Static step, the default
     quarter.write("dynamic_filter", "static_person_outline", 5);
+    quarter.write("dynamic_filter", "static_person_outline_after", 90);
     DynamicObjectFilter::Options o;
     o.loadFromConfig(quarter);
     EXPECT_EQ(o.static_person_outline, 5);
+    EXPECT_EQ(o.static_person_outline_after, 90);
     mrpt::config::CConfigFileMemory saved;
     o.saveToConfig(saved);
     DynamicObjectFilter::Options o2;
     o2.loadFromConfig(saved);
     EXPECT_EQ(o2.static_person_outline, 5);
-    EXPECT_EQ(o2.static_person_outline_after, 0);  // from the first Static step, the default
-    quarter.write("dynamic_filter", "static_person_outline_after", 90);
-    DynamicObjectFilter::Options o3;
-    o3.loadFromConfig(quarter);
-    mrpt::config::CConfigFileMemory saved3;
-    o3.saveToConfig(saved3);
-    DynamicObjectFilter::Options o4;
-    o4.loadFromConfig(saved3);
-    EXPECT_EQ(o4.static_person_outline_after, 90);
+    EXPECT_EQ(o2.static_person_outline_after, 90);
     for (const auto& [name, p] : std::vector<std::pair<std::string, double>>{
              {"narrower", -1.0}, {"same", 0.0}, {"wider", 1.0}}) {
         quarter.write("dynamic_filter", "static_person_gate", name);

@@ -393,9 +393,9 @@ struct Residuals {
 struct DynamicObjectFilter::Impl {
     struct Track {
         TrackedBox tb;
-        int quiet = 0;   ///< consecutive frames without moving evidence
+        int quiet = 0;         ///< consecutive frames without moving evidence
         int static_steps = 0;  ///< consecutive steps, this one included, in state Static
-        int missed = 0;  ///< detector runs without a matching detection
+        int missed = 0;        ///< detector runs without a matching detection
         /// consecutive steps unmatched at the last detector run and with fewer than
         /// min_points points in the box: nothing shows the person is still there
         int unseen = 0;
@@ -1052,13 +1052,16 @@ cv::Mat silhouetteIn(const cv::Mat& depth, const cv::Rect& outer, const cv::Rect
     return sil;
 }
 
+/// `r` grown by gx px left and right and gy px up and down, clipped to an image of `size`.
+cv::Rect grownClipped(const cv::Rect& r, int gx, int gy, const cv::Size& size) {
+    return cv::Rect(r.x - gx, r.y - gy, r.width + 2 * gx, r.height + 2 * gy) & cv::Rect({}, size);
+}
+
 /// The box grown by silhouette_grow (the region the silhouette is sought in), clipped.
 cv::Rect grownBox(const cv::Rect& inner, const cv::Rect2f& box, const cv::Size& size,
                   const DynamicObjectFilter::Options& o) {
-    const int gx = static_cast<int>(std::lround(o.silhouette_grow * box.width));
-    const int gy = static_cast<int>(std::lround(o.silhouette_grow * box.height));
-    return cv::Rect(inner.x - gx, inner.y - gy, inner.width + 2 * gx, inner.height + 2 * gy) &
-           cv::Rect({}, size);
+    return grownClipped(inner, static_cast<int>(std::lround(o.silhouette_grow * box.width)),
+                        static_cast<int>(std::lround(o.silhouette_grow * box.height)), size);
 }
 
 /// Sets in `mask` the pixels within `w` px of a Static person's outline where it is a depth
@@ -1071,26 +1074,22 @@ cv::Rect grownBox(const cv::Rect& inner, const cv::Rect2f& box, const cv::Size& 
 /// scattered missing pixels of the person and the wall make no edges. A cut of the
 /// silhouette by the grown box (a box that stops at the knees) and a box on a flat wall (a
 /// false detection) have no outline, and the image's border none either: the first version
-/// of this band, the silhouette's dilation less its erosion, outlined the first two (docs/dynamic.md, "A band along the still
-/// person's outline").
+/// of this band, the silhouette's dilation less its erosion, outlined the first two
+/// (docs/dynamic.md, "A band along the still person's outline").
 void drawOutline(const core::Frame& frame, const cv::Rect& inner, const cv::Rect2f& box, float zp,
                  const DynamicObjectFilter::Options& o, cv::Mat& mask) {
     constexpr int kEdgeReach = 5;  // [px]
     const int w = o.static_person_outline;
     const cv::Size size = mask.size();
     const cv::Rect outer = grownBox(inner, box, size, o);
-    const cv::Rect region =
-        cv::Rect(outer.x - w, outer.y - w, outer.width + 2 * w, outer.height + 2 * w) &
-        cv::Rect({}, size);
+    const cv::Rect region = grownClipped(outer, w, w, size);
     // The span of the valid depths around each pixel, from the image beyond the grown box
     // too (a head at the box's top, with the wall above it). Holes: 0, never the largest;
     // set to +max, never the smallest.
-    const cv::Rect wide = cv::Rect(outer.x - kEdgeReach, outer.y - kEdgeReach,
-                                   outer.width + 2 * kEdgeReach, outer.height + 2 * kEdgeReach) &
-                          cv::Rect({}, size);
+    const cv::Rect wide = grownClipped(outer, kEdgeReach, kEdgeReach, size);
     const cv::Mat depth = frame.depth(wide);
-    const cv::Mat reach = cv::getStructuringElement(
-        cv::MORPH_RECT, cv::Size(2 * kEdgeReach + 1, 2 * kEdgeReach + 1));
+    const cv::Mat reach =
+        cv::getStructuringElement(cv::MORPH_RECT, cv::Size(2 * kEdgeReach + 1, 2 * kEdgeReach + 1));
     cv::Mat dmax, dmin, no_hole = depth.clone(), jump;
     no_hole.setTo(std::numeric_limits<float>::max(), depth <= 0.f);
     cv::dilate(depth, dmax, reach, {-1, -1}, 1, cv::BORDER_REPLICATE);
@@ -1100,8 +1099,8 @@ void drawOutline(const core::Frame& frame, const cv::Rect& inner, const cv::Rect
     // a head cut by it is an edge, legs or a flat wall are not)
     const cv::Mat sil = silhouetteIn(frame.depth, outer, inner, zp, o);
     cv::Mat eroded;
-    cv::erode(sil, eroded, cv::getStructuringElement(cv::MORPH_CROSS, cv::Size(3, 3)), {-1, -1},
-              1, cv::BORDER_CONSTANT, cv::Scalar(0));
+    cv::erode(sil, eroded, cv::getStructuringElement(cv::MORPH_CROSS, cv::Size(3, 3)), {-1, -1}, 1,
+              cv::BORDER_CONSTANT, cv::Scalar(0));
     const cv::Mat edge = sil & ~eroded & jump(outer - wide.tl());
     // The band: every pixel within w px of an edge pixel (the zeros of `far`). A distance
     // transform, not a dilation by a disc: linear in the region's pixels, whatever w.
