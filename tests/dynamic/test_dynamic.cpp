@@ -421,6 +421,59 @@ TEST(DynamicFilter, StaticPersonOutlineStartsAfterTheGivenStaticSteps) {
     }
 }
 
+// first_frame_as_static: in a frame with no previous one the person (Unknown, unmasked) gets
+// the static person's weight and outline band, whatever static_person_outline_after; from the
+// second frame on the filter runs as without it.
+TEST(DynamicFilter, FirstFrameAsStaticWeighsAndOutlinesTheFirstFramesPerson) {
+    const auto& seq = standingPerson();
+    struct Run {
+        std::vector<cv::Mat> masks, weighed;
+        std::vector<BoxState> states;
+    };
+    const auto run = [&](MaskMode mode, bool first_as_static) {
+        auto fo = testOptions();
+        fo.mode = mode;
+        fo.static_person_weight = 0.5;
+        fo.static_person_outline = 4;
+        fo.static_person_outline_after = 3;
+        fo.first_frame_as_static = first_as_static;
+        auto det = std::make_unique<ScriptedDetector>();
+        ScriptedDetector* script = det.get();
+        DynamicObjectFilter filter(fo, std::move(det));
+        Run r;
+        for (const auto& f : seq) {
+            script->next = {{boxWithWall(f), 0, "person", 0.9f}};
+            const auto out = filter.step(f.frame, f.T_prev_cur);
+            r.states.push_back(out.boxes.at(0).state);
+            r.masks.push_back(out.mask.clone());
+            r.weighed.push_back(out.static_people.clone());
+        }
+        return r;
+    };
+    const Run off = run(MaskMode::Dynamic, false), on = run(MaskMode::Dynamic, true);
+    ASSERT_EQ(off.states.at(0), BoxState::Unknown);
+    ASSERT_EQ(on.states.at(0), BoxState::Unknown);
+    EXPECT_EQ(cv::countNonZero(off.masks[0]), 0) << "without it the first frame masks nobody";
+    EXPECT_EQ(cv::countNonZero(off.weighed[0]), 0) << "and weighs nobody down";
+    const cv::Rect box = cv::Rect(boxWithWall(seq[0])) & cv::Rect(0, 0, 640, 480);
+    ASSERT_GT(box.area(), 0);
+    EXPECT_EQ(cv::countNonZero(on.weighed[0](box)), box.area()) << "the box is weighed down";
+    EXPECT_EQ(cv::countNonZero(on.weighed[0]), box.area()) << "nothing beyond it";
+    const int band = cv::countNonZero(on.masks[0]);
+    EXPECT_GT(band, 0) << "the outline is masked in the first frame, before any Static step";
+    EXPECT_LT(band, box.area() / 2) << "the outline, not the person";
+    for (std::size_t k = 1; k < seq.size(); ++k) {
+        EXPECT_EQ(on.states[k], off.states[k]) << "frame " << k;
+        EXPECT_EQ(cv::norm(on.masks[k], off.masks[k], cv::NORM_INF), 0) << "frame " << k;
+        EXPECT_EQ(cv::norm(on.weighed[k], off.weighed[k], cv::NORM_INF), 0) << "frame " << k;
+    }
+    // all_persons masks the first frame's person whole either way
+    const Run all_off = run(MaskMode::AllPersons, false), all_on = run(MaskMode::AllPersons, true);
+    EXPECT_GT(cv::countNonZero(all_on.masks[0]), box.area() / 2);
+    for (std::size_t k = 0; k < seq.size(); ++k)
+        EXPECT_EQ(cv::norm(all_on.masks[k], all_off.masks[k], cv::NORM_INF), 0) << "frame " << k;
+}
+
 TEST(DynamicFilter, PureCameraMotionFlagsNothing) {
     // No person; two boxes on the wall (false detections) must never be flagged, with or
     // without ego-motion prior. Raw displacement (no compensation) flags them: that is the

@@ -58,6 +58,7 @@ const std::vector<std::string> kKeys{"mode",
                                      "flow_scale",
                                      "mask_unknown",
                                      "mask_unknown_first_frame",
+                                     "first_frame_as_static",
                                      "mask_border_snap",
                                      "fg_depth_band",
                                      "mask_silhouette",
@@ -235,6 +236,7 @@ void DynamicObjectFilter::Options::loadFromConfig(const mrpt::config::CConfigFil
     mask_unknown = core::readBool(c, s, "mask_unknown", mask_unknown);
     mask_unknown_first_frame =
         core::readBool(c, s, "mask_unknown_first_frame", mask_unknown_first_frame);
+    first_frame_as_static = core::readBool(c, s, "first_frame_as_static", first_frame_as_static);
     mask_border_snap = core::readInt(c, s, "mask_border_snap", mask_border_snap);
     validate(s);
 }
@@ -353,6 +355,7 @@ void DynamicObjectFilter::Options::saveToConfig(mrpt::config::CConfigFileBase& c
     core::writeKey(c, s, "mask_margin", mask_margin);
     core::writeKey(c, s, "mask_unknown", mask_unknown);
     core::writeKey(c, s, "mask_unknown_first_frame", mask_unknown_first_frame);
+    core::writeKey(c, s, "first_frame_as_static", first_frame_as_static);
     core::writeKey(c, s, "mask_border_snap", mask_border_snap);
 }
 
@@ -1131,7 +1134,9 @@ void DynamicObjectFilter::Impl::drawMask(const core::Frame& frame, bool have_pre
         const bool masked = o.mode == MaskMode::AllPersons || t.tb.state == BoxState::Moving ||
                             (mask_unknown && t.tb.state == BoxState::Unknown);
         if (!masked) {
-            if (t.tb.state != BoxState::Static) continue;
+            const bool first_unknown =
+                o.first_frame_as_static && !have_prev && t.tb.state == BoxState::Unknown;
+            if (t.tb.state != BoxState::Static && !first_unknown) continue;
             // The whole box, not the silhouette (with or without the margin): on sitting_xyz
             // the silhouette's weights were worse (docs/dynamic.md, "Weighing seated people
             // down"); a gesturing hand leaves the person's depth band, not the box.
@@ -1140,7 +1145,7 @@ void DynamicObjectFilter::Impl::drawMask(const core::Frame& frame, bool have_pre
             // (a person Static for static_person_outline_after steps: walkers the filter
             // holds Static for a while are left alone, docs/dynamic.md)
             if (outline_static && t.depth && !inner.empty() &&
-                t.static_steps >= o.static_person_outline_after)
+                (first_unknown || t.static_steps >= o.static_person_outline_after))
                 drawOutline(frame, inner, t.tb.box, *t.depth, o, out.mask);
             continue;
         }

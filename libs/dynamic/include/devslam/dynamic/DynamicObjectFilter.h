@@ -208,6 +208,13 @@ class DynamicObjectFilter {
         /// this masks every person, seated ones too, in the frame the SLAM builds its
         /// first keyframe from. Off by default (docs/dynamic.md, session 11).
         bool mask_unknown_first_frame = false;
+        /// Mode dynamic, a frame with no previous one: the Unknown boxes left unmasked there
+        /// (mask_unknown_first_frame off) get what the boxes of people judged Static get:
+        /// static_person_weight, and the static_person_outline band, which needs no
+        /// static_person_outline_after there (nobody can have been held Static yet). That is
+        /// the frame the SLAM builds its first keyframe from; without this the people in it
+        /// enter the map at full weight (docs/dynamic.md, "The first frame's people").
+        bool first_frame_as_static = false;
         /// [px] a masked box edge (the box grown by mask_margin) this close to the image
         /// border is extended to it: a person cut off by the border is detected with a box
         /// that stops short of it, leaving a strip of the person unmasked. 0 snaps only an
