@@ -1134,6 +1134,8 @@ void DynamicObjectFilter::Impl::drawMask(const core::Frame& frame, bool have_pre
         const bool masked = o.mode == MaskMode::AllPersons || t.tb.state == BoxState::Moving ||
                             (mask_unknown && t.tb.state == BoxState::Unknown);
         if (!masked) {
+            // first_frame_as_static: the people of a frame with no previous one (all
+            // Unknown, unmasked there) are treated as people judged Static
             const bool first_unknown =
                 o.first_frame_as_static && !have_prev && t.tb.state == BoxState::Unknown;
             if (t.tb.state != BoxState::Static && !first_unknown) continue;

@@ -57,8 +57,9 @@ struct TrackedBox {
 /// Result of one step.
 struct FilterOutput {
     cv::Mat mask;  ///< CV_8UC1, frame size, 255 = masked (drop keypoints here), 0 = keep
-    /// CV_8UC1, frame size, 255 = inside the box of a person judged Static, for the SLAM's
-    /// static_person_weight. Empty unless mode Dynamic and that weight < 1.
+    /// CV_8UC1, frame size, 255 = inside the box of a person judged Static (with
+    /// first_frame_as_static also an unmasked person of a frame with no previous one), for
+    /// the SLAM's static_person_weight. Empty unless mode Dynamic and that weight < 1.
     cv::Mat static_people;
     std::vector<TrackedBox> boxes;
     bool detector_ran = false;
