@@ -231,6 +231,21 @@ cv::Rect2f boxWithWall(const dynamic::SyntheticFrame& f) {
             static_cast<float>(person.height)};
 }
 
+/// standingPerson() through a filter with options `fo`, its detector scripted to find the
+/// person's boxWithWall in every frame: the outputs, frame by frame (each step's mask and
+/// static_people are Mats of their own).
+std::vector<dynamic::FilterOutput> runStandingPerson(const DynamicObjectFilter::Options& fo) {
+    auto det = std::make_unique<ScriptedDetector>();
+    ScriptedDetector* script = det.get();
+    DynamicObjectFilter filter(fo, std::move(det));
+    std::vector<dynamic::FilterOutput> outs;
+    for (const auto& f : standingPerson()) {
+        script->next = {{boxWithWall(f), 0, "person", 0.9f}};
+        outs.push_back(filter.step(f.frame, f.T_prev_cur));
+    }
+    return outs;
+}
+
 // static_person_weight: the filter marks the box of a person judged Static for the SLAM
 // (wall and all: docs/dynamic.md measured the silhouette and found it worse), in mode Dynamic
 // only (all_persons masks them).
@@ -248,16 +263,14 @@ TEST(DynamicFilter, StaticPeopleRegionIsTheStaticPersonsBox) {
         fo.mode = c.mode;
         fo.static_person_weight = c.weight;
         fo.mask_silhouette = c.silhouette;
-        auto det = std::make_unique<ScriptedDetector>();
-        ScriptedDetector* script = det.get();
-        DynamicObjectFilter filter(fo, std::move(det));
         const std::string what = dynamic::toString(c.mode) + " weight " + std::to_string(c.weight) +
                                  " silhouette " + std::to_string(c.silhouette);
+        const auto outs = runStandingPerson(fo);
+        ASSERT_EQ(outs.size(), seq.size());
         int statics = 0;
         for (std::size_t k = 0; k < seq.size(); ++k) {
             ASSERT_TRUE(seq[k].person_box.has_value()) << "frame " << k;
-            script->next = {{boxWithWall(seq[k]), 0, "person", 0.9f}};
-            const auto out = filter.step(seq[k].frame, seq[k].T_prev_cur);
+            const auto& out = outs[k];
             ASSERT_EQ(out.boxes.size(), 1u) << what;
             const bool is_static = out.boxes[0].state == BoxState::Static;
             statics += is_static ? 1 : 0;
@@ -300,15 +313,10 @@ TEST(DynamicFilter, StaticPersonOutlineMasksABandAlongTheSilhouetteOnly) {
             fo.slow_frames = 0;
         }
         fo.static_person_outline = width;
-        auto det = std::make_unique<ScriptedDetector>();
-        ScriptedDetector* script = det.get();
-        DynamicObjectFilter filter(fo, std::move(det));
         std::vector<cv::Mat> masks;
-        for (const auto& f : seq) {
-            script->next = {{boxWithWall(f), 0, "person", 0.9f}};
-            const auto out = filter.step(f.frame, f.T_prev_cur);
+        for (const auto& out : runStandingPerson(fo)) {
             if (states) states->push_back(out.boxes.at(0).state);
-            masks.push_back(out.mask.clone());
+            masks.push_back(out.mask);
         }
         return masks;
     };
@@ -404,13 +412,8 @@ TEST(DynamicFilter, StaticPersonOutlineStartsAfterTheGivenStaticSteps) {
         auto fo = testOptions();
         fo.static_person_outline = 4;
         fo.static_person_outline_after = after;
-        auto det = std::make_unique<ScriptedDetector>();
-        ScriptedDetector* script = det.get();
-        DynamicObjectFilter filter(fo, std::move(det));
         int static_steps = 0, banded = 0;
-        for (const auto& f : seq) {
-            script->next = {{boxWithWall(f), 0, "person", 0.9f}};
-            const auto out = filter.step(f.frame, f.T_prev_cur);
+        for (const auto& out : runStandingPerson(fo)) {
             static_steps = out.boxes.at(0).state == BoxState::Static ? static_steps + 1 : 0;
             const bool band = static_steps > 0 && static_steps >= after;
             banded += band ? 1 : 0;
@@ -437,16 +440,11 @@ TEST(DynamicFilter, FirstFrameAsStaticWeighsAndOutlinesTheFirstFramesPerson) {
         fo.static_person_outline = 4;
         fo.static_person_outline_after = 3;
         fo.first_frame_as_static = first_as_static;
-        auto det = std::make_unique<ScriptedDetector>();
-        ScriptedDetector* script = det.get();
-        DynamicObjectFilter filter(fo, std::move(det));
         Run r;
-        for (const auto& f : seq) {
-            script->next = {{boxWithWall(f), 0, "person", 0.9f}};
-            const auto out = filter.step(f.frame, f.T_prev_cur);
+        for (const auto& out : runStandingPerson(fo)) {
             r.states.push_back(out.boxes.at(0).state);
-            r.masks.push_back(out.mask.clone());
-            r.weighed.push_back(out.static_people.clone());
+            r.masks.push_back(out.mask);
+            r.weighed.push_back(out.static_people);
         }
         return r;
     };
