@@ -138,4 +138,31 @@ PairedRatio pairedRatio(const Target& t, const std::string& sequence,
     return r;
 }
 
+RenderVerdict renderVerdict(const Target& t, const PairedRatio& p) {
+    if (p.count < 2 || !std::isfinite(p.lo) || !std::isfinite(p.hi)) return RenderVerdict::None;
+    const bool lo = t.holds(p.lo), hi = t.holds(p.hi);
+    if (lo && hi) return RenderVerdict::Met;
+    if (!lo && !hi) return RenderVerdict::Missed;
+    return RenderVerdict::Open;
+}
+
+std::string targetsSummary(int met, std::size_t count, const std::vector<std::string>& open,
+                           const std::vector<std::string>& against) {
+    const auto names = [](const std::vector<std::string>& keys) {
+        std::string s;
+        for (std::size_t i = 0; i < keys.size(); ++i)
+            s += (i ? (i + 1 == keys.size() ? " and " : ", ") : "") + keys[i];
+        return s;
+    };
+    std::string s =
+        std::to_string(met) + " of " + std::to_string(count) + " targets met on the medians.";
+    if (!open.empty())
+        s += " The per-render interval holds the bound of " + names(open) +
+             ": the renders do not settle " + (open.size() > 1 ? "these." : "this one.");
+    if (!against.empty())
+        s += " The per-render interval lies wholly on the other side of the bound for " +
+             names(against) + ".";
+    return s;
+}
+
 }  // namespace devslam::bench

@@ -89,4 +89,16 @@ struct PairedRatio {
                                       const std::vector<SequenceInputs>& inputs,
                                       const FigureOf& figure);
 
+/// What a ratio target's per-render interval says of its bound: both ends meet it (Met), both
+/// miss it (Missed), or the bound lies inside (Open: the renders cannot tell whether the target
+/// holds, however the medians fall); None without an interval (no ratio, under two renders).
+enum class RenderVerdict { None, Met, Missed, Open };
+[[nodiscard]] RenderVerdict renderVerdict(const Target& t, const PairedRatio& p);
+
+/// The sentence under the targets table: "5 of 7 targets met on the medians.", then the keys
+/// whose interval is Open, and those whose interval lies wholly against the medians' verdict.
+[[nodiscard]] std::string targetsSummary(int met, std::size_t count,
+                                         const std::vector<std::string>& open,
+                                         const std::vector<std::string>& against);
+
 }  // namespace devslam::bench

@@ -148,7 +148,8 @@ TEST(DevslamBench, TwoFrameSmokeRunOfTheWholeCommand) {
     // missed on both, on sit's render and on fr1 (one input).
     EXPECT_NE(results.find(" | yes | 2 of 2 |"), std::string::npos) << results;
     EXPECT_NE(results.find(" | **no** | 0 of 4 |"), std::string::npos) << results;
-    EXPECT_NE(results.find("1 of 3 targets met."), std::string::npos) << results;
+    // No target has a per-render interval here, so the count stands alone.
+    EXPECT_NE(results.find("1 of 3 targets met on the medians.\n"), std::string::npos) << results;
     const std::string targets = readFile(tmp / "out/targets.csv");
     EXPECT_EQ(countLines(targets), 1u + 3u) << targets;
     const auto row = [&](const std::string& key) {
@@ -161,10 +162,10 @@ TEST(DevslamBench, TwoFrameSmokeRunOfTheWholeCommand) {
     const auto endsWith = [](const std::string& a, const std::string& b) {
         return a.size() >= b.size() && a.compare(a.size() - b.size(), b.size(), b) == 0;
     };
-    EXPECT_TRUE(endsWith(row("a_fps"), ",1,2,2,n/a,n/a,n/a")) << targets;  // met, 2 of 2 renders
-    EXPECT_TRUE(endsWith(row("b_fps"), ",0,0,4,n/a,n/a,n/a")) << targets;
+    EXPECT_TRUE(endsWith(row("a_fps"), ",1,2,2,n/a,n/a,n/a,")) << targets;  // met, 2 of 2 renders
+    EXPECT_TRUE(endsWith(row("b_fps"), ",0,0,4,n/a,n/a,n/a,")) << targets;
     // No paired ratio: fps is no ratio, and fr1 is one input without an ATE here.
-    EXPECT_EQ(row("c_ratio"), "c_ratio,fr1,dynamic,ate/none,<=,1e+09,n/a,,0,0,0,n/a,n/a,n/a")
+    EXPECT_EQ(row("c_ratio"), "c_ratio,fr1,dynamic,ate/none,<=,1e+09,n/a,,0,0,0,n/a,n/a,n/a,")
         << targets;
     EXPECT_NE(results.find(" (seed 5), "), std::string::npos) << results;
     EXPECT_NE(results.find("Sequences: short is scenario `short_walking` with `devslam-synth "
@@ -332,8 +333,30 @@ TEST(BenchTargets, MediansDecideRendersAreCountedOneByOne) {
     EXPECT_NEAR(p.hi, std::exp(mean + half), 1e-9);
     EXPECT_LT(p.lo, 1.0);
     EXPECT_GT(p.hi, 1.0);
+    // The bound 1 inside the interval: open, whichever side the medians fall on.
+    using devslam::bench::RenderVerdict;
+    EXPECT_EQ(devslam::bench::renderVerdict(ratio, p), RenderVerdict::Open);
+    // Bounds beyond either end of the interval: both ends meet it, or both miss it.
+    const Target loose{"k", "s", "dynamic", "ate/all", "<", p.hi * 1.01};
+    EXPECT_EQ(devslam::bench::renderVerdict(loose, p), RenderVerdict::Met);
+    const Target tight{"k", "s", "dynamic", "ate/all", "<", p.lo * 0.99};
+    EXPECT_EQ(devslam::bench::renderVerdict(tight, p), RenderVerdict::Missed);
+    const Target above{"k", "s", "dynamic", "ate/all", ">=", p.lo * 0.99};
+    EXPECT_EQ(devslam::bench::renderVerdict(above, p), RenderVerdict::Met);
+    // The sentence under the table names the open ones and those the interval contradicts.
+    EXPECT_EQ(devslam::bench::targetsSummary(7, 7, {}, {}), "7 of 7 targets met on the medians.");
+    EXPECT_EQ(devslam::bench::targetsSummary(6, 7, {"a", "b", "c"}, {"d"}),
+              "6 of 7 targets met on the medians. The per-render interval holds the bound of a, "
+              "b and c: the renders do not settle these. The per-render interval lies wholly on "
+              "the other side of the bound for d.");
+    EXPECT_EQ(devslam::bench::targetsSummary(7, 7, {"a"}, {}),
+              "7 of 7 targets met on the medians. The per-render interval holds the bound of a: "
+              "the renders do not settle this one.");
     // A real sequence (one input, no renders), a plain figure: no paired ratio.
     EXPECT_EQ(devslam::bench::pairedRatio(ratio, "r", inputs, figure).count, 0u);
+    EXPECT_EQ(devslam::bench::renderVerdict(ratio, devslam::bench::pairedRatio(ratio, "r", inputs,
+                                                                               figure)),
+              RenderVerdict::None);
     const Target plain{"k", "s", "dynamic", "ate", "<=", 2.0};
     EXPECT_TRUE(std::isnan(devslam::bench::pairedRatio(plain, "s", inputs, figure).geomean));
 }
