@@ -600,6 +600,24 @@ TEST(Results, SectionsAreReplacedInPlaceAndBrokenMarkersRefused) {
     EXPECT_NO_THROW(checkResultsSection(path, "b"));
     EXPECT_THROW(checkResultsSection(path, "B c"), std::invalid_argument);
     EXPECT_THROW(checkResultsSection(path + "_none/R.md", "b"), std::runtime_error);
+    // Not a Markdown file (a bench's own INI named by mistake): refused, nothing written.
+    const std::string ini = path + ".ini";
+    std::ofstream(ini) << "[bench]\n";
+    try {
+        replaceResultsSection(ini, "b", "x");
+        ADD_FAILURE() << "no error";
+    } catch (const std::runtime_error& e) {
+        EXPECT_NE(std::string(e.what()).find("results file '" + ini +
+                                             "' is not a Markdown file (.md); nothing was written"),
+                  std::string::npos)
+            << e.what();
+    }
+    EXPECT_THROW(checkResultsSection(ini, "b"), std::runtime_error);
+    {
+        std::ifstream in(ini);
+        EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), "[bench]\n");
+    }
+    std::filesystem::remove(ini);
     // A folder no file can be made in (as root too): refused before the work, not after it.
     try {
         checkResultsSection("/proc/R.md", "b");

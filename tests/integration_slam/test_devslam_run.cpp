@@ -218,11 +218,24 @@ TEST(DevslamRun, BadInputIsReported) {
         EXPECT_EQ(r.rc, 1) << opt;
         EXPECT_NE(r.out.find(" goes with --bench N only"), std::string::npos) << r.out;
     }
-    std::ofstream(ini) << "# R\n<!-- END slam -->\n";
-    r = run("--bench 1 --modes-only --results " + ini.string());
+    const fs::path md = devslam::test::scratchPath("devslam_bad_results").string() + ".md";
+    std::ofstream(md) << "# R\n<!-- END slam -->\n";
+    r = run("--bench 1 --modes-only --results " + md.string());
     EXPECT_EQ(r.rc, 1);
     EXPECT_NE(r.out.find("section 'slam' needs"), std::string::npos) << r.out;
     EXPECT_EQ(r.out.find("bench none run"), std::string::npos) << "ran before refusing";
+    fs::remove(md);
+    // The INI itself named as the results file: refused before any run, the INI untouched.
+    std::ofstream(ini) << "[tracker]\nfine_radius = 3\n";
+    r = run("--config " + ini.string() + " --bench 1 --modes-only --results " + ini.string());
+    EXPECT_EQ(r.rc, 1);
+    EXPECT_NE(r.out.find("results file '" + ini.string() + "' is not a Markdown file (.md)"),
+              std::string::npos)
+        << r.out;
+    EXPECT_EQ(r.out.find("bench none run"), std::string::npos) << "ran before refusing";
+    std::ifstream back(ini);
+    EXPECT_EQ(std::string(std::istreambuf_iterator<char>(back), {}), "[tracker]\nfine_radius = 3\n");
+    back.close();
     fs::remove(ini);
     // a replay makes new stamps, by which the truth is found: refused before any frame
     r = run("--mode truth --replay 2 --quiet --out ''");

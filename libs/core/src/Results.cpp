@@ -34,6 +34,11 @@ std::string withSection(const std::string& path, const std::string& name,
         throw std::invalid_argument("results section name '" + name + "' must match [a-z0-9_-]+");
     if (std::filesystem::is_directory(path))
         throw std::runtime_error("results file '" + path + "' is a folder");
+    // A section is appended to whatever file is named: a bench's own INI given by mistake
+    // (`--results config_ini/bench.ini`) got Markdown appended and no longer parsed.
+    if (std::filesystem::path(path).extension() != ".md")
+        throw std::runtime_error("results file '" + path +
+                                 "' is not a Markdown file (.md); nothing was written");
     std::string text;
     {
         // A file that is there but cannot be read is no new file: taken for one, it was

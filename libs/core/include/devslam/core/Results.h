@@ -15,7 +15,8 @@ namespace devslam::core {
 
 /// Replaces (or appends) the named section; creates the file with a title if missing.
 /// Throws std::runtime_error, writing nothing, if the file has only one of the section's
-/// markers or its END before its BEGIN, or if the file cannot be written; std::invalid_argument if
+/// markers or its END before its BEGIN, if its name does not end in ".md" (an INI or source
+/// file named by mistake), or if the file cannot be written; std::invalid_argument if
 /// `name` is empty or contains characters other than [a-z0-9_-].
 /// The file is replaced whole (writeFileWhole): a command killed while writing leaves it as
 /// it was. Commands writing at once take turns (an exclusive flock on the file's folder held
