@@ -556,7 +556,13 @@ Bench benchOf(const Args& a) {
         if (!o.has_filename() && o.has_parent_path()) o = o.parent_path();
         b.out_dir = o.string();
     }
-    fs::create_directories(b.out_dir);
+    std::error_code ec;
+    fs::create_directories(b.out_dir, ec);
+    if (!fs::is_directory(b.out_dir))
+        throw std::invalid_argument(
+            std::string(a.out_override.empty() ? "[bench] out_dir" : "--out") + " '" + b.out_dir +
+            "': cannot make the folder (" +
+            (ec ? ec.message() : std::string("a file is there")) + ")");
     return b;
 }
 

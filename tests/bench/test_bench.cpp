@@ -662,6 +662,26 @@ TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
     for (const auto& [ini, msg] : cases)
         EXPECT_NE(refused(ini).find(msg), std::string::npos) << ini << "\n"
                                                              << readFile(tmp / "log.txt");
+    // --out onto a file, --results onto the bench's own INI: refused naming the option, the
+    // INI left as it was (it got a Markdown section appended and no longer parsed).
+    std::ofstream(tmp / "bench.ini") << real;
+    std::ofstream(tmp / "a_file") << "x";
+    const auto ran = [&](const std::string& opts) {
+        const std::string cmd = "'" + bin + "/devslam-bench' --config '" +
+                                (tmp / "bench.ini").string() + "' " + opts + " > '" +
+                                (tmp / "log.txt").string() + "' 2>&1";
+        EXPECT_NE(std::system(cmd.c_str()), 0) << cmd;
+        return readFile(tmp / "log.txt");
+    };
+    std::string said = ran("--out '" + (tmp / "a_file").string() + "' --results none");
+    EXPECT_NE(said.find("--out '" + (tmp / "a_file").string() + "': cannot make the folder"),
+              std::string::npos)
+        << said;
+    said = ran("--out '" + (tmp / "out").string() + "' --results '" + (tmp / "bench.ini").string() +
+               "'");
+    EXPECT_NE(said.find("is not a Markdown file (.md)"), std::string::npos) << said;
+    EXPECT_EQ(readFile(tmp / "bench.ini"), real);
+    EXPECT_FALSE(fs::exists(tmp / "out/runs.csv")) << "nothing may run";
     // A run that fails (here: a folder that is no TUM sequence) is counted and named; the
     // results file keeps its last whole bench, and the exit status says so.
     fs::create_directories(tmp / "not_tum");
