@@ -240,6 +240,40 @@ TEST(IntegrationNav, TheIniChoosesTheHolonomicMethod) {
               "CHolonomicFullEval");
 }
 
+// What MRPT finds wrong only while navigating (a score formula that does not compile) it
+// logged at every step, and the run went on to a 60 s timeout, the robot standing: it ends
+// the run now, on its first step, as an error naming the INI. What MRPT refuses when the
+// navigator is made (a section the chosen method needs is missing) names the INI too.
+TEST(IntegrationNav, MrptErrorsEndTheRunNamingTheIni) {
+    auto world = devslam::sim::loadWorld(kSrc + "/sim_worlds/obstacle_near_goal.ini");
+    std::ifstream in(kIni);
+    std::stringstream text;
+    text << in.rdbuf();
+    mrpt::config::CConfigFileMemory bad(text.str());
+    bad.write("CMultiObjectiveMotionOptimizerBase", "score3_formula", "1/(1+dist_eucl_min^2");
+    const auto opts = devslam::nav::NavigatorOptions::fromConfig(bad, "bad.ini");
+    const auto r = devslam::sim::runEpisode(world, bad, opts, {});
+    EXPECT_EQ(r.outcome, devslam::sim::Outcome::Error) << r.reason;
+    EXPECT_LT(r.time, 1.0) << r.reason;
+    EXPECT_NE(r.reason.find("navigator error: MRPT's navigation step failed (settings in bad.ini?)"),
+              std::string::npos)
+        << r.reason;
+    EXPECT_NE(r.reason.find("1/(1+dist_eucl_min^2"), std::string::npos) << r.reason;
+
+    mrpt::config::CConfigFileMemory no_nd(text.str());
+    no_nd.write("navigator", "holonomic_method", "CHolonomicND");
+    std::vector<std::string> keys;
+    no_nd.getAllKeys("CHolonomicND", keys);
+    for (const auto& k : keys) no_nd.write("CHolonomicND", k, "");  // as good as missing
+    try {
+        const auto o = devslam::nav::NavigatorOptions::fromConfig(no_nd, "nond.ini");
+        (void)devslam::sim::runEpisode(world, no_nd, o, {});
+        ADD_FAILURE() << "ran without CHolonomicND's settings";
+    } catch (const std::exception& e) {
+        EXPECT_NE(std::string(e.what()).find("nond.ini"), std::string::npos) << e.what();
+    }
+}
+
 // A navlog on a full disk (a file-size limit stands in for one: CI cannot mount a small
 // disk): MRPT writes the log inside navigationStep(), and its handler of its own stream's
 // exception stopped the robot at every step (a 60 s timeout standing at the start, 12000

@@ -446,6 +446,21 @@ TEST(NavConfig, MrptSectionsAreReadStrictly) {
     EXPECT_EQ(errorOf("CHolonomicFullEval", "factorWeights", "[0.25]"),
               "x.ini [CHolonomicFullEval] factorWeights: expected 7 numbers, got 1");
     EXPECT_EQ(errorOf("CHolonomicFullEval", "factorWeights", "1 1 1 0 1 1 1"), "");
+    // FullEval's phases and VFF's forces, which MRPT checks only inside a navigation step
+    // (an index out of range or PHASE_COUNT 0: an error at every step until the timeout) or
+    // not at all (a force below 0: the robot stood still until the timeout).
+    EXPECT_EQ(errorOf("CHolonomicFullEval", "PHASE_COUNT", "0"),
+              "x.ini [CHolonomicFullEval] PHASE_COUNT: must be 1..16");
+    EXPECT_EQ(errorOf("CHolonomicFullEval", "PHASE_COUNT", "4"),
+              "x.ini [CHolonomicFullEval] PHASE4_FACTORS: missing (PHASE_COUNT is 4)");
+    EXPECT_EQ(errorOf("CHolonomicFullEval", "PHASE1_FACTORS", "[99]"),
+              "x.ini [CHolonomicFullEval] PHASE1_FACTORS: factor indices must be integers 0..6");
+    EXPECT_EQ(errorOf("CHolonomicFullEval", "PHASE1_FACTORS", "[0.5]"),
+              "x.ini [CHolonomicFullEval] PHASE1_FACTORS: factor indices must be integers 0..6");
+    EXPECT_EQ(errorOf("CHolonomicFullEval", "PHASE2_THRESHOLD", "1.5"),
+              "x.ini [CHolonomicFullEval] PHASE2_THRESHOLD: must be in [0, 1]");
+    EXPECT_EQ(errorOf("CHolonomicVFF", "TARGET_ATTRACTIVE_FORCE", "-20"),
+              "x.ini [CHolonomicVFF] TARGET_ATTRACTIVE_FORCE: must be > 0");
     EXPECT_EQ(errorOf("CHolonomicVFHPlus", "window", "0.6x"),
               "x.ini [CHolonomicVFHPlus] window: expected a number, got '0.6x'");
     // The PTGs: their count, classes and each class's own keys.

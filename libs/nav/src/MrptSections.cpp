@@ -12,12 +12,14 @@
 #include <mrpt/nav/holonomic/CHolonomicVFF.h>
 #include <mrpt/nav/reactive/CAbstractPTGBasedReactive.h>
 #include <mrpt/nav/reactive/CMultiObjMotionOpt_Scalarization.h>
+#include <mrpt/nav/reactive/CMultiObjectiveMotionOptimizerBase.h>
 #include <mrpt/nav/reactive/CReactiveNavigationSystem.h>
 #include <mrpt/nav/reactive/CWaypointsNavigator.h>
 #include <mrpt/nav/tpspace/CParameterizedTrajectoryGenerator.h>
 #include <mrpt/rtti/CObject.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cctype>
 #include <map>
 #include <regex>
@@ -184,6 +186,36 @@ void checkMrptSections(const mrpt::config::CConfigFileBase& c, const std::string
                                    "expected " + std::to_string(n) + " numbers, got " +
                                        std::to_string(w.size()));
             }
+        // FullEval's phases: MRPT indexes factorWeights with PHASE<i>_FACTORS and asserts
+        // PHASE_COUNT >= 1 only inside each navigation step.
+        const std::string fe = "CHolonomicFullEval";
+        const std::size_t n_factors = CHolonomicFullEval::TOptions().factorWeights.size();
+        if (c.keyExists(fe, "PHASE_COUNT")) {
+            const int phases = core::readInt(c, fe, "PHASE_COUNT", 0);
+            core::requireValue(phases >= 1 && phases <= 16, fe, "PHASE_COUNT", "must be 1..16");
+            for (int i = 1; i <= phases; ++i) {
+                const std::string k = "PHASE" + std::to_string(i) + "_FACTORS";
+                const std::string t = "PHASE" + std::to_string(i) + "_THRESHOLD";
+                core::requireValue(c.keyExists(fe, k) && c.keyExists(fe, t), fe,
+                                   c.keyExists(fe, k) ? t : k,
+                                   "missing (PHASE_COUNT is " + std::to_string(phases) + ")");
+                const auto f = core::parseNumberList(c.read_string(fe, k, ""), "[" + fe + "] " + k);
+                core::requireValue(!f.empty(), fe, k, "expected factor indices");
+                for (const double x : f)
+                    core::requireValue(x >= 0 && x < static_cast<double>(n_factors) &&
+                                           x == std::floor(x),
+                                       fe, k,
+                                       "factor indices must be integers 0.." +
+                                           std::to_string(n_factors - 1));
+                const double th = core::readDouble(c, fe, t, 0.0);
+                core::requireValue(th >= 0 && th <= 1, fe, t, "must be in [0, 1]");
+            }
+        }
+        // VFF: a force of 0 or below, or no slow-down distance, leaves the robot standing.
+        for (const char* k : {"TARGET_ATTRACTIVE_FORCE", "TARGET_SLOW_APPROACHING_DISTANCE"})
+            if (c.keyExists("CHolonomicVFF", k))
+                core::requireValue(core::readDouble(c, "CHolonomicVFF", k, 0.0) > 0,
+                                   "CHolonomicVFF", k, "must be > 0");
     });
     // Ours: its own strict reader names the file.
     if (c.sectionExists("CHolonomicVFHPlus")) {

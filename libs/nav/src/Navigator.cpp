@@ -150,6 +150,7 @@ NavigatorOptions readNavigatorOptions(const mrpt::config::CConfigFileBase& c,
                                         "] section (MRPT's navigator needs it; see "
                                         "config_ini/nav_reactive.ini)");
     NavigatorOptions o;
+    o.source = source;
     const std::string s = "navigator";
     core::requireKnownKeys(c, s,
                            {"nav_period", "waypoint_allowed_distance", "holonomic_method",
@@ -256,8 +257,16 @@ Navigator::Navigator(mrpt::nav::CRobot2NavInterface& robot,
     }
     mrpt::system::createDirectory(cache);
     nav_->params_abstract_ptg_navigator.ptg_cache_files_directory = cache;
-    nav_->loadConfigFile(cfg);
-    nav_->initialize();
+    // What only MRPT itself can tell (a motion decider class it does not know, a holonomic
+    // method's section that is missing, a FullEval phase without its factors) it throws here,
+    // naming no file and often with a stack trace: said with the INI's name.
+    try {
+        nav_->loadConfigFile(cfg);
+        nav_->initialize();
+    } catch (const std::exception& e) {
+        throw std::invalid_argument(opts_.source + ": MRPT's navigator refuses these settings: " +
+                                    core::innermostMessage(e.what()));
+    }
 }
 
 Navigator::~Navigator() = default;
@@ -394,6 +403,20 @@ NavState Navigator::step(double t) {
     // robot, not the ones ahead of it.
     path_segment_ =
         pathProgress(path_.points, {pose.x, pose.y}, path_segment_, opts_.replan.blocked_lookahead);
+    // An exception inside MRPT's step (an exprtk formula that does not compile, a FullEval
+    // factor index out of range) makes it stop the robot as in an emergency: replanned, the
+    // run met it again at every step until its timeout, the robot standing. It comes from the
+    // settings, which no replan changes: the run ends with it. (MRPT also stops so when the
+    // robot cannot give its pose or its obstacles, which SimRobot always gives.) MRPT 2.5
+    // leaves its state NAVIGATING then: the reason, kept until the next navigate(), tells.
+    if (const auto& why = nav_->getErrorReason();
+        why.error_code == mrpt::nav::CAbstractNavigator::ERR_EMERGENCY_STOP ||
+        why.error_code == mrpt::nav::CAbstractNavigator::ERR_OTHER) {
+        last_error_ = "MRPT's navigation step failed (settings in " + opts_.source +
+                      "?): " + core::innermostMessage(why.error_msg);
+        active_ = false;
+        return NavState::Error;
+    }
     if (st == mrpt::nav::CAbstractNavigator::NAV_ERROR ||
         st == mrpt::nav::CAbstractNavigator::IDLE) {
         // MRPT gave up ("not approaching target") or ended short of the goal: replan

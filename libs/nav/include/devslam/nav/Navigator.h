@@ -43,6 +43,8 @@ struct NavigatorOptions {
     std::string log_directory = "reactivenav.logs";
     std::string ptg_cache_directory = "";  ///< "" = a folder in the system temp dir
     bool verbose = false;  ///< MRPT navigator log level INFO instead of ERROR (not in INI)
+    /// The INI these options and MRPT's sections came from, for messages (fromConfig sets it).
+    std::string source = "the navigation INI";
     GridPlannerOptions planner;
     ReplanOptions replan;
 
