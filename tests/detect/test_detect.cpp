@@ -12,6 +12,8 @@
 #include "Scratch.h"
 #include "ConfigRoundTrip.h"
 
+#include <algorithm>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -172,6 +174,9 @@ TEST(DetectYolo, NonFiniteOutputsAreDropped) {
     o.model = model;
     o.weights = "";
     o.classes = {"person", "dog"};
+    // (Its NaN outputs fail the check at load, CorruptWeightsGiveAClearError; the decoder's
+    // own guard is what this test is for.)
+    o.validate_on_load = false;
     detect::YoloDetector det(o);
     const auto dets = det.detect(cv::Mat(480, 640, CV_8UC3, cv::Scalar(30, 60, 90)));
     ASSERT_EQ(dets.size(), 1u);
@@ -211,7 +216,24 @@ TEST(DetectYolo, CorruptWeightsGiveAClearError) {
     std::ofstream(short_by_30k, std::ios::binary).write(bytes.data(), bytes.size() - 30000);
     const std::string folder = (dir / "folder.weights").string();
     fs::create_directories(folder);
-    for (const auto& w : {half, tiny, short_by_30k, folder}) {
+    // The right size, but every weight 0 or NaN after the 20-byte header: these loaded, and
+    // the detector found nobody, ever, without a word.
+    std::vector<char> zeroed = bytes;
+    std::fill(zeroed.begin() + 20, zeroed.end(), 0);
+    const std::string zero = (dir / "zero.weights").string();
+    std::ofstream(zero, std::ios::binary).write(zeroed.data(), zeroed.size());
+    std::vector<char> nans = bytes;
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    for (std::size_t i = 20; i + 4 <= nans.size(); i += 4) std::memcpy(&nans[i], &nan, 4);
+    const std::string nan_w = (dir / "nan.weights").string();
+    std::ofstream(nan_w, std::ios::binary).write(nans.data(), nans.size());
+    for (const auto& [w, why] : std::vector<std::pair<std::string, std::string>>{
+             {half, ""},
+             {tiny, ""},
+             {short_by_30k, ""},
+             {folder, ""},
+             {zero, "the same objectness"},
+             {nan_w, "non-finite outputs"}}) {
         detect::YoloDetector::Options o;
         o.weights = w;
         try {
@@ -219,6 +241,7 @@ TEST(DetectYolo, CorruptWeightsGiveAClearError) {
             FAIL() << "no error for " << w;
         } catch (const std::runtime_error& e) {
             EXPECT_NE(std::string(e.what()).find(w), std::string::npos) << e.what();
+            EXPECT_NE(std::string(e.what()).find(why), std::string::npos) << e.what();
         }
     }
     fs::remove_all(dir);

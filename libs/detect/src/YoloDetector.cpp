@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -222,15 +223,44 @@ YoloDetector::YoloDetector(const Options& opts) : opts_(opts) {
     net_.setPreferableTarget(cv::dnn::DNN_TARGET_CPU);
     out_names_ = net_.getUnconnectedOutLayersNames();
     if (opts_.validate_on_load) {
+        const std::string what =
+            "yolo: model '" + model + "'" + (weights.empty() ? "" : " with weights '" + weights + "'");
         try {
             (void)detect(
                 cv::Mat(opts_.input_height, opts_.input_width, CV_8UC3, cv::Scalar(127, 127, 127)));
         } catch (const std::exception& e) {
-            throw std::runtime_error(
-                "yolo: model '" + model + "'" +
-                (weights.empty() ? "" : " with weights '" + weights + "'") +
-                " fails on a test image (corrupt or mismatched file?): " + e.what());
+            throw std::runtime_error(what + " fails on a test image (corrupt or mismatched file?): " +
+                                     e.what());
         }
+        // A weights file of the right size but zeroed, or full of NaN, ran without an error
+        // and found nobody, ever: its raw outputs on a noise image tell. Any trained network
+        // scores the cells of noise differently; zeroed weights give every cell the same
+        // objectness (the logistic of 0), NaN weights give NaN.
+        cv::Mat noise(opts_.input_height, opts_.input_width, CV_8UC3);
+        cv::RNG(1).fill(noise, cv::RNG::UNIFORM, 0, 256);
+        net_.setInput(cv::dnn::blobFromImage(noise, 1.0 / 255.0,
+                                             cv::Size(opts_.input_width, opts_.input_height),
+                                             cv::Scalar(), /*swapRB=*/true, /*crop=*/false));
+        std::vector<cv::Mat> outs;
+        net_.forward(outs, out_names_);
+        double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+        std::size_t cells = 0;
+        for (cv::Mat out : outs) {
+            if (out.dims == 3) out = out.reshape(1, out.size[1]);
+            if (!cv::checkRange(out))
+                throw std::runtime_error(what + " gives non-finite outputs (NaN or infinite) on a "
+                                                "test image: corrupt weights?");
+            if (out.dims != 2 || out.cols < 5 || out.rows == 0) continue;  // detect() said so
+            double a = 0, b = 0;
+            cv::minMaxLoc(out.col(4), &a, &b);
+            lo = std::min(lo, a);
+            hi = std::max(hi, b);
+            cells += static_cast<std::size_t>(out.rows);
+        }
+        if (cells > 1 && !(hi - lo > 1e-6))
+            throw std::runtime_error(what + " gives every one of its " + std::to_string(cells) +
+                                     " outputs the same objectness (" + std::to_string(lo) +
+                                     ") on a noise image: zeroed or corrupt weights?");
     }
 }
 
