@@ -215,6 +215,12 @@ int convert(int argc, char** argv) {
         const Args& args = std::get<Args>(parsed);
         refuseOverwritingInput(args.input, args.output);
         auto reader = devslam::io::openRgbd(args.input, args.ro);
+        // Each observation of a rawlog carries its own camera: --camera was ignored, and the
+        // output kept the rawlog's intrinsics without a word.
+        if (args.ro.camera != "auto" && dynamic_cast<devslam::io::RawlogReader*>(reader.get()))
+            throw std::invalid_argument("--camera " + args.ro.camera + ": '" + args.input +
+                                        "' is a rawlog, whose observations carry their own "
+                                        "camera; --camera is for TUM folders");
         if (const int sig = devslam::core::stopSignal()) {  // before the output is opened
             std::cerr << "devslam-convert: interrupted (" << devslam::core::signalName(sig)
                       << ") before the first frame; nothing written\n";

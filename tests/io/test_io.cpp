@@ -169,6 +169,10 @@ TEST(TumReader, MalformedListsNameFileAndLine) {
     writeText(rgb, header + l1 + "\nabc rgb/x.png\n");
     expectError([&] { io::TumReader r(d.str("s")); },
                 "rgb\\.txt line 5: timestamp 'abc' is not a number");
+    // A NUL inside a file name: the name was opened cut at it, without a word.
+    writeText(rgb, header + l1 + "\n" + l2 + std::string(1, '\0') + "junk\n");
+    expectError([&] { io::TumReader r(d.str("s")); },
+                "rgb\\.txt line 5: control byte 0x00 \\(not a text file\\?\\)");
     writeText(rgb, header + l2 + "\n" + l1 + "\n");
     expectError([&] { io::TumReader r(d.str("s")); }, "rgb\\.txt line 5: unsorted timestamp");
     writeText(rgb, header + l1 + "\n" + l1 + "\n");
@@ -433,6 +437,16 @@ TEST(Rawlog, MrptsRawlogEditReadsOurFiles) {
     EXPECT_TRUE(std::regex_search(text, std::regex("RGBD\\s*/\\s*5\\s*/"))) << text;
     EXPECT_TRUE(std::regex_search(text, std::regex("Actions/SensoryFrame format\\s*:\\s*Yes")))
         << text;
+    // A rawlog's observations carry their camera: --camera on one is refused, not ignored.
+    const std::string again = std::string(DEVSLAM_BIN_DIR) + "/devslam-convert " + path + " " +
+                              d.str("again.rawlog") + " --camera freiburg2 > " + d.str("c2.log") +
+                              " 2>&1";
+    EXPECT_NE(std::system(again.c_str()), 0) << again;
+    std::ifstream log(d.str("c2.log"));
+    const std::string said((std::istreambuf_iterator<char>(log)), std::istreambuf_iterator<char>());
+    EXPECT_NE(said.find("--camera freiburg2: '" + path + "' is a rawlog"), std::string::npos)
+        << said;
+    EXPECT_FALSE(fs::exists(d.str("again.rawlog")));
 }
 
 TEST(Rawlog, TruncatedFileReportsWhatWasRead) {
@@ -465,6 +479,17 @@ TEST(Rawlog, TruncatedFileReportsWhatWasRead) {
     std::size_t n = 0;
     while (partial->next()) ++n;
     EXPECT_EQ(n, 3u);
+    // Cut inside the first observation: a truncated rawlog, not "not a rawlog?" (MRPT 2's
+    // class names start "mrpt::obs::", which the check for a rawlog's start did not know).
+    fs::resize_file(path, size / 12);
+    try {
+        io::RawlogReader r(path);
+        ADD_FAILURE() << "a rawlog cut in its first observation opened";
+    } catch (const std::exception& e) {
+        const std::string m = e.what();
+        EXPECT_NE(m.find("truncated object at byte 0"), std::string::npos) << m;
+        EXPECT_EQ(m.find("not a rawlog"), std::string::npos) << m;
+    }
     // Cut inside the gzip header: nothing decodes, and the error says so.
     fs::resize_file(path, 60);
     expectError([&] { io::RawlogReader r(path); }, "truncated or corrupt gzip stream .* after 0");

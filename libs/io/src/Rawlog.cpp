@@ -285,8 +285,12 @@ struct RawlogReader::Stream {
             n = again.Read(head, sizeof head);
         } catch (const std::exception&) {
         }
-        // MRPT's objects start with 0x80 + the class name's length, then the name.
-        if (n >= 2 && (static_cast<unsigned char>(head[0]) & 0x80) && head[1] == 'C') return "";
+        // MRPT's objects start with 0x80 + the class name's length, then the name: "C..." in
+        // old rawlogs, "mrpt::obs::C..." since MRPT 2.
+        const std::string name(head + std::min<std::size_t>(n, 1), head + n);
+        if (n >= 2 && (static_cast<unsigned char>(head[0]) & 0x80) &&
+            (name[0] == 'C' || name.rfind("mrpt::", 0) == 0))
+            return "";
         return ": not a rawlog? It starts with '" + printable(std::string(head, n)) +
                "' where a rawlog starts with an MRPT class name (CSensoryFrame, "
                "CObservation3DRangeScan...)";
@@ -311,6 +315,14 @@ struct RawlogReader::Stream {
                 if (file.getPosition() == pos && file.checkEOF()) return nullptr;  // clean end
                 throw std::runtime_error("truncated object at byte " + std::to_string(pos));
             } catch (const std::exception& e) {
+                // Cut inside an object's data: MRPT's archive says "Truncated data stream"
+                // (no EOF exception); at byte 0 that read as "not a rawlog?".
+                const std::string why = core::innermostMessage(e.what());
+                if (why.find("Truncated data stream") != std::string::npos)
+                    throw std::runtime_error("truncated object at byte " + std::to_string(pos) +
+                                             " (object " + std::to_string(objects) +
+                                             " of the uncompressed stream ends early: " +
+                                             printable(why) + ")");
                 throw std::runtime_error("cannot decode object " + std::to_string(objects) +
                                          " at byte " + std::to_string(pos) +
                                          " of the uncompressed stream" +

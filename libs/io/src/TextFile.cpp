@@ -6,6 +6,7 @@
 
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -22,6 +23,18 @@ void forEachDataLine(const std::string& path,
         ++n;
         // A UTF-8 byte-order mark (Windows editors write one) is not part of the first line.
         if (n == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);
+        // A NUL or other control byte (a file damaged, or not text): a file name holding a
+        // NUL was opened cut at it, a different file, without a word. (Tabs and a Windows
+        // line end's '\r' are white space.)
+        for (const char ch : line) {
+            const auto u = static_cast<unsigned char>(ch);
+            if (u < 0x20 && u != '\t' && u != '\r' && u != '\v' && u != '\f') {
+                char code[8];
+                std::snprintf(code, sizeof code, "0x%02x", u);
+                throw std::runtime_error(
+                    lineError(path, n, std::string("control byte ") + code + " (not a text file?)"));
+            }
+        }
         // A comment: from a '#' that starts the line or a word ("# note" after the values), not
         // one inside a file name ("take#2.png"), which the TUM tools read as part of it.
         for (std::size_t hash = line.find('#'); hash != std::string::npos;
