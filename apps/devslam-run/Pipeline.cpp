@@ -98,6 +98,20 @@ double peakRssMb() {
     return 0.0;
 }
 
+namespace {
+/// Whether `dir` holds the outputs of a run that went through its whole input.
+bool holdsWholeRun(const std::string& dir) {
+    std::ifstream in(std::filesystem::path(dir) / "run.json");
+    if (!in) return false;
+    std::stringstream ss;
+    ss << in.rdbuf();
+    const std::string j = ss.str();
+    // run.json is written last, whole; a run that stopped says why in these two.
+    return j.find("\"read_error\": \"\"") != std::string::npos &&
+           j.find("\"interrupted\": \"\"") != std::string::npos;
+}
+}  // namespace
+
 void checkOutputFolder(const std::string& dir) {
     namespace fs = std::filesystem;
     std::error_code ec;
@@ -335,14 +349,27 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
     rep.loop_reports =
         scoreLoops(slam.closedLoops(), rep.ground_truth ? &*rep.ground_truth : nullptr);
 
-    if (!rc.out_dir.empty()) {
+    rep.out_dir = rc.out_dir;
+    // A run that stopped early (a frame that does not read, Ctrl-C) replaced the whole run
+    // an earlier command had left in the folder with its few frames: it goes beside it.
+    if (!rc.out_dir.empty() && (!rep.read_error.empty() || !rep.interrupted.empty()) &&
+        holdsWholeRun(rc.out_dir)) {
+        rep.out_dir = (std::filesystem::path(rc.out_dir) / "stopped_run").string();
+        try {
+            checkOutputFolder(rep.out_dir);
+        } catch (const std::exception& e) {
+            rep.output_errors.push_back(e.what());
+            rep.out_dir.clear();  // nothing written; the earlier run stays whole
+        }
+    }
+    if (!rep.out_dir.empty()) {
         namespace fs = std::filesystem;
-        fs::create_directories(rc.out_dir);
+        fs::create_directories(rep.out_dir);
         // An earlier run's outputs go first: a run that writes fewer (no ATE plot without
         // ground truth, no mask errors without person truth) or is killed while writing
         // leaves none of them beside its own. run.json comes last and says they are whole.
-        for (const char* f : kOutputFiles) fs::remove(fs::path(rc.out_dir) / f);
-        auto out = [&](const std::string& name) { return (fs::path(rc.out_dir) / name).string(); };
+        for (const char* f : kOutputFiles) fs::remove(fs::path(rep.out_dir) / f);
+        auto out = [&](const std::string& name) { return (fs::path(rep.out_dir) / name).string(); };
         // Each output on its own: one that cannot be written (a full disk) is named in
         // output_errors, and the others are still tried; the figures are printed whatever.
         const auto write = [&](const std::string& path, const std::function<void()>& fn) {
@@ -411,7 +438,7 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
             std::cerr << "devslam-run: map_grid not written: " << e.what() << "\n";
         }
         if (grid) {
-            const std::string stem = (fs::path(rc.out_dir) / "map_grid").string();
+            const std::string stem = (fs::path(rep.out_dir) / "map_grid").string();
             const std::size_t errors = rep.output_errors.size();
             write(stem + ".png", [&] { slam::saveGrid(*grid, stem); });
             if (rep.output_errors.size() == errors) rep.outputs.push_back(stem + ".gridmap");

@@ -80,6 +80,9 @@ struct RunReport {
     /// The signal (core/Interrupt.h) that stopped the run early ("SIGINT"; "" = none): its
     /// outputs hold the frames before it.
     std::string interrupted;
+    /// Where the outputs went: RunConfig::out_dir, or its `stopped_run` subfolder for a run
+    /// that stopped early where a whole earlier run's outputs were (kept, not replaced).
+    std::string out_dir;
     bool async_filter = false;
     std::size_t frames = 0, keyframes = 0, landmarks = 0, loops = 0;
     std::size_t keyframes_culled = 0;  ///< redundant keyframes removed ([mapping])

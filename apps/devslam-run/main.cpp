@@ -265,7 +265,11 @@ int runOnce(const Args& a) {
         std::cerr << "devslam-run: " << rep.output_errors.size() << " of the run's outputs in "
                   << a.out << " were not written, nor run.json (which says they are whole); "
                   << "the figures above are whole\n";
-    const std::string kept = a.out.empty() ? std::string() : "; " + a.out + " holds their results";
+    const std::string kept =
+        rep.out_dir.empty()     ? std::string()
+        : rep.out_dir == a.out  ? "; " + a.out + " holds their results"
+                                : "; " + rep.out_dir + " holds their results (" + a.out +
+                                     " keeps the whole run that was there)";
     if (!rep.read_error.empty()) {
         std::cerr << "devslam-run: " << rep.read_error << "\ndevslam-run: stopped after "
                   << rep.frames << " frames" << kept << "\n";

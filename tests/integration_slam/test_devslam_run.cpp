@@ -595,6 +595,18 @@ TEST(DevslamRun, AnUndecodableFrameMidRunKeepsTheFramesBeforeIt) {
     const auto all = run("--input " + (dir / "seq").string() +
                          " --mode dynamic --quiet --allow-damaged --out " + (dir / "all").string());
     EXPECT_EQ(all.rc, 0) << all.out;
+    // A run that stops early where a whole run's outputs are goes beside them: the whole run
+    // of 7 frames was replaced by the 5 frames of the stopped one.
+    const auto stopped = run("--input " + (dir / "seq").string() + " --mode dynamic --quiet --out " +
+                             (dir / "all").string());
+    EXPECT_EQ(stopped.rc, 1) << stopped.out;
+    EXPECT_NE(stopped.out.find("stopped after 5 frames; " + (dir / "all" / "stopped_run").string() +
+                               " holds their results (" + (dir / "all").string() +
+                               " keeps the whole run that was there)"),
+              std::string::npos)
+        << stopped.out;
+    EXPECT_EQ(lines(dir / "all" / "trajectory.txt"), 7u);
+    EXPECT_EQ(lines(dir / "all" / "stopped_run" / "trajectory.txt"), 5u);
     EXPECT_NE(all.out.find("left out   : 1 frames that do not decode (--allow-damaged), the "
                            "first: " +
                            (dir / "seq" / image).string() + ": cannot decode colour image"),
