@@ -34,7 +34,8 @@ const char* kUsage =
     "                   [--allow-damaged]  (a rawlog cut short, a TUM folder missing images,\n"
     "                                       frames that do not decode: run on what is intact)\n"
     "       devslam-run --bench N [--input PATH] [--config INI] [--results FILE]\n"
-    "                   [--section NAME] [--modes-only]\n"
+    "                   [--section NAME] [--modes-only]  (--results none: print the\n"
+    "                   section only)\n"
     "defaults: --input " DEVSLAM_SOURCE_DIR
     "/data/tum/fr1_xyz_first37\n"
     "          --config " DEVSLAM_SOURCE_DIR
@@ -145,7 +146,7 @@ Args parse(int argc, char** argv) {
         if (a.section != "slam" && a.section != "slam-synthetic")
             throw std::invalid_argument("--section '" + a.section +
                                         "': devslam-run writes 'slam' or 'slam-synthetic'");
-        core::checkResultsSection(a.results, a.section);
+        if (a.results != "none") core::checkResultsSection(a.results, a.section);
     }
     return a;
 }
@@ -473,7 +474,7 @@ int runBench(const Args& a) {
     // Printed first: a results file that cannot be written after the whole bench must not
     // take the table with it.
     std::cout << md << std::flush;
-    core::replaceResultsSection(a.results, a.section, md);
+    if (a.results != "none") core::replaceResultsSection(a.results, a.section, md);
     return 0;
 }
 

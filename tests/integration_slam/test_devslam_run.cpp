@@ -237,6 +237,19 @@ TEST(DevslamRun, BadInputIsReported) {
     EXPECT_EQ(std::string(std::istreambuf_iterator<char>(back), {}), "[tracker]\nfine_radius = 3\n");
     back.close();
     fs::remove(ini);
+    // --results none prints the section and writes no file (it is no Markdown file's name;
+    // before the check it wrote one named 'none').
+    const fs::path here = devslam::test::scratchPath("devslam_bench_none");
+    fs::remove_all(here);
+    fs::create_directories(here);
+    const std::string cmd = "cd '" + here.string() + "' && '" + DEVSLAM_BIN_DIR +
+                            "/devslam-run' --bench 1 --modes-only --results none > out.txt 2>&1";
+    EXPECT_EQ(std::system(cmd.c_str()), 0);
+    std::ifstream said(here / "out.txt");
+    const std::string text((std::istreambuf_iterator<char>(said)), {});
+    EXPECT_NE(text.find("| dynamic |"), std::string::npos) << text;
+    EXPECT_FALSE(fs::exists(here / "none"));
+    fs::remove_all(here);
     // a replay makes new stamps, by which the truth is found: refused before any frame
     r = run("--mode truth --replay 2 --quiet --out ''");
     EXPECT_EQ(r.rc, 1);
