@@ -461,6 +461,9 @@ TEST(NavConfig, MrptSectionsAreReadStrictly) {
               "x.ini [CHolonomicFullEval] PHASE2_THRESHOLD: must be in [0, 1]");
     EXPECT_EQ(errorOf("CHolonomicVFF", "TARGET_ATTRACTIVE_FORCE", "-20"),
               "x.ini [CHolonomicVFF] TARGET_ATTRACTIVE_FORCE: must be > 0");
+    EXPECT_EQ(errorOf("CHolonomicVFF", "TARGET_SLOW_APPROACHING_DISTANCE", "-0.1"),
+              "x.ini [CHolonomicVFF] TARGET_SLOW_APPROACHING_DISTANCE: must be >= 0");
+    EXPECT_EQ(errorOf("CHolonomicVFF", "TARGET_SLOW_APPROACHING_DISTANCE", "0"), "");
     EXPECT_EQ(errorOf("CHolonomicVFHPlus", "window", "0.6x"),
               "x.ini [CHolonomicVFHPlus] window: expected a number, got '0.6x'");
     // The PTGs: their count, classes and each class's own keys.

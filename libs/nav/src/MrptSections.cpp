@@ -211,11 +211,16 @@ void checkMrptSections(const mrpt::config::CConfigFileBase& c, const std::string
                 core::requireValue(th >= 0 && th <= 1, fe, t, "must be in [0, 1]");
             }
         }
-        // VFF: a force of 0 or below, or no slow-down distance, leaves the robot standing.
-        for (const char* k : {"TARGET_ATTRACTIVE_FORCE", "TARGET_SLOW_APPROACHING_DISTANCE"})
-            if (c.keyExists("CHolonomicVFF", k))
-                core::requireValue(core::readDouble(c, "CHolonomicVFF", k, 0.0) > 0,
-                                   "CHolonomicVFF", k, "must be > 0");
+        // VFF: an attractive force of 0 or below leaves the robot standing; a slow-down
+        // distance below 0 makes its speed negative (0 is no slow-down: MRPT's min(1, d/0)).
+        const std::string vff = "CHolonomicVFF";
+        if (c.keyExists(vff, "TARGET_ATTRACTIVE_FORCE"))
+            core::requireValue(core::readDouble(c, vff, "TARGET_ATTRACTIVE_FORCE", 0.0) > 0, vff,
+                               "TARGET_ATTRACTIVE_FORCE", "must be > 0");
+        if (c.keyExists(vff, "TARGET_SLOW_APPROACHING_DISTANCE"))
+            core::requireValue(
+                core::readDouble(c, vff, "TARGET_SLOW_APPROACHING_DISTANCE", 0.0) >= 0, vff,
+                "TARGET_SLOW_APPROACHING_DISTANCE", "must be >= 0");
     });
     // Ours: its own strict reader names the file.
     if (c.sectionExists("CHolonomicVFHPlus")) {
