@@ -356,6 +356,11 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
         holdsWholeRun(rc.out_dir)) {
         rep.out_dir = (std::filesystem::path(rc.out_dir) / "stopped_run").string();
         try {
+            std::error_code ec;
+            if (std::filesystem::exists(rep.out_dir, ec) &&
+                !std::filesystem::is_directory(rep.out_dir, ec))
+                throw std::runtime_error("'" + rep.out_dir +
+                                         "' is not a folder: the stopped run's outputs go there");
             checkOutputFolder(rep.out_dir);
         } catch (const std::exception& e) {
             rep.output_errors.push_back(e.what());

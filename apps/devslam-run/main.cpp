@@ -262,9 +262,12 @@ int runOnce(const Args& a) {
     std::cout << run::formatSummary(rep);
     // Outputs the disk did not take: named, after the figures (whole, above).
     for (const auto& e : rep.output_errors) std::cerr << "devslam-run: " << e << "\n";
-    if (!rep.output_errors.empty())
+    if (!rep.output_errors.empty() && rep.out_dir.empty() && !a.out.empty())
+        std::cerr << "devslam-run: nothing of this run was written; " << a.out
+                  << " keeps the whole run that was there; the figures above are whole\n";
+    else if (!rep.output_errors.empty())
         std::cerr << "devslam-run: " << rep.output_errors.size() << " of the run's outputs in "
-                  << a.out << " were not written, nor run.json (which says they are whole); "
+                  << rep.out_dir << " were not written, nor run.json (which says they are whole); "
                   << "the figures above are whole\n";
     const std::string kept =
         rep.out_dir.empty()     ? std::string()

@@ -620,6 +620,22 @@ TEST(DevslamRun, AnUndecodableFrameMidRunKeepsTheFramesBeforeIt) {
         << stopped.out;
     EXPECT_EQ(lines(dir / "all" / "trajectory.txt"), 7u);
     EXPECT_EQ(lines(dir / "all" / "stopped_run" / "trajectory.txt"), 5u);
+    // A file where stopped_run would go: nothing of the stopped run is written, the whole run
+    // is kept, and the summary is still printed (the folder's error escaped the run before).
+    fs::remove_all(dir / "all" / "stopped_run");
+    std::ofstream(dir / "all" / "stopped_run") << "in the way";
+    const auto blocked = run("--input " + (dir / "seq").string() + " --mode dynamic --quiet --out " +
+                             (dir / "all").string());
+    EXPECT_EQ(blocked.rc, 1) << blocked.out;
+    EXPECT_NE(blocked.out.find("STOPPED    : after 5 frames"), std::string::npos) << blocked.out;
+    EXPECT_NE(blocked.out.find("is not a folder: the stopped run's outputs go there"),
+              std::string::npos)
+        << blocked.out;
+    EXPECT_NE(blocked.out.find("nothing of this run was written; " + (dir / "all").string() +
+                               " keeps the whole run that was there"),
+              std::string::npos)
+        << blocked.out;
+    EXPECT_EQ(lines(dir / "all" / "trajectory.txt"), 7u);
     EXPECT_NE(all.out.find("left out   : 1 frames that do not decode (--allow-damaged), the "
                            "first: " +
                            (dir / "seq" / image).string() + ": cannot decode colour image"),
