@@ -19,6 +19,7 @@
 #include <devslam/eval/MaskScore.h>
 #include <devslam/io/RgbdReader.h>
 
+#include "BenchConfig.h"
 #include "RunJson.h"
 #include "Targets.h"
 
@@ -52,8 +53,14 @@
 
 namespace fs = std::filesystem;
 using namespace devslam;
+using bench::Bench;
+using bench::Input;
+using bench::inputsOf;
+using bench::loadBench;
 using bench::readRun;
 using bench::RunFigures;
+using bench::runsMode;
+using bench::Sequence;
 
 namespace {
 
@@ -82,213 +89,6 @@ const char* kUsage =
     "          --results " DEVSLAM_SOURCE_DIR
     "/docs/RESULTS.md (section 'bench'), --bin: this program's folder\n";
 
-struct Sequence {
-    std::string name;      ///< table row label
-    std::string path;      ///< real data: TUM folder or rawlog
-    std::string scenario;  ///< synthetic: scenario name/file (rendered when missing)
-    std::string slam_config;
-    /// Synthetic: renders of the scenario (`devslam-synth --seed`); empty = the scenario's
-    /// own seed, one render.
-    std::vector<std::uint64_t> seeds;
-    /// Synthetic: `devslam-synth --set` items (SECTION.KEY=VALUE) over the scenario file, e.g.
-    /// the same scene with still people; empty = the scenario as shipped.
-    std::vector<std::string> sets;
-    int repeats = 0;  ///< runs per render and mode; 0 = [bench] repeats
-};
-
-/// One input the SLAM runs on: a render of a synthetic sequence, or the real data.
-struct Input {
-    std::string path;
-    std::optional<std::uint64_t> seed;  ///< the render's seed when it was given
-};
-
-/// Where the renders of a sequence go: <out>/synth/<name> (scenario's seed) or
-/// <out>/synth/<name>_seed<S>.
-std::vector<Input> inputsOf(const Sequence& q, const std::string& out_dir) {
-    if (q.scenario.empty()) return {{q.path, std::nullopt}};
-    const fs::path synth = fs::path(out_dir) / "synth";
-    if (q.seeds.empty()) return {{(synth / q.name).string(), std::nullopt}};
-    std::vector<Input> v;
-    for (const auto s : q.seeds)
-        v.push_back({(synth / (q.name + "_seed" + std::to_string(s))).string(), s});
-    return v;
-}
-
-struct Bench {
-    std::vector<std::string> modes{"none", "all_persons", "dynamic"};
-    int repeats = 5;
-    std::size_t max_frames = 0;
-    int render_jobs = 0;  ///< renders made at once; 0 = the CPU's threads
-    std::string out_dir = "out/bench";
-    std::string slam_config = kRoot + "/config_ini/slam_synthetic.ini";
-    std::vector<Sequence> sequences;
-    std::vector<bench::Target> targets;  ///< [targets], checked on the medians
-    [[nodiscard]] std::vector<std::string> names() const {
-        std::vector<std::string> v;
-        for (const auto& q : sequences) v.push_back(q.name);
-        return v;
-    }
-};
-
-std::string resolve(const std::string& p, const std::string& base) {
-    if (p.empty() || fs::path(p).is_absolute()) return p;
-    const fs::path a = fs::path(base) / p;
-    if (fs::exists(a)) return a.lexically_normal().string();
-    return (fs::path(kRoot) / p).lexically_normal().string();  // repository-relative
-}
-
-Bench readBench(const std::string& path) {
-    auto cfg = core::loadIni(path);
-    Bench b;
-    const std::string base = fs::absolute(path).parent_path().string();
-    core::requireKnownKeys(
-        *cfg, "bench", {"modes", "repeats", "max_frames", "render_jobs", "out_dir", "slam_config"},
-        path);
-    const std::string modes = cfg->read_string("bench", "modes", "");
-    if (!modes.empty()) {
-        b.modes.clear();
-        std::istringstream ss(modes);
-        for (std::string m; ss >> m;) {
-            if (m != "truth") {
-                try {
-                    (void)dynamic::parseMaskMode(m);  // throws with the known names
-                } catch (const std::invalid_argument& e) {
-                    throw std::invalid_argument("[bench] modes: " + std::string(e.what()) +
-                                                " or truth");
-                }
-            }
-            // Runs are kept in <out>/runs/SEQ/MODE: a mode twice would run into one folder.
-            if (std::find(b.modes.begin(), b.modes.end(), m) != b.modes.end())
-                throw std::invalid_argument("[bench] modes: '" + m + "' is listed twice");
-            b.modes.push_back(m);
-        }
-    }
-    b.repeats = core::readInt(*cfg, "bench", "repeats", b.repeats);
-    const int max_frames = core::readInt(*cfg, "bench", "max_frames", 0);
-    core::requireValue(max_frames >= 0, "bench", "max_frames",
-                       "must be >= 0 (0 = whole sequences)");
-    b.max_frames = std::size_t(max_frames);
-    b.render_jobs = core::readInt(*cfg, "bench", "render_jobs", 0);
-    core::requireValue(b.render_jobs >= 0 && b.render_jobs <= 64, "bench", "render_jobs",
-                       "must be 0..64 (0 = the CPU's threads)");
-    b.out_dir = cfg->read_string("bench", "out_dir", b.out_dir);
-    b.slam_config = resolve(cfg->read_string("bench", "slam_config", b.slam_config), base);
-    core::requireValue(b.repeats >= 1 && b.repeats <= 100, "bench", "repeats", "must be 1..100");
-    core::requireKnownSections(*cfg, {"bench", "sequence_*", "targets"}, path);
-    // In the file's order: the tables list the sequences as the user wrote them.
-    for (const auto& s : core::sectionsInFileOrder(*cfg, path)) {
-        if (s.rfind("sequence_", 0) != 0) continue;  // [bench], [targets]
-        core::requireKnownKeys(
-            *cfg, s, {"name", "path", "scenario", "slam_config", "seeds", "set", "repeats"}, path);
-        Sequence q;
-        q.name = cfg->read_string(s, "name", s.substr(9));
-        q.scenario = cfg->read_string(s, "scenario", "");
-        // A scenario file (not a name devslam-synth finds in sim_worlds/synth) is found as
-        // `path` is, from the bench INI's folder first: devslam-synth would look in the
-        // working directory.
-        if (q.scenario.find('/') != std::string::npos || core::endsWithNoCase(q.scenario, ".ini"))
-            q.scenario = resolve(q.scenario, base);
-        q.path = resolve(cfg->read_string(s, "path", ""), base);
-        q.slam_config = resolve(cfg->read_string(s, "slam_config", ""), base);
-        if (q.slam_config.empty()) q.slam_config = b.slam_config;
-        // Found now, not as every run of the sequence failing after minutes of work.
-        if (!fs::is_regular_file(q.slam_config))
-            throw std::invalid_argument(
-                path + " [" + (cfg->keyExists(s, "slam_config") ? s : std::string("bench")) +
-                "] slam_config: no such file '" + q.slam_config + "'");
-        // ... and read, with the filter INI it names: a syntax error in the last sequence's
-        // INI stopped the bench there, hours into it, with no table.
-        {
-            const std::string filter =
-                core::filterIniPath(*core::loadIni(q.slam_config), q.slam_config);
-            if (filter != q.slam_config) (void)core::loadIni(filter);
-        }
-        if (!q.path.empty() && !fs::exists(q.path))
-            throw std::invalid_argument(path + " [" + s + "] path: no such file or folder '" +
-                                        q.path + "'");
-        // The name is a folder and a file name prefix, and a cell of runs.csv.
-        if (q.name.empty() ||
-            q.name.find_first_not_of(
-                "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789"
-                "_.-") != std::string::npos ||
-            q.name == "." || q.name == "..")
-            throw std::invalid_argument(path + " [" + s + "] name: '" + q.name +
-                                        "' (letters, digits, '_', '.', '-' only: it names "
-                                        "folders, files and a CSV column)");
-        if (q.scenario.empty() && q.path.empty())
-            throw std::invalid_argument(path + " [" + s +
-                                        "]: give 'path' (a TUM folder) or 'scenario' (synthetic)");
-        if (!q.scenario.empty() && !q.path.empty())  // the path was ignored without a word
-            throw std::invalid_argument(path + " [" + s +
-                                        "]: give 'path' (a TUM folder) or 'scenario' "
-                                        "(synthetic), not both");
-        const std::string where = path + " [" + s + "]";
-        std::istringstream seeds(cfg->read_string(s, "seeds", ""));
-        for (std::string w; seeds >> w;) {
-            const auto seed = std::uint64_t(core::parseInteger(
-                w, where + " seeds", 0, std::numeric_limits<std::uint32_t>::max()));
-            if (std::find(q.seeds.begin(), q.seeds.end(), seed) != q.seeds.end())
-                throw std::invalid_argument(where + " seeds: seed " + w + " is listed twice");
-            q.seeds.push_back(seed);
-        }
-        if (!q.seeds.empty() && q.scenario.empty())
-            throw std::invalid_argument(where +
-                                        " seeds: only a synthetic sequence (scenario) has renders");
-        // Whitespace-separated, as [run] filter_overrides; the format is checked here, the
-        // sections and keys by devslam-synth, which renders before any run starts.
-        q.sets = core::overrideItems(cfg->read_string(s, "set", ""), where + " set");
-        if (!q.sets.empty() && q.scenario.empty())
-            throw std::invalid_argument(where + " set: only a synthetic sequence (scenario) " +
-                                        "has render settings");
-        {
-            mrpt::config::CConfigFileMemory scratch;
-            core::applyOverrides(scratch, q.sets, where + " set item");
-        }
-        q.repeats = core::readInt(*cfg, s, "repeats", 0);
-        core::requireValue(q.repeats >= 0 && q.repeats <= 100, s, "repeats",
-                           "must be 1..100 (0 or missing = [bench] repeats)");
-        // The name is the runs' and renders' folder: two sequences of one name would write
-        // over each other's runs and mix them in one row.
-        for (const auto& other : b.sequences)
-            if (other.name == q.name)
-                throw std::invalid_argument(where + " name: '" + q.name +
-                                            "' is already the name of an earlier sequence");
-        // Nor may their renders share a folder: 'a_seed1' renders where 'a' with seed 1 does.
-        for (const auto& other : b.sequences)
-            for (const auto& mine : inputsOf(q, "out"))
-                for (const auto& theirs : inputsOf(other, "out"))
-                    if (!q.scenario.empty() && !other.scenario.empty() && mine.path == theirs.path)
-                        throw std::invalid_argument(
-                            where + " name: its render " + fs::path(mine.path).filename().string() +
-                            " would share a folder with sequence '" + other.name + "''s");
-        b.sequences.push_back(q);
-    }
-    if (b.sequences.empty()) throw std::invalid_argument(path + ": no [sequence_*] section");
-    // Mode truth runs only where there is person truth (renders); with none it would run
-    // nothing and leave its column empty.
-    if (std::find(b.modes.begin(), b.modes.end(), "truth") != b.modes.end() &&
-        std::none_of(b.sequences.begin(), b.sequences.end(), [](const Sequence& q) {
-            return !q.scenario.empty() || eval::PersonTruth::available(q.path);
-        }))
-        throw std::invalid_argument(path +
-                                    " [bench] modes: truth needs person truth, which "
-                                    "no sequence has (a scenario, or a devslam-synth "
-                                    "folder as path)");
-    b.targets = bench::loadTargets(*cfg, path, b.names(), b.modes);
-    return b;
-}
-
-/// readBench, with the file named in front of the "[section] key: ..." errors of the
-/// strict readers.
-Bench loadBench(const std::string& path) {
-    return core::namingSource(path, [&] { return readBench(path); });
-}
-
-/// devslam-run's diagnostic mode `truth` (the renderer's walkers as the mask) needs the
-/// person truth that devslam-synth writes; sequences without it skip that mode.
-bool runsMode(const Sequence& q, const std::string& out_dir, const std::string& mode) {
-    return mode != "truth" || eval::PersonTruth::available(inputsOf(q, out_dir).front().path);
-}
 
 std::string fmt(double v, int prec) {
     if (std::isnan(v)) return "n/a";
