@@ -89,7 +89,6 @@ const char* kUsage =
     "          --results " DEVSLAM_SOURCE_DIR
     "/docs/RESULTS.md (section 'bench'), --bin: this program's folder\n";
 
-
 std::string fmt(double v, int prec) {
     if (std::isnan(v)) return "n/a";
     char b[64];
@@ -361,8 +360,8 @@ Bench benchOf(const Args& a) {
     if (!fs::is_directory(b.out_dir))
         throw std::invalid_argument(
             std::string(a.out_override.empty() ? "[bench] out_dir" : "--out") + " '" + b.out_dir +
-            "': cannot make the folder (" +
-            (ec ? ec.message() : std::string("a file is there")) + ")");
+            "': cannot make the folder (" + (ec ? ec.message() : std::string("a file is there")) +
+            ")");
     return b;
 }
 

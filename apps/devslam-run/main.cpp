@@ -269,11 +269,11 @@ int runOnce(const Args& a) {
         std::cerr << "devslam-run: " << rep.output_errors.size() << " of the run's outputs in "
                   << rep.out_dir << " were not written, nor run.json (which says they are whole); "
                   << "the figures above are whole\n";
-    const std::string kept =
-        rep.out_dir.empty()     ? std::string()
-        : rep.out_dir == a.out  ? "; " + a.out + " holds their results"
-                                : "; " + rep.out_dir + " holds their results (" + a.out +
-                                     " keeps the whole run that was there)";
+    const std::string kept = rep.out_dir.empty() ? std::string()
+                             : rep.out_dir == a.out
+                                 ? "; " + a.out + " holds their results"
+                                 : "; " + rep.out_dir + " holds their results (" + a.out +
+                                       " keeps the whole run that was there)";
     if (!rep.read_error.empty()) {
         std::cerr << "devslam-run: " << rep.read_error << "\ndevslam-run: stopped after "
                   << rep.frames << " frames" << kept << "\n";

@@ -354,8 +354,8 @@ TEST(BenchTargets, MediansDecideRendersAreCountedOneByOne) {
               "the renders do not settle this one.");
     // A real sequence (one input, no renders), a plain figure: no paired ratio.
     EXPECT_EQ(devslam::bench::pairedRatio(ratio, "r", inputs, figure).count, 0u);
-    EXPECT_EQ(devslam::bench::renderVerdict(ratio, devslam::bench::pairedRatio(ratio, "r", inputs,
-                                                                               figure)),
+    EXPECT_EQ(devslam::bench::renderVerdict(
+                  ratio, devslam::bench::pairedRatio(ratio, "r", inputs, figure)),
               RenderVerdict::None);
     const Target plain{"k", "s", "dynamic", "ate", "<=", 2.0};
     EXPECT_TRUE(std::isnan(devslam::bench::pairedRatio(plain, "s", inputs, figure).geomean));

@@ -227,13 +227,13 @@ TEST(DetectYolo, CorruptWeightsGiveAClearError) {
     for (std::size_t i = 20; i + 4 <= nans.size(); i += 4) std::memcpy(&nans[i], &nan, 4);
     const std::string nan_w = (dir / "nan.weights").string();
     std::ofstream(nan_w, std::ios::binary).write(nans.data(), nans.size());
-    for (const auto& [w, why] : std::vector<std::pair<std::string, std::string>>{
-             {half, ""},
-             {tiny, ""},
-             {short_by_30k, ""},
-             {folder, ""},
-             {zero, "the same objectness"},
-             {nan_w, "non-finite outputs"}}) {
+    for (const auto& [w, why] :
+         std::vector<std::pair<std::string, std::string>>{{half, ""},
+                                                          {tiny, ""},
+                                                          {short_by_30k, ""},
+                                                          {folder, ""},
+                                                          {zero, "the same objectness"},
+                                                          {nan_w, "non-finite outputs"}}) {
         detect::YoloDetector::Options o;
         o.weights = w;
         try {

@@ -255,8 +255,9 @@ TEST(IntegrationNav, MrptErrorsEndTheRunNamingTheIni) {
     const auto r = devslam::sim::runEpisode(world, bad, opts, {});
     EXPECT_EQ(r.outcome, devslam::sim::Outcome::Error) << r.reason;
     EXPECT_LT(r.time, 1.0) << r.reason;
-    EXPECT_NE(r.reason.find("navigator error: MRPT's navigation step failed (settings in bad.ini?)"),
-              std::string::npos)
+    EXPECT_NE(
+        r.reason.find("navigator error: MRPT's navigation step failed (settings in bad.ini?)"),
+        std::string::npos)
         << r.reason;
     EXPECT_NE(r.reason.find("1/(1+dist_eucl_min^2"), std::string::npos) << r.reason;
 

@@ -234,7 +234,8 @@ TEST(DevslamRun, BadInputIsReported) {
         << r.out;
     EXPECT_EQ(r.out.find("bench none run"), std::string::npos) << "ran before refusing";
     std::ifstream back(ini);
-    EXPECT_EQ(std::string(std::istreambuf_iterator<char>(back), {}), "[tracker]\nfine_radius = 3\n");
+    EXPECT_EQ(std::string(std::istreambuf_iterator<char>(back), {}),
+              "[tracker]\nfine_radius = 3\n");
     back.close();
     fs::remove(ini);
     // --results none prints the section and writes no file (it is no Markdown file's name;
@@ -610,8 +611,8 @@ TEST(DevslamRun, AnUndecodableFrameMidRunKeepsTheFramesBeforeIt) {
     EXPECT_EQ(all.rc, 0) << all.out;
     // A run that stops early where a whole run's outputs are goes beside them: the whole run
     // of 7 frames was replaced by the 5 frames of the stopped one.
-    const auto stopped = run("--input " + (dir / "seq").string() + " --mode dynamic --quiet --out " +
-                             (dir / "all").string());
+    const auto stopped = run("--input " + (dir / "seq").string() +
+                             " --mode dynamic --quiet --out " + (dir / "all").string());
     EXPECT_EQ(stopped.rc, 1) << stopped.out;
     EXPECT_NE(stopped.out.find("stopped after 5 frames; " + (dir / "all" / "stopped_run").string() +
                                " holds their results (" + (dir / "all").string() +
@@ -624,8 +625,8 @@ TEST(DevslamRun, AnUndecodableFrameMidRunKeepsTheFramesBeforeIt) {
     // is kept, and the summary is still printed (the folder's error escaped the run before).
     fs::remove_all(dir / "all" / "stopped_run");
     std::ofstream(dir / "all" / "stopped_run") << "in the way";
-    const auto blocked = run("--input " + (dir / "seq").string() + " --mode dynamic --quiet --out " +
-                             (dir / "all").string());
+    const auto blocked = run("--input " + (dir / "seq").string() +
+                             " --mode dynamic --quiet --out " + (dir / "all").string());
     EXPECT_EQ(blocked.rc, 1) << blocked.out;
     EXPECT_NE(blocked.out.find("STOPPED    : after 5 frames"), std::string::npos) << blocked.out;
     EXPECT_NE(blocked.out.find("is not a folder: the stopped run's outputs go there"),

@@ -223,14 +223,14 @@ YoloDetector::YoloDetector(const Options& opts) : opts_(opts) {
     net_.setPreferableTarget(cv::dnn::DNN_TARGET_CPU);
     out_names_ = net_.getUnconnectedOutLayersNames();
     if (opts_.validate_on_load) {
-        const std::string what =
-            "yolo: model '" + model + "'" + (weights.empty() ? "" : " with weights '" + weights + "'");
+        const std::string what = "yolo: model '" + model + "'" +
+                                 (weights.empty() ? "" : " with weights '" + weights + "'");
         try {
             (void)detect(
                 cv::Mat(opts_.input_height, opts_.input_width, CV_8UC3, cv::Scalar(127, 127, 127)));
         } catch (const std::exception& e) {
-            throw std::runtime_error(what + " fails on a test image (corrupt or mismatched file?): " +
-                                     e.what());
+            throw std::runtime_error(
+                what + " fails on a test image (corrupt or mismatched file?): " + e.what());
         }
         // A weights file of the right size but zeroed, or full of NaN, ran without an error
         // and found nobody, ever: its raw outputs on a noise image tell. Any trained network
@@ -248,8 +248,9 @@ YoloDetector::YoloDetector(const Options& opts) : opts_(opts) {
         for (cv::Mat out : outs) {
             if (out.dims == 3) out = out.reshape(1, out.size[1]);
             if (!cv::checkRange(out))
-                throw std::runtime_error(what + " gives non-finite outputs (NaN or infinite) on a "
-                                                "test image: corrupt weights?");
+                throw std::runtime_error(what +
+                                         " gives non-finite outputs (NaN or infinite) on a "
+                                         "test image: corrupt weights?");
             if (out.dims != 2 || out.cols < 5 || out.rows == 0) continue;  // detect() said so
             double a = 0, b = 0;
             cv::minMaxLoc(out.col(4), &a, &b);

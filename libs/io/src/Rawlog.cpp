@@ -319,10 +319,10 @@ struct RawlogReader::Stream {
                 // (no EOF exception); at byte 0 that read as "not a rawlog?".
                 const std::string why = core::innermostMessage(e.what());
                 if (why.find("Truncated data stream") != std::string::npos)
-                    throw std::runtime_error("truncated object at byte " + std::to_string(pos) +
-                                             " (object " + std::to_string(objects) +
-                                             " of the uncompressed stream ends early: " +
-                                             printable(why) + ")");
+                    throw std::runtime_error(
+                        "truncated object at byte " + std::to_string(pos) + " (object " +
+                        std::to_string(objects) +
+                        " of the uncompressed stream ends early: " + printable(why) + ")");
                 throw std::runtime_error("cannot decode object " + std::to_string(objects) +
                                          " at byte " + std::to_string(pos) +
                                          " of the uncompressed stream" +

@@ -31,8 +31,8 @@ void forEachDataLine(const std::string& path,
             if (u < 0x20 && u != '\t' && u != '\r' && u != '\v' && u != '\f') {
                 char code[8];
                 std::snprintf(code, sizeof code, "0x%02x", u);
-                throw std::runtime_error(
-                    lineError(path, n, std::string("control byte ") + code + " (not a text file?)"));
+                throw std::runtime_error(lineError(
+                    path, n, std::string("control byte ") + code + " (not a text file?)"));
             }
         }
         // A comment: from a '#' that starts the line or a word ("# note" after the values), not

@@ -19,8 +19,8 @@
 #include <mrpt/rtti/CObject.h>
 
 #include <algorithm>
-#include <cmath>
 #include <cctype>
+#include <cmath>
 #include <map>
 #include <regex>
 #include <sstream>
@@ -202,11 +202,9 @@ void checkMrptSections(const mrpt::config::CConfigFileBase& c, const std::string
                 const auto f = core::parseNumberList(c.read_string(fe, k, ""), "[" + fe + "] " + k);
                 core::requireValue(!f.empty(), fe, k, "expected factor indices");
                 for (const double x : f)
-                    core::requireValue(x >= 0 && x < static_cast<double>(n_factors) &&
-                                           x == std::floor(x),
-                                       fe, k,
-                                       "factor indices must be integers 0.." +
-                                           std::to_string(n_factors - 1));
+                    core::requireValue(
+                        x >= 0 && x < static_cast<double>(n_factors) && x == std::floor(x), fe, k,
+                        "factor indices must be integers 0.." + std::to_string(n_factors - 1));
                 const double th = core::readDouble(c, fe, t, 0.0);
                 core::requireValue(th >= 0 && th <= 1, fe, t, "must be in [0, 1]");
             }
