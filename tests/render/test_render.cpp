@@ -1111,6 +1111,13 @@ TEST(Scenario, ShippedFilesLoadAndTyposAreReported) {
     (void)withEdit(text, "n_frames", "n_frames");  // s.ini (= base) as it was
     expectMessage([&] { (void)loadScenario(base, {"scenario.n_frames=0"}); },
                   tmp.str("s.ini") + " [scenario] n_frames: must be >= 1");
+    // Clip planes that ruin the depth: near_clip 0.001 put it 4 cm off and lost person
+    // pixels, far_clip 1e300 rendered no depth and nobody; both went without a word.
+    expectMessage([&] { (void)loadScenario(base, {"scenario.near_clip=0.001"}); },
+                  tmp.str("s.ini") + " [scenario] near_clip: must be >= 0.01 [m]");
+    expectMessage([&] { (void)loadScenario(base, {"scenario.far_clip=1e300"}); },
+                  tmp.str("s.ini") + " [scenario] far_clip: must be <= 1e4 [m]");
+    EXPECT_NO_THROW((void)loadScenario(base, {"scenario.near_clip=0.01", "scenario.far_clip=1e4"}));
     expectMessage([&] { (void)loadScenario(base, {"person_9.speed=1"}); },  // a new person
                   tmp.str("s.ini") + " [person_9] kind: missing");
     expectMessage([&] { (void)loadScenario(base, {"scenario.room=nowhere.ini"}); },
