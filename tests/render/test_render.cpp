@@ -1151,14 +1151,21 @@ TEST(Scenario, ShippedFilesLoadAndTyposAreReported) {
 // sitting_bare is sitting_xyz's room with every box blurred through room_set: the same
 // room file, boxes and walls, only the boxes' blur differs.
 TEST(Scenario, TheCameraAndThePeopleStayInTheRoom) {
-    // Outside the room they rendered walls seen from behind, or nobody, without a word.
+    // Outside the room they rendered walls seen from behind, or nobody, without a word; so
+    // did the room's boxes.
     const std::string path = kRoot + "/sim_worlds/synth/walking_xyz.ini";
     for (const auto& [item, message] : std::vector<std::pair<std::string, std::string>>{
              {"person_1.path=[100 100 200 200]",
               "[person_1] path: the point (100, 100) lies outside the room (0..5.5 x 0..5 m)"},
              {"trajectory.position=[100 100 100]",
               "[trajectory] position: the camera at t = 0 s is at ("},
-             {"person_.height=1.7", "[person_]: a person's section needs a name"}}) {
+             {"person_.height=1.7", "[person_]: a person's section needs a name"},
+             // A box outside the room, or under its floor, rendered as nothing.
+             {"scenario.room_set=box_crate.base=[40 4.3 0]",
+              "office_room.ini [box_crate] base: (40, 4.3, 0) lies outside the room (0..5.5 x "
+              "0..5 x 0..2.8 m)"},
+             {"scenario.room_set=box_crate.base=[4.9 4.3 -10]",
+              "[box_crate] base: (4.9, 4.3, -10) lies outside the room"}}) {
         try {
             (void)render::loadScenario(path, {item});
             ADD_FAILURE() << "accepted: " << item;

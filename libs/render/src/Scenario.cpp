@@ -137,6 +137,16 @@ void readRoom(const std::string& path, RoomSpec& room) {
         box.base = vec3(*cfg, b, "base", path, true);
         box.size = vec3(*cfg, b, "size", path, true);
         core::requireValue(box.size.minCoeff() > 0, b, "size", "must be > 0 [m]");
+        {  // Outside the room (or under its floor) a box rendered as nothing, without a word.
+            const auto& R = room.size;
+            const auto& p = box.base;
+            std::ostringstream m;
+            m << "(" << p.x() << ", " << p.y() << ", " << p.z() << ") lies outside the room (0.."
+              << R.x() << " x 0.." << R.y() << " x 0.." << R.z() << " m)";
+            core::requireValue(p.x() > 0 && p.x() < R.x() && p.y() > 0 && p.y() < R.y() &&
+                                   p.z() >= 0 && p.z() < R.z(),
+                               b, "base", m.str());
+        }
         box.yaw = core::readDouble(*cfg, b, "yaw_deg", 0.0) * kPi / 180.0;
         box.textures =
             resolveImages(requiredText(*cfg, b, "textures"), base, path + " [" + b + "] textures");
