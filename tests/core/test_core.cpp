@@ -216,6 +216,20 @@ TEST(Config, FilterIniFollowsRunFilterConfigWithOverrides) {
                   std::string::npos)
             << e.what();
     }
+    // A filter INI without the filter's sections (an empty file, a slip of the name) ran the
+    // filter on its defaults.
+    std::ofstream(dir + "/empty.ini") << "# nothing yet\n";
+    std::ofstream(missing) << "[run]\nfilter_config = empty.ini\n";
+    try {
+        (void)loadFilterIni(*loadIni(missing), missing);
+        FAIL() << "a filter INI without [detector] or [dynamic_filter] was taken";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_STREQ(e.what(), (missing + " [run] filter_config: '" + dir +
+                                "/empty.ini' has no [detector] or [dynamic_filter] section")
+                                   .c_str());
+    }
+    std::ofstream(dir + "/empty.ini") << "[detector]\n";  // one of them is enough
+    EXPECT_NO_THROW((void)loadFilterIni(*loadIni(missing), missing));
     std::filesystem::remove_all(dir);
 }
 

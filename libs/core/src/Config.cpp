@@ -259,8 +259,15 @@ std::unique_ptr<mrpt::config::CConfigFileMemory> loadFilterIni(
     if (!fc.empty() && !std::filesystem::is_regular_file(file))
         throw std::runtime_error(path + " [run] filter_config: no such file '" + file + "'");
     auto out = loadIni(file);
-    // A file of its own holds only the filter's sections (else the SLAM INI's check covers it).
-    if (!fc.empty()) requireKnownSections(*out, filterSections(), file);
+    // A file of its own holds only the filter's sections (else the SLAM INI's check covers it),
+    // and at least one of them: an empty file, or the wrong one, ran the filter on its
+    // defaults without a word.
+    if (!fc.empty()) {
+        requireKnownSections(*out, filterSections(), file);
+        if (!out->sectionExists("detector") && !out->sectionExists("dynamic_filter"))
+            throw std::invalid_argument(path + " [run] filter_config: '" + file +
+                                        "' has no [detector] or [dynamic_filter] section");
+    }
     const auto items = overrideItems(cfg.read_string("run", "filter_overrides", ""),
                                      path + " [run] filter_overrides");
     // An item for another section would add that section and be read by nothing.
