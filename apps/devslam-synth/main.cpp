@@ -129,10 +129,17 @@ int run(int argc, char** argv) {
     bool labels = true, if_changed = false;
     for (std::size_t i = 0; i < a.size(); ++i) {
         const auto value = [&] { return devslam::core::optionValue(a, i); };
+        // An empty name (a script's unset variable) rendered into out/synth/<name>, over the
+        // render there, or wrote no rawlog, without a word.
+        const auto name = [&] {
+            const std::string option = a[i], v = value();
+            if (v.empty()) throw std::invalid_argument(option + ": the name is empty");
+            return v;
+        };
         if (a[i] == "-o" || a[i] == "--out")
-            out_dir = value();
+            out_dir = name();
         else if (a[i] == "--rawlog")
-            rawlog = value();
+            rawlog = name();
         else if (a[i] == "--frames")
             frames = std::size_t(devslam::core::parseInteger(value(), "--frames", 1));
         else if (a[i] == "--no-labels")

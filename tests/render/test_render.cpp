@@ -593,7 +593,11 @@ TEST(DevslamSynth, RefusesOutputsThatAreNotItsOwnAndMissingValues) {
              {"--cut-texture " + photo + " 178,88,102,292 " + tmp.str("out.txt"),
               "--cut-texture OUT '" + tmp.str("out.txt") + "': the name must end in .png"},
              {"short_walking -o --frames 2", "devslam-synth: -o needs a value"},
-             {"short_walking --rawlog --frames 2", "devslam-synth: --rawlog needs a value"}}) {
+             {"short_walking --rawlog --frames 2", "devslam-synth: --rawlog needs a value"},
+             // (an unset variable: it rendered into out/synth/short_walking, or no rawlog)
+             {"short_walking -o '' --frames 2", "devslam-synth: -o: the name is empty"},
+             {"short_walking -o " + tmp.str("so") + " --rawlog '' --frames 2",
+              "devslam-synth: --rawlog: the name is empty"}}) {
         const auto r = devslam::test::runApp("devslam-synth", args);
         EXPECT_EQ(r.rc, 1) << args << "\n" << r.out;
         EXPECT_NE(r.out.find(says), std::string::npos) << args << "\n" << r.out;
