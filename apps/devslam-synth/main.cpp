@@ -21,6 +21,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <iostream>
@@ -89,6 +90,11 @@ int cutTexture(const std::vector<std::string>& a) {
     const cv::Mat img = cv::imread(a[1], cv::IMREAD_COLOR);
     if (img.empty()) throw std::runtime_error("cannot read '" + a[1] + "'");
     const auto v = core::parseNumberList(a[2], "--cut-texture box", 4);
+    // Pixels: 180.5 was cut at 180 without a word, and 1e10 overflowed the int.
+    for (double x : v)
+        if (x != std::floor(x) || std::abs(x) > 1e6)
+            throw std::invalid_argument("--cut-texture box '" + a[2] +
+                                        "': X,Y,W,H must be whole pixels");
     const cv::Rect box{int(v[0]), int(v[1]), int(v[2]), int(v[3])};
     const cv::Mat rgba = render::cutPersonTexture(img, box);
     core::writePngWhole(a[3], rgba);

@@ -592,6 +592,10 @@ TEST(DevslamSynth, RefusesOutputsThatAreNotItsOwnAndMissingValues) {
               "--cut-texture OUT '" + photo + "' is the IMAGE"},
              {"--cut-texture " + photo + " 178,88,102,292 " + tmp.str("out.txt"),
               "--cut-texture OUT '" + tmp.str("out.txt") + "': the name must end in .png"},
+             {"--cut-texture " + photo + " 178.5,88,102,292 " + tmp.str("out.png"),
+              "--cut-texture box '178.5,88,102,292': X,Y,W,H must be whole pixels"},
+             {"--cut-texture " + photo + " 178,88,1e10,292 " + tmp.str("out.png"),
+              "--cut-texture box '178,88,1e10,292': X,Y,W,H must be whole pixels"},
              {"short_walking -o --frames 2", "devslam-synth: -o needs a value"},
              {"short_walking --rawlog --frames 2", "devslam-synth: --rawlog needs a value"},
              // (an unset variable: it rendered into out/synth/short_walking, or no rawlog)
@@ -620,6 +624,7 @@ TEST(DevslamSynth, RefusesOutputsThatAreNotItsOwnAndMissingValues) {
     EXPECT_FALSE(fs::exists(tmp.str("so")));
     EXPECT_EQ(readFile(photo), photo_text);
     EXPECT_FALSE(fs::exists(tmp.str("out.txt")));
+    EXPECT_FALSE(fs::exists(tmp.str("out.png")));
     EXPECT_FALSE(fs::exists("--frames"));
 }
 
