@@ -275,7 +275,16 @@ int appMain(int argc, char** argv) {
                 if (a.use_prior) prior = in.synth[k].T_prev_cur;
             } else {
                 if (a.frames > 0 && k >= static_cast<std::size_t>(a.frames)) break;
-                f = in.reader->next();
+                try {
+                    f = in.reader->next();
+                } catch (const std::exception& e) {
+                    // A frame that does not decode: the overlays written so far replaced an
+                    // earlier run's, whose later ones stay; said as an interrupt says it.
+                    throw std::runtime_error(
+                        std::string(e.what()) + "; stopped after " + std::to_string(k) +
+                        " frames: wrote " + std::to_string(written) + " overlays to " + a.out_dir +
+                        "; overlays there of later frames are an earlier run's");
+                }
                 if (!f) break;
                 if (in.fixed_camera && a.use_prior) prior = Eigen::Isometry3d::Identity();
             }

@@ -111,6 +111,41 @@ TEST(DevslamOverlay, ATinyFrameGetsItsOverlay) {
     EXPECT_EQ(cv::imread(d.str("o/overlay_00001.png")).size(), cv::Size(1, 1));
 }
 
+// A frame that does not decode stops the run naming it, and says how far it got: the
+// overlays it wrote replaced an earlier run's, whose later ones are still there (it named
+// only the image, as if the folder were all of one run or untouched).
+TEST(DevslamOverlay, AnUndecodableFrameSaysWhichOverlaysAreThisRuns) {
+    devslam::test::TempDir d("devslam_overlay_");
+    const std::string in = d.str("tum");
+    fs::create_directories(in + "/rgb");
+    fs::create_directories(in + "/depth");
+    std::ofstream(in + "/camera.ini") << "[camera]\nfx = 50\nfy = 50\ncx = 4\ncy = 4\nwidth = 8\n"
+                                         "height = 8\ndist = [0 0 0 0 0]\n";
+    std::ofstream rgb(in + "/rgb.txt"), depth(in + "/depth.txt");
+    for (const char* t : {"100.0", "100.1", "100.2"}) {
+        ASSERT_TRUE(cv::imwrite(in + "/rgb/" + t + ".png", cv::Mat(8, 8, CV_8UC3, cv::Scalar(9))));
+        ASSERT_TRUE(
+            cv::imwrite(in + "/depth/" + t + ".png", cv::Mat(8, 8, CV_16UC1, cv::Scalar(5000))));
+        rgb << t << " rgb/" << t << ".png\n";
+        depth << t << " depth/" << t << ".png\n";
+    }
+    rgb.close();
+    depth.close();
+    const std::string args = "--input " + in + " --mode none --out " + d.str("o");
+    auto r = runApp("devslam-overlay", args);
+    ASSERT_EQ(r.rc, 0) << r.out;
+    ASSERT_EQ(pngsIn(d.str("o")), 3);
+    std::ofstream(in + "/rgb/100.1.png") << "not a png";
+    r = runApp("devslam-overlay", args);
+    EXPECT_EQ(r.rc, 1) << r.out;
+    EXPECT_NE(r.out.find(in + "/rgb/100.1.png"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("; stopped after 1 frames: wrote 1 overlays to " + d.str("o") +
+                         "; overlays there of later frames are an earlier run's"),
+              std::string::npos)
+        << r.out;
+    EXPECT_EQ(pngsIn(d.str("o")), 3);  // the earlier run's later overlays are not removed
+}
+
 // Ctrl-C: the overlay being written is finished, the run stops there, says how far it got and
 // exits 130. It stopped at once, silent, and left the overlay it was writing empty.
 TEST(DevslamOverlay, CtrlCStopsAfterAWholeOverlay) {
