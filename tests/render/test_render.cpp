@@ -501,6 +501,25 @@ TEST(RenderSequence, ARawlogItCannotOrMayNotWriteLeavesTheEarlierRenderAsItWas) 
     }
     EXPECT_EQ(readFile(theirs), "their data\n");
     EXPECT_EQ(readFile(file), "a file\n");
+    // A folder under the name of a file the render writes is refused before the first frame
+    // (render.txt, groundtruth.txt and camera.ini failed after the last one, and the render
+    // was lost; preview.png half-way, with a bare filesystem error).
+    for (const char* name : {"render.txt", "groundtruth.txt", "camera.ini", "persons.txt",
+                             "rgb.txt", "depth.txt", "preview.png"}) {
+        const std::string path = o.out_dir + "/" + name, aside = tmp.str("aside");
+        if (fs::exists(path)) fs::rename(path, aside);
+        fs::create_directories(path + "/x");
+        expectMessage([&] { (void)writeSequence(sc, o); },
+                      "'" + path + "' is not a file: the render writes its " + name +
+                          " there; move it or name another folder");
+        EXPECT_TRUE(fs::is_directory(path + "/x")) << name;
+        if (std::string(name) != "rgb.txt") EXPECT_EQ(readFile(o.out_dir + "/rgb.txt"), list);
+        if (std::string(name) != "groundtruth.txt")
+            EXPECT_EQ(readFile(o.out_dir + "/groundtruth.txt"), gt);
+        fs::remove_all(path);
+        if (fs::exists(aside)) fs::rename(aside, path);
+    }
+    ASSERT_TRUE(isRenderCurrent(sc, o));
     // The rawlog a render into the folder wrote is written again, whole or stopped (resumed).
     WriteOptions w = o;
     w.rawlog_path = tmp.str("mine.rawlog");

@@ -128,6 +128,18 @@ void checkOutputs(const Scenario& sc, const WriteOptions& o) {
                 throw std::invalid_argument("output folder '" + o.out_dir + "' holds " + name +
                                             ", not of a devslam-synth render (no render.txt or "
                                             "persons.txt); remove it or name another folder");
+    // A folder under the name of a file the render writes: render.txt, groundtruth.txt and
+    // camera.ini failed after the last frame (minutes of render lost, "cannot write" without
+    // a reason), preview.png in the middle with a bare filesystem error.
+    for (const char* name : {"render.txt", "groundtruth.txt", "camera.ini", "persons.txt",
+                             "rgb.txt", "depth.txt", "preview.png"}) {
+        std::error_code ec;
+        const auto st = fs::status(dir / name, ec);
+        if (!o.out_dir.empty() && fs::exists(st) && !fs::is_regular_file(st))
+            throw std::invalid_argument("'" + (dir / name).string() +
+                                        "' is not a file: the render writes its " + name +
+                                        " there; move it or name another folder");
+    }
     if (o.rawlog_path.empty()) return;
     const std::string ext = ".rawlog";
     const auto& r = o.rawlog_path;
