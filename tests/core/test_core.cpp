@@ -460,6 +460,13 @@ TEST(Config, RepeatedKeysAndSectionsAreRefused) {
     std::filesystem::create_directories(path);
     EXPECT_EQ(error("x"), "INI file '" + path + "' is a folder");
     std::filesystem::remove_all(path);
+    // A file without end (or a rawlog given for the INI) was read until memory ran out.
+    try {
+        (void)loadIni("/dev/zero");
+        FAIL() << "/dev/zero was read as an INI";
+    } catch (const std::runtime_error& e) {
+        EXPECT_STREQ(e.what(), "INI file '/dev/zero' is over 16 MiB: not an INI file");
+    }
 }
 
 // A NUL byte in a line hid the key before it from requireKnownKeys (fuzz: "bogus_key\0 = 1"

@@ -120,14 +120,21 @@ std::unique_ptr<mrpt::config::CConfigFileMemory> loadIni(const std::string& path
     // An ifstream opens a folder and then reads nothing: an empty INI, all defaults.
     if (std::filesystem::is_directory(path))
         throw std::runtime_error("INI file '" + path + "' is a folder");
-    std::ifstream in(path);
+    std::ifstream in(path, std::ios::binary);
     if (!in) throw std::runtime_error("cannot open INI file '" + path + "'");
-    std::stringstream ss;
-    ss << in.rdbuf();
+    // Read up to a bound: /dev/zero (or a rawlog given for the INI) was read until memory ran
+    // out ("std::bad_alloc", naming nothing). The largest INI shipped is a few kB.
+    constexpr std::size_t kMaxIniBytes = std::size_t(16) << 20;
+    std::string text;
+    char chunk[1 << 16];
+    while (in.read(chunk, sizeof chunk), in.gcount() > 0) {
+        text.append(chunk, static_cast<std::size_t>(in.gcount()));
+        if (text.size() > kMaxIniBytes)
+            throw std::runtime_error("INI file '" + path + "' is over 16 MiB: not an INI file");
+    }
     if (in.bad()) throw std::runtime_error("cannot read INI file '" + path + "'");
     // A UTF-8 byte-order mark (Windows editors write one) made the first line "neither a
     // [section] nor a key = value", and MRPT lost the first section to it.
-    std::string text = ss.str();
     if (text.rfind("\xEF\xBB\xBF", 0) == 0) text.erase(0, 3);
     refuseMisreadLines(text, path);
     try {
