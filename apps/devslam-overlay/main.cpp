@@ -144,8 +144,10 @@ std::variant<Args, int> parseArgs(int argc, char** argv) {
             return 2;
         }
     }
-    if (a.input.empty() || a.out_dir.empty()) {
-        std::cerr << kUsage;
+    if (a.input.empty() || a.out_dir.empty()) {  // (the usage alone named neither)
+        std::cerr << "devslam-overlay: " << (a.input.empty() ? "--input" : "--out")
+                  << " is required (and not empty)\n"
+                  << kUsage;
         return 2;
     }
     return a;

@@ -217,6 +217,16 @@ TEST(DevslamOverlay, BadInputIsNamed) {
     r = runApp("devslam-overlay", "--input synthetic:walking --every 0" + out);
     EXPECT_EQ(r.rc, 2) << r.out;
     EXPECT_NE(r.out.find("--every"), std::string::npos) << r.out;
+
+    // A missing or empty --input or --out is named (the usage alone named neither).
+    for (const auto& [args, says] : std::vector<std::pair<std::string, std::string>>{
+             {"--input synthetic:walking", "devslam-overlay: --out is required (and not empty)"},
+             {"--input synthetic:walking --out ''", "devslam-overlay: --out is required"},
+             {"--input ''" + out, "devslam-overlay: --input is required (and not empty)"}}) {
+        r = runApp("devslam-overlay", args);
+        EXPECT_EQ(r.rc, 2) << args << "\n" << r.out;
+        EXPECT_EQ(r.out.rfind(says, 0), 0u) << args << "\n" << r.out;
+    }
 }
 
 // The bench reads its filter INI before the detectors' minutes of work: a bad one stops it at
