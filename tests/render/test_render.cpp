@@ -1188,6 +1188,10 @@ TEST(Scenario, TheCameraAndThePeopleStayInTheRoom) {
              {"trajectory.position=[100 100 100]",
               "[trajectory] position: the camera at t = 0 s is at ("},
              {"person_.height=1.7", "[person_]: a person's section needs a name"},
+             {"person_1.base_z=-100",
+              "[person_1] base_z: must be in (-height, room height) = (-1.75, 2.8) [m]: the "
+              "person is under the floor or over the ceiling"},
+             {"person_1.base_z=1e9", "[person_1] base_z: must be in (-height, room height)"},
              // A box outside the room, or under its floor, rendered as nothing.
              {"scenario.room_set=box_crate.base=[40 4.3 0]",
               "office_room.ini [box_crate] base: (40, 4.3, 0) lies outside the room (0..5.5 x "

@@ -361,10 +361,17 @@ Scenario readScenario(const std::string& path, const std::vector<std::string>& o
           << " m)";
         return m.str();
     };
-    for (std::size_t k = 0; k < sc.people.size(); ++k)
+    for (std::size_t k = 0; k < sc.people.size(); ++k) {
         for (const auto& q : sc.people[k].path)
             core::requireValue(inRoom(q.x(), q.y()), sc.people[k].name, "path",
                                "the point " + where(q.x(), q.y()));
+        // Sunk through the floor or lifted over the ceiling (base_z -100, 1e9): nobody.
+        const auto& p = sc.people[k];
+        std::ostringstream m;
+        m << "must be in (-height, room height) = (" << -p.height << ", " << R.z()
+          << ") [m]: the person is under the floor or over the ceiling";
+        core::requireValue(p.base_z > -p.height && p.base_z < R.z(), p.name, "base_z", m.str());
+    }
     // Every frame (a few microseconds each): a sample of them let a short excursion through
     // on a long scenario.
     for (std::size_t i = 0; i < sc.n_frames; ++i) {
