@@ -288,7 +288,7 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
     if (bar) bar->finish();
     {
         const auto t0 = Clock::now();
-        if (!rep.log.empty()) slam.finalize(reader.intrinsics());
+        if (!rep.log.empty()) rep.final_ba = slam.finalize(reader.intrinsics());
         rep.finalize_ms = msSince(t0);
     }
 
@@ -542,6 +542,14 @@ std::string formatSummary(const RunReport& r) {
     }
     o << "finalize   : " << num(r.finalize_ms, 1)
       << " ms once at the end (final BA and frame refinement; not in the FPS)\n";
+    if (const auto& b = r.final_ba; b.n_keyframes > 0) {
+        o << "final BA   : " << b.n_keyframes << " keyframes, " << b.n_landmarks
+          << " landmarks, largest keyframe shift " << num(1000 * b.max_shift, 1) << " mm";
+        if (b.rejected)
+            o << ": not applied (over [local_ba] max_keyframe_shift " << num(r.ba_max_shift, 3)
+              << " m)";
+        o << "\n";
+    }
     o << "memory     : peak RSS " << num(r.peak_rss_mb, 1) << " MB, map " << num(r.map_mb, 2)
       << " MB (" << num(r.bytes_per_keyframe / 1024.0, 1) << " KiB per keyframe)\n";
     if (r.ate) {
@@ -631,6 +639,10 @@ std::string toJson(const RunReport& r) {
       << ",\n  \"stage_median_ms\": " << timingJson(r.stage_median_ms)
       << ",\n  \"stage_mean_ms\": " << timingJson(r.stage_mean_ms)
       << ",\n  \"finalize_ms\": " << num(r.finalize_ms, 3)
+      << ",\n  \"final_ba\": {\"keyframes\": " << r.final_ba.n_keyframes
+      << ", \"landmarks\": " << r.final_ba.n_landmarks
+      << ", \"max_shift_m\": " << num(r.final_ba.max_shift, 6)
+      << ", \"rejected\": " << (r.final_ba.rejected ? "true" : "false") << "}"
       << ",\n  \"peak_rss_mb\": " << num(r.peak_rss_mb, 1)
       << ",\n  \"map_mb\": " << num(r.map_mb, 3)
       << ",\n  \"bytes_per_keyframe\": " << num(r.bytes_per_keyframe, 0);

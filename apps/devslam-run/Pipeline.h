@@ -98,6 +98,7 @@ struct RunReport {
     double median_cpu_ms = 0;  ///< process CPU time per frame, all threads (load-independent)
     FrameTiming stage_mean_ms, stage_median_ms;
     double finalize_ms = 0;  ///< end-of-sequence BA + frame refinement (not in FPS)
+    slam::LocalBaResult final_ba;  ///< the end-of-sequence BA (Slam::finalize)
     double peak_rss_mb = 0;  ///< VmHWM of the process at the end
     double map_mb = 0;       ///< approximate map heap
     double bytes_per_keyframe = 0;

@@ -51,7 +51,7 @@ TEST(DevslamRun, WritesEveryOutputAndPrintsTheSummary) {
     ASSERT_EQ(r.rc, 0) << r.out;
     EXPECT_FALSE(fs::exists(out / "mask_errors.csv"));
     for (const char* key : {"frames     : 32", "lost frames: 0", "ATE        : RMSE", "RPE (1 f)",
-                            "median", "tracking", "backend", "finalize   : "})
+                            "median", "tracking", "backend", "finalize   : ", "final BA   : "})
         EXPECT_NE(r.out.find(key), std::string::npos) << key << "\n" << r.out;
     EXPECT_EQ(lines(out / "trajectory.txt"), 32u);
     EXPECT_GE(lines(out / "keyframes.txt"), 3u);
@@ -71,6 +71,7 @@ TEST(DevslamRun, WritesEveryOutputAndPrintsTheSummary) {
     ss << js.rdbuf();
     EXPECT_NE(ss.str().find("\"per_frame\""), std::string::npos);
     EXPECT_NE(ss.str().find("\"ate\""), std::string::npos);
+    EXPECT_NE(ss.str().find("\"final_ba\": {\"keyframes\": "), std::string::npos);
     // run.json is written whole under its own name (a .part file renamed).
     EXPECT_FALSE(fs::exists(out / "run.json.part"));
     fs::remove_all(out);

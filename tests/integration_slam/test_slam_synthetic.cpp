@@ -95,3 +95,46 @@ TEST(SlamSynthetic, MovingPersonNeverEntersTheMap) {
     EXPECT_EQ(masked.lost, 0u);
     EXPECT_LE(masked.ate, 0.01);
 }
+
+TEST(SlamSynthetic, AFinalWindowAdjustsTheOlderKeyframesAtTheEnd) {
+    // [local_ba] final_window: the BA at the end of the run adjusts the newest N keyframes
+    // (ORB-SLAM2's global BA) instead of the last local window. With 0 the keyframes older
+    // than the window stay where tracking and the local BAs left them; with 100 (more than
+    // the map has) every keyframe but the gauge is adjusted.
+    const auto& r = rendered();
+    for (const int final_window : {0, 100}) {
+        SCOPED_TRACE("final_window " + std::to_string(final_window));
+        auto opts =
+            slam::SlamOptions::fromConfig(*core::loadIni(kRoot + "/config_ini/slam_synthetic.ini"));
+        opts.local_ba.final_window = final_window;
+        opts.local_ba.window = 3;  // 30 frames make about 6 keyframes
+        slam::Slam s(opts);
+        for (std::size_t i = 0; i < r.frames.size(); ++i) {
+            cv::Mat m;
+            cv::dilate(r.moving_mask[i], m, cv::Mat(), cv::Point(-1, -1), 3);
+            (void)s.process(r.frames[i], m);
+        }
+        const auto n_kf = static_cast<int>(s.map().keyframes().size());
+        ASSERT_GT(n_kf, opts.local_ba.window + 1) << "too few keyframes to tell the two apart";
+        std::map<slam::KeyframeId, Eigen::Isometry3d> before;
+        for (const auto& [id, kf] : s.map().keyframes()) before[id] = kf.T_wc;
+        const double ate_before = eval::computeAte(r.gt, s.trajectory()).trans.rmse;
+        const auto ba = s.finalize(r.frames.front().K);
+        const double ate_after = eval::computeAte(r.gt, s.trajectory()).trans.rmse;
+        const auto window = s.map().lastKeyframes(static_cast<std::size_t>(opts.local_ba.window));
+        int older_moved = 0;
+        for (const auto& [id, kf] : s.map().keyframes())
+            if (id < window.front() && !kf.T_wc.isApprox(before.at(id), 1e-12)) ++older_moved;
+        EXPECT_TRUE(s.map().keyframe(0).T_wc.isApprox(before.at(0)));  // the gauge
+        EXPECT_FALSE(ba.rejected);
+        if (final_window == 0) {
+            EXPECT_EQ(ba.n_keyframes, opts.local_ba.window);
+            EXPECT_EQ(older_moved, 0);
+        } else {
+            EXPECT_EQ(ba.n_keyframes, n_kf - 1);  // all but keyframe 0
+            EXPECT_EQ(older_moved, n_kf - 1 - opts.local_ba.window);
+        }
+        std::printf("final_window %d: %d keyframes, %d adjusted; ATE %.5f -> %.5f m\n",
+                    final_window, n_kf, ba.n_keyframes, ate_before, ate_after);
+    }
+}

@@ -986,7 +986,11 @@ TEST(Config, EveryShippedSlamIniLoadsAndUnknownKeysAreRejected) {
               "[loop_closure] sigma_t: must be in [1e-6, 1e3]"},
              {"[local_ba]\nchi2_mono = -1\n", "[local_ba] chi2_mono: must be > 0"},
              // (a window of 1 was accepted and adjusted nothing, silently)
-             {"[local_ba]\nwindow = 1\n", "[local_ba] window: must be in [2, 30]"}}) {
+             {"[local_ba]\nwindow = 1\n", "[local_ba] window: must be in [2, 30]"},
+             {"[local_ba]\nfinal_window = 1\n",
+              "[local_ba] final_window: must be 0 (the window) or in [2, 1000]"},
+             {"[local_ba]\nfinal_window = 1e6\n",
+              "[local_ba] final_window: must be 0 (the window) or in [2, 1000]"}}) {
         mrpt::config::CConfigFileMemory c(text);
         try {
             (void)SlamOptions::fromConfig(c);

@@ -14,10 +14,9 @@
 namespace devslam::slam {
 
 void LocalBaOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, const std::string& s) {
-    core::requireKnownKeys(
-        c, s,
-        {"enabled", "window", "iterations", "bf", "chi2_mono", "chi2_stereo", "outlier_rounds",
-         "max_keyframe_shift"});
+    core::requireKnownKeys(c, s,
+                           {"enabled", "window", "iterations", "bf", "chi2_mono", "chi2_stereo",
+                            "outlier_rounds", "max_keyframe_shift", "final_window"});
     enabled = core::readBool(c, s, "enabled", enabled);
     window = core::readInt(c, s, "window", window);
     outlier_rounds = core::readInt(c, s, "outlier_rounds", outlier_rounds);
@@ -37,6 +36,9 @@ void LocalBaOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, cons
     core::requireValue(chi2_stereo > 0, s, "chi2_stereo", "must be > 0");
     max_keyframe_shift = core::readDouble(c, s, "max_keyframe_shift", max_keyframe_shift);
     core::requireValue(max_keyframe_shift >= 0, s, "max_keyframe_shift", "must be >= 0 (0 = off)");
+    final_window = core::readInt(c, s, "final_window", final_window);
+    core::requireValue(final_window == 0 || (final_window >= 2 && final_window <= 1000), s,
+                       "final_window", "must be 0 (the window) or in [2, 1000]");
 }
 
 void LocalBaOptions::saveToConfig(mrpt::config::CConfigFileBase& c, const std::string& s) const {
@@ -48,6 +50,7 @@ void LocalBaOptions::saveToConfig(mrpt::config::CConfigFileBase& c, const std::s
     core::writeKey(c, s, "chi2_mono", chi2_mono);
     core::writeKey(c, s, "chi2_stereo", chi2_stereo);
     core::writeKey(c, s, "max_keyframe_shift", max_keyframe_shift);
+    core::writeKey(c, s, "final_window", final_window);
 }
 
 namespace {

@@ -346,12 +346,18 @@ std::size_t Slam::framesHeldForRefinement() const {
         records_.begin(), records_.end(), [](const FrameRecord& r) { return !r.obs.empty(); }));
 }
 
-void Slam::finalize(const core::CameraIntrinsics& K) {
+LocalBaResult Slam::finalize(const core::CameraIntrinsics& K) {
+    LocalBaResult ba;
     const auto last = map_.lastKeyframes(1);
-    if (last.empty()) return;
-    if (opts_.local_ba.enabled) (void)localBundleAdjust(map_, last.front(), K, opts_.local_ba);
+    if (last.empty()) return ba;
+    if (opts_.local_ba.enabled) {
+        LocalBaOptions o = opts_.local_ba;
+        if (o.final_window > 0) o.window = o.final_window;
+        ba = localBundleAdjust(map_, last.front(), K, o);
+    }
     if (opts_.mapping.refine_frames)
         refineFrames(map_.lastKeyframes(static_cast<std::size_t>(opts_.local_ba.window)), K);
+    return ba;
 }
 
 BackendResult Slam::backendStep(const MappingResult& mapping, const core::CameraIntrinsics& K) {

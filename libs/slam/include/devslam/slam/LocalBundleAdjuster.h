@@ -38,6 +38,11 @@ struct LocalBaOptions {
     /// image: the window's own points then fit it better elsewhere; docs/slam.md, session
     /// 20), and it drags the keyframes, and every frame tracked from them, away at once.
     double max_keyframe_shift = 0.0;
+    /// keyframes adjusted by the last BA, at the end of the run (Slam::finalize): 0 = the
+    /// last `window`, as after every keyframe; N = the newest N (all of them when the map
+    /// has fewer; keyframe 0 stays the gauge): ORB-SLAM2's global BA, on a dense reduced
+    /// system of 6N unknowns (N = 150: a few hundred ms), 0..1000
+    int final_window = 0;
 
     void loadFromConfig(const mrpt::config::CConfigFileBase& cfg,
                         const std::string& section = "local_ba");

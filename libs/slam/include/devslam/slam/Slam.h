@@ -135,9 +135,11 @@ class Slam {
     /// Loop detection and pose-graph optimisation after a keyframe insertion.
     [[nodiscard]] BackendResult backendStep(const MappingResult& mapping,
                                             const core::CameraIntrinsics& K);
-    /// End of sequence: a last local BA over the newest keyframes and the re-refinement of
-    /// the frames that reference them (see MappingOptions::refine_frames).
-    void finalize(const core::CameraIntrinsics& K);
+    /// End of sequence: a last BA over the newest keyframes (LocalBaOptions::final_window
+    /// of them, else the local window) and the re-refinement of the frames that reference
+    /// the last window's keyframes (see MappingOptions::refine_frames). Returns that BA's
+    /// result (empty when local BA is off or there is no keyframe).
+    LocalBaResult finalize(const core::CameraIntrinsics& K);
     /// All stages for one frame.
     [[nodiscard]] FrameResult process(
         const core::Frame& frame, const cv::Mat& mask,
