@@ -984,6 +984,9 @@ TEST(Scenario, ShippedFilesLoadAndTyposAreReported) {
     expectRoomMessage(  // a box's blur
         [](std::string& r) { r.replace(r.find("[box_crate]\n"), 12, "[box_crate]\nblur = 101\n"); },
         tmp.str("bad_room.ini") + " [box_crate] blur: must be 0..100");
+    expectRoomMessage(  // a box without a name (was accepted; [person_] was refused)
+        [](std::string& r) { r.replace(r.find("[box_crate]\n"), 12, "[box_]\n"); },
+        tmp.str("bad_room.ini") + " [box_]: a box's section needs a name after 'box_'");
     expectRoomMessage(  // a mistyped section is not ignored
         [](std::string& r) { r.replace(r.find("[room]\n"), 7, "[rooom]\n"); },
         tmp.str("bad_room.ini") + ": unknown section [rooom] (known: room, box_*)");

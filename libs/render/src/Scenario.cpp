@@ -131,6 +131,10 @@ void readRoom(const std::string& path, RoomSpec& room) {
     room.floor_textures = resolveImages(requiredText(*cfg, s, "floor_textures"), base,
                                         path + " [room] floor_textures");
     for (const auto& b : sectionsWithPrefix(*cfg, "box_")) {
+        // As [person_]: a [box_] was a box with no name, which room_set could not reach.
+        if (b.size() <= std::string("box_").size())
+            throw std::invalid_argument(path + " [" + b +
+                                        "]: a box's section needs a name after 'box_'");
         core::requireKnownKeys(*cfg, b, {"base", "size", "yaw_deg", "textures", "blur"}, path);
         BoxSpec box;
         box.name = b;
