@@ -200,7 +200,15 @@ Loaded loadConfig(const Args& a, const std::vector<std::string>& extra_sets = {}
     }
     // [run] filter_config / filter_overrides: the filter's INI, with "section.key=value ..."
     // overrides (so a SLAM config can pick e.g. the detection interval without copying it).
-    l.filter_cfg = core::loadFilterIni(*l.cfg, a.config);
+    // (Its errors name a.config, which filter_config is relative to; a value --set gave is
+    // named as such, as the other keys' are.)
+    try {
+        l.filter_cfg = core::loadFilterIni(*l.cfg, a.config);
+    } catch (const std::exception& e) {
+        const std::string msg = e.what();
+        if (!set || msg.rfind(a.config + " [run]", 0) != 0) throw;
+        throw std::invalid_argument(l.config_source + msg.substr(a.config.size()));
+    }
     applySets(*l.filter_cfg, a.sets);
     applySets(*l.filter_cfg, extra_sets);
     core::namingSource(l.config_source, [&] { l.reader.loadFromConfig(*l.cfg, "dataset"); });

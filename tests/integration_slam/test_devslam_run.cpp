@@ -266,6 +266,12 @@ TEST(DevslamRun, BadInputIsReported) {
     EXPECT_NE(r.out.find("slam_tum_fr1.ini with --set [run]: unknown key 'moed'"),
               std::string::npos)
         << r.out;
+    // so is a filter_config --set gave (it was blamed on the file)
+    r = run("--set run.filter_config=nothere.ini --quiet --out ''");
+    EXPECT_EQ(r.rc, 1);
+    EXPECT_NE(r.out.find("slam_tum_fr1.ini with --set [run] filter_config: no such file"),
+              std::string::npos)
+        << r.out;
     r = run("--frobnicate");
     EXPECT_EQ(r.rc, 1);
     EXPECT_NE(r.out.find("usage"), std::string::npos);
