@@ -3,7 +3,8 @@
 /// are refined together (keyframes outside the window that see those landmarks are held
 /// fixed), minimising the same reprojection + virtual-right-coordinate residuals as the
 /// tracker, with a Huber kernel. Own Levenberg-Marquardt on Eigen with the Schur
-/// complement on the 3x3 landmark blocks (dense reduced camera system, window <= ~20).
+/// complement on the 3x3 landmark blocks (a dense reduced camera system of 6 x keyframes:
+/// the local window, or every keyframe for the final BA, LocalBaOptions::final_window).
 ///
 /// Usage:
 ///   auto r = devslam::slam::localBundleAdjust(map, newest_kf, K, opts);
