@@ -14,6 +14,7 @@
 #include <iterator>
 #include <regex>
 #include <string>
+#include <vector>
 
 namespace fs = std::filesystem;
 using devslam::test::runApp;
@@ -23,6 +24,24 @@ int pngsIn(const std::string& dir) {
     int n = 0;
     for (const auto& e : fs::directory_iterator(dir)) n += e.path().extension() == ".png";
     return n;
+}
+/// A TUM folder `in` of `stamps.size()` frames, `side` x `side` px: grey 9 colour, depth
+/// 1 m (5000 in TUM's units), intrinsics f = 50 with the principal point in the middle.
+void writeUniformTum(const std::string& in, int side, const std::vector<const char*>& stamps) {
+    fs::create_directories(in + "/rgb");
+    fs::create_directories(in + "/depth");
+    std::ofstream(in + "/camera.ini")
+        << "[camera]\nfx = 50\nfy = 50\ncx = " << side / 2 << "\ncy = " << side / 2
+        << "\nwidth = " << side << "\nheight = " << side << "\ndist = [0 0 0 0 0]\n";
+    std::ofstream rgb(in + "/rgb.txt"), depth(in + "/depth.txt");
+    for (const char* t : stamps) {
+        ASSERT_TRUE(
+            cv::imwrite(in + "/rgb/" + t + ".png", cv::Mat(side, side, CV_8UC3, cv::Scalar(9))));
+        ASSERT_TRUE(cv::imwrite(in + "/depth/" + t + ".png",
+                                cv::Mat(side, side, CV_16UC1, cv::Scalar(5000))));
+        rgb << t << " rgb/" << t << ".png\n";
+        depth << t << " depth/" << t << ".png\n";
+    }
 }
 }  // namespace
 
@@ -91,20 +110,8 @@ TEST(DevslamOverlay, RunsOnTheShippedTumFramesThroughASlamIni) {
 TEST(DevslamOverlay, ATinyFrameGetsItsOverlay) {
     devslam::test::TempDir d("devslam_overlay_");
     const std::string in = d.str("tiny");
-    fs::create_directories(in + "/rgb");
-    fs::create_directories(in + "/depth");
-    std::ofstream(in + "/camera.ini") << "[camera]\nfx = 50\nfy = 50\ncx = 0\ncy = 0\nwidth = 1\n"
-                                         "height = 1\ndist = [0 0 0 0 0]\n";
-    std::ofstream rgb(in + "/rgb.txt"), depth(in + "/depth.txt");
-    for (const char* t : {"100.0", "100.1"}) {
-        ASSERT_TRUE(cv::imwrite(in + "/rgb/" + t + ".png", cv::Mat(1, 1, CV_8UC3, cv::Scalar(9))));
-        ASSERT_TRUE(
-            cv::imwrite(in + "/depth/" + t + ".png", cv::Mat(1, 1, CV_16UC1, cv::Scalar(5000))));
-        rgb << t << " rgb/" << t << ".png\n";
-        depth << t << " depth/" << t << ".png\n";
-    }
-    rgb.close();
-    depth.close();
+    writeUniformTum(in, 1, {"100.0", "100.1"});
+    ASSERT_FALSE(HasFatalFailure());
     const auto r = runApp("devslam-overlay", "--input " + in + " --mode none --out " + d.str("o"));
     ASSERT_EQ(r.rc, 0) << r.out;
     EXPECT_EQ(pngsIn(d.str("o")), 2);
@@ -117,20 +124,8 @@ TEST(DevslamOverlay, ATinyFrameGetsItsOverlay) {
 TEST(DevslamOverlay, AnUndecodableFrameSaysWhichOverlaysAreThisRuns) {
     devslam::test::TempDir d("devslam_overlay_");
     const std::string in = d.str("tum");
-    fs::create_directories(in + "/rgb");
-    fs::create_directories(in + "/depth");
-    std::ofstream(in + "/camera.ini") << "[camera]\nfx = 50\nfy = 50\ncx = 4\ncy = 4\nwidth = 8\n"
-                                         "height = 8\ndist = [0 0 0 0 0]\n";
-    std::ofstream rgb(in + "/rgb.txt"), depth(in + "/depth.txt");
-    for (const char* t : {"100.0", "100.1", "100.2"}) {
-        ASSERT_TRUE(cv::imwrite(in + "/rgb/" + t + ".png", cv::Mat(8, 8, CV_8UC3, cv::Scalar(9))));
-        ASSERT_TRUE(
-            cv::imwrite(in + "/depth/" + t + ".png", cv::Mat(8, 8, CV_16UC1, cv::Scalar(5000))));
-        rgb << t << " rgb/" << t << ".png\n";
-        depth << t << " depth/" << t << ".png\n";
-    }
-    rgb.close();
-    depth.close();
+    writeUniformTum(in, 8, {"100.0", "100.1", "100.2"});
+    ASSERT_FALSE(HasFatalFailure());
     const std::string args = "--input " + in + " --mode none --out " + d.str("o");
     auto r = runApp("devslam-overlay", args);
     ASSERT_EQ(r.rc, 0) << r.out;
