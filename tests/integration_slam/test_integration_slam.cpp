@@ -321,20 +321,30 @@ TEST(SlamIntegration, FramesHeldForRefinementStayBoundedWithoutLocalBa) {
     // refine_frames keeps a frame's observations while its keyframe is in the local-BA
     // window and releases them when it leaves: with local BA off too (they were kept to the
     // end of the run then). A keyframe every 3 frames: 12 keyframes on the 37 frames, the
-    // window 5 of them, so about 15 frames may be held at a time.
+    // window 5 of them, so about 15 frames may be held at a time. A final BA over 8
+    // keyframes (final_window) holds the frames of those 8, for its own refinement.
     const auto& seq = realSequence();
-    for (const bool ba : {true, false}) {
+    std::size_t held_window = 0;
+    for (const auto& [ba, final_window] : {std::pair{true, 0}, {false, 0}, {true, 8}}) {
+        SCOPED_TRACE("local BA " + std::to_string(ba) + ", final_window " +
+                     std::to_string(final_window));
         auto opts = options();
         opts.keyframes.max_frames = 3;
         opts.local_ba.enabled = ba;
+        opts.local_ba.final_window = final_window;
         slam::Slam* s = nullptr;
         const auto r = runSlam(seq.frames, opts, {}, &s);
         ASSERT_NE(s, nullptr);
-        EXPECT_TRUE(r.lost.empty()) << ba;
-        ASSERT_GE(r.keyframes, 10u) << ba;
-        const auto bound =
-            static_cast<std::size_t>(opts.local_ba.window * opts.keyframes.max_frames);
-        EXPECT_LE(s->framesHeldForRefinement(), bound) << "local BA " << ba;
-        EXPECT_GT(s->framesHeldForRefinement(), 0u) << "the newest frames are held";
+        EXPECT_TRUE(r.lost.empty());
+        ASSERT_GE(r.keyframes, 10u);
+        const auto bound = static_cast<std::size_t>(
+            std::max(opts.local_ba.window, final_window) * opts.keyframes.max_frames);
+        const std::size_t held = s->framesHeldForRefinement();
+        EXPECT_LE(held, bound);
+        EXPECT_GT(held, 0u) << "the newest frames are held";
+        if (ba && final_window == 0) held_window = held;
+        if (final_window > 0) {
+            EXPECT_GT(held, held_window) << "the final window's older frames are held too";
+        }
     }
 }

@@ -96,6 +96,30 @@ TEST(SlamSynthetic, MovingPersonNeverEntersTheMap) {
     EXPECT_LE(masked.ate, 0.01);
 }
 
+namespace {
+
+/// Each frame's pose in its reference keyframe (the newest keyframe at or before it).
+struct PoseInKeyframe {
+    double t = 0;
+    bool is_keyframe = false;
+    Eigen::Isometry3d T;
+};
+std::vector<PoseInKeyframe> posesInKeyframe(const slam::Slam& s) {
+    std::vector<PoseInKeyframe> out;
+    const auto& kfs = s.map().keyframes();
+    for (const auto& p : s.trajectory()) {
+        const slam::Keyframe* ref = nullptr;
+        for (const auto& [id, kf] : kfs)
+            if (kf.timestamp <= p.t) ref = &kf;
+        if (!ref) continue;
+        const Eigen::Isometry3d T_wc = core::toIsometry(p.pose);
+        out.push_back({p.t, ref->timestamp == p.t, ref->T_wc.inverse() * T_wc});
+    }
+    return out;
+}
+
+}  // namespace
+
 TEST(SlamSynthetic, AFinalWindowAdjustsTheOlderKeyframesAtTheEnd) {
     // [local_ba] final_window: the BA at the end of the run adjusts the newest N keyframes
     // (ORB-SLAM2's global BA) instead of the last local window. With 0 the keyframes older
@@ -118,6 +142,8 @@ TEST(SlamSynthetic, AFinalWindowAdjustsTheOlderKeyframesAtTheEnd) {
         ASSERT_GT(n_kf, opts.local_ba.window + 1) << "too few keyframes to tell the two apart";
         std::map<slam::KeyframeId, Eigen::Isometry3d> before;
         for (const auto& [id, kf] : s.map().keyframes()) before[id] = kf.T_wc;
+        const std::size_t held = s.framesHeldForRefinement();
+        const auto rel_before = posesInKeyframe(s);
         const double ate_before = eval::computeAte(r.gt, s.trajectory()).trans.rmse;
         const auto ba = s.finalize(r.frames.front().K);
         const double ate_after = eval::computeAte(r.gt, s.trajectory()).trans.rmse;
@@ -125,14 +151,31 @@ TEST(SlamSynthetic, AFinalWindowAdjustsTheOlderKeyframesAtTheEnd) {
         int older_moved = 0;
         for (const auto& [id, kf] : s.map().keyframes())
             if (id < window.front() && !kf.T_wc.isApprox(before.at(id), 1e-12)) ++older_moved;
+        // Frames (not keyframes) of the keyframes older than the window: re-refined against
+        // the final map only when their observations were held for it.
+        const auto rel_after = posesInKeyframe(s);
+        const double t_window = s.map().keyframe(window.front()).timestamp;
+        int older_frames = 0, older_frames_refined = 0;
+        for (std::size_t i = 0; i < rel_after.size(); ++i) {
+            if (rel_after[i].t >= t_window || rel_after[i].is_keyframe) continue;
+            ++older_frames;
+            if (!rel_after[i].T.isApprox(rel_before[i].T, 1e-12)) ++older_frames_refined;
+        }
+        ASSERT_GT(older_frames, 10);
         EXPECT_TRUE(s.map().keyframe(0).T_wc.isApprox(before.at(0)));  // the gauge
         EXPECT_FALSE(ba.rejected);
         if (final_window == 0) {
             EXPECT_EQ(ba.n_keyframes, opts.local_ba.window);
             EXPECT_EQ(older_moved, 0);
+            EXPECT_EQ(older_frames_refined, 0);
         } else {
             EXPECT_EQ(ba.n_keyframes, n_kf - 1);  // all but keyframe 0
             EXPECT_EQ(older_moved, n_kf - 1 - opts.local_ba.window);
+            // Every tracked frame since the first keyframe is held (r.frames.size() less
+            // the keyframes), and nearly all of them move (a frame whose optimum did not
+            // move by 1e-12 relative would stay).
+            EXPECT_EQ(held, r.frames.size() - static_cast<std::size_t>(n_kf));
+            EXPECT_GE(older_frames_refined, older_frames * 9 / 10);
         }
         std::printf("final_window %d: %d keyframes, %d adjusted; ATE %.5f -> %.5f m\n",
                     final_window, n_kf, ba.n_keyframes, ate_before, ate_after);

@@ -179,8 +179,11 @@ TrackResult Slam::track(const core::Frame& frame, const FrameFeatures& features,
         for (std::size_t i = 0; i < features.size(); ++i) {
             const LandmarkId lm = res.landmark_of_kp[i];
             if (lm == kNoId) continue;
-            rec.obs.emplace_back(
-                lm, observationOf(features, i, Eigen::Vector3d::Zero(), opts_.orb.scale_factor));
+            const auto o =
+                observationOf(features, i, Eigen::Vector3d::Zero(), opts_.orb.scale_factor);
+            rec.obs.push_back({lm, static_cast<float>(o.uv.x()), static_cast<float>(o.uv.y()),
+                               static_cast<float>(o.depth), static_cast<float>(o.inv_sigma2),
+                               static_cast<float>(o.weight)});
         }
     }
     records_.push_back(std::move(rec));
@@ -267,8 +270,10 @@ MappingResult Slam::mapStep(const core::Frame& frame, FrameFeatures features,
     // Without local BA nothing moved to refine against until finalize(), but the frames
     // whose keyframe left the window are released all the same (else a long run keeps
     // every frame's observations).
+    // With a final BA over more keyframes than the window, the frames of those keyframes
+    // stay held (not refined) until finalize() refines them against the final map.
     if (opts_.mapping.refine_frames)
-        refineFrames(map_.lastKeyframes(static_cast<std::size_t>(opts_.local_ba.window)), frame.K,
+        refineFrames(oldestOfNewest(opts_.local_ba.window), oldestOfNewest(heldWindow()), frame.K,
                      opts_.local_ba.enabled);
     // The tracker continues from the (possibly adjusted) keyframe pose.
     tracker_.applyCorrection(map_.keyframe(id).T_wc * track.T_wc.inverse());
@@ -307,32 +312,42 @@ int Slam::cullKeyframes(KeyframeId newest) {
     return culled;
 }
 
-void Slam::refineFrames(const std::vector<KeyframeId>& window, const core::CameraIntrinsics& K,
-                        bool adjust) {
-    if (window.empty()) return;
-    const KeyframeId oldest = window.front();
+int Slam::heldWindow() const {
+    const auto& ba = opts_.local_ba;
+    return ba.enabled && ba.final_window > 0 ? std::max(ba.window, ba.final_window) : ba.window;
+}
+
+KeyframeId Slam::oldestOfNewest(int n) const {
+    const auto kfs = map_.lastKeyframes(static_cast<std::size_t>(n));
+    return kfs.empty() ? kNoId : kfs.front();
+}
+
+void Slam::refineFrames(KeyframeId refine_from, KeyframeId keep_from,
+                        const core::CameraIntrinsics& K, bool adjust) {
+    if (keep_from == kNoId) return;
     bool release = true;
+    std::vector<PoseObservation> obs;
     for (std::size_t i = first_record_with_obs_; i < records_.size(); ++i) {
         FrameRecord& r = records_[i];
         if (r.obs.empty()) {
             if (release) first_record_with_obs_ = i + 1;
             continue;
         }
-        if (r.ref_kf < oldest) {  // the keyframe has left the window: final
+        if (r.ref_kf < keep_from) {  // the keyframe has left the window: final
             r.obs.clear();
             r.obs.shrink_to_fit();
             if (release) first_record_with_obs_ = i + 1;
             continue;
         }
         release = false;
-        if (!adjust || r.is_keyframe || !r.valid || r.ref_kf == kNoId) continue;
-        std::vector<PoseObservation> obs;
+        if (!adjust || r.ref_kf < refine_from || r.is_keyframe || !r.valid || r.ref_kf == kNoId)
+            continue;
+        obs.clear();
         obs.reserve(r.obs.size());
-        for (const auto& [lm, o] : r.obs) {
-            const Landmark* l = map_.landmark(lm);
+        for (const auto& h : r.obs) {
+            const Landmark* l = map_.landmark(h.lm);
             if (!l) continue;
-            obs.push_back(o);
-            obs.back().p_w = l->p_w;
+            obs.push_back({l->p_w, {h.u, h.v}, h.depth, h.inv_sigma2, h.weight});
         }
         if (static_cast<int>(obs.size()) < opts_.tracker.min_inliers) continue;
         const Eigen::Isometry3d T_wk = map_.keyframe(r.ref_kf).T_wc;
@@ -355,8 +370,12 @@ LocalBaResult Slam::finalize(const core::CameraIntrinsics& K) {
         if (o.final_window > 0) o.window = o.final_window;
         ba = localBundleAdjust(map_, last.front(), K, o);
     }
-    if (opts_.mapping.refine_frames)
-        refineFrames(map_.lastKeyframes(static_cast<std::size_t>(opts_.local_ba.window)), K);
+    // Every frame still held (mapStep: those of the final BA's keyframes too) against the
+    // final map.
+    if (opts_.mapping.refine_frames) {
+        const KeyframeId oldest = oldestOfNewest(heldWindow());
+        refineFrames(oldest, oldest, K);
+    }
     return ba;
 }
 

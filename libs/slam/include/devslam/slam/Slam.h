@@ -55,7 +55,10 @@ struct MappingOptions {
     /// the depth image has its own stamp (TUM: up to 20 ms apart; see depthStamp()).
     bool depth_time_compensation = true;
     /// After each local BA, re-refine the poses of the frames between the optimised
-    /// keyframes against the adjusted landmarks (frames get keyframe-like accuracy).
+    /// keyframes against the adjusted landmarks (frames get keyframe-like accuracy); with
+    /// LocalBaOptions::final_window, once more after the final BA for the frames of every
+    /// keyframe it adjusts (their inliers are held until then, 32 bytes each: +0.1-6 MB of
+    /// peak memory on the bench's 750-frame runs).
     bool refine_frames = true;
 
     void loadFromConfig(const mrpt::config::CConfigFileBase& cfg,
@@ -137,8 +140,8 @@ class Slam {
                                             const core::CameraIntrinsics& K);
     /// End of sequence: a last BA over the newest keyframes (LocalBaOptions::final_window
     /// of them, else the local window) and the re-refinement of the frames that reference
-    /// the last window's keyframes (see MappingOptions::refine_frames). Returns that BA's
-    /// result (empty when local BA is off or there is no keyframe).
+    /// those keyframes against the final map (see MappingOptions::refine_frames). Returns
+    /// that BA's result (empty when local BA is off or there is no keyframe).
     LocalBaResult finalize(const core::CameraIntrinsics& K);
     /// All stages for one frame.
     [[nodiscard]] FrameResult process(
@@ -172,26 +175,42 @@ class Slam {
     [[nodiscard]] std::vector<ClosedLoop> closedLoops() const;
     [[nodiscard]] const SlamOptions& options() const { return opts_; }
     /// Frames whose observations are still kept for refine_frames (those referencing a
-    /// keyframe in the local-BA window); bounded, whatever the sequence's length.
+    /// keyframe in the local-BA window, or in the final BA's when final_window is set);
+    /// bounded by the window in keyframes, whatever the sequence's length.
     [[nodiscard]] std::size_t framesHeldForRefinement() const;
 
   private:
+    /// A tracked inlier as a frame record holds it: 32 bytes where a PoseObservation with
+    /// its landmark id takes 80 (the point is the landmark's current one, looked up at
+    /// refinement; pixels are floats in cv::KeyPoint already).
+    struct HeldObservation {
+        LandmarkId lm = kNoId;
+        float u = 0, v = 0;  ///< [px]
+        float depth = 0;     ///< [m], 0 = none
+        float inv_sigma2 = 1, weight = 1;
+    };
     struct FrameRecord {
         double t = 0.0;
         KeyframeId ref_kf = kNoId;  ///< kNoId: pose is absolute (before the first keyframe)
         Eigen::Isometry3d T_ref_c = Eigen::Isometry3d::Identity();
         bool valid = false;
         bool is_keyframe = false;
-        /// Inlier observations kept while the reference keyframe is in the BA window, so
-        /// the frame can be re-refined against the adjusted map (then released).
-        std::vector<std::pair<LandmarkId, PoseObservation>> obs;
+        /// Inlier observations kept while the reference keyframe is in the BA window (or
+        /// in the final BA's, LocalBaOptions::final_window), so the frame can be
+        /// re-refined against the adjusted map (then released).
+        std::vector<HeldObservation> obs;
     };
     void applyCorrections(const std::map<std::int64_t, Eigen::Isometry3d>& new_poses);
-    /// Motion-only refinement of the non-keyframe frames whose reference keyframe is in
-    /// `window`, against the current landmark positions (only when `adjust`); releases the
-    /// observations of older frames.
-    void refineFrames(const std::vector<KeyframeId>& window, const core::CameraIntrinsics& K,
-                      bool adjust = true);
+    /// Motion-only refinement, against the current landmark positions, of the non-keyframe
+    /// frames whose reference keyframe is `refine_from` or newer (only when `adjust`);
+    /// the observations of frames older than `keep_from` are released.
+    void refineFrames(KeyframeId refine_from, KeyframeId keep_from,
+                      const core::CameraIntrinsics& K, bool adjust = true);
+    /// Keyframes whose frames keep their observations: the local-BA window, or the final
+    /// BA's when that is larger (the frames are refined once more after it).
+    [[nodiscard]] int heldWindow() const;
+    /// The oldest of the newest `n` keyframes (kNoId when the map has none).
+    [[nodiscard]] KeyframeId oldestOfNewest(int n) const;
     /// Removes the redundant keyframes of the local window before `newest` (see
     /// MappingOptions::redundant_keyframe_ratio); their frames move to the keyframe before.
     int cullKeyframes(KeyframeId newest);
