@@ -309,6 +309,7 @@ struct Args {
 std::optional<Args> parseArgs(int argc, char** argv) {
     Args a;
     a.bin = fs::absolute(argv[0]).parent_path().string();
+    devslam::core::refuseRepeatedOptions(argc, argv);
     for (int i = 1; i < argc; ++i) {
         const std::string k = argv[i];
         const auto value = [&] { return core::optionValue(argc, argv, i); };

@@ -72,6 +72,7 @@ struct Args {
 std::variant<Args, int> parseArgs(int argc, char** argv) {
     Args args;
     std::vector<std::string> pos;
+    devslam::core::refuseRepeatedOptions(argc, argv);
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
         auto value = [&] { return devslam::core::optionValue(argc, argv, i); };

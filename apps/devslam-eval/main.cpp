@@ -47,6 +47,7 @@ static int appMain(int argc, char** argv) {
         devslam::eval::RpeOptions ro;
         std::string json, plot, title;
         bool rpe = true;
+        devslam::core::refuseRepeatedOptions(argc, argv);
         for (int i = 1; i < argc; ++i) {
             const std::string a = argv[i];
             auto value = [&] { return devslam::core::optionValue(argc, argv, i); };

@@ -137,6 +137,7 @@ struct Args {
 /// --help, 2 for a bad argument, said on stderr).
 std::optional<int> parseArgs(int argc, char** argv, Args& a) {
     try {
+        devslam::core::refuseRepeatedOptions(argc, argv);
         for (int i = 1; i < argc; ++i) {
             const std::string k = argv[i];
             const auto value = [&] { return devslam::core::optionValue(argc, argv, i); };

@@ -175,6 +175,7 @@ void writeChart(const std::string& path, const std::vector<devslam::sim::Categor
 std::optional<int> parseArgs(int argc, char** argv, Args& a) {
     bool results_given = false, per_category_given = false, png_dir_given = false;
     try {
+        devslam::core::refuseRepeatedOptions(argc, argv);
         for (int i = 1; i < argc; i++) {
             const std::string s = argv[i];
             auto next = [&] { return devslam::core::optionValue(argc, argv, i); };

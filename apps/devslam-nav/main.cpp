@@ -119,6 +119,7 @@ static int appMain(int argc, char** argv) {
     std::string config = std::string(DEVSLAM_SOURCE_DIR) + "/config_ini/nav_reactive.ini";
     std::string method;  // empty: the INI's [navigator] holonomic_method
     bool verbose = false;
+    devslam::core::refuseRepeatedOptions(argc, argv);
     for (int i = 1; i < argc; i++) {
         const std::string a = argv[i];
         auto next = [&] { return devslam::core::optionValue(argc, argv, i); };

@@ -67,6 +67,7 @@ struct Args {
 Args parse(int argc, char** argv) {
     Args a;
     auto value = [&](int& i) { return core::optionValue(argc, argv, i); };
+    devslam::core::refuseRepeatedOptions(argc, argv, {"--set"});
     for (int i = 1; i < argc; ++i) {
         const std::string k = argv[i];
         if (k == "--input")

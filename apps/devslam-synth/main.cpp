@@ -128,6 +128,7 @@ int run(int argc, char** argv) {
     }
     if (a[0] == "--cut-texture") return cutTexture(a);
 
+    devslam::core::refuseRepeatedOptions(a, {"--set"}, {{"-o", "--out"}});
     std::string scenario_arg, out_dir, rawlog;
     std::size_t frames = 0;
     std::optional<std::uint64_t> seed;

@@ -273,6 +273,35 @@ TEST(Parse, AnOptionsValueIsNotTheNextOption) {
     EXPECT_EQ(invalidArgument([&] { (void)optionValue(args, i); }), "x.png needs a value");
 }
 
+TEST(Parse, AnOptionGivenTwiceIsRefused) {
+    // A parser kept the last of two --out without a word: the first run's folder was not
+    // written, and nothing said so.
+    EXPECT_NO_THROW(refuseRepeatedOptions(
+        std::vector<std::string>{"--set", "a.b=1", "--set", "a.c=2", "--out", "x", "-1,2"},
+        {"--set"}));
+    EXPECT_EQ(invalidArgument([] {
+                  refuseRepeatedOptions(std::vector<std::string>{"--out", "x", "--quiet", "--out",
+                                                                 "y"});
+              }),
+              "--out is given twice (give it once: the last one would replace the first)");
+    EXPECT_EQ(invalidArgument([] {
+                  refuseRepeatedOptions(std::vector<std::string>{"-o", "x", "--out", "y"}, {},
+                                        {{"-o", "--out"}});
+              }).substr(0, 20),
+              "--out is given twice");
+    // Flags too; --help and one-dash words (values, negative numbers) are not counted.
+    EXPECT_NE(invalidArgument([] {
+                  refuseRepeatedOptions(std::vector<std::string>{"--quiet", "--quiet"});
+              }),
+              "");
+    EXPECT_NO_THROW(refuseRepeatedOptions(
+        std::vector<std::string>{"--help", "--help", "-1", "-1", "pos", "pos"}));
+    // main's argv: argv[0], the program, is not an option.
+    char prog[] = "--out", a1[] = "--out", a2[] = "x";
+    char* argv[] = {prog, a1, a2};
+    EXPECT_NO_THROW(refuseRepeatedOptions(3, argv));
+}
+
 TEST(Parse, NumberListsNameTheBadToken) {
     EXPECT_EQ(parseNumberList("[1 2.5, -3]", "x"), (std::vector<double>{1, 2.5, -3}));
     EXPECT_TRUE(parseNumberList("  ", "x").empty());

@@ -299,6 +299,33 @@ TEST(Apps, AnOptionsValueIsNotTheNextOption) {
     EXPECT_FALSE(fs::exists("x.rawlog"));
 }
 
+// An option given twice kept its last value without a word ("--out a ... --out b" wrote
+// only b): every app refuses it before any work, --set (a list) excepted.
+TEST(Apps, AnOptionGivenTwiceIsRefused) {
+    const std::string fr1 = std::string(DEVSLAM_SOURCE_DIR) + "/data/tum/fr1_xyz_first37";
+    const std::string world = std::string(DEVSLAM_SOURCE_DIR) + "/sim_worlds/paper_fig6.ini";
+    const std::string twice = " is given twice";
+    for (const auto& [app, args, option] :
+         std::vector<std::tuple<std::string, std::string, std::string>>{
+             {"devslam-run", "--input " + fr1 + " --out twice_a --quiet --out twice_b", "--out"},
+             {"devslam-synth", "short_walking -o twice_a --out twice_b", "--out"},
+             {"devslam-overlay", "--input synthetic:walking --frames 2 --frames 3 --out twice_a",
+              "--frames"},
+             {"devslam-convert", "--max-frames 2 --max-frames 3 " + fr1 + " twice.rawlog",
+              "--max-frames"},
+             {"devslam-eval", "--no-rpe --no-rpe a.txt b.txt", "--no-rpe"},
+             {"devslam-bench", "--repeats 1 --repeats 2", "--repeats"},
+             {"devslam-filter-bench", "--threads 1 --threads 2", "--threads"},
+             {"devslam-nav", world + " --method CHolonomicVFF --method CHolonomicND", "--method"},
+             {"devslam-nav-bench", "--quick --quick", "--quick"}}) {
+        const auto r = devslam::test::runApp(app, args);
+        EXPECT_NE(r.rc, 0) << app << " " << args << "\n" << r.out;
+        EXPECT_NE(r.out.find(option + twice), std::string::npos) << app << " " << args << "\n"
+                                                                   << r.out;
+    }
+    for (const char* made : {"twice_a", "twice_b", "twice.rawlog"}) EXPECT_FALSE(fs::exists(made));
+}
+
 // A rawlog cut short (a recording that crashed): refused with how much is intact, and run
 // on that part with --allow-damaged, which says what was left out.
 // TUM -> rawlog keeps the images bit-exact, but a rawlog has one stamp per frame and no ground

@@ -5,6 +5,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 
@@ -149,6 +150,30 @@ std::string optionValue(int argc, char** argv, int& i) {
     if (i + 1 >= argc || anOption(argv[i + 1]))
         throw std::invalid_argument(std::string(argv[i]) + " needs a value");
     return argv[++i];
+}
+
+void refuseRepeatedOptions(const std::vector<std::string>& args,
+                           const std::vector<std::string>& repeatable,
+                           const std::vector<std::pair<std::string, std::string>>& aliases) {
+    std::set<std::string> seen;
+    for (const auto& word : args) {
+        std::string option = word;
+        for (const auto& [alias, name] : aliases)
+            if (word == alias) option = name;
+        if (!anOption(option) || option == "--help" ||
+            std::find(repeatable.begin(), repeatable.end(), option) != repeatable.end())
+            continue;
+        if (!seen.insert(option).second)
+            throw std::invalid_argument(option +
+                                        " is given twice (give it once: the last one would "
+                                        "replace the first)");
+    }
+}
+
+void refuseRepeatedOptions(int argc, char** argv, const std::vector<std::string>& repeatable,
+                           const std::vector<std::pair<std::string, std::string>>& aliases) {
+    refuseRepeatedOptions(std::vector<std::string>(argv + std::min(argc, 1), argv + argc),
+                          repeatable, aliases);
 }
 
 }  // namespace devslam::core

@@ -12,6 +12,7 @@
 #include <cstddef>
 #include <limits>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace devslam::core {
@@ -64,5 +65,16 @@ namespace devslam::core {
 [[nodiscard]] std::string optionValue(const std::vector<std::string>& args, std::size_t& i);
 /// The same for main's argc/argv.
 [[nodiscard]] std::string optionValue(int argc, char** argv, int& i);
+
+/// Throws std::invalid_argument "<option> is given twice ..." when an option of `args`
+/// (a word with two dashes: optionValue takes no such word as a value) appears more than
+/// once, except those in `repeatable` and --help; a parser kept the last value without a
+/// word. `aliases` maps a short spelling to its option ("-o" -> "--out").
+void refuseRepeatedOptions(const std::vector<std::string>& args,
+                           const std::vector<std::string>& repeatable = {},
+                           const std::vector<std::pair<std::string, std::string>>& aliases = {});
+/// The same for main's argc/argv (argv[0] is the program).
+void refuseRepeatedOptions(int argc, char** argv, const std::vector<std::string>& repeatable = {},
+                           const std::vector<std::pair<std::string, std::string>>& aliases = {});
 
 }  // namespace devslam::core
