@@ -513,9 +513,12 @@ TEST(RenderSequence, ARawlogItCannotOrMayNotWriteLeavesTheEarlierRenderAsItWas) 
                       "'" + path + "' is not a file: the render writes its " + name +
                           " there; move it or name another folder");
         EXPECT_TRUE(fs::is_directory(path + "/x")) << name;
-        if (std::string(name) != "rgb.txt") EXPECT_EQ(readFile(o.out_dir + "/rgb.txt"), list);
-        if (std::string(name) != "groundtruth.txt")
+        if (std::string(name) != "rgb.txt") {
+            EXPECT_EQ(readFile(o.out_dir + "/rgb.txt"), list);
+        }
+        if (std::string(name) != "groundtruth.txt") {
             EXPECT_EQ(readFile(o.out_dir + "/groundtruth.txt"), gt);
+        }
         fs::remove_all(path);
         if (fs::exists(aside)) fs::rename(aside, path);
     }
@@ -987,6 +990,16 @@ TEST(Scenario, ShippedFilesLoadAndTyposAreReported) {
     expectRoomMessage(  // a box without a name (was accepted; [person_] was refused)
         [](std::string& r) { r.replace(r.find("[box_crate]\n"), 12, "[box_]\n"); },
         tmp.str("bad_room.ini") + " [box_]: a box's section needs a name after 'box_'");
+    // A file that is no image was named only by the renderer, at the first frame, without
+    // the key that listed it.
+    std::ofstream(tmp.str("not_a_photo.png")) << "text, not a PNG\n";
+    expectRoomMessage(
+        [&](std::string& r) {
+            const auto at = r.find("floor_textures");
+            r.replace(at, r.find('\n', at) - at, "floor_textures = " + tmp.str("not_a_photo.png"));
+        },
+        tmp.str("bad_room.ini") + " [room] floor_textures: '" + tmp.str("not_a_photo.png") +
+            "' is not an image OpenCV can read");
     expectRoomMessage(  // a mistyped section is not ignored
         [](std::string& r) { r.replace(r.find("[room]\n"), 7, "[rooom]\n"); },
         tmp.str("bad_room.ini") + ": unknown section [rooom] (known: room, box_*)");
@@ -1016,7 +1029,21 @@ TEST(Scenario, ShippedFilesLoadAndTyposAreReported) {
     expectMessage([&] { (void)loadScenario(base, {"depth_noise.sigma_b=-1"}); },
                   tmp.str("s.ini") + " [depth_noise] sigma_b: must be >= 0");
     expectMessage([&] { (void)loadScenario(base, {"trajectory.elevation_period=0"}); },
-                  tmp.str("s.ini") + " [trajectory] elevation_period: must be > 0 [s]");
+                  tmp.str("s.ini") + " [trajectory] elevation_period: must be in [0.1, 1e5] [s]");
+    // Bounds (fuzz): values no camera or sensor comes near, which rendered nonsense silently.
+    expectMessage([&] { (void)loadScenario(base, {"trajectory.period=[7 9 1e-300]"}); },
+                  tmp.str("s.ini") + " [trajectory] period: must be in [0.1, 1e5] [s]");
+    expectMessage([&] { (void)loadScenario(base, {"trajectory.rot_period=[5 1e300 8]"}); },
+                  "[trajectory] rot_period: must be in [0.1, 1e5] [s]");
+    expectMessage([&] { (void)loadScenario(base, {"trajectory.rot_amplitude_deg=[1 1 1e6]"}); },
+                  "[trajectory] rot_amplitude_deg: must be in [-90, 90] [deg]");
+    expectMessage([&] { (void)loadScenario(base, {"trajectory.azimuth_amplitude_deg=400"}); },
+                  "[trajectory] azimuth_amplitude_deg: must be in [-180, 180] [deg]");
+    expectMessage([&] { (void)loadScenario(base, {"scenario.rgb_noise_sigma=1e300"}); },
+                  tmp.str("s.ini") + " [scenario] rgb_noise_sigma: must be in [0, 255]");
+    EXPECT_NO_THROW((void)loadScenario(
+        base, {"trajectory.period=[0.1 1e5 11]", "trajectory.rot_amplitude_deg=[-90 90 0]",
+               "scenario.rgb_noise_sigma=255"}));
     // A key given with no value is refused, not read as the built-in default (look_at = took
     // [4 2.5 1.0] over the file's value, name = wrote into out/synth/ itself).
     expectMessage([&] { (void)loadScenario(base, {"trajectory.look_at="}); },

@@ -121,12 +121,22 @@ void TrajectoryOptions::loadFromConfig(const mrpt::config::CConfigFileBase& cfg,
         core::readDouble(cfg, s, "elevation_amplitude_deg", elevation_amplitude_deg);
     azimuth_period = core::readDouble(cfg, s, "azimuth_period", azimuth_period);
     elevation_period = core::readDouble(cfg, s, "elevation_period", elevation_period);
+    // Bounds no camera comes near (the shipped scenes: 2 deg, 5-20 s), so that a typo fails
+    // here: a period of 1e-300 s sampled its sine at random, a rotation of 1e6 deg spun the
+    // view from frame to frame, both without a word. (An amplitude that takes the camera
+    // out of the room is refused by loadScenario, which checks every frame's position.)
+    const auto period_ok = [](double p) { return p >= 0.1 && p <= 1e5; };
+    const std::string period_msg = "must be in [0.1, 1e5] [s]";
     for (int i = 0; i < 3; ++i) {
-        core::requireValue(period[i] > 0, s, "period", "must be > 0 [s]");
-        core::requireValue(rot_period[i] > 0, s, "rot_period", "must be > 0 [s]");
+        core::requireValue(period_ok(period[i]), s, "period", period_msg);
+        core::requireValue(period_ok(rot_period[i]), s, "rot_period", period_msg);
+        core::requireValue(std::abs(rot_amplitude_deg[i]) <= 90.0, s, "rot_amplitude_deg",
+                           "must be in [-90, 90] [deg]");
     }
-    core::requireValue(azimuth_period > 0, s, "azimuth_period", "must be > 0 [s]");
-    core::requireValue(elevation_period > 0, s, "elevation_period", "must be > 0 [s]");
+    core::requireValue(period_ok(azimuth_period), s, "azimuth_period", period_msg);
+    core::requireValue(period_ok(elevation_period), s, "elevation_period", period_msg);
+    core::requireValue(std::abs(azimuth_amplitude_deg) <= 180.0, s, "azimuth_amplitude_deg",
+                       "must be in [-180, 180] [deg]");
     core::requireValue((look_at - position).norm() > 1e-3, s, "look_at",
                        "must differ from position");
     // lookAtPose levels the camera's roll on the horizontal: a vertical view has none.

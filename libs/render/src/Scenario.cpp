@@ -3,6 +3,7 @@
 #include <devslam/render/Scenario.h>
 
 #include <mrpt/config/CConfigFileBase.h>
+#include <opencv2/imgcodecs.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -56,6 +57,12 @@ std::vector<std::string> resolveImages(const std::string& list, const std::strin
             throw std::runtime_error(what + ": no such file or folder '" + p.string() + "'");
         }
     }
+    // Checked here, where the key is known (the renderer, which reads them at the first
+    // frame, could name only the file): OpenCV must have a decoder for each one's bytes.
+    for (const auto& f : out)
+        if (!cv::haveImageReader(f))
+            throw std::runtime_error(what + ": '" + f +
+                                     "' is not an image OpenCV can read (or cannot be opened)");
     return out;
 }
 
@@ -293,7 +300,9 @@ Scenario readScenario(const std::string& path, const std::vector<std::string>& o
     core::requireValue(filter == "linear" || filter == "nearest", s, "texture_filter",
                        "must be linear or nearest, got '" + filter + "'");
     sc.texture_linear = filter == "linear";
-    core::requireValue(sc.rgb_noise_sigma >= 0, "scenario", "rgb_noise_sigma", "must be >= 0");
+    // (1e300 became an infinite float std: frames of saturated noise, without a word.)
+    core::requireValue(sc.rgb_noise_sigma >= 0 && sc.rgb_noise_sigma <= 255, "scenario",
+                       "rgb_noise_sigma", "must be in [0, 255] [grey levels]");
     core::requireValue(sc.near_clip > 0 && sc.far_clip > sc.near_clip, "scenario", "far_clip",
                        "need 0 < near_clip < far_clip [m]");
     // The depth read back from GL loses precision as near_clip shrinks (0.001 m: depth 4 cm
