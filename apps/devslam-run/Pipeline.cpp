@@ -230,8 +230,13 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
             const auto t_score = Clock::now();
             const double cpu_score = processCpuMs();
             try {
+                const double px0 = rep.mask_score->moving_px,
+                             masked0 = rep.mask_score->moving_px_masked;
                 truth->score(ms.mask, cur->timestamp, rc.min_person_pixels, *rep.mask_score,
                              ms.boxes);
+                fl.walker_px = rep.mask_score->moving_px - px0;
+                fl.walker_px_unmasked =
+                    fl.walker_px - (rep.mask_score->moving_px_masked - masked0);
             } catch (const eval::MissingTruth& e) {
                 // No person truth for this frame: this frame is the last (its SLAM step runs,
                 // its mask is unscored), and the frames done are kept.
@@ -670,7 +675,11 @@ std::string toJson(const RunReport& r) {
         const auto& l = r.log[i];
         o << (i ? ",\n    " : "\n    ") << "{\"index\": " << l.index << ", \"t\": " << num(l.t, 6)
           << ", \"state\": \"" << l.state << "\", \"features\": " << l.n_features
-          << ", \"masked\": " << l.n_masked << ", \"masked_area\": " << num(l.masked_fraction, 3)
+          << ", \"masked\": " << l.n_masked << ", \"masked_area\": " << num(l.masked_fraction, 3);
+        if (l.walker_px >= 0)
+            o << ", \"walker_px\": " << num(l.walker_px, 0)
+              << ", \"walker_px_unmasked\": " << num(l.walker_px_unmasked, 0);
+        o
           << ", \"inliers\": " << l.n_inliers << ", \"boxes\": " << l.n_boxes
           << ", \"moving\": " << l.n_moving << ", \"keyframe\": " << (l.keyframe ? "true" : "false")
           << ", \"keyframe_reason\": \"" << l.keyframe_reason << "\""

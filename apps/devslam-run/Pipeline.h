@@ -50,6 +50,10 @@ struct FrameLog {
     std::string state, keyframe_reason;
     int n_features = 0, n_masked = 0, n_inliers = 0, n_boxes = 0, n_moving = 0;
     double masked_fraction = 0;  ///< of the image, by the dynamic mask
+    /// With the renderer's person truth: the walking people's visible pixels in the frame and
+    /// those the mask left open (-1: no truth). A walker partly outside its box shows here,
+    /// not in the per-person recall, which counts them masked from half their area.
+    double walker_px = -1, walker_px_unmasked = 0;
     bool keyframe = false, loop = false;
     bool ba_rejected = false;  ///< the keyframe's local BA was not applied (max_keyframe_shift)
     FrameTiming ms;      ///< per stage (detect/filter overlap the SLAM when async)

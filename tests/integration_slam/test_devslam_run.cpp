@@ -812,3 +812,47 @@ TEST(DevslamRun, MissingPersonTruthStopsTheRunAndKeepsTheFramesDone) {
     }
     fs::remove_all(dir);
 }
+
+// Per frame, with the renderer's truth: the walking people's visible pixels and those the
+// mask left open (per_frame walker_px, walker_px_unmasked). The per-person recall counts a
+// walker masked from half their area, so a walker partly outside a carried box (one coming
+// out from behind another) showed nowhere. No mask leaves every walker pixel open; the
+// renderer's own walker mask leaves none.
+TEST(DevslamRun, PerFrameWalkerPixelsLeftUnmasked) {
+    const fs::path dir = devslam::test::scratchPath("devslam_run_walker_px");
+    fs::remove_all(dir);
+    const fs::path seq = dir / "seq";
+    const std::string synth = std::string(DEVSLAM_BIN_DIR) + "/devslam-synth short_walking -o '" +
+                              seq.string() + "' --frames 6 > /dev/null 2>&1";
+    ASSERT_EQ(std::system(synth.c_str()), 0) << synth;
+    const std::regex entry(R"re("walker_px": (\d+), "walker_px_unmasked": (-?\d+))re");
+    for (const std::string mode : {"none", "truth"}) {
+        const fs::path out = dir / ("run_" + mode);
+        const auto r =
+            run("--input '" + seq.string() + "' --config " + DEVSLAM_SOURCE_DIR +
+                "/config_ini/slam_synthetic.ini --mode " + mode + " --quiet --out " + out.string());
+        ASSERT_EQ(r.rc, 0) << r.out;
+        std::ifstream js(out / "run.json");
+        const std::string json((std::istreambuf_iterator<char>(js)),
+                               std::istreambuf_iterator<char>());
+        int frames = 0;
+        double walker = 0, unmasked = 0;
+        for (std::sregex_iterator it(json.begin(), json.end(), entry), end; it != end; ++it) {
+            ++frames;
+            const double w = std::stod((*it)[1]), u = std::stod((*it)[2]);
+            EXPECT_GE(u, 0) << mode;
+            EXPECT_LE(u, w) << mode;
+            if (mode == "none") {
+                EXPECT_EQ(u, w);
+            }
+            walker += w;
+            unmasked += u;
+        }
+        EXPECT_EQ(frames, 6) << mode;
+        EXPECT_GT(walker, 1000) << mode << ": short_walking's walker is in view";
+        if (mode == "truth") {
+            EXPECT_EQ(unmasked, 0);
+        }
+    }
+    fs::remove_all(dir);
+}
