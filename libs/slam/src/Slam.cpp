@@ -333,7 +333,7 @@ void Slam::refineFrames(KeyframeId refine_from, KeyframeId keep_from,
             if (release) first_record_with_obs_ = i + 1;
             continue;
         }
-        if (r.ref_kf < keep_from) {  // the keyframe has left the window: final
+        if (r.ref_kf < keep_from) {  // the keyframe has left the held window: final
             r.obs.clear();
             r.obs.shrink_to_fit();
             if (release) first_record_with_obs_ = i + 1;
