@@ -17,11 +17,13 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <iterator>
 #include <memory>
 #include <regex>
 #include <sstream>
 #include <string>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 namespace fs = std::filesystem;
@@ -37,6 +39,24 @@ std::size_t lines(const fs::path& p) {
     while (std::getline(in, l))
         if (!l.empty() && l[0] != '#') ++n;
     return n;
+}
+/// Renders `frames` frames of short_walking into `seq` (with the person truth); the command,
+/// for the failure message, and its status.
+std::pair<std::string, int> renderShortWalking(const fs::path& seq, int frames) {
+    const std::string cmd = std::string(DEVSLAM_BIN_DIR) + "/devslam-synth short_walking -o '" +
+                            seq.string() + "' --frames " + std::to_string(frames) +
+                            " > /dev/null 2>&1";
+    return {cmd, std::system(cmd.c_str())};
+}
+/// devslam-run on a rendered folder with slam_synthetic.ini, in `mode`, into `out`.
+devslam::test::CommandResult runSynthetic(const fs::path& seq, const std::string& mode,
+                                          const fs::path& out) {
+    return run("--input '" + seq.string() + "' --config " + DEVSLAM_SOURCE_DIR +
+               "/config_ini/slam_synthetic.ini --mode " + mode + " --quiet --out " + out.string());
+}
+std::string readText(const fs::path& p) {
+    std::ifstream in(p);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
 }
 }  // namespace
 
@@ -769,9 +789,8 @@ TEST(DevslamRun, MissingPersonTruthStopsTheRunAndKeepsTheFramesDone) {
     const fs::path dir = devslam::test::scratchPath("devslam_run_no_truth");
     fs::remove_all(dir);
     const fs::path seq = dir / "se\tq";
-    const std::string synth = std::string(DEVSLAM_BIN_DIR) + "/devslam-synth short_walking -o '" +
-                              seq.string() + "' --frames 8 > /dev/null 2>&1";
-    ASSERT_EQ(std::system(synth.c_str()), 0) << synth;
+    const auto [synth, synth_rc] = renderShortWalking(seq, 8);
+    ASSERT_EQ(synth_rc, 0) << synth;
     std::ifstream list(seq / "rgb.txt");
     std::string line, stamp;
     for (int k = 0; k <= 5 && std::getline(list, line);)
@@ -792,9 +811,7 @@ TEST(DevslamRun, MissingPersonTruthStopsTheRunAndKeepsTheFramesDone) {
 
     for (const auto& [mode, frames] : {std::pair{"none", 6u}, {"truth", 5u}}) {
         const fs::path out = dir / (std::string("run_") + mode);
-        const auto r =
-            run("--input '" + seq.string() + "' --config " + DEVSLAM_SOURCE_DIR +
-                "/config_ini/slam_synthetic.ini --mode " + mode + " --quiet --out " + out.string());
+        const auto r = runSynthetic(seq, mode, out);
         EXPECT_EQ(r.rc, 1) << r.out;
         EXPECT_NE(r.out.find("persons.txt: no entry for frame " + stamp), std::string::npos)
             << r.out;
@@ -803,9 +820,7 @@ TEST(DevslamRun, MissingPersonTruthStopsTheRunAndKeepsTheFramesDone) {
                   std::string::npos)
             << r.out;
         EXPECT_EQ(lines(out / "trajectory.txt"), frames) << mode;
-        std::ifstream js(out / "run.json");
-        const std::string json((std::istreambuf_iterator<char>(js)),
-                               std::istreambuf_iterator<char>());
+        const std::string json = readText(out / "run.json");
         EXPECT_NE(json.find("\"input\": \"" + dir.string() + "/se\\u0009q\""), std::string::npos)
             << json.substr(0, 300);
         EXPECT_EQ(json.find('\t'), std::string::npos);
@@ -822,19 +837,14 @@ TEST(DevslamRun, PerFrameWalkerPixelsLeftUnmasked) {
     const fs::path dir = devslam::test::scratchPath("devslam_run_walker_px");
     fs::remove_all(dir);
     const fs::path seq = dir / "seq";
-    const std::string synth = std::string(DEVSLAM_BIN_DIR) + "/devslam-synth short_walking -o '" +
-                              seq.string() + "' --frames 6 > /dev/null 2>&1";
-    ASSERT_EQ(std::system(synth.c_str()), 0) << synth;
+    const auto [synth, synth_rc] = renderShortWalking(seq, 6);
+    ASSERT_EQ(synth_rc, 0) << synth;
     const std::regex entry(R"re("walker_px": (\d+), "walker_px_unmasked": (-?\d+))re");
     for (const std::string mode : {"none", "truth"}) {
         const fs::path out = dir / ("run_" + mode);
-        const auto r =
-            run("--input '" + seq.string() + "' --config " + DEVSLAM_SOURCE_DIR +
-                "/config_ini/slam_synthetic.ini --mode " + mode + " --quiet --out " + out.string());
+        const auto r = runSynthetic(seq, mode, out);
         ASSERT_EQ(r.rc, 0) << r.out;
-        std::ifstream js(out / "run.json");
-        const std::string json((std::istreambuf_iterator<char>(js)),
-                               std::istreambuf_iterator<char>());
+        const std::string json = readText(out / "run.json");
         int frames = 0;
         double walker = 0, unmasked = 0;
         for (std::sregex_iterator it(json.begin(), json.end(), entry), end; it != end; ++it) {
