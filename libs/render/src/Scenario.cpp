@@ -14,6 +14,14 @@
 namespace devslam::render {
 namespace fs = std::filesystem;
 namespace {
+
+/// "the room (0..X x 0..Y x 0..Z m)", for the errors that place something outside it.
+std::string roomExtent(const Eigen::Vector3d& R) {
+    std::ostringstream m;
+    m << "the room (0.." << R.x() << " x 0.." << R.y() << " x 0.." << R.z() << " m)";
+    return m.str();
+}
+
 /// A key that must be given: "[section] key: missing" (MRPT's own required read throws
 /// a stack trace that names neither).
 std::string requiredText(const mrpt::config::CConfigFileBase& c, const std::string& section,
@@ -152,8 +160,8 @@ void readRoom(const std::string& path, RoomSpec& room) {
             const auto& R = room.size;
             const auto& p = box.base;
             std::ostringstream m;
-            m << "(" << p.x() << ", " << p.y() << ", " << p.z() << ") lies outside the room (0.."
-              << R.x() << " x 0.." << R.y() << " x 0.." << R.z() << " m)";
+            m << "(" << p.x() << ", " << p.y() << ", " << p.z() << ") lies outside "
+              << roomExtent(R);
             core::requireValue(p.x() > 0 && p.x() < R.x() && p.y() > 0 && p.y() < R.y() &&
                                    p.z() >= 0 && p.z() < R.z(),
                                b, "base", m.str());
@@ -392,8 +400,7 @@ Scenario readScenario(const std::string& path, const std::vector<std::string>& o
         if (inRoom(T.x(), T.y()) && T.z() > 0 && T.z() < R.z()) continue;
         std::ostringstream m;
         m << "the camera at t = " << sc.elapsed(i) << " s is at (" << T.x() << ", " << T.y() << ", "
-          << T.z() << "), outside the room (0.." << R.x() << " x 0.." << R.y() << " x 0.." << R.z()
-          << " m)";
+          << T.z() << "), outside " << roomExtent(R);
         core::requireValue(false, "trajectory", "position", m.str());
     }
 
