@@ -340,8 +340,8 @@ void Slam::refineFrames(KeyframeId refine_from, KeyframeId keep_from,
             continue;
         }
         release = false;
-        if (!adjust || r.ref_kf < refine_from || r.is_keyframe || !r.valid || r.ref_kf == kNoId)
-            continue;
+        // (a frame before the first keyframe, ref_kf kNoId, was released above)
+        if (!adjust || r.ref_kf < refine_from || r.is_keyframe || !r.valid) continue;
         obs.clear();
         obs.reserve(r.obs.size());
         for (const auto& h : r.obs) {
