@@ -1290,6 +1290,26 @@ TEST(DynamicFilter, SilhouetteGrowsBeyondTheBoxOnlyThroughThePerson) {
     EXPECT_EQ(cv::countNonZero(grown), person.area()) << "nothing of the wall";
 }
 
+TEST(DynamicFilter, SilhouetteDepthSlopeNarrowsAFarPersonsBand) {
+    // A person 3 m away; in their box, beside them, a cabinet 0.3 m farther (the wall is
+    // 4 m away). At the default slope the band is 0.1 m + 10 % of 3 m = 0.4 m, and the
+    // cabinet is masked with the person; at 0.03 it is 0.19 m, and only the person is.
+    const cv::Rect person(260, 100, 120, 300), cabinet(200, 200, 55, 200);
+    core::Frame f = wallWithNearRegions({});
+    f.depth(person).setTo(3.f);
+    f.depth(cabinet).setTo(3.3f);
+    const cv::Rect2f box(200.f, 100.f, 240.f, 300.f);
+    const auto masks = [&](double slope) {
+        return silhouetteMask(f, box, [&](auto& fo) { fo.silhouette_depth_slope = slope; });
+    };
+    const cv::Mat wide = masks(0.1), narrow = masks(0.03);
+    EXPECT_EQ(maskedFraction(wide, person), 1.0);
+    EXPECT_EQ(maskedFraction(wide, cabinet), 1.0) << "0.3 m behind is inside a 0.4 m band";
+    EXPECT_EQ(maskedFraction(narrow, person), 1.0) << "the narrow band still covers the person";
+    EXPECT_EQ(maskedFraction(narrow, cabinet), 0.0) << "and leaves the cabinet";
+    EXPECT_EQ(cv::countNonZero(narrow), person.area()) << "nothing of the wall";
+}
+
 TEST(DynamicFilter, BorderSnapLetsTheSilhouetteReachTheBorder) {
     // A person cut by the left border, 2 m away in front of a wall 4 m away, whose box stops
     // 30 px short of the border; a bag at the person's depth lies by the border below them,

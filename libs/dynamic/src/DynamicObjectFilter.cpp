@@ -64,6 +64,7 @@ const std::vector<std::string> kKeys{"mode",
                                      "mask_silhouette",
                                      "silhouette_depth_band",
                                      "silhouette_grow",
+                                     "silhouette_depth_slope",
                                      "slow_frames",
                                      "slow_threshold",
                                      "slow_speed",
@@ -206,6 +207,8 @@ void DynamicObjectFilter::Options::loadFromConfig(const mrpt::config::CConfigFil
     mask_silhouette = core::readBool(c, s, "mask_silhouette", mask_silhouette);
     silhouette_depth_band = core::readDouble(c, s, "silhouette_depth_band", silhouette_depth_band);
     silhouette_grow = core::readDouble(c, s, "silhouette_grow", silhouette_grow);
+    silhouette_depth_slope =
+        core::readDouble(c, s, "silhouette_depth_slope", silhouette_depth_slope);
     static_person_weight = core::readDouble(c, s, "static_person_weight", static_person_weight);
     if (c.keyExists(s, "static_person_gate")) {
         const std::string g = c.read_string(s, "static_person_gate", "");
@@ -273,6 +276,8 @@ void DynamicObjectFilter::Options::validate(const std::string& s) const {
                        "must be >= 0 (0 = fg_depth_band's)");
     core::requireValue(silhouette_grow >= 0 && silhouette_grow <= 1, s, "silhouette_grow",
                        "must be in [0, 1] (0 = the box only)");
+    core::requireValue(silhouette_depth_slope >= 0 && silhouette_depth_slope <= 1, s,
+                       "silhouette_depth_slope", "must be in [0, 1] (m per m of depth)");
     core::requireValue(static_person_weight > 0 && static_person_weight <= 1, s,
                        "static_person_weight", "must be in (0, 1] (1 = like any keypoint)");
     core::requireValue(gateName(static_person_gate) != nullptr, s, "static_person_gate",
@@ -328,6 +333,7 @@ void DynamicObjectFilter::Options::saveToConfig(mrpt::config::CConfigFileBase& c
     core::writeKey(c, s, "mask_silhouette", mask_silhouette);
     core::writeKey(c, s, "silhouette_depth_band", silhouette_depth_band);
     core::writeKey(c, s, "silhouette_grow", silhouette_grow);
+    core::writeKey(c, s, "silhouette_depth_slope", silhouette_depth_slope);
     core::writeKey(c, s, "static_person_weight", static_person_weight);
     // An exponent outside the table (options set in code, not validated) is written as a
     // number, which loading refuses naming the key.
@@ -1036,7 +1042,7 @@ float silhouetteBand(const DynamicObjectFilter::Options& o, float zp) {
     const double band = o.silhouette_depth_band > 0 ? o.silhouette_depth_band
                         : o.fg_depth_band > 0       ? o.fg_depth_band
                                                     : 0.5;
-    return depthBand(band, zp);
+    return static_cast<float>(band + o.silhouette_depth_slope * zp);
 }
 
 /// The person's silhouette as mask_silhouette draws it: the pixels of `outer` in the

@@ -228,7 +228,8 @@ class DynamicObjectFilter {
         /// else 0.5 m) or without depth, dilated by mask_margin: the background seen inside
         /// the box stays usable. Falls back to the whole box when the torso has no depth.
         bool mask_silhouette = false;
-        /// [m] the silhouette's depth band (+ 10 % of the person's depth) when > 0;
+        /// [m] the silhouette's depth band (+ silhouette_depth_slope x the person's depth)
+        /// when > 0;
         /// 0 = fg_depth_band's. The evidence band wants to be wide (a near person's
         /// arms and back), the mask's narrow (the background right behind a person
         /// keeps its features).
@@ -238,6 +239,11 @@ class DynamicObjectFilter {
         /// person's depth band (or without depth) connected to the silhouette inside the
         /// box. A detector's box often stops short of the head or a hand; 0 = the box only.
         double silhouette_grow = 0.0;
+        /// The silhouette band's growth with the person's depth: its half-width is
+        /// silhouette_depth_band (or its fallbacks) + this x the person's depth (the
+        /// evidence band, fg_depth_band, keeps 0.1). A far person's band at 0.1 reached the
+        /// wall behind them (docs/dynamic.md, "The silhouette band's slope").
+        double silhouette_depth_slope = 0.1;
         /// In (0, 1]: the SLAM's weight for keypoints inside the boxes of people judged
         /// Static (FilterOutput::static_people, mode Dynamic only; devslam-run multiplies
         /// their 1/sigma^2 in tracking, relocalisation, loop checks and local bundle
