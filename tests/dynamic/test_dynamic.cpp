@@ -1087,6 +1087,8 @@ TEST(DynamicConfig, BadValuesAreRejected) {
              {"depth_rate_threshold", "0"},
              {"depth_noise_z2", "-0.1"},
              {"hide_unseen_frames", "-1"},
+             {"silhouette_depth_slope", "-0.05"},
+             {"silhouette_depth_slope", "1.5"},
              {"forget_unseen_frames", "4"}}) {  // under the default hide_unseen_frames 5
         mrpt::config::CConfigFileMemory c;
         c.write("dynamic_filter", key, value);
