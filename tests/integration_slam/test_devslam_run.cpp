@@ -297,6 +297,15 @@ TEST(DevslamRun, BadInputIsReported) {
     EXPECT_NE(r.out.find("usage"), std::string::npos);
 }
 
+namespace {
+/// `app args` fails (non-zero status) and says `says`.
+void expectAppRefuses(const std::string& app, const std::string& args, const std::string& says) {
+    const auto r = devslam::test::runApp(app, args);
+    EXPECT_NE(r.rc, 0) << app << " " << args << "\n" << r.out;
+    EXPECT_NE(r.out.find(says), std::string::npos) << app << " " << args << "\n" << r.out;
+}
+}  // namespace
+
 // An option whose value is the next option was taken as the value: "--out --quiet" made a
 // folder named "--quiet" and ran. Every app names the option instead, and runs nothing.
 TEST(Apps, AnOptionsValueIsNotTheNextOption) {
@@ -311,9 +320,7 @@ TEST(Apps, AnOptionsValueIsNotTheNextOption) {
               "--camera needs a value"},
              {"devslam-bench", "--config --reuse-runs", "--config needs a value"},
              {"devslam-filter-bench", "--results --threads 1", "--results needs a value"}}) {
-        const auto r = devslam::test::runApp(app, args);
-        EXPECT_NE(r.rc, 0) << app << " " << args << "\n" << r.out;
-        EXPECT_NE(r.out.find(says), std::string::npos) << app << " " << args << "\n" << r.out;
+        expectAppRefuses(app, args, says);
     }
     EXPECT_FALSE(fs::exists("--quiet"));
     EXPECT_FALSE(fs::exists("x.rawlog"));
@@ -338,10 +345,7 @@ TEST(Apps, AnOptionGivenTwiceIsRefused) {
              {"devslam-filter-bench", "--threads 1 --threads 2", "--threads"},
              {"devslam-nav", world + " --method CHolonomicVFF --method CHolonomicND", "--method"},
              {"devslam-nav-bench", "--quick --quick", "--quick"}}) {
-        const auto r = devslam::test::runApp(app, args);
-        EXPECT_NE(r.rc, 0) << app << " " << args << "\n" << r.out;
-        EXPECT_NE(r.out.find(option + twice), std::string::npos) << app << " " << args << "\n"
-                                                                   << r.out;
+        expectAppRefuses(app, args, option + twice);
     }
     for (const char* made : {"twice_a", "twice_b", "twice.rawlog"}) EXPECT_FALSE(fs::exists(made));
 }
