@@ -177,6 +177,12 @@ TEST(TumReader, MalformedListsNameFileAndLine) {
     expectError([&] { io::TumReader r(d.str("s")); }, "rgb\\.txt line 5: unsorted timestamp");
     writeText(rgb, header + l1 + "\n" + l1 + "\n");
     expectError([&] { io::TumReader r(d.str("s")); }, "rgb\\.txt line 5: duplicate timestamp");
+    // Lists that share no stamp (10 s apart): what each holds, to tell two recordings apart
+    writeText(rgb, header + "1305031112.2 rgb/x.png\n");
+    expectError([&] { io::TumReader r(d.str("s")); },
+                "no rgb/depth pair within 0\\.02 s \\(rgb\\.txt: 1 image, stamps "
+                "1305031112\\.200000 to 1305031112\\.200000; depth\\.txt: 3 images, stamps "
+                "1305031102\\.[0-9]+ to 1305031102\\.[0-9]+\\)$");
     writeText(rgb, header);
     expectError([&] { io::TumReader r(d.str("s")); }, "rgb\\.txt: no entries");
     fs::remove(rgb);

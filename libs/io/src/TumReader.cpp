@@ -9,6 +9,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
+#include <cstdio>
 #include <filesystem>
 #include <regex>
 #include <stdexcept>
@@ -99,9 +101,21 @@ TumReader::TumReader(std::string folder, ReaderOptions opts)
         }
         if (complete) pairs_.emplace_back(rgb[i], depth[j]);
     }
-    if (n_pairs == 0)
-        throw std::runtime_error(folder_ + ": no rgb/depth pair within " +
-                                 std::to_string(opts_.max_dt) + " s");
+    if (n_pairs == 0) {
+        // Say what the two lists hold: empty, or stamps of two different recordings
+        const auto span = [](const std::vector<double>& t) {
+            if (t.empty()) return std::string("no images");
+            const auto [lo, hi] = std::minmax_element(t.begin(), t.end());
+            char b[96];
+            std::snprintf(b, sizeof b, "%zu image%s, stamps %.6f to %.6f", t.size(),
+                          t.size() == 1 ? "" : "s", *lo, *hi);
+            return std::string(b);
+        };
+        char dt[32];
+        std::snprintf(dt, sizeof dt, "%g", opts_.max_dt);
+        throw std::runtime_error(folder_ + ": no rgb/depth pair within " + dt +
+                                 " s (rgb.txt: " + span(ta) + "; depth.txt: " + span(tb) + ")");
+    }
     if (!missing.empty()) {
         damage_ = missing.front();
         if (missing.size() > 1)
