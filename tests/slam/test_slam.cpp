@@ -578,37 +578,6 @@ TEST(LoopDetector, MeasuresFromTheKeyframesAndRejectsImplausibleCorrections) {
     }
 }
 
-TEST(LoopDetector, CandidatesCanBeLimitedToKeyframesLookingTheSameWay) {
-    // Keyframe A saw a textured plane 1 cm from where the camera is now and looking the same
-    // way; keyframe C stands exactly here but looks 90 deg to the side, at other texture.
-    // With one candidate verified, position alone picks C and finds no loop; with
-    // max_axis_angle_deg = 30, C is no candidate, A is, and the loop is found.
-    const core::Frame f = noisePlaneFrame(9, 2.0f), other = noisePlaneFrame(3, 2.0f);
-    const auto feats = OrbExtractor({}).extract(f, cv::Mat());
-    Map map;
-    Keyframe a;
-    a.features = feats;
-    a.landmark_of_kp.assign(feats.size(), kNoId);
-    a.T_wc.translation() = Eigen::Vector3d(0.01, 0, 0);
-    const KeyframeId ida = map.addKeyframe(a);
-    Keyframe c;
-    c.features = OrbExtractor({}).extract(other, cv::Mat());
-    c.landmark_of_kp.assign(c.features.size(), kNoId);
-    c.T_wc.linear() = Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY()).toRotationMatrix();
-    (void)map.addKeyframe(c);
-    Keyframe b = a;
-    b.T_wc = Eigen::Isometry3d::Identity();
-    const KeyframeId idb = map.addKeyframe(b);
-    LoopOptions lo;
-    lo.min_keyframe_gap = 1;
-    lo.max_candidates = 1;
-    EXPECT_FALSE(detectLoop(map, idb, f.K, lo).has_value()) << "the nearest looks elsewhere";
-    lo.max_axis_angle_deg = 30;
-    const auto loop = detectLoop(map, idb, f.K, lo);
-    ASSERT_TRUE(loop.has_value());
-    EXPECT_EQ(loop->old_kf, ida);
-}
-
 TEST(Tracker, RelocalizationCannotJumpFarAfterAShortLoss) {
     // Bound: 0.1 m + 1 m/s x time since the last tracked frame, 10 deg + 90 deg/s x that time.
     TrackerOptions o;
@@ -984,8 +953,6 @@ TEST(Config, EveryShippedSlamIniLoadsAndUnknownKeysAreRejected) {
     // landmark culled or every frame lost) are refused at the start, naming their own key.
     for (const auto& [text, message] : std::vector<std::pair<std::string, std::string>>{
              {"[loop_closure]\nmax_candidates = -1\n", "[loop_closure] max_candidates: must be"},
-             {"[loop_closure]\nmax_axis_angle_deg = 0\n",
-              "[loop_closure] max_axis_angle_deg: must be"},
              {"[tracker]\npnp_confidence = 1\n", "[tracker] pnp_confidence: must be in (0, 1)"},
              {"[mapping]\ncull_keyframe_age = 0\n", "[mapping] cull_keyframe_age: must be >= 1"},
              {"[mapping]\ncull_ratio_keyframes = -1\n",

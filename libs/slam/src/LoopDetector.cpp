@@ -13,14 +13,13 @@ void LoopOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, const s
     core::requireKnownKeys(
         c, s,
         {"enabled", "min_keyframe_gap", "cooldown_keyframes", "max_distance", "max_candidates",
-         "max_axis_angle_deg", "max_hamming", "ratio", "min_inliers", "sigma_t", "sigma_r_deg",
-         "max_correction", "max_correction_deg", "confirm_keyframes", "confirm_t", "confirm_deg"});
+         "max_hamming", "ratio", "min_inliers", "sigma_t", "sigma_r_deg", "max_correction",
+         "max_correction_deg", "confirm_keyframes", "confirm_t", "confirm_deg"});
     enabled = core::readBool(c, s, "enabled", enabled);
     min_keyframe_gap = core::readInt(c, s, "min_keyframe_gap", min_keyframe_gap);
     cooldown_keyframes = core::readInt(c, s, "cooldown_keyframes", cooldown_keyframes);
     max_distance = core::readDouble(c, s, "max_distance", max_distance);
     max_candidates = core::readInt(c, s, "max_candidates", max_candidates);
-    max_axis_angle_deg = core::readDouble(c, s, "max_axis_angle_deg", max_axis_angle_deg);
     max_hamming = core::readInt(c, s, "max_hamming", max_hamming);
     ratio = core::readDouble(c, s, "ratio", ratio);
     min_inliers = core::readInt(c, s, "min_inliers", min_inliers);
@@ -35,8 +34,6 @@ void LoopOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, const s
     core::requireValue(cooldown_keyframes >= 0, s, "cooldown_keyframes", "must be >= 0");
     core::requireValue(max_candidates >= 1 && max_candidates <= 1000, s, "max_candidates",
                        "must be in [1, 1000]");
-    core::requireValue(max_axis_angle_deg > 0 && max_axis_angle_deg <= 180, s, "max_axis_angle_deg",
-                       "must be in (0, 180]");
     core::requireValue(max_hamming > 0 && max_hamming <= 256, s, "max_hamming",
                        "must be in (0, 256]");
     core::requireValue(ratio > 0 && ratio <= 1, s, "ratio", "must be in (0, 1]");
@@ -60,7 +57,6 @@ void LoopOptions::saveToConfig(mrpt::config::CConfigFileBase& c, const std::stri
     core::writeKey(c, s, "cooldown_keyframes", cooldown_keyframes);
     core::writeKey(c, s, "max_distance", max_distance);
     core::writeKey(c, s, "max_candidates", max_candidates);
-    core::writeKey(c, s, "max_axis_angle_deg", max_axis_angle_deg);
     core::writeKey(c, s, "max_hamming", max_hamming);
     core::writeKey(c, s, "ratio", ratio);
     core::writeKey(c, s, "min_inliers", min_inliers);
@@ -93,12 +89,7 @@ std::optional<LoopConstraint> detectLoop(const Map& map, KeyframeId current,
     for (const auto& [id, kf] : map.keyframes()) {
         if (id > current - opts.min_keyframe_gap) break;  // std::map: ascending ids
         const double d = (kf.T_wc.translation() - cur.T_wc.translation()).norm();
-        if (d > opts.max_distance) continue;
-        if (opts.max_axis_angle_deg < 180.0) {
-            const double c = kf.T_wc.linear().col(2).dot(cur.T_wc.linear().col(2));
-            if (c < std::cos(opts.max_axis_angle_deg * M_PI / 180.0)) continue;
-        }
-        cands.emplace_back(d, id);
+        if (d <= opts.max_distance) cands.emplace_back(d, id);
     }
     std::sort(cands.begin(), cands.end());
     if (static_cast<int>(cands.size()) > opts.max_candidates) cands.resize(opts.max_candidates);

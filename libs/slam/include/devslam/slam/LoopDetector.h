@@ -45,10 +45,6 @@ struct LoopOptions {
     double sigma_t = 0.02;             ///< [m] loop-edge translation std (pose-graph information)
     double sigma_r_deg = 1.0;          ///< [deg] loop-edge rotation std
     double scale_factor = 1.3;         ///< ORB pyramid scale for level sigmas (copied from [orb])
-    /// [deg] candidates only among keyframes whose optical axis lies within this of the
-    /// current one's; 180 = any. The nearest keyframes by position may look elsewhere when
-    /// the camera mostly turns (walking_rpy, walking_halfsphere).
-    double max_axis_angle_deg = 180.0;
 
     void loadFromConfig(const mrpt::config::CConfigFileBase& cfg,
                         const std::string& section = "loop_closure");
