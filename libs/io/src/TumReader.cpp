@@ -9,7 +9,6 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <regex>
@@ -102,14 +101,11 @@ TumReader::TumReader(std::string folder, ReaderOptions opts)
         if (complete) pairs_.emplace_back(rgb[i], depth[j]);
     }
     if (n_pairs == 0) {
-        // Say what the two lists hold: empty, or stamps of two different recordings
+        // Say what the two lists hold, to tell two recordings apart (readTumList refuses an
+        // empty list and stamps that do not increase: first and last are the range)
         const auto span = [](const std::vector<double>& t) {
-            if (t.empty()) return std::string("no images");
-            const auto [lo, hi] = std::minmax_element(t.begin(), t.end());
-            char b[96];
-            std::snprintf(b, sizeof b, "%zu image%s, stamps %.6f to %.6f", t.size(),
-                          t.size() == 1 ? "" : "s", *lo, *hi);
-            return std::string(b);
+            return std::to_string(t.size()) + (t.size() == 1 ? " image" : " images") + ", stamps " +
+                   detail::stampText(t.front()) + " to " + detail::stampText(t.back());
         };
         char dt[32];
         std::snprintf(dt, sizeof dt, "%g", opts_.max_dt);
