@@ -61,9 +61,9 @@ std::string methodList(const std::vector<std::string>& methods) {
     return s;
 }
 
-void usage() {
-    std::cerr
-        << "usage: devslam-nav-bench [options]\n"
+/// On std::cout when asked for (--help), on std::cerr after a bad command line.
+void usage(std::ostream& os = std::cerr) {
+    os << "usage: devslam-nav-bench [options]\n"
            "  --per-category N  worlds per category (default 50 -> 200 worlds)\n"
            "  --quick           smoke test: 2 worlds per category, RESULTS.md untouched,\n"
            "                    pictures in out/devslam-nav-bench unless --png-dir\n"
@@ -211,7 +211,7 @@ std::optional<int> parseArgs(int argc, char** argv, Args& a) {
                         a.methods.push_back(m);
                     }
             } else if (s == "-h" || s == "--help") {
-                usage();
+                usage(std::cout);
                 return 0;
             } else
                 throw std::invalid_argument("unknown option " + s);

@@ -96,9 +96,9 @@ int planOnSlamMap(const std::string& map, const std::string& from, const std::st
     return plan.path ? 0 : 1;
 }
 
-void usage() {
-    std::cerr
-        << "usage: devslam-nav WORLD.ini|random:CATEGORY:SEED [options]\n"
+/// On std::cout when asked for (--help), on std::cerr after a bad command line.
+void usage(std::ostream& os = std::cerr) {
+    os << "usage: devslam-nav WORLD.ini|random:CATEGORY:SEED [options]\n"
            "  --config FILE   navigation INI (default config_ini/nav_reactive.ini)\n"
            "  --method NAME   holonomic method: CHolonomicVFHPlus, CHolonomicND,\n"
            "                  CHolonomicVFF, CHolonomicFullEval (default: the INI's\n"
@@ -119,7 +119,17 @@ static int appMain(int argc, char** argv) {
     std::string config = std::string(DEVSLAM_SOURCE_DIR) + "/config_ini/nav_reactive.ini";
     std::string method;  // empty: the INI's [navigator] holonomic_method
     bool verbose = false;
-    devslam::core::refuseRepeatedOptions(argc, argv);
+    bool from_given = false;
+    const auto refuse = [](const std::exception& e) {
+        std::cerr << "devslam-nav: " << e.what() << "\n";
+        usage();
+        return 2;
+    };
+    try {
+        devslam::core::refuseRepeatedOptions(argc, argv);
+    } catch (const std::exception& e) {
+        return refuse(e);
+    }
     for (int i = 1; i < argc; i++) {
         const std::string a = argv[i];
         auto next = [&] { return devslam::core::optionValue(argc, argv, i); };
@@ -136,12 +146,14 @@ static int appMain(int argc, char** argv) {
                 verbose = true;
             else if (a == "--map")
                 map = next();
-            else if (a == "--from")
+            else if (a == "--from") {
                 from = next();
+                from_given = true;
+            }
             else if (a == "--to")
                 to = next();
             else if (a == "-h" || a == "--help") {
-                usage();
+                usage(std::cout);
                 return 0;
             } else if (!a.empty() && a[0] == '-')
                 throw std::invalid_argument("unknown option " + a);
@@ -150,13 +162,17 @@ static int appMain(int argc, char** argv) {
             else
                 throw std::invalid_argument("more than one world file given");
         } catch (const std::exception& e) {
-            std::cerr << "devslam-nav: " << e.what() << "\n";
-            usage();
-            return 2;
+            return refuse(e);
         }
     }
     if (!map.empty() && !world_path.empty()) {
         std::cerr << "devslam-nav: give a world or --map, not both\n";
+        return 2;
+    }
+    // A world file has its own start and goal: --from and --to were ignored without a word.
+    if (map.empty() && (from_given || !to.empty())) {
+        std::cerr << "devslam-nav: " << (from_given ? "--from" : "--to")
+                  << " needs --map (a world file has its own start and goal)\n";
         return 2;
     }
     if (map.empty() && world_path.empty()) {
@@ -184,20 +200,34 @@ static int appMain(int argc, char** argv) {
         devslam::sim::EpisodeOptions eo;
         eo.holonomic_method = method;
         if (!navlog.empty()) {  // over the INI's [navigator] log_file / log_directory
+            // Made here, so that its error names --navlog, not the INI's log_directory.
+            std::error_code ec;
+            std::filesystem::create_directories(navlog, ec);
+            if (!std::filesystem::is_directory(navlog))
+                throw std::invalid_argument("--navlog '" + navlog + "': cannot make that folder" +
+                                            (ec ? ": " + ec.message() : std::string()));
             nav_opts.log_file = true;
             nav_opts.log_directory = navlog;
         }
         const auto r = devslam::sim::runEpisode(world, *ini, nav_opts, eo);
         if (png.empty()) png = kDefaultDir + "/nav_" + world.name + ".png";
         // The result first: a picture that cannot be written must not lose it.
+        // A clearance never measured (nothing of that kind in the world; no path, so no step
+        // driven) is "none", not the result's 1e9 placeholder.
+        const auto clearance = [](double v) {
+            if (v >= 1e8) return std::string("none");
+            char text[32];
+            std::snprintf(text, sizeof text, "%.3f m", v);
+            return std::string(text);
+        };
         std::printf(
             "world=%s method=%s result=%s time=%.2f s path=%.2f m astar=%.2f m "
-            "min_clearance_static=%.3f m min_clearance_people=%.3f m collisions_static=%d "
+            "min_clearance_static=%s min_clearance_people=%s collisions_static=%d "
             "collisions_people=%d replans=%d png=%s%s%s\n",
             world.name.c_str(), r.holonomic_method.c_str(), devslam::sim::toString(r.outcome),
-            r.time, r.path_length, r.astar_length, r.min_clearance_static,
-            world.pedestrians.empty() ? -1.0 : r.min_clearance_people, r.static_collisions,
-            r.person_collisions, r.replans, png.c_str(),
+            r.time, r.path_length, r.astar_length,
+            clearance(r.min_clearance_static).c_str(), clearance(r.min_clearance_people).c_str(),
+            r.static_collisions, r.person_collisions, r.replans, png.c_str(),
             r.navlog.empty() ? "" : " navlog=", r.navlog.c_str());
         if (!r.reason.empty()) std::printf("reason: %s\n", r.reason.c_str());
         std::fflush(stdout);

@@ -114,7 +114,12 @@ struct Args {
 /// The command line, or the exit code to return now (0 after --help, 2 for a bad argument).
 std::variant<Args, int> parseArgs(int argc, char** argv) {
     Args a;
-    devslam::core::refuseRepeatedOptions(argc, argv);
+    try {
+        devslam::core::refuseRepeatedOptions(argc, argv);
+    } catch (const std::exception& e) {
+        std::cerr << "devslam-overlay: " << e.what() << "\n" << kUsage;
+        return 2;
+    }
     for (int i = 1; i < argc; ++i) {
         const std::string arg = argv[i];
         auto next = [&] { return devslam::core::optionValue(argc, argv, i); };

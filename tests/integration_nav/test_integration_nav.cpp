@@ -467,6 +467,32 @@ TEST(IntegrationNav, AppsSmokeTest) {
               std::string::npos)
         << r.out;
     EXPECT_FALSE(std::filesystem::exists(out + "/cut/fig6.png"));
+    // Its result line onto a full disk: an error, not 0 (it is printed with printf, and only
+    // std::cout was checked). The usage asked for goes to the standard output too.
+    r = devslam::test::runAppOntoFullDisk(
+        "devslam-nav", kSrc + "/sim_worlds/paper_fig6.ini --png " + out + "/full.png");
+    EXPECT_EQ(r.rc, 1) << r.out;
+    EXPECT_NE(r.out.find("devslam-nav: cannot write the standard output"), std::string::npos)
+        << r.out;
+    for (const char* app : {"devslam-nav", "devslam-nav-bench"}) {
+        r = devslam::test::runAppOntoFullDisk(app, "--help");
+        EXPECT_EQ(r.rc, 1) << app << ": " << r.out;
+    }
+    // --from and --to are for --map: with a world file (its own start and goal) they were
+    // ignored without a word.
+    r = nav("--to 2,2 --png " + out + "/to.png");
+    EXPECT_EQ(r.rc, 2);
+    EXPECT_NE(r.out.find("--to needs --map"), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("result="), std::string::npos) << r.out;
+    // A --navlog that cannot be a folder is named as the option (it was blamed on the INI's
+    // [navigator] log_directory).
+    std::ofstream(out + "/not_a_folder") << "x";
+    r = nav("--navlog " + out + "/not_a_folder --png " + out + "/navlog.png");
+    EXPECT_EQ(r.rc, 2);
+    EXPECT_NE(r.out.find("--navlog '" + out + "/not_a_folder': cannot make that folder"),
+              std::string::npos)
+        << r.out;
+    EXPECT_EQ(r.out.find("result="), std::string::npos) << r.out;
     // bench smoke test: one method, one world per category, RESULTS.md untouched
     const std::string bench =
         bin + "/devslam-nav-bench --per-category 1 --methods CHolonomicVFHPlus --png-dir " + out +

@@ -100,6 +100,9 @@ TEST(MapPlan, BadFilesAndGoalsAreNamed) {
               std::string::npos);
     EXPECT_EQ(errorOf([&] { (void)loadGridMap(d.str("none.gridmap")); }),
               d.str("none.gridmap") + ": no such grid map file");
+    std::filesystem::create_directory(d.str("folder.gridmap"));
+    EXPECT_EQ(errorOf([&] { (void)loadGridMap(d.str("folder.gridmap")); }),
+              d.str("folder.gridmap") + ": is a folder, not a grid map file");
     std::ofstream(d.str("text.gridmap")) << "not a grid";
     EXPECT_NE(errorOf([&] {
                   (void)loadGridMap(d.str("text.gridmap"));

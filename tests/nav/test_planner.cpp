@@ -508,6 +508,18 @@ TEST(NavConfig, UnknownKeyIsReported) {
     EXPECT_NE(errorOf({{"navigator", "nav_perod", 0.1}}).find("nav_perod"), std::string::npos);
     EXPECT_EQ(errorOf({{"navigator", "person_margin", -0.1}}),
               "x.ini [navigator] person_margin: must be in [0, 2] m");
+    EXPECT_EQ(errorOf({{"navigator", "nav_period", 5.0}}),
+              "x.ini [navigator] nav_period: must be in (0, 1] s");
+    for (const double d : {-1.0, 0.0, 1e9})
+        EXPECT_EQ(errorOf({{"navigator", "waypoint_allowed_distance", d}}),
+                  "x.ini [navigator] waypoint_allowed_distance: must be in (0, 10] m")
+            << d;
+    // MRPT asserted end > start inside every navigation step.
+    EXPECT_EQ(errorOf({{"CAbstractPTGBasedReactive", "secure_distance_start", 0.2}}),
+              "x.ini [CAbstractPTGBasedReactive] secure_distance_end: must be > "
+              "secure_distance_start (0.2)");
+    EXPECT_EQ(errorOf({{"CAbstractPTGBasedReactive", "secure_distance_start", -0.1}}),
+              "x.ini [CAbstractPTGBasedReactive] secure_distance_start: must be >= 0");
     // Values of the planner's and the replanner's sections, and MRPT's ref_distance, name the
     // file as well.
     EXPECT_EQ(errorOf({{"global_planner", "robot_radius", -1.0}}),

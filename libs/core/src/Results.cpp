@@ -306,7 +306,10 @@ FolderClaim::~FolderClaim() {
 int withStandardOutput(const char* program, int rc) {
     errno = 0;
     std::cout.flush();
-    if (std::cout) return rc;
+    // Both streams: the apps that print with printf lost their result line onto a full disk
+    // and said 0 (a failed write or flush leaves stdout's error flag set).
+    const bool c_ok = std::fflush(stdout) == 0 && !std::ferror(stdout);
+    if (std::cout && c_ok) return rc;
     std::cerr << program << ": cannot write the standard output"
               << (errno ? std::string(" (") + std::strerror(errno) + ")" : std::string()) << "\n";
     return rc == 0 ? 1 : rc;

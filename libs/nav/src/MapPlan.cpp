@@ -19,6 +19,8 @@
 namespace devslam::nav {
 
 mrpt::maps::COccupancyGridMap2D loadGridMap(const std::string& path) {
+    if (std::filesystem::is_directory(path))
+        throw std::runtime_error(path + ": is a folder, not a grid map file");
     if (!std::filesystem::is_regular_file(path))
         throw std::runtime_error(path + ": no such grid map file");
     mrpt::maps::COccupancyGridMap2D grid;

@@ -175,6 +175,17 @@ void checkMrptSections(const mrpt::config::CConfigFileBase& c, const std::string
         for (const char* k : {"robotMax_V_mps", "robotMax_W_degps"})
             if (c.keyExists(ptg, k))
                 core::requireValue(core::readDouble(c, ptg, k, 0.0) > 0, ptg, k, "must be > 0");
+        // MRPT asserts end > start in every step (a run of stack traces, ended as an error).
+        {
+            const CAbstractPTGBasedReactive::TAbstractPTGNavigatorParams d;
+            const double start =
+                core::readDouble(c, ptg, "secure_distance_start", d.secure_distance_start);
+            const double end = core::readDouble(c, ptg, "secure_distance_end", d.secure_distance_end);
+            core::requireValue(start >= 0, ptg, "secure_distance_start", "must be >= 0");
+            std::ostringstream why;
+            why << "must be > secure_distance_start (" << start << ")";
+            core::requireValue(end > start, ptg, "secure_distance_end", why.str());
+        }
         for (const auto& [section, n] :
              {std::pair{std::string("CHolonomicND"), CHolonomicND::TOptions().factorWeights.size()},
               {std::string("CHolonomicFullEval"),

@@ -165,7 +165,12 @@ NavigatorOptions readNavigatorOptions(const mrpt::config::CConfigFileBase& c,
     o.person_margin = core::readDouble(c, s, "person_margin", o.person_margin);
     o.log_file = core::readBool(c, s, "log_file", o.log_file);
     o.log_directory = c.read_string(s, "log_directory", o.log_directory);
-    core::requireValue(o.nav_period > 0, s, "nav_period", "must be > 0 s");
+    // At a period of seconds the robot drove blind into what it had not yet seen; a reached
+    // radius of kilometres skipped every waypoint of the route.
+    core::requireValue(o.nav_period > 0 && o.nav_period <= 1.0, s, "nav_period",
+                       "must be in (0, 1] s");
+    core::requireValue(o.waypoint_allowed_distance > 0 && o.waypoint_allowed_distance <= 10.0, s,
+                       "waypoint_allowed_distance", "must be in (0, 10] m");
     core::requireValue(o.robot_radius > 0, s, "robot_radius", "must be > 0 m");
     core::requireValue(o.person_margin >= 0 && o.person_margin <= 2.0, s, "person_margin",
                        "must be in [0, 2] m");
@@ -234,7 +239,8 @@ Navigator::Navigator(mrpt::nav::CRobot2NavInterface& robot,
         std::error_code ec;
         std::filesystem::create_directories(opts_.log_directory, ec);
         if (!std::filesystem::is_directory(opts_.log_directory))
-            throw std::runtime_error("[navigator] log_directory: cannot create '" +
+            throw std::runtime_error((opts_.source.empty() ? "" : opts_.source + " ") +
+                                     "[navigator] log_directory: cannot create '" +
                                      opts_.log_directory + "'" +
                                      (ec ? ": " + ec.message() : std::string()));
         log_path_ = freeNavlogName(opts_.log_directory);

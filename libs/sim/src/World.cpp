@@ -218,8 +218,11 @@ void validateBoundsAndTiming(const WorldSpec& w) {
     if (!(w.y_max > w.y_min)) fail(src, "world", "y_max", "must be > y_min");
     // The name makes the default picture's file name (out/nav_<name>.png): "../../x" wrote
     // outside out/, "a/b" into a folder.
-    if (w.name == "." || w.name == ".." || w.name.find_first_of("/\\") != std::string::npos)
-        fail(src, "world", "name", "must be a file name: not '.' or '..', no '/' or '\\'");
+    // An empty one named the picture "nav_.png" and left the result line's world= blank.
+    if (w.name.empty() || w.name == "." || w.name == ".." ||
+        w.name.find_first_of("/\\") != std::string::npos)
+        fail(src, "world", "name",
+             "must be a file name: not empty, '.' or '..', no '/' or '\\'");
     // Bullet simulates in single precision: at 1e6 m one float step is 6 cm, more than the
     // robot moves in a physics step, and it never moved.
     constexpr double kMaxCoordinate = 1e4;

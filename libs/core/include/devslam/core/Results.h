@@ -54,9 +54,9 @@ class FolderClaim {
     bool made_ = false;
 };
 
-/// Flushes std::cout and returns `rc`, or 1 where `rc` is 0 and the standard output could not
-/// be written (a full disk behind '>': the figures were lost, and the program said 0), saying
-/// so on std::cerr as "<program>: cannot write the standard output".
+/// Flushes std::cout and C's stdout and returns `rc`, or 1 where `rc` is 0 and the standard
+/// output could not be written (a full disk behind '>': the figures were lost, and the
+/// program said 0), saying so on std::cerr as "<program>: cannot write the standard output".
 [[nodiscard]] int withStandardOutput(const char* program, int rc);
 
 /// FNV-1a (64 bit) of a file's bytes as 16 hex digits, "" when it cannot be read: tells
