@@ -622,6 +622,40 @@ TEST(Rawlog, ADamagedImageSizeIsAnErrorNotACrash) {
     }
 }
 
+TEST(Rawlog, ADamagedPointCountIsAnErrorNotACrash) {
+    // A 3D scan's point lists are std::vectors that MRPT resizes to the count it reads: one
+    // flipped byte (hasPoints3D) made that 1.4e9 points, and a list that could not be
+    // allocated after one that could ended the program from the scan's destructor ("terminate
+    // called", Rawlog.cpp's operator new). 80 million points (320 MB a list) is over the
+    // reader's cap, so the first list is refused: the error names the block, where without
+    // the cap 1.3 GB would be allocated and the stream would end early.
+    mrpt::obs::CObservation3DRangeScan o;
+    o.hasRangeImage = true;
+    o.rangeImage_setSize(2, 2);
+    o.rangeImage.fill(1000);
+    o.hasPoints3D = true;
+    o.resizePoints3DVectors(3);
+    o.points3D_x = {1.25f, 2.5f, 3.75f};
+    mrpt::io::CMemoryStream mem;
+    mrpt::serialization::archiveFrom(mem) << o;
+    const auto* bytes = static_cast<const char*>(mem.getRawBufferData());
+    std::string damaged(bytes, bytes + mem.getTotalBytesCount());
+    const std::uint32_t count = 3;
+    const float xs[3] = {1.25f, 2.5f, 3.75f};
+    const std::string pattern = std::string(reinterpret_cast<const char*>(&count), sizeof count) +
+                                std::string(reinterpret_cast<const char*>(xs), sizeof xs);
+    const auto at = damaged.find(pattern);
+    ASSERT_NE(at, std::string::npos) << "the point count and the x list";
+    const std::uint32_t huge = 80'000'000;
+    damaged.replace(at, sizeof huge, reinterpret_cast<const char*>(&huge), sizeof huge);
+    TempDir d;
+    const std::string path = d.str("points.rawlog");
+    std::ofstream(path, std::ios::binary) << damaged;
+    expectError([&] { io::RawlogReader r(path); },
+                R"(points\.rawlog: cannot decode object 0 .*a block of 320000000 bytes could not )"
+                R"(be allocated)");
+}
+
 TEST(Rawlog, ImpossibleCamerasAndDepthUnitsAreErrors) {
     // A focal length of 0, inf or 1e-300 made devslam-run's grid map loop forever; a depth
     // unit of 0 m read every depth as 0 without a word.

@@ -46,6 +46,25 @@ std::string rawlogImagesDir(const std::string& rawlog_path) {
 
 namespace {
 
+// The largest block operator new gives on this thread (SIZE_MAX: no cap), set while an
+// object is decoded: see the operator new at the end of this file.
+thread_local std::size_t t_new_block_cap = std::numeric_limits<std::size_t>::max();
+
+/// While alive, a single operator-new block over `bytes` on this thread throws
+/// std::bad_alloc instead of being allocated.
+class NewBlockCap {
+  public:
+    explicit NewBlockCap(std::size_t bytes) : before_(t_new_block_cap) {
+        t_new_block_cap = bytes;
+    }
+    ~NewBlockCap() { t_new_block_cap = before_; }
+    NewBlockCap(const NewBlockCap&) = delete;
+    NewBlockCap& operator=(const NewBlockCap&) = delete;
+
+  private:
+    std::size_t before_;
+};
+
 // Optical frame of MRPT's 3D-scan depth camera, seen from the observation frame (X forward,
 // Y left, Z up): the (0,0,0,-90deg,0,-90deg) rotation of CObservation3DRangeScan.
 const mrpt::poses::CPose3D& opticalInObs() {
@@ -310,6 +329,9 @@ struct RawlogReader::Stream {
             mrpt::serialization::CSerializable::Ptr obj;
             const uint64_t pos = file.getPosition();
             try {
+                // 256 MiB: a 3D scan's point list of 67 million points (an 8K x 8K depth
+                // image), where this project's are 300 000 (operator new, end of this file).
+                const NewBlockCap cap(std::size_t(256) << 20);
                 obj = arch.ReadObject();
             } catch (const mrpt::serialization::CExceptionEOF&) {
                 if (file.getPosition() == pos && file.checkEOF()) return nullptr;  // clean end
@@ -644,3 +666,32 @@ void* mrpt::aligned_malloc(std::size_t size, std::size_t alignment) {
     if (!p && size > 0) throw MrptAllocationRefused(size);
     return p;
 }
+
+// ---------------------------------------------------------------------------------------
+// A damaged point count in a 3D scan (its hasPoints3D flag set by one flipped byte, the next
+// four bytes read as 1.4e9 points) makes CObservation3DRangeScan::serializeFrom resize its
+// std::vector point lists, which allocate through the global operator new, not
+// mrpt::aligned_malloc. Some of them allocated and the next failed, and the destructor then
+// resized the others to the same size to give them to MRPT's memory pool: std::bad_alloc
+// inside a destructor, and the program ended with "terminate called" (or, with the memory
+// there, took 21 GB and a minute before the stream ran out). This program-wide replacement
+// of operator new is the default one (malloc, the new-handler, std::bad_alloc) except that,
+// while the rawlog reader decodes an object (NewBlockCap, this thread only), a block over the
+// cap throws at once: the first point list is refused, the others are never made, and the
+// destructor has nothing to give back. Its delete is free, as the default's. (Written by hand:
+// neither MRPT nor the standard library offers a per-thread allocation limit.)
+void* operator new(std::size_t bytes) {
+    if (bytes > devslam::io::t_new_block_cap) throw MrptAllocationRefused(bytes);
+    if (bytes == 0) bytes = 1;
+    for (;;) {
+        if (void* p = std::malloc(bytes)) return p;
+        const std::new_handler handler = std::get_new_handler();
+        if (!handler) throw std::bad_alloc();
+        handler();
+    }
+}
+void* operator new[](std::size_t bytes) { return ::operator new(bytes); }
+void operator delete(void* p) noexcept { std::free(p); }
+void operator delete[](void* p) noexcept { std::free(p); }
+void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
