@@ -6,6 +6,7 @@
 #include <devslam/core/Config.h>
 
 #ifdef DEVSLAM_HAVE_DYNAMIC
+#include <devslam/detect/PersonDetector.h>
 #include <devslam/dynamic/DynamicObjectFilter.h>
 #endif
 
@@ -92,6 +93,7 @@ std::unique_ptr<MaskSource> makeMaskSource(const std::string& mode,
         dynamic::DynamicObjectFilter::Options o;
         o.loadFromConfig(cfg);
         const int margin = o.mask_margin;
+        (void)detect::makeDetector(cfg, "detector");  // ... and [detector], as the other modes
 #else
         const int margin = core::readInt(cfg, "dynamic_filter", "mask_margin", 10);
         if (margin < 0)

@@ -280,6 +280,22 @@ TEST(DevslamRun, BadInputIsReported) {
     r = run("--set dynamic_filter.mask_margn=3 --mode truth --quiet --out ''");
     EXPECT_EQ(r.rc, 1);
     EXPECT_NE(r.out.find("[dynamic_filter]: unknown key 'mask_margn'"), std::string::npos) << r.out;
+    // ... and [detector], in every mode: an unknown detector, a mistyped key or a score out of
+    // range was accepted in modes none and truth, and found only when the mode changed.
+    for (const std::string mode : {"none", "truth"}) {
+        r = run("--set detector.detector=yolov9 --mode " + mode + " --quiet --out ''");
+        EXPECT_EQ(r.rc, 1) << mode;
+        EXPECT_NE(r.out.find("[detector] detector: unknown detector 'yolov9' (known: "),
+                  std::string::npos)
+            << mode << ": " << r.out;
+        r = run("--set detector.conf_treshold=0.3 --mode " + mode + " --quiet --out ''");
+        EXPECT_EQ(r.rc, 1) << mode;
+        EXPECT_NE(r.out.find("unknown key 'conf_treshold'"), std::string::npos)
+            << mode << ": " << r.out;
+        r = run("--set detector.conf_threshold=7 --mode " + mode + " --quiet --out ''");
+        EXPECT_EQ(r.rc, 1) << mode;
+        EXPECT_NE(r.out.find("conf_threshold"), std::string::npos) << mode << ": " << r.out;
+    }
     // a mistyped [run] key from --set is not blamed on the file alone
     r = run("--set run.moed=none --quiet --out ''");
     EXPECT_EQ(r.rc, 1);

@@ -1216,8 +1216,10 @@ std::unique_ptr<DynamicObjectFilter> makeFilterFromConfig(const mrpt::config::CC
     DynamicObjectFilter::Options o;
     o.loadFromConfig(cfg, "dynamic_filter");
     if (mode_override) o.mode = *mode_override;
-    std::unique_ptr<detect::PersonDetector> det;
-    if (o.mode != MaskMode::None) det = detect::makeDetector(cfg, "detector");
+    // Made in mode None too, and dropped there: a mistyped [detector] key, an unknown
+    // detector or a missing weights file was accepted until the mode changed (about 60 ms).
+    auto det = detect::makeDetector(cfg, "detector");
+    if (o.mode == MaskMode::None) det.reset();
     return std::make_unique<DynamicObjectFilter>(o, std::move(det));
 }
 

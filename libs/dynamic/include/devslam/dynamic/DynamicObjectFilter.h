@@ -308,8 +308,8 @@ class DynamicObjectFilter {
 };
 
 /// Builds detector + filter from one INI (sections [detector] and [dynamic_filter]).
-/// `mode_override` replaces the INI's mode (e.g. from a command-line flag); in mode None
-/// no detector is built.
+/// `mode_override` replaces the INI's mode (e.g. from a command-line flag). In mode None the
+/// detector is built (its section, names and files checked) and dropped: the filter has none.
 [[nodiscard]] std::unique_ptr<DynamicObjectFilter> makeFilterFromConfig(
     const mrpt::config::CConfigFileBase& cfg, std::optional<MaskMode> mode_override = {});
 
