@@ -4,6 +4,7 @@
 #include <devslam/core/Parse.h>
 #include <devslam/dynamic/DynamicObjectFilter.h>
 #include <devslam/eval/MaskScore.h>
+#include <devslam/io/RgbdReader.h>
 
 #include <mrpt/config/CConfigFileMemory.h>
 
@@ -47,6 +48,10 @@ Bench readBench(const std::string& path) {
     core::requireKnownKeys(
         *cfg, "bench", {"modes", "repeats", "max_frames", "render_jobs", "out_dir", "slam_config"},
         path);
+    // Given empty, it ran the default modes without a word.
+    if (cfg->keyExists("bench", "modes") &&
+        cfg->read_string("bench", "modes", "").find_first_not_of(" \t") == std::string::npos)
+        throw std::invalid_argument("[bench] modes: empty (list the devslam-run modes to run)");
     const std::string modes = cfg->read_string("bench", "modes", "");
     if (!modes.empty()) {
         b.modes.clear();
@@ -100,15 +105,33 @@ Bench readBench(const std::string& path) {
                 path + " [" + (cfg->keyExists(s, "slam_config") ? s : std::string("bench")) +
                 "] slam_config: no such file '" + q.slam_config + "'");
         // ... and read, with the filter INI it names: a syntax error in the last sequence's
-        // INI stopped the bench there, hours into it, with no table.
+        // INI stopped the bench there, hours into it, with no table. The filter and its
+        // detector are made from them too: a mistyped [detector] key or a missing weights
+        // file failed only the runs that detect, after the renders and the other modes' runs.
         {
-            const std::string filter =
-                core::filterIniPath(*core::loadIni(q.slam_config), q.slam_config);
-            if (filter != q.slam_config) (void)core::loadIni(filter);
+            std::string filter_source;
+            const auto filter_cfg = core::loadFilterConfig(q.slam_config, &filter_source);
+            core::namingSource(filter_source,
+                               [&] { (void)dynamic::makeFilterFromConfig(*filter_cfg); });
         }
         if (!q.path.empty() && !fs::exists(q.path))
             throw std::invalid_argument(path + " [" + s + "] path: no such file or folder '" +
                                         q.path + "'");
+        // A folder must be a TUM sequence (its lists are read now; a rawlog's frames are
+        // counted only when it is run, which reads it whole).
+        if (!q.path.empty() && fs::is_directory(q.path)) try {
+                (void)io::openRgbd(q.path);
+            } catch (const std::exception& e) {
+                throw std::invalid_argument(path + " [" + s + "] path: " + e.what());
+            }
+        // The scenario as devslam-synth finds it (a file, or a name in sim_worlds/synth): a
+        // name it does not know failed at the render, naming no INI.
+        if (!q.scenario.empty() && !fs::is_regular_file(q.scenario) &&
+            !fs::is_regular_file(kRoot + "/sim_worlds/synth/" + q.scenario + ".ini"))
+            throw std::invalid_argument(path + " [" + s + "] scenario: no scenario file '" +
+                                        q.scenario + "' and no sim_worlds/synth/" + q.scenario +
+                                        ".ini (devslam-synth --list shows the shipped ones)");
+        q.where = path + " [" + s + "]";
         // The name is a folder and a file name prefix, and a cell of runs.csv.
         if (q.name.empty() ||
             q.name.find_first_not_of(

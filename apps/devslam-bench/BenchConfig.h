@@ -14,6 +14,7 @@ namespace devslam::bench {
 
 struct Sequence {
     std::string name;      ///< table row label
+    std::string where;     ///< "<bench INI> [sequence_x]", for messages
     std::string path;      ///< real data: TUM folder or rawlog
     std::string scenario;  ///< synthetic: scenario name/file (rendered when missing)
     std::string slam_config;

@@ -225,7 +225,8 @@ std::string staleRun(const fs::path& dir, const std::string& made_from) {
 
 /// One devslam-synth call of the bench: its command line, the log its output goes to.
 struct RenderJob {
-    std::string what;  ///< "walking_xyz seed 11", for messages
+    std::string what;   ///< "walking_xyz seed 11", for messages
+    std::string where;  ///< the sequence's section, "<bench INI> [sequence_x]"
     std::string cmd;
     std::string log;
 };
@@ -263,8 +264,9 @@ void runRenders(const std::vector<RenderJob>& renders, int jobs) {
                 say("  render " + renders[i].what + " interrupted");
             } else if (rc != 0) {
                 if (failure.empty())
-                    failure = "devslam-synth failed for " + renders[i].what + " (" + endedBy(rc) +
-                              "):\n" + lastLines(renders[i].log, 5) +
+                    failure = "devslam-synth failed for " + renders[i].what + " of " +
+                              renders[i].where + " (" + endedBy(rc) + "):\n" +
+                              lastLines(renders[i].log, 5) +
                               "(whole output: " + renders[i].log + ")";
                 say("  render " + renders[i].what + " FAILED, see " + renders[i].log);
             } else {
@@ -381,6 +383,7 @@ void renderSequences(const Bench& b, const Args& a) {
         for (const auto& in : inputsOf(q, b.out_dir)) {
             RenderJob j;
             j.what = q.name + (in.seed ? " seed " + std::to_string(*in.seed) : std::string());
+            j.where = q.where;
             j.log = in.path + ".log";
             fs::create_directories(fs::path(in.path).parent_path());
             j.cmd = quote(a.bin + "/devslam-synth") + " " + quote(q.scenario) + " -o " +

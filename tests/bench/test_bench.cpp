@@ -601,6 +601,10 @@ TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
     };
     std::ofstream(tmp / "dup.ini") << "[tracker]\nmin_matches = 5\nmin_matches = 6\n";
     std::ofstream(tmp / "nofilter.ini") << "[run]\nfilter_config = nowhere_filter.ini\n";
+    // A SLAM INI whose filter INI names a detector there is not: it failed only the runs
+    // that detect, after the renders and the runs of mode none.
+    std::ofstream(tmp / "baddet_filter.ini") << "[detector]\ndetector = yolov9\n";
+    std::ofstream(tmp / "baddet.ini") << "[run]\nfilter_config = baddet_filter.ini\n";
     const std::string fr1 = "path = " + root + "/data/tum/fr1_xyz_first37\n";
     const std::string synth = "[sequence_a]\nscenario = short_walking\n";
     const std::string real = "[sequence_a]\n" + fr1;
@@ -620,6 +624,14 @@ TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
          "bench.ini [bench] modes: unknown mask mode 'Dynamic'"},
         {"[bench]\nmodes = none dynamic none\n" + real,
          "bench.ini [bench] modes: 'none' is listed twice"},
+        {"[bench]\nmodes =\n" + real, "bench.ini [bench] modes: empty"},
+        {real + "slam_config = " + (tmp / "baddet.ini").string() + "\n",
+         "baddet_filter.ini [detector] detector: unknown detector 'yolov9'"},
+        {"[sequence_a]\npath = " + root + "/data/tum\n",
+         "bench.ini [sequence_a] path: " + root + "/data/tum"},
+        {"[sequence_a]\nscenario = no_such_scenario\n",
+         "bench.ini [sequence_a] scenario: no scenario file 'no_such_scenario' and no "
+         "sim_worlds/synth/no_such_scenario.ini"},
         {"[sequence_a]\npath = " + root + "/data/tum/no_such_folder\n",
          "bench.ini [sequence_a] path: no such file or folder '"},
         {real + "slam_config = nowhere.ini\n", "bench.ini [sequence_a] slam_config: no such file"},
@@ -646,7 +658,8 @@ TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
         // A key the scenario does not know stops the bench at the render, before any run.
         // devslam-synth's own message reaches the bench's output (its log holds all of it).
         {synth + "set = person_1.sped=1\n",
-         "devslam-synth failed for a (exit 1):\n  devslam-synth: " + root +
+         "devslam-synth failed for a of " + (tmp / "bench.ini").string() +
+             " [sequence_a] (exit 1):\n  devslam-synth: " + root +
              "/sim_worlds/synth/short_walking.ini [person_1]: unknown key 'sped'"},
         {real + "[targets]\nx = a dynamic ate <=\n",
          "[targets] x: expected 'SEQUENCE MODE FIGURE OP VALUE'"},
@@ -682,9 +695,17 @@ TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
     EXPECT_NE(said.find("is not a Markdown file (.md)"), std::string::npos) << said;
     EXPECT_EQ(readFile(tmp / "bench.ini"), real);
     EXPECT_FALSE(fs::exists(tmp / "out/runs.csv")) << "nothing may run";
-    // A run that fails (here: a folder that is no TUM sequence) is counted and named; the
-    // results file keeps its last whole bench, and the exit status says so.
-    fs::create_directories(tmp / "not_tum");
+    // A run that fails (here: a TUM folder whose first colour image does not decode; a folder
+    // that is no TUM sequence is refused before any run) is counted and named; the results
+    // file keeps its last whole bench, and the exit status says so.
+    fs::copy(root + "/data/tum/fr1_xyz_first37", tmp / "not_tum", fs::copy_options::recursive);
+    {
+        std::ifstream list(tmp / "not_tum/rgb.txt");
+        std::string line;
+        while (std::getline(list, line) && (line.empty() || line[0] == '#')) {
+        }
+        std::ofstream(tmp / "not_tum" / line.substr(line.find(' ') + 1)) << "not a png";
+    }
     std::ofstream(tmp / "RESULTS.md") << "# Results\n";
     std::ofstream(tmp / "bench.ini")
         << "[bench]\nmodes = none\nrepeats = 1\n[sequence_a]\npath = " << (tmp / "not_tum").string()
@@ -697,7 +718,7 @@ TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
     EXPECT_EQ(WEXITSTATUS(std::system(cmd.c_str())), 1);
     const std::string log = readFile(tmp / "log.txt");
     EXPECT_NE(log.find("devslam-run failed (exit 1):\n  devslam-run: "), std::string::npos) << log;
-    EXPECT_NE(log.find("folder has no rgb.txt"), std::string::npos) << log;
+    EXPECT_NE(log.find("cannot decode colour image"), std::string::npos) << log;
     EXPECT_NE(log.find("  to run it again: '" + bin + "/devslam-run' --input '" +
                        (tmp / "not_tum").string() + "' --config "),
               std::string::npos)
