@@ -573,6 +573,22 @@ TEST(Rawlog, LaterObservationsNameTheFileAndObservation) {
                     R"(ext\.rawlog observation 2: external depth file '.*frame_2_depth\.bin' is )"
                     R"(damaged \(unexpected end of file\))");
     }
+    // Cut early (MRPT's own read fails) or not gzip at all: named as well (MRPT's message
+    // alone, "Cannot read requested number of bytes from stream", named no file).
+    const std::string whole_depth = [&] {
+        std::ifstream in(depth2, std::ios::binary);
+        return std::string(std::istreambuf_iterator<char>(in), {});
+    }();
+    for (const auto& [content, says] : std::vector<std::pair<std::string, std::string>>{
+             {whole_depth.substr(0, 100), "is damaged"}, {"junk\n", "does not decode"}}) {
+        std::ofstream(depth2, std::ios::binary | std::ios::trunc) << content;
+        io::RawlogReader r(path);
+        EXPECT_TRUE(r.next());
+        expectError([&] { (void)r.next(); }, R"(ext\.rawlog observation 1: )");  // the PNG
+        expectError([&] { (void)r.next(); },
+                    R"(ext\.rawlog observation 2: external depth file '.*frame_2_depth\.bin' )" +
+                        says);
+    }
     // A missing one is damage found at open: the frames before it stay usable.
     ASSERT_TRUE(fs::remove(d.str("ext_Images/frame_2_rgb.png")));
     expectError([&] { io::RawlogReader r(path); },

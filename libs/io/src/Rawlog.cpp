@@ -497,18 +497,35 @@ std::optional<core::Frame> RawlogReader::next() {
     const std::string what = path_ + " observation " + std::to_string(index);
     mrpt::img::CImage::setImagesPathBase(rawlogImagesDir(path_));
     core::Frame f;
+    // MRPT reads an external depth file with a plain gz read that stops quietly at a cut
+    // end, leaving the rest of the depth image unset (zeros or old memory); zlib finds it.
+    // "" when the depth is not external or its file is whole.
+    const auto depth_file_damage = [&]() -> std::string {
+        if (!o->hasRangeImage || !o->rangeImage_isExternallyStored()) return "";
+        const std::string p = o->rangeImage_getExternalStorageFileAbsolutePath("");
+        std::string gz = core::gzipDamage(p);
+        if (gz.empty()) return "";
+        if (gz.rfind(p + ": ", 0) == 0) gz.erase(0, p.size() + 2);  // zlib names it too
+        return what + ": external depth file '" + p + "' is damaged (" + gz + ")";
+    };
     try {
-        o->load();  // external images are decoded here (their presence was checked at open)
-        // MRPT reads an external depth file with a plain gz read that stops quietly at a cut
-        // end, leaving the rest of the depth image unset (zeros or old memory); zlib finds it.
-        if (o->hasRangeImage && o->rangeImage_isExternallyStored()) {
-            const std::string p = o->rangeImage_getExternalStorageFileAbsolutePath("");
-            if (std::string gz = core::gzipDamage(p); !gz.empty()) {
-                if (gz.rfind(p + ": ", 0) == 0) gz.erase(0, p.size() + 2);  // zlib names it too
-                throw std::runtime_error(what + ": external depth file '" + p + "' is damaged (" +
-                                         gz + ")");
-            }
+        try {
+            o->load();  // external images are decoded here (their presence was checked at open)
+        } catch (const std::exception& e) {
+            // A depth file cut early or garbled throws in there (load() reads the external
+            // depth; the colour image is read when used), with MRPT's message alone ("Cannot
+            // read requested number of bytes"): the file is named.
+            if (const std::string damage = depth_file_damage(); !damage.empty())
+                throw std::runtime_error(damage);
+            if (o->hasRangeImage && o->rangeImage_isExternallyStored())
+                throw std::runtime_error(
+                    what + ": external depth file '" +
+                    o->rangeImage_getExternalStorageFileAbsolutePath("") + "' does not decode (" +
+                    core::innermostMessage(e.what()) + ")");
+            throw;
         }
+        if (const std::string damage = depth_file_damage(); !damage.empty())
+            throw std::runtime_error(damage);
         f = frameFromObservation(*o, what);
     } catch (const std::exception& e) {
         o->unload();
