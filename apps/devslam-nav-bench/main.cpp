@@ -64,15 +64,15 @@ std::string methodList(const std::vector<std::string>& methods) {
 /// On std::cout when asked for (--help), on std::cerr after a bad command line.
 void usage(std::ostream& os = std::cerr) {
     os << "usage: devslam-nav-bench [options]\n"
-           "  --per-category N  worlds per category (default 50 -> 200 worlds)\n"
-           "  --quick           smoke test: 2 worlds per category, RESULTS.md untouched,\n"
-           "                    pictures in out/devslam-nav-bench unless --png-dir\n"
-           "  --methods a,b     holonomic methods (default all four)\n"
-           "  --config FILE     navigation INI (default config_ini/nav_reactive.ini)\n"
-           "  --results FILE    RESULTS.md to update (default docs/RESULTS.md; none: no file)\n"
-           "  --png-dir DIR     where PNGs go (default docs/images)\n"
-           "  --seed S          first world seed (default 1)\n"
-           "  --person-margin M [m] overrides the INI's [navigator] person_margin\n";
+          "  --per-category N  worlds per category (default 50 -> 200 worlds)\n"
+          "  --quick           smoke test: 2 worlds per category, RESULTS.md untouched,\n"
+          "                    pictures in out/devslam-nav-bench unless --png-dir\n"
+          "  --methods a,b     holonomic methods (default all four)\n"
+          "  --config FILE     navigation INI (default config_ini/nav_reactive.ini)\n"
+          "  --results FILE    RESULTS.md to update (default docs/RESULTS.md; none: no file)\n"
+          "  --png-dir DIR     where PNGs go (default docs/images)\n"
+          "  --seed S          first world seed (default 1)\n"
+          "  --person-margin M [m] overrides the INI's [navigator] person_margin\n";
 }
 
 struct Tally {

@@ -99,18 +99,18 @@ int planOnSlamMap(const std::string& map, const std::string& from, const std::st
 /// On std::cout when asked for (--help), on std::cerr after a bad command line.
 void usage(std::ostream& os = std::cerr) {
     os << "usage: devslam-nav WORLD.ini|random:CATEGORY:SEED [options]\n"
-           "  --config FILE   navigation INI (default config_ini/nav_reactive.ini)\n"
-           "  --method NAME   holonomic method: CHolonomicVFHPlus, CHolonomicND,\n"
-           "                  CHolonomicVFF, CHolonomicFullEval (default: the INI's\n"
-           "                  [navigator] holonomic_method)\n"
-           "  --png FILE      picture of the run (default out/devslam-nav/nav_<world>.png)\n"
-           "  --navlog DIR    also write MRPT's navlog into DIR\n"
-           "  --verbose       MRPT navigator messages (DEBUG level)\n"
-           "       devslam-nav --map GRIDMAP --to X,Y [--from X,Y] [--config FILE] [--png FILE]\n"
-           "  the global route (A* and waypoints, [global_planner] of --config) on a map\n"
-           "  devslam-run built (its map_grid.gridmap: x forward, y left, metres, the\n"
-           "  camera's start at 0,0, the default --from); picture in --png\n"
-           "  (default out/devslam-nav/plan.png)\n";
+          "  --config FILE   navigation INI (default config_ini/nav_reactive.ini)\n"
+          "  --method NAME   holonomic method: CHolonomicVFHPlus, CHolonomicND,\n"
+          "                  CHolonomicVFF, CHolonomicFullEval (default: the INI's\n"
+          "                  [navigator] holonomic_method)\n"
+          "  --png FILE      picture of the run (default out/devslam-nav/nav_<world>.png)\n"
+          "  --navlog DIR    also write MRPT's navlog into DIR\n"
+          "  --verbose       MRPT navigator messages (DEBUG level)\n"
+          "       devslam-nav --map GRIDMAP --to X,Y [--from X,Y] [--config FILE] [--png FILE]\n"
+          "  the global route (A* and waypoints, [global_planner] of --config) on a map\n"
+          "  devslam-run built (its map_grid.gridmap: x forward, y left, metres, the\n"
+          "  camera's start at 0,0, the default --from); picture in --png\n"
+          "  (default out/devslam-nav/plan.png)\n";
 }
 }  // namespace
 
@@ -149,8 +149,7 @@ static int appMain(int argc, char** argv) {
             else if (a == "--from") {
                 from = next();
                 from_given = true;
-            }
-            else if (a == "--to")
+            } else if (a == "--to")
                 to = next();
             else if (a == "-h" || a == "--help") {
                 usage(std::cout);

@@ -1022,17 +1022,29 @@ TEST(Scenario, ShippedFilesLoadAndTyposAreReported) {
                 withEdit(text, "n_frames        = 60", "n_frames = 60\ntexture_filter = cubic"));
         },
         "[scenario] texture_filter: must be linear or nearest, got 'cubic'");
+    // A person photo without alpha is named by the file, section and key that give it (the
+    // renderer named only the image).
+    (void)withEdit(text, "n_frames", "n_frames");  // s.ini (= base) as it was
+    std::ofstream(tmp.str("cut.png"), std::ios::binary)
+        << readFile(kRoot + "/data/textures/person_standing.png").substr(0, 200);
+    for (const auto& [image, says] : std::vector<std::pair<std::string, std::string>>{
+             {kRoot + "/data/images/person.jpg", "': need an RGBA PNG (alpha = person)"},
+             {tmp.str("cut.png"), "': cannot read"}})
+        expectMessage(
+            [&] { (void)loadScenario(base, {"person_1.texture=" + image}); },
+            tmp.str("s.ini") + " with --set [person_1] texture: person texture '" + image + says);
     expectMessage([&] { (void)loadScenario(withEdit(text, "kind    = walking", "kind = flying")); },
                   tmp.str("s.ini") + " [person_1] kind: unknown person kind 'flying'");
     (void)withEdit(text, "n_frames", "n_frames");  // s.ini (= base) as it was
     // Each range error names its own key (they named the first key of a pair).
     expectMessage([&] { (void)loadScenario(base, {"depth_noise.sigma_b=-1"}); },
-                  tmp.str("s.ini") + " [depth_noise] sigma_b: must be >= 0");
-    expectMessage([&] { (void)loadScenario(base, {"trajectory.elevation_period=0"}); },
-                  tmp.str("s.ini") + " [trajectory] elevation_period: must be in [0.1, 1e5] [s]");
+                  tmp.str("s.ini") + " with --set [depth_noise] sigma_b: must be >= 0");
+    expectMessage(
+        [&] { (void)loadScenario(base, {"trajectory.elevation_period=0"}); },
+        tmp.str("s.ini") + " with --set [trajectory] elevation_period: must be in [0.1, 1e5] [s]");
     // Bounds (fuzz): values no camera or sensor comes near, which rendered nonsense silently.
     expectMessage([&] { (void)loadScenario(base, {"trajectory.period=[7 9 1e-300]"}); },
-                  tmp.str("s.ini") + " [trajectory] period: must be in [0.1, 1e5] [s]");
+                  tmp.str("s.ini") + " with --set [trajectory] period: must be in [0.1, 1e5] [s]");
     expectMessage([&] { (void)loadScenario(base, {"trajectory.rot_period=[5 1e300 8]"}); },
                   "[trajectory] rot_period: must be in [0.1, 1e5] [s]");
     expectMessage([&] { (void)loadScenario(base, {"trajectory.rot_amplitude_deg=[1 1 1e6]"}); },
@@ -1040,23 +1052,23 @@ TEST(Scenario, ShippedFilesLoadAndTyposAreReported) {
     expectMessage([&] { (void)loadScenario(base, {"trajectory.azimuth_amplitude_deg=400"}); },
                   "[trajectory] azimuth_amplitude_deg: must be in [-180, 180] [deg]");
     expectMessage([&] { (void)loadScenario(base, {"scenario.rgb_noise_sigma=1e300"}); },
-                  tmp.str("s.ini") + " [scenario] rgb_noise_sigma: must be in [0, 255]");
+                  tmp.str("s.ini") + " with --set [scenario] rgb_noise_sigma: must be in [0, 255]");
     EXPECT_NO_THROW((void)loadScenario(
         base, {"trajectory.period=[0.1 1e5 11]", "trajectory.rot_amplitude_deg=[-90 90 0]",
                "scenario.rgb_noise_sigma=255"}));
     // A key given with no value is refused, not read as the built-in default (look_at = took
     // [4 2.5 1.0] over the file's value, name = wrote into out/synth/ itself).
     expectMessage([&] { (void)loadScenario(base, {"trajectory.look_at="}); },
-                  tmp.str("s.ini") + " [trajectory] look_at: expected 3 numbers, got 0");
+                  tmp.str("s.ini") + " with --set [trajectory] look_at: expected 3 numbers, got 0");
     expectMessage([&] { (void)loadScenario(base, {"scenario.name="}); },
-                  tmp.str("s.ini") + " [scenario] name: must be a non-empty name");
+                  tmp.str("s.ini") + " with --set [scenario] name: must be a non-empty name");
     // A halfsphere orbit over the top would turn the view over between two frames.
     expectMessage(
         [&] {
             (void)loadScenario(
                 base, {"trajectory.type=halfsphere", "trajectory.elevation_amplitude_deg=120"});
         },
-        tmp.str("s.ini") + " [trajectory] elevation_amplitude_deg: the orbit reaches");
+        tmp.str("s.ini") + " with --set [trajectory] elevation_amplitude_deg: the orbit reaches");
     // A duration shorter than half a frame is no sequence at all (it wrote empty lists).
     expectMessage(
         [&] {
@@ -1070,7 +1082,7 @@ TEST(Scenario, ShippedFilesLoadAndTyposAreReported) {
     // one stamp (each overwrote the last), rate_hz = 1e-300 gave 300-digit stamps.
     (void)withEdit(text, "n_frames", "n_frames");  // s.ini (= base) as it was
     expectMessage([&] { (void)loadScenario(base, {"scenario.n_frames=1000000000"}); },
-                  tmp.str("s.ini") + " [scenario] n_frames: must be at most 100000");
+                  tmp.str("s.ini") + " with --set [scenario] n_frames: must be at most 100000");
     expectMessage([&] { (void)loadScenario(base, {"scenario.n_frames=100001"}); },
                   "[scenario] n_frames: must be at most 100000");
     EXPECT_EQ(loadScenario(base, {"scenario.n_frames=100000"}).n_frames, 100000u);
@@ -1079,11 +1091,11 @@ TEST(Scenario, ShippedFilesLoadAndTyposAreReported) {
         tmp.str("s.ini") + " [scenario] duration: gives more than 100000 frames");
     (void)withEdit(text, "n_frames", "n_frames");  // s.ini (= base) as it was
     expectMessage([&] { (void)loadScenario(base, {"scenario.t0=1e300"}); },
-                  tmp.str("s.ini") + " [scenario] t0: must be in [0, 1e10] [s]");
+                  tmp.str("s.ini") + " with --set [scenario] t0: must be in [0, 1e10] [s]");
     expectMessage([&] { (void)loadScenario(base, {"scenario.t0=-1"}); },
                   "[scenario] t0: must be in [0, 1e10] [s]");
     expectMessage([&] { (void)loadScenario(base, {"scenario.rate_hz=1e-300"}); },
-                  tmp.str("s.ini") + " [scenario] rate_hz: must be in [1, 1000] [Hz]");
+                  tmp.str("s.ini") + " with --set [scenario] rate_hz: must be in [1, 1000] [Hz]");
     expectMessage([&] { (void)loadScenario(base, {"scenario.rate_hz=1001"}); },
                   "[scenario] rate_hz: must be in [1, 1000] [Hz]");
     expectMessage(
@@ -1128,36 +1140,39 @@ TEST(Scenario, ShippedFilesLoadAndTyposAreReported) {
     EXPECT_NO_THROW((void)loadScenario(base, {"person_2.gesture_pivot=[0.8,0.2]"}));
     // A bob or sway no person makes.
     expectMessage([&] { (void)loadScenario(base, {"person_2.bob=-5"}); },
-                  tmp.str("s.ini") + " [person_2] bob: must be in [0, 0.3] [m]");
+                  tmp.str("s.ini") + " with --set [person_2] bob: must be in [0, 0.3] [m]");
     expectMessage([&] { (void)loadScenario(base, {"person_2.bob=1e9"}); }, "bob: must be in");
     expectMessage([&] { (void)loadScenario(base, {"person_2.sway_deg=90"}); },
                   "[person_2] sway_deg: must be in [-45, 45] [deg]");
     // The camera's sections name the file too, and are checked when loaded, not at the render.
     expectMessage([&] { (void)loadScenario(base, {"trajectory.typ=xyz"}); },
-                  tmp.str("s.ini") + " [trajectory]: unknown key 'typ'");
-    expectMessage([&] { (void)loadScenario(base, {"trajectory.look_at=[0.6 2.5 0.2]"}); },
-                  tmp.str("s.ini") + " [trajectory] look_at: straight above or below position");
+                  tmp.str("s.ini") + " with --set [trajectory]: unknown key 'typ'");
+    expectMessage(
+        [&] { (void)loadScenario(base, {"trajectory.look_at=[0.6 2.5 0.2]"}); },
+        tmp.str("s.ini") + " with --set [trajectory] look_at: straight above or below position");
     expectMessage([&] { (void)loadScenario(base, {"camera.dist=[0 0 x 0 0]"}); },
-                  tmp.str("s.ini") + " [camera] dist: 'x' is not a number");
+                  tmp.str("s.ini") + " with --set [camera] dist: 'x' is not a number");
     expectMessage([&] { (void)loadScenario(base, {"camera.dist=[0 0 0 0]"}); },
                   "[camera] dist: must have 5 values");
     // Names the key, and refuses what would take gigabytes before the first frame.
     expectMessage([&] { (void)loadScenario(base, {"camera.preset=fr9"}); },
-                  tmp.str("s.ini") + " [camera] preset: unknown camera preset 'fr9'");
-    expectMessage([&] { (void)loadScenario(base, {"trajectory.type=spiral"}); },
-                  tmp.str("s.ini") + " [trajectory] type: unknown trajectory type 'spiral'");
+                  tmp.str("s.ini") + " with --set [camera] preset: unknown camera preset 'fr9'");
+    expectMessage(
+        [&] { (void)loadScenario(base, {"trajectory.type=spiral"}); },
+        tmp.str("s.ini") + " with --set [trajectory] type: unknown trajectory type 'spiral'");
     expectMessage([&] { (void)loadScenario(base, {"camera.width=16000"}); },
-                  tmp.str("s.ini") + " [camera] width/height: must be 1..4096 [px]");
+                  tmp.str("s.ini") + " with --set [camera] width/height: must be 1..4096 [px]");
     expectMessage(
         [&] {
             (void)loadScenario(
                 base, {"camera.width=4", "camera.height=4", "camera.cx=1.5", "camera.cy=1.5"});
         },
-        tmp.str("s.ini") + " [camera] width/height: must be at least 8 px");
+        tmp.str("s.ini") + " with --set [camera] width/height: must be at least 8 px");
     // Depth a TUM PNG cannot hold (16 bits of 1/5000 m) failed at the first far frame, after
     // the old outputs were gone.
-    expectMessage([&] { (void)loadScenario(base, {"depth_noise.max_range=20"}); },
-                  tmp.str("s.ini") + " [depth_noise] max_range: must be at most 13.107 m");
+    expectMessage(
+        [&] { (void)loadScenario(base, {"depth_noise.max_range=20"}); },
+        tmp.str("s.ini") + " with --set [depth_noise] max_range: must be at most 13.107 m");
     EXPECT_NO_THROW((void)loadScenario(base, {"depth_noise.enabled=false"}));
     expectMessage(
         [&] {
@@ -1168,16 +1183,16 @@ TEST(Scenario, ShippedFilesLoadAndTyposAreReported) {
         "[scenario] far_clip: with [depth_noise] enabled = false the depth reaches");
     (void)withEdit(text, "n_frames", "n_frames");  // s.ini (= base) as it was
     expectMessage([&] { (void)loadScenario(base, {"scenario.n_frames=0"}); },
-                  tmp.str("s.ini") + " [scenario] n_frames: must be >= 1");
+                  tmp.str("s.ini") + " with --set [scenario] n_frames: must be >= 1");
     // Clip planes that ruin the depth: near_clip 0.001 put it 4 cm off and lost person
     // pixels, far_clip 1e300 rendered no depth and nobody; both went without a word.
     expectMessage([&] { (void)loadScenario(base, {"scenario.near_clip=0.001"}); },
-                  tmp.str("s.ini") + " [scenario] near_clip: must be >= 0.01 [m]");
+                  tmp.str("s.ini") + " with --set [scenario] near_clip: must be >= 0.01 [m]");
     expectMessage([&] { (void)loadScenario(base, {"scenario.far_clip=1e300"}); },
-                  tmp.str("s.ini") + " [scenario] far_clip: must be <= 1e4 [m]");
+                  tmp.str("s.ini") + " with --set [scenario] far_clip: must be <= 1e4 [m]");
     EXPECT_NO_THROW((void)loadScenario(base, {"scenario.near_clip=0.01", "scenario.far_clip=1e4"}));
     expectMessage([&] { (void)loadScenario(base, {"person_9.speed=1"}); },  // a new person
-                  tmp.str("s.ini") + " [person_9] kind: missing");
+                  tmp.str("s.ini") + " with --set [person_9] kind: missing");
     expectMessage([&] { (void)loadScenario(base, {"scenario.room=nowhere.ini"}); },
                   tmp.str("s.ini") + " [scenario] room: no such file '");
     // room_set: written over the room file's [room] and [box_*] settings, checked like them.

@@ -1,5 +1,6 @@
 #include <devslam/core/Config.h>
 #include <devslam/core/Parse.h>
+#include <devslam/render/PersonTexture.h>
 #include <devslam/render/Scenario.h>
 
 #include <mrpt/config/CConfigFileBase.h>
@@ -200,6 +201,13 @@ PersonSpec loadPerson(const mrpt::config::CConfigFileBase& cfg, const std::strin
         resolveImages(requiredText(cfg, s, "texture"), dirOf(path), where + " texture");
     if (tex.size() != 1) throw std::invalid_argument(where + " texture: need exactly one file");
     p.texture = tex.front();
+    // Read now, so that an image without alpha or one that does not decode is named by its
+    // file, section and key (the renderer, which reads it again, knew only the image).
+    try {
+        (void)loadPersonTexture(p.texture);
+    } catch (const std::exception& e) {
+        throw std::invalid_argument("[" + s + "] texture: " + e.what());  // the file is added
+    }
     p.height = core::readDouble(cfg, s, "height", p.height);
     p.speed = core::readDouble(cfg, s, "speed", p.speed);
     p.start_offset = core::readDouble(cfg, s, "start_offset", p.start_offset);
@@ -412,7 +420,9 @@ Scenario readScenario(const std::string& path, const std::vector<std::string>& o
 }  // namespace
 
 Scenario loadScenario(const std::string& path, const std::vector<std::string>& overrides) {
-    return core::namingSource(path, [&] { return readScenario(path, overrides); });
+    // As devslam-run says it: a key --set wrote is not blamed on the file alone.
+    return core::namingSource(overrides.empty() ? path : path + " with --set",
+                              [&] { return readScenario(path, overrides); });
 }
 
 }  // namespace devslam::render
