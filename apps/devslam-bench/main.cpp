@@ -557,11 +557,12 @@ struct Tables {
     std::ostringstream c1, c2, c3, c4;      ///< the CSV files of t1-t4
     std::map<std::string, std::vector<std::string>> plots;      ///< sequence -> modes with a plot
     std::vector<std::pair<fs::path, fs::path>> results_images;  ///< copied beside RESULTS.md
+    int filter_rows = 0;                                        ///< rows of t4
 };
 
 /// Copies the plot of the run of `v` whose ATE is nearest the median (with an even number of
 /// runs the median lies between two) into the output folder as <seq>_<mode>_trajectory.png,
-/// and lists it for RESULTS.md's images when there is a results file.
+/// and lists it (for tables.md), and for RESULTS.md's images when there is a results file.
 void keepMedianPlot(const Bench& b, const Sequence& q, const std::string& m,
                     const std::vector<RunFigures>& v, const std::string& results, Tables& t) {
     const double target = med(v, &RunFigures::ate_rmse);
@@ -581,12 +582,13 @@ void keepMedianPlot(const Bench& b, const Sequence& q, const std::string& m,
     if (ec)
         std::cerr << "devslam-bench: warning: plot not copied to " << dst.string() << " ("
                   << ec.message() << ")\n";
+    else
+        t.plots[q.name].push_back(m);
     // Beside RESULTS.md, for its figures (the diagnostic truth mode's plots stay in the
     // results folder).
     if (!results.empty() && m != "truth") {  // copied with the section, if whole
         const fs::path img = fs::path(results).parent_path() / "images";
         t.results_images.emplace_back(src, img / ("bench_" + q.name + "_" + m + ".png"));
-        t.plots[q.name].push_back(m);
     }
 }
 
@@ -606,6 +608,7 @@ void filterRow(const Sequence& q, const std::string& m, const std::vector<RunFig
         return n > 0 ? pct(med(v, frac)) + " of " + fmt(n, 0) : std::string(none);
     };
     const bool walkers = med(v, &R::moving_instances) > 0;
+    ++t.filter_rows;
     t.t4 << "| " << q.name << " | " << m << " | "
          << ofInstances(&R::moving_recall, &R::moving_instances, "n/a (no walkers)") << " | "
          << (walkers ? pct(med(v, &R::moving_area_recall)) : "n/a") << " | "
@@ -682,17 +685,27 @@ Tables makeTables(const Bench& b, const Runs& runs, const std::string& results) 
     return t;
 }
 
-/// The trajectory plots beside RESULTS.md, a table per sequence.
-std::string plotsMarkdown(const Tables& t) {
+/// The trajectory plots, a table per sequence: those beside RESULTS.md (`beside_results`:
+/// images/bench_<seq>_<mode>.png, truth's left out) or those in the output folder, beside
+/// tables.md (<seq>_<mode>_trajectory.png; its links were RESULTS.md's, which it has not).
+/// "" when there is none.
+std::string plotsMarkdown(const Tables& t, bool beside_results) {
     std::ostringstream figs;
-    for (const auto& [seq, modes] : t.plots) {
+    for (const auto& [seq, all] : t.plots) {
+        std::vector<std::string> modes;
+        for (const auto& m : all)
+            if (!beside_results || m != "truth") modes.push_back(m);
+        if (modes.empty()) continue;
         figs << "| " << seq << " |";
         for (const auto& m : modes) figs << " " << m << " |";
         figs << "\n|---|";
         for (std::size_t k = 0; k < modes.size(); ++k) figs << "---|";
         figs << "\n| |";
         for (const auto& m : modes)
-            figs << " ![" << seq << " " << m << "](images/bench_" << seq << "_" << m << ".png) |";
+            figs << " ![" << seq << " " << m << "]("
+                 << (beside_results ? "images/bench_" + seq + "_" + m + ".png"
+                                    : seq + "_" + m + "_trajectory.png")
+                 << ") |";
         figs << "\n\n";
     }
     return figs.str();
@@ -805,9 +818,11 @@ std::string scenesLine(const Bench& b) {
 }
 
 /// The bench's section: how it was measured, the targets, Tables 1-3, the filter's table,
-/// the plots and the paper's figures for reference (tables.md, RESULTS.md's `bench`).
+/// the plots and the paper's figures for reference: RESULTS.md's `bench` (`beside_results`,
+/// its plots in images/) or tables.md (its plots beside it).
 std::string sectionMarkdown(const Args& a, const Bench& b, const Runs& runs, const Tables& t,
-                            const std::string& targets_md) {
+                            const std::string& targets_md, bool beside_results) {
+    const std::string plots = plotsMarkdown(t, beside_results);
     std::ostringstream md;
     md << "## Dynamic-SLAM benchmark: the paper's Tables 1-3 (`devslam-bench`)\n\n"
        << "Measured " << core::measuredOnLine() << " by `devslam-bench --config "
@@ -852,14 +867,19 @@ std::string sectionMarkdown(const Args& a, const Bench& b, const Runs& runs, con
                      t.t5.str())
        << "\n**Table 3: speed** (wall clock, whole pipeline with the detector)\n\n"
        << t.t3.str()
-       << "\n**Filter against the renderer's person truth**: the masks the SLAM runs used, "
-          "scored by `devslam-run` frame by frame (medians over the runs). A person counts as "
-          "masked in a frame when at least half of its visible pixels are masked; people with "
-          "fewer than 500 visible pixels are not counted.\n\n"
-       << t.t4.str()
-       << "\n**Trajectories** (estimate vs ground truth after alignment, the run with the median "
-          "ATE)\n\n"
-       << plotsMarkdown(t)
+       << (t.filter_rows == 0
+               ? std::string("\n**Filter against the renderer's person truth**: no row (no "
+                             "run of a filter on a sequence with person truth, i.e. a "
+                             "render).\n")
+               : "\n**Filter against the renderer's person truth**: the masks the SLAM runs "
+                 "used, scored by `devslam-run` frame by frame (medians over the runs). A person "
+                 "counts as masked in a frame when at least half of its visible pixels are "
+                 "masked; people with fewer than 500 visible pixels are not counted.\n\n" +
+                     t.t4.str())
+       << (plots.empty() ? std::string("\n")
+                         : "\n**Trajectories** (estimate vs ground truth after alignment, the "
+                           "run with the median ATE)\n\n" +
+                               plots)
        << "For reference, the paper's figures on the real TUM fr3 sequences (not comparable one "
           "to one: "
           "different scenes and sensors): walking_xyz ATE RMSE ORB-SLAM2 0.197 m (paper re-run), "
@@ -975,7 +995,10 @@ int run(int argc, char** argv) {
     const Runs runs = runSlam(b, a);
     const Tables t = makeTables(b, runs, a.results);
     const auto [targets_md, targets_csv] = checkTargets(b, runs);
-    const std::string md = sectionMarkdown(a, b, runs, t, targets_md);
+    // RESULTS.md's section (its plots in images/ beside it), and tables.md's (in the output
+    // folder, beside its plots); the standard output shows the one of the file written.
+    const std::string md = sectionMarkdown(a, b, runs, t, targets_md, true);
+    const std::string tables_md = sectionMarkdown(a, b, runs, t, targets_md, false);
 
     const fs::path out(b.out_dir);
     for (const auto& [name, text] :
@@ -984,13 +1007,13 @@ int run(int argc, char** argv) {
                                                           {"table2_ate.csv", t.c2.str()},
                                                           {"table3_fps.csv", t.c3.str()},
                                                           {"filter_truth.csv", t.c4.str()},
-                                                          {"tables.md", md}})
+                                                          {"tables.md", tables_md}})
         core::writeFileWhole((out / name).string(), text);
     if (!b.targets.empty())
         core::writeFileWhole((out / "targets.csv").string(), targets_csv);
     else
         fs::remove(out / "targets.csv");  // an earlier bench's, for targets no longer asked
-    std::cout << md;
+    std::cout << (a.results.empty() ? tables_md : md);
     if (!runs.failed.empty()) {
         // The tables count them as failed runs; a results file keeps its last whole bench.
         std::cerr << "devslam-bench: " << runs.failed.size() << " of " << runs.total

@@ -114,6 +114,8 @@ TEST(DevslamBench, TwoFrameSmokeRunOfTheWholeCommand) {
             << line;
     for (const char* f : {"table1_rpe.csv", "table3_fps.csv", "filter_truth.csv", "tables.md"})
         EXPECT_TRUE(fs::exists(tmp / "out" / f)) << f;
+    // Two frames give no ATE, so no run has a plot: no Trajectories heading over nothing.
+    EXPECT_EQ(readFile(tmp / "out/tables.md").find("**Trajectories**"), std::string::npos);
     const std::string filter = readFile(tmp / "out/filter_truth.csv");
     EXPECT_EQ(countLines(filter), 1u + 2u + 2u) << filter;  // {short, sit} x {all_persons, dynamic}
     // A sequence without walkers has no walker figures (not "0 % of 0").
@@ -759,6 +761,16 @@ TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
     EXPECT_NE(readFile(tmp / "whole/runs/a/none/r0/log.txt").find("frames     : 32 "),
               std::string::npos)
         << readFile(tmp / "whole/runs/a/none/r0/log.txt");
+    // tables.md shows the plots beside it in the output folder (it linked RESULTS.md's
+    // images/, which that folder has not); with no filter run on a render, its table is a
+    // line, not a header over no rows.
+    const std::string whole_md = readFile(tmp / "whole/tables.md");
+    EXPECT_NE(whole_md.find("![a none](a_none_trajectory.png)"), std::string::npos) << whole_md;
+    EXPECT_TRUE(fs::exists(tmp / "whole/a_none_trajectory.png"));
+    EXPECT_EQ(whole_md.find("images/"), std::string::npos) << whole_md;
+    EXPECT_NE(whole_md.find("person truth**: no row"), std::string::npos) << whole_md;
+    EXPECT_NE(readFile(tmp / "log.txt").find("![a none](a_none_trajectory.png)"),
+              std::string::npos);
     // A scenario file is found from the bench INI's folder, as `path` is (devslam-synth
     // looked in the working directory): run from another one.
     fs::create_directories(tmp / "conf");
