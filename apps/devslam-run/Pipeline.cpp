@@ -335,13 +335,18 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
         rep.keyframes ? static_cast<double>(slam.map().approxBytes()) / rep.keyframes : 0.0;
 
     rep.ground_truth = reader.groundTruth();
+    if (rep.ground_truth && rep.trajectory.size() < 3)
+        rep.ate_missing = std::to_string(rep.trajectory.size()) + " poses (the ATE needs 3)";
     if (rep.ground_truth && rep.trajectory.size() >= 3) {
         try {
             rep.ate = eval::computeAte(*rep.ground_truth, rep.trajectory);
             eval::RpeOptions one_s;
             rep.rpe_1s = eval::computeRpe(*rep.ground_truth, rep.trajectory, one_s);
-        } catch (const std::invalid_argument&) {
-            // Too short for a 1 s delta (or no association): reported as absent.
+        } catch (const std::invalid_argument& e) {
+            // Too short for a 1 s delta (or no association): reported as absent. Without an
+            // ATE the reason is kept (ground truth of another sequence, stamps in other
+            // units): run.json alone did not tell it from a folder without ground truth.
+            if (!rep.ate) rep.ate_missing = e.what();
         }
         try {
             eval::RpeOptions per_frame;
@@ -563,7 +568,7 @@ std::string formatSummary(const RunReport& r) {
           << num(r.ate->trans.max, 4) << " m (" << r.ate->trans.count
           << " poses, lost frames included)\n";
     } else if (r.ground_truth) {
-        o << "ATE        : not computed (too few associated poses)\n";
+        o << "ATE        : not computed (" << r.ate_missing << ")\n";
     } else {
         o << "ATE        : no ground truth\n";
     }
@@ -652,6 +657,7 @@ std::string toJson(const RunReport& r) {
       << ",\n  \"map_mb\": " << num(r.map_mb, 3)
       << ",\n  \"bytes_per_keyframe\": " << num(r.bytes_per_keyframe, 0);
     if (r.ate) o << ",\n  \"ate\": " << summaryJson(r.ate->trans);
+    if (!r.ate && r.ground_truth) o << ",\n  \"ate_missing\": \"" << esc(r.ate_missing) << "\"";
     if (const auto e = loopErrors(r.loop_reports); !e.empty())
         o << ",\n  \"loop_error_m\": " << summaryJson(core::summarize(e));
     if (r.mask_score) {

@@ -97,6 +97,9 @@ struct RunReport {
     core::Trajectory trajectory, keyframe_trajectory;
     std::optional<core::Trajectory> ground_truth;
     std::optional<eval::AteResult> ate;
+    /// Why there is no `ate` though there is ground truth (too few poses, no pose associated
+    /// with the ground truth's stamps); "" otherwise.
+    std::string ate_missing;
     std::optional<eval::RpeResult> rpe_1s, rpe_frame;
     double median_fps = 0, mean_fps = 0, median_ms = 0;
     double median_cpu_ms = 0;  ///< process CPU time per frame, all threads (load-independent)

@@ -17,6 +17,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <iomanip>
 #include <iterator>
 #include <memory>
 #include <regex>
@@ -654,6 +655,41 @@ TEST(DevslamRun, CtrlCStopsTheRunAndKeepsTheFramesDone) {
 
 // A frame whose image is there but does not decode is found only when it is read: the run
 // stops there, keeps (writes) the frames before it, names the file and exits with 1.
+// Ground truth whose stamps match no frame (another sequence's, stamps in other units): the
+// run says why there is no ATE, in its summary and in run.json, which alone did not tell it
+// from a folder without ground truth.
+TEST(DevslamRun, GroundTruthThatMatchesNoFrameSaysWhyThereIsNoAte) {
+    const fs::path dir = devslam::test::scratchPath("devslam_run_gt_off");
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    fs::copy(std::string(DEVSLAM_SOURCE_DIR) + "/data/tum/fr1_xyz_first37", dir / "seq",
+             fs::copy_options::recursive);
+    {
+        std::ifstream in(dir / "seq" / "groundtruth.txt");
+        std::ostringstream shifted;
+        for (std::string line; std::getline(in, line);) {
+            if (line.empty() || line[0] == '#') {
+                shifted << line << "\n";
+                continue;
+            }
+            const auto space = line.find(' ');
+            shifted << std::fixed << std::setprecision(4) << std::stod(line.substr(0, space)) + 1000
+                    << line.substr(space) << "\n";
+        }
+        in.close();
+        std::ofstream(dir / "seq" / "groundtruth.txt") << shifted.str();
+    }
+    const auto r = run("--input " + (dir / "seq").string() + " --mode none --max-frames 8 --out " +
+                       (dir / "run").string());
+    EXPECT_EQ(r.rc, 0) << r.out;
+    const std::string why = "only 0 of 8 estimated poses associate with the ground truth";
+    EXPECT_NE(r.out.find("ATE        : not computed (ATE: " + why), std::string::npos) << r.out;
+    const std::string js = readText(dir / "run" / "run.json");
+    EXPECT_NE(js.find("\"ate_missing\": \"ATE: " + why), std::string::npos) << js;
+    EXPECT_EQ(js.find("\"ate\":"), std::string::npos) << js;
+    fs::remove_all(dir);
+}
+
 TEST(DevslamRun, AnUndecodableFrameMidRunKeepsTheFramesBeforeIt) {
     const fs::path dir = devslam::test::scratchPath("devslam_run_undecodable");
     fs::remove_all(dir);
