@@ -270,6 +270,7 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
         const auto br = slam.backendStep(mr, cur->K);
         fl.ms.backend = msSince(t0);
         fl.state = slam::toString(tr.state);
+        if (!tr.pose_valid) fl.lost_reason = tr.reason;
         fl.n_inliers = tr.n_inliers;
         fl.keyframe = mr.keyframe_inserted;
         fl.ba_rejected = mr.ba.rejected;
@@ -335,9 +336,17 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
         rep.keyframes ? static_cast<double>(slam.map().approxBytes()) / rep.keyframes : 0.0;
 
     rep.ground_truth = reader.groundTruth();
+    // The ATE counts the lost frames' poses (motion-model predictions), but only beside
+    // tracked ones: a run that never initialised (all-black frames, depth in other units)
+    // scored its identity poses against the truth and printed that as its ATE.
+    const std::size_t tracked =
+        rep.trajectory.size() - std::min(rep.lost.size(), rep.trajectory.size());
     if (rep.ground_truth && rep.trajectory.size() < 3)
         rep.ate_missing = std::to_string(rep.trajectory.size()) + " poses (the ATE needs 3)";
-    if (rep.ground_truth && rep.trajectory.size() >= 3) {
+    else if (rep.ground_truth && tracked < 3)
+        rep.ate_missing = std::to_string(tracked) + " of " + std::to_string(rep.trajectory.size()) +
+                          " frames tracked (the ATE needs 3)";
+    if (rep.ground_truth && rep.ate_missing.empty()) {
         try {
             rep.ate = eval::computeAte(*rep.ground_truth, rep.trajectory);
             eval::RpeOptions one_s;
@@ -408,8 +417,13 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
         });
         {
             std::ostringstream lf;  // each file written whole, or an error
-            lf << "# index timestamp (frames without a tracked pose)\n";
-            for (std::size_t i : rep.lost) lf << i << " " << num(rep.trajectory[i].t, 6) << "\n";
+            lf << "# index timestamp reason (frames without a tracked pose)\n";
+            for (std::size_t i : rep.lost) {
+                lf << i << " " << num(rep.trajectory[i].t, 6);
+                if (i < rep.log.size() && !rep.log[i].lost_reason.empty())
+                    lf << " " << rep.log[i].lost_reason;
+                lf << "\n";
+            }
             write(out("lost_frames.txt"),
                   [&] { core::writeFileWhole(out("lost_frames.txt"), lf.str()); });
         }
@@ -526,6 +540,11 @@ std::string formatSummary(const RunReport& r) {
         for (std::size_t i = 0; i < r.lost.size() && i < 20; ++i) o << " " << r.lost[i];
         if (r.lost.size() > 20) o << " ...";
         o << ")";
+        // Why, for the first of them (lost_frames.txt and run.json give each frame's): 32 lost
+        // frames that never initialised said nothing of the 0 keypoints with depth.
+        const std::size_t first = r.lost.front();
+        if (first < r.log.size() && !r.log[first].lost_reason.empty())
+            o << "\n             first (" << first << "): " << r.log[first].lost_reason;
     }
     o << "\n";
     if (r.ba_rejected > 0)
@@ -680,7 +699,10 @@ std::string toJson(const RunReport& r) {
     for (std::size_t i = 0; i < r.log.size(); ++i) {
         const auto& l = r.log[i];
         o << (i ? ",\n    " : "\n    ") << "{\"index\": " << l.index << ", \"t\": " << num(l.t, 6)
-          << ", \"state\": \"" << l.state << "\", \"features\": " << l.n_features
+          << ", \"state\": \"" << l.state << "\""
+          << (l.lost_reason.empty() ? std::string()
+                                    : ", \"reason\": \"" + esc(l.lost_reason) + "\"")
+          << ", \"features\": " << l.n_features
           << ", \"masked\": " << l.n_masked << ", \"masked_area\": " << num(l.masked_fraction, 3);
         if (l.walker_px >= 0)
             o << ", \"walker_px\": " << num(l.walker_px, 0)

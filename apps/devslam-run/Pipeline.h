@@ -48,6 +48,7 @@ struct FrameLog {
     std::size_t index = 0;
     double t = 0;
     std::string state, keyframe_reason;
+    std::string lost_reason;  ///< why the frame has no tracked pose ("" when tracked)
     int n_features = 0, n_masked = 0, n_inliers = 0, n_boxes = 0, n_moving = 0;
     double masked_fraction = 0;  ///< of the image, by the dynamic mask
     /// With the renderer's person truth: the walking people's visible pixels in the frame and

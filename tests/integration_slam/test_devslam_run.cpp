@@ -655,10 +655,10 @@ TEST(DevslamRun, CtrlCStopsTheRunAndKeepsTheFramesDone) {
 
 // A frame whose image is there but does not decode is found only when it is read: the run
 // stops there, keeps (writes) the frames before it, names the file and exits with 1.
-// Ground truth whose stamps match no frame (another sequence's, stamps in other units): the
-// run says why there is no ATE, in its summary and in run.json, which alone did not tell it
-// from a folder without ground truth.
-TEST(DevslamRun, GroundTruthThatMatchesNoFrameSaysWhyThereIsNoAte) {
+// Ground truth whose stamps match no frame (another sequence's, stamps in other units), or no
+// frame tracked: the run says why there is no ATE, in its summary and in run.json, which
+// alone did not tell it from a folder without ground truth.
+TEST(DevslamRun, WithoutAnAteTheRunSaysWhy) {
     const fs::path dir = devslam::test::scratchPath("devslam_run_gt_off");
     fs::remove_all(dir);
     fs::create_directories(dir);
@@ -687,6 +687,26 @@ TEST(DevslamRun, GroundTruthThatMatchesNoFrameSaysWhyThereIsNoAte) {
     const std::string js = readText(dir / "run" / "run.json");
     EXPECT_NE(js.find("\"ate_missing\": \"ATE: " + why), std::string::npos) << js;
     EXPECT_EQ(js.find("\"ate\":"), std::string::npos) << js;
+    // Nor is there an ATE when no frame was tracked (depth read in the wrong units: no
+    // keypoint has depth): it scored the untracked identity poses against the truth (0.12 m).
+    // Each lost frame says why, in the summary, lost_frames.txt and run.json.
+    const auto lost = run("--mode none --max-frames 5 --set dataset.tum_depth_scale=1e300 --out " +
+                          (dir / "lost").string());
+    EXPECT_EQ(lost.rc, 0) << lost.out;
+    EXPECT_NE(lost.out.find("ATE        : not computed (0 of 5 frames tracked (the ATE needs 3))"),
+              std::string::npos)
+        << lost.out;
+    EXPECT_NE(lost.out.find("first (0): not initialized: 0 keypoints with depth"),
+              std::string::npos)
+        << lost.out;
+    EXPECT_EQ(lost.out.find("RPE"), std::string::npos) << lost.out;
+    EXPECT_NE(readText(dir / "lost" / "lost_frames.txt")
+                  .find(" not initialized: 0 keypoints with depth\n"),
+              std::string::npos);
+    const std::string lost_js = readText(dir / "lost" / "run.json");
+    EXPECT_NE(lost_js.find("\"reason\": \"not initialized: 0 keypoints with depth\""),
+              std::string::npos);
+    EXPECT_NE(lost_js.find("\"ate_missing\": \"0 of 5 frames tracked"), std::string::npos);
     fs::remove_all(dir);
 }
 
