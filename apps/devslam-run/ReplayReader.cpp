@@ -9,7 +9,10 @@ namespace devslam::run {
 ReplayReader::ReplayReader(io::RgbdReader& source, int passes) : K_(source.intrinsics()) {
     if (passes < 1) throw std::invalid_argument("replay: passes must be >= 1");
     while (auto f = source.next()) frames_.push_back(std::move(*f));
-    if (frames_.size() < 2) throw std::invalid_argument("replay: the source has < 2 frames");
+    if (frames_.size() < 2)
+        throw std::invalid_argument("--replay: " + source.describe() + " has " +
+                                    std::to_string(frames_.size()) +
+                                    " frame(s); a replay needs 2 or more");
     const double dt = (frames_.back().timestamp - frames_.front().timestamp) /
                       static_cast<double>(frames_.size() - 1);
     const auto n = frames_.size();
