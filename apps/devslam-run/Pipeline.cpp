@@ -203,6 +203,10 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
             // step are the program's, and end it.)
             rep.read_error = e.what();
             break;
+        } catch (const std::invalid_argument& e) {
+            // A frame the filter refuses (smaller than its flow window): the input named, as
+            // a reader's error names it.
+            throw std::invalid_argument(rc.input + ": " + e.what());
         }
         // Reading/decoding the next frame is not part of the pipeline time.
         const auto t_read = Clock::now();

@@ -2,6 +2,7 @@
 #include <devslam/core/Results.h>
 #include <devslam/io/Rawlog.h>
 #include <devslam/io/TumReader.h>
+#include <devslam/io/TumWriter.h>
 
 #include <gtest/gtest.h>
 
@@ -707,6 +708,34 @@ TEST(DevslamRun, WithoutAnAteTheRunSaysWhy) {
     EXPECT_NE(lost_js.find("\"reason\": \"not initialized: 0 keypoints with depth\""),
               std::string::npos);
     EXPECT_NE(lost_js.find("\"ate_missing\": \"0 of 5 frames tracked"), std::string::npos);
+    fs::remove_all(dir);
+}
+
+// A frame the dynamic filter refuses (smaller than its flow window) names the input, as a
+// reader's error does ("devslam-run: dynamic filter: frame 0 is 16x12 px" named none).
+TEST(DevslamRun, AFrameTheFilterRefusesNamesTheInput) {
+    const fs::path dir = devslam::test::scratchPath("devslam_run_tiny");
+    fs::remove_all(dir);
+    {
+        devslam::io::TumWriter w((dir / "seq").string());
+        for (std::size_t i = 0; i < 2; ++i) {
+            devslam::core::Frame f;
+            f.index = i;
+            f.timestamp = 100.0 + 0.1 * static_cast<double>(i);
+            f.bgr = cv::Mat(12, 16, CV_8UC3, cv::Scalar(40, 90, 160));
+            f.depth = cv::Mat(12, 16, CV_32FC1, cv::Scalar(2.0f));
+            f.K = {13.0, 13.0, 7.5, 5.5, 16, 12};
+            w.write(f);
+        }
+        w.close();
+    }
+    const auto r = run("--input " + (dir / "seq").string() +
+                       " --mode dynamic --set dataset.camera=auto --quiet --out ''");
+    EXPECT_EQ(r.rc, 1) << r.out;
+    EXPECT_NE(r.out.find("devslam-run: " + (dir / "seq").string() +
+                         ": dynamic filter: frame 0 is 16x12 px"),
+              std::string::npos)
+        << r.out;
     fs::remove_all(dir);
 }
 
