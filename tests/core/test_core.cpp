@@ -511,6 +511,16 @@ TEST(Config, NulByteIsRefusedWithItsLine) {
         EXPECT_EQ(std::string(e.what()),
                   path + " line 3: a NUL byte (a binary file, or a damaged INI)");
     }
+    // Another control byte (a binary file given for the INI): its line and code, not the raw
+    // bytes as an unknown "key".
+    std::ofstream(path, std::ios::binary) << "[a]\nk = 1\n\x0f\x8b\x03 = 1\n";
+    try {
+        (void)loadIni(path);
+        FAIL() << "no error for a control byte";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_EQ(std::string(e.what()),
+                  path + " line 3: control byte 0x0f (a binary file, or a damaged INI)");
+    }
 }
 
 // A UTF-8 byte-order mark (Windows editors write one) made line 1 "neither a [section] nor

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cctype>
 #include <charconv>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -53,6 +54,18 @@ void refuseMisreadLines(const std::string& text, const std::string& path) {
         if (line.find('\0') != std::string::npos)
             throw std::invalid_argument(path + " line " + std::to_string(n) +
                                         ": a NUL byte (a binary file, or a damaged INI)");
+        // Nor another control byte: a binary file given for the INI was refused for its first
+        // "key", the raw bytes in the message.
+        for (const char ch : line) {
+            const auto c = static_cast<unsigned char>(ch);
+            if ((c < 0x20 && c != '\r' && c != '\t') || c == 0x7f) {
+                char code[8];
+                std::snprintf(code, sizeof code, "0x%02x", c);
+                throw std::invalid_argument(path + " line " + std::to_string(n) +
+                                            ": control byte " + code +
+                                            " (a binary file, or a damaged INI)");
+            }
+        }
         if (!line.empty() && line.back() == '\r') line.pop_back();
         const bool continuation = continued;
         continued = !line.empty() && line.back() == '\\';  // MRPT joins only there
