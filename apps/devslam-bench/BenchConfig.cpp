@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <limits>
+#include <set>
 #include <sstream>
 #include <stdexcept>
 
@@ -83,6 +84,7 @@ Bench readBench(const std::string& path) {
     b.slam_config = resolve(cfg->read_string("bench", "slam_config", b.slam_config), base);
     core::requireValue(b.repeats >= 1 && b.repeats <= 100, "bench", "repeats", "must be 1..100");
     core::requireKnownSections(*cfg, {"bench", "sequence_*", "targets"}, path);
+    std::set<std::string> checked_configs;  // SLAM INIs read and their filter made, below
     // In the file's order: the tables list the sequences as the user wrote them.
     for (const auto& s : core::sectionsInFileOrder(*cfg, path)) {
         if (s.rfind("sequence_", 0) != 0) continue;  // [bench], [targets]
@@ -108,7 +110,8 @@ Bench readBench(const std::string& path) {
         // INI stopped the bench there, hours into it, with no table. The filter and its
         // detector are made from them too: a mistyped [detector] key or a missing weights
         // file failed only the runs that detect, after the renders and the other modes' runs.
-        {
+        // (Once per SLAM INI: most sequences share one, and each check loads the detector.)
+        if (checked_configs.insert(q.slam_config).second) {
             std::string filter_source;
             const auto filter_cfg = core::loadFilterConfig(q.slam_config, &filter_source);
             core::namingSource(filter_source,

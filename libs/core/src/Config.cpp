@@ -49,22 +49,16 @@ void refuseMisreadLines(const std::string& text, const std::string& path) {
     };
     for (std::string line; std::getline(in, line);) {
         ++n;
-        // A NUL byte hid a key from the checks ("bogus_key\0 = 1" passed requireKnownKeys):
-        // no INI holds one, so it is refused where it is.
-        if (line.find('\0') != std::string::npos)
-            throw std::invalid_argument(path + " line " + std::to_string(n) +
-                                        ": a NUL byte (a binary file, or a damaged INI)");
-        // Nor another control byte: a binary file given for the INI was refused for its first
-        // "key", the raw bytes in the message.
+        // No INI holds a control byte, so one is refused where it is: a NUL hid a key from the
+        // checks ("bogus_key\0 = 1" passed requireKnownKeys), and a binary file given for the
+        // INI was refused for its first "key", the raw bytes in the message.
         for (const char ch : line) {
             const auto c = static_cast<unsigned char>(ch);
-            if ((c < 0x20 && c != '\r' && c != '\t') || c == 0x7f) {
-                char code[8];
-                std::snprintf(code, sizeof code, "0x%02x", c);
-                throw std::invalid_argument(path + " line " + std::to_string(n) +
-                                            ": control byte " + code +
-                                            " (a binary file, or a damaged INI)");
-            }
+            if ((c >= 0x20 && c != 0x7f) || c == '\r' || c == '\t') continue;
+            char code[24];
+            std::snprintf(code, sizeof code, c == 0 ? "a NUL byte" : "control byte 0x%02x", c);
+            throw std::invalid_argument(path + " line " + std::to_string(n) + ": " + code +
+                                        " (a binary file, or a damaged INI)");
         }
         if (!line.empty() && line.back() == '\r') line.pop_back();
         const bool continuation = continued;

@@ -497,16 +497,19 @@ std::optional<core::Frame> RawlogReader::next() {
     const std::string what = path_ + " observation " + std::to_string(index);
     mrpt::img::CImage::setImagesPathBase(rawlogImagesDir(path_));
     core::Frame f;
-    // MRPT reads an external depth file with a plain gz read that stops quietly at a cut
-    // end, leaving the rest of the depth image unset (zeros or old memory); zlib finds it.
-    // "" when the depth is not external or its file is whole.
+    // The external depth file, "" when the depth is stored inside the rawlog. MRPT reads it
+    // with a plain gz read that stops quietly at a cut end, leaving the rest of the depth image
+    // unset (zeros or old memory); zlib finds that: `depth_file_damage` is its message, "" for
+    // a whole file.
+    const std::string depth_file = o->hasRangeImage && o->rangeImage_isExternallyStored()
+                                       ? o->rangeImage_getExternalStorageFileAbsolutePath("")
+                                       : std::string();
     const auto depth_file_damage = [&]() -> std::string {
-        if (!o->hasRangeImage || !o->rangeImage_isExternallyStored()) return "";
-        const std::string p = o->rangeImage_getExternalStorageFileAbsolutePath("");
-        std::string gz = core::gzipDamage(p);
+        if (depth_file.empty()) return "";
+        std::string gz = core::gzipDamage(depth_file);
         if (gz.empty()) return "";
-        if (gz.rfind(p + ": ", 0) == 0) gz.erase(0, p.size() + 2);  // zlib names it too
-        return what + ": external depth file '" + p + "' is damaged (" + gz + ")";
+        if (gz.rfind(depth_file + ": ", 0) == 0) gz.erase(0, depth_file.size() + 2);  // zlib's
+        return what + ": external depth file '" + depth_file + "' is damaged (" + gz + ")";
     };
     try {
         try {
@@ -515,14 +518,12 @@ std::optional<core::Frame> RawlogReader::next() {
             // A depth file cut early or garbled throws in there (load() reads the external
             // depth; the colour image is read when used), with MRPT's message alone ("Cannot
             // read requested number of bytes"): the file is named.
-            if (const std::string damage = depth_file_damage(); !damage.empty())
-                throw std::runtime_error(damage);
-            if (o->hasRangeImage && o->rangeImage_isExternallyStored())
-                throw std::runtime_error(
-                    what + ": external depth file '" +
-                    o->rangeImage_getExternalStorageFileAbsolutePath("") + "' does not decode (" +
-                    core::innermostMessage(e.what()) + ")");
-            throw;
+            if (depth_file.empty()) throw;
+            const std::string damage = depth_file_damage();
+            throw std::runtime_error(!damage.empty() ? damage
+                                                     : what + ": external depth file '" +
+                                                           depth_file + "' does not decode (" +
+                                                           core::innermostMessage(e.what()) + ")");
         }
         if (const std::string damage = depth_file_damage(); !damage.empty())
             throw std::runtime_error(damage);
