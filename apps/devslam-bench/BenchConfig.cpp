@@ -216,7 +216,7 @@ Bench loadBench(const std::string& path) {
 }
 
 bool runsMode(const Sequence& q, const std::string& out_dir, const std::string& mode) {
-    return mode != "truth" || eval::PersonTruth::available(inputsOf(q, out_dir).front().path);
+    return mode != "truth" || eval::PersonTruth::hasWalkers(inputsOf(q, out_dir).front().path);
 }
 
 }  // namespace devslam::bench

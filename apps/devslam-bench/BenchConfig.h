@@ -59,7 +59,10 @@ struct Bench {
 [[nodiscard]] Bench loadBench(const std::string& path);
 
 /// devslam-run's diagnostic mode `truth` (the renderer's walkers as the mask) needs the
-/// person truth that devslam-synth writes; sequences without it skip that mode.
+/// person truth that devslam-synth writes, and someone walking in it: sequences without
+/// truth skip that mode, and so do renders without walkers, where its mask is empty in
+/// every frame and its run would repeat mode `none`'s to the digit. Call it once the first
+/// render exists.
 [[nodiscard]] bool runsMode(const Sequence& q, const std::string& out_dir, const std::string& mode);
 
 }  // namespace devslam::bench

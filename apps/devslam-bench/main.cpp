@@ -851,7 +851,9 @@ std::string sectionMarkdown(const Args& a, const Bench& b, const Runs& runs, con
                ? std::string("Mode `truth` is a diagnostic, not a method: the SLAM gets the "
                              "renderer's walking people (their pixels, dilated by the filter's "
                              "mask_margin) as the mask, i.e. what a perfect filter would give. "
-                             "It bounds what any mask can do on a sequence (synthetic only).\n\n")
+                             "It bounds what any mask can do on a sequence (synthetic "
+                             "sequences where someone walks: elsewhere its mask is empty and "
+                             "the run is `none`'s).\n\n")
                : std::string())
        << targets_md << "**Table 1: RPE**\n\n"
        << t.t1.str() << "\n**Table 2: ATE**\n\n"

@@ -545,7 +545,9 @@ TEST(MaskScore, PersonTruthOfAFolder) {
         p << "# t id name state x y w h visible\n1.000000 1 p moving 0 0 10 10 100\n";
     }
     EXPECT_FALSE(eval::PersonTruth::open(dir.string()).has_value());  // no labels/ (--no-labels)
+    EXPECT_FALSE(eval::PersonTruth::hasWalkers(dir.string()));  // no truth, no walkers
     fs::create_directories(dir / "labels");
+    EXPECT_TRUE(eval::PersonTruth::hasWalkers(dir.string()));
     const auto truth = eval::PersonTruth::open(dir.string());
     ASSERT_TRUE(truth.has_value());
     eval::MaskScore s;
@@ -592,10 +594,17 @@ TEST(MaskScore, PersonTruthOfAFolder) {
             << e.what();
     }
     {
+        // Seated people only: mode truth's mask would be empty in every frame.
+        std::ofstream p(dir / "persons.txt");
+        p << "1.000000 1 p static 0 0 10 10 100\n2.000000 1 p static 0 0 10 10 90\n";
+    }
+    EXPECT_FALSE(eval::PersonTruth::hasWalkers(dir.string()));
+    {
         std::ofstream p(dir / "persons.txt");
         p << "1.0 1 p walking 0 0 10 10 100\n";  // bad state
     }
     EXPECT_THROW((void)eval::PersonTruth::open(dir.string()), std::runtime_error);
+    EXPECT_THROW((void)eval::PersonTruth::hasWalkers(dir.string()), std::runtime_error);
     fs::remove_all(dir);
 }
 

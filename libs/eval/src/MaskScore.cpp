@@ -101,6 +101,15 @@ bool PersonTruth::available(const std::string& folder) {
            fs::is_directory(fs::path(folder) / "labels");
 }
 
+bool PersonTruth::hasWalkers(const std::string& folder) {
+    if (!available(folder)) return false;
+    for (const auto& [stamp, persons] :
+         readPersons((std::filesystem::path(folder) / "persons.txt").string()))
+        for (const auto& p : persons)
+            if (p.moving) return true;
+    return false;
+}
+
 std::optional<PersonTruth> PersonTruth::open(const std::string& folder) {
     if (!available(folder)) return std::nullopt;
     PersonTruth t;

@@ -86,6 +86,10 @@ class PersonTruth {
     /// Whether `folder` has both parts of the truth (persons.txt and labels/), without
     /// reading them: what open() checks first.
     [[nodiscard]] static bool available(const std::string& folder);
+    /// Whether `folder` has the truth and its persons.txt lists a walking person in some
+    /// frame. Without one, walkerMask() is empty in every frame (mode `truth` is mode
+    /// `none` there). Throws on a malformed persons.txt, as open() does.
+    [[nodiscard]] static bool hasWalkers(const std::string& folder);
     /// Adds the frame at `timestamp` to `score`. Throws naming the file when the frame has
     /// no truth (a missing label image or persons.txt entry), or when a non-empty `mask` and
     /// the label image differ in size.
