@@ -154,7 +154,9 @@ std::optional<int> parseArgs(int argc, char** argv, Args& a) {
                 std::cout << kUsage
                           << "  the detectors and the dynamic-object filter on synthetic and "
                              "shipped frames;\n  writes the 'detect' section of --results "
-                             "(default docs/RESULTS.md)\n";
+                             "(default docs/RESULTS.md)\n"
+                             "  defaults: --threads 1 (OpenCV threads), --frames 30 (of each "
+                             "synthetic sequence),\n  --config config_ini/dynamic_filter.ini\n";
                 return 0;
             } else {
                 std::cerr << "devslam-filter-bench: unknown argument '" << k << "'\n" << kUsage;

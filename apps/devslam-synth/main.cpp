@@ -35,7 +35,7 @@ using namespace devslam;
 namespace {
 
 const char* kUsage =
-    "usage: devslam-synth SCENARIO [-o DIR] [--rawlog FILE] [--frames N] [--no-labels]\n"
+    "usage: devslam-synth SCENARIO [-o|--out DIR] [--rawlog FILE] [--frames N] [--no-labels]\n"
     "                     [--seed N]  (another render of the scenario: noise, panel crops)\n"
     "                     [--if-changed]  (skip when DIR already holds this exact render)\n"
     "                     [--set SECTION.KEY=VALUE]...  (over the scenario file's settings)\n"

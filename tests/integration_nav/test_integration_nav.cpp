@@ -217,6 +217,37 @@ TEST(IntegrationNav, AStarPlusVfhInBulletWorld) {
     EXPECT_GT(r.path_length, 6.5);  // straight-line distance is 7.0 m (minus the tolerance)
 }
 
+// A robot whose edge starts 2 cm from a wall never moves: MRPT's navigator needs
+// secure_distance_start x ref_distance of free path (12.5 cm with the shipped INI). The world
+// check cannot know that (it does not see the navigation INI), so the run times out; its
+// reason now says the robot stood at its start and names the wall, where it said only "not
+// at the goal". A run that drove but ran out of time says nothing of the kind.
+TEST(IntegrationNav, ATimeoutStandingAtTheStartSaysWhy) {
+    devslam::nav::registerNavClasses();
+    const auto ini = devslam::core::loadIni(kIni);
+    const auto opts = devslam::nav::NavigatorOptions::fromConfig(*ini, kIni);
+    auto world = devslam::sim::loadWorld(kSrc + "/sim_worlds/obstacle_near_goal.ini");
+    world.timeout = 3;  // [s] far too short to reach the goal, 7 m away
+    const auto drove = devslam::sim::runEpisode(world, *ini, opts, {});
+    ASSERT_EQ(drove.outcome, devslam::sim::Outcome::Timeout) << drove.reason;
+    EXPECT_GT(drove.path_length, 0.3);
+    EXPECT_EQ(drove.reason, "not at the goal after 3 s");
+    // The west wall's face is at x = 0.1 m; the robot (radius 0.25 m) starts 2 cm from it.
+    world.robot.start.x = 0.1 + 0.25 + 0.02;
+    const auto stood = devslam::sim::runEpisode(world, *ini, opts, {});
+    ASSERT_EQ(stood.outcome, devslam::sim::Outcome::Timeout) << stood.reason;
+    EXPECT_LT(stood.path_length, 0.02);
+    EXPECT_NE(stood.reason.find("not at the goal after 3 s: the robot never left its start "
+                                "(it moved "),
+              std::string::npos)
+        << stood.reason;
+    EXPECT_NE(stood.reason.find("; its edge starts 2.00 cm from obstacle 'boundary_west', less "
+                                "than the navigator's secure distance (secure_distance_start x "
+                                "ref_distance = 12.50 cm of free path to move)"),
+              std::string::npos)
+        << stood.reason;
+}
+
 // The INI's [navigator] holonomic_method is the method used unless the episode names another
 // (devslam-nav --method, the bench); until session 33 the episode's default always won.
 TEST(IntegrationNav, TheIniChoosesTheHolonomicMethod) {

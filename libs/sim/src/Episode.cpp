@@ -2,15 +2,20 @@
 #include <devslam/sim/SimRobot.h>
 #include <devslam/sim/Simulator.h>
 
+#include <devslam/core/Config.h>
 #include <devslam/core/Picture.h>
 #include <devslam/nav/GridPlanner.h>
 #include <devslam/nav/RoutePicture.h>
 
 #include <mrpt/core/Clock.h>
+#include <mrpt/nav/reactive/CAbstractPTGBasedReactive.h>
 
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <string>
+#include <vector>
 #include <sstream>
 
 namespace devslam::sim {
@@ -33,6 +38,33 @@ class SimulatedClock {
   private:
     mrpt::Clock::Source previous_;
 };
+
+/// Why a run that timed out never left its start, "" when it did (moved more than 2 cm).
+/// MRPT's navigator does not drive off a start within its secure distance of an obstacle
+/// (`secure_distance_start` x `ref_distance` of free path: 12.5 cm with the shipped INI,
+/// which stopped a robot whose edge started 1-6 cm from a wall, docs/sim.md). The world
+/// check cannot refuse such a start, as it does not see the navigation INI; before this the
+/// run only said "not at the goal".
+std::string standingReason(double farthest, const mrpt::math::TPoint2D& start, double radius,
+                           const std::vector<Obstacle>& statics, double secure) {
+    if (farthest > 0.02) return "";
+    std::ostringstream why;
+    why.precision(2);
+    why << std::fixed << ": the robot never left its start (it moved " << farthest * 100
+        << " cm)";
+    const Obstacle* nearest = nullptr;
+    double edge = 0;  // [m] robot edge to the nearest obstacle at the start
+    for (const auto& o : statics) {
+        const double d = distanceToObstacle(o, start) - radius;
+        if (!nearest || d < edge) nearest = &o, edge = d;
+    }
+    if (nearest && edge < secure)
+        why << "; its edge starts " << edge * 100 << " cm from obstacle '" << nearest->name
+            << "', less than the navigator's secure distance (secure_distance_start x "
+               "ref_distance = "
+            << secure * 100 << " cm of free path to move): start it farther away";
+    return why.str();
+}
 }  // namespace
 
 const char* toString(Outcome o) {
@@ -65,6 +97,12 @@ EpisodeResult runEpisode(const WorldSpec& world, const mrpt::config::CConfigFile
     const auto statics = staticObstacles(world);
     nav::Navigator navigator(robot, nav_ini, nav_opts);
     res.holonomic_method = navigator.holonomicMethod();
+    // [m] the free path MRPT's navigator needs to move at all (its default where unset).
+    const double secure =
+        core::readDouble(nav_ini, "CAbstractPTGBasedReactive", "secure_distance_start",
+                         mrpt::nav::CAbstractPTGBasedReactive::TAbstractPTGNavigatorParams()
+                             .secure_distance_start) *
+        navigator.refDistance();
     res.navlog = navigator.logPath();
     // Closed at every return: a navlog cut short is said, with the run.
     const auto closeLog = [&] { res.navlog_error = navigator.closeLog(); };
@@ -98,11 +136,14 @@ EpisodeResult runEpisode(const WorldSpec& world, const mrpt::config::CConfigFile
 
     double next_nav = 0, next_rec = 0;
     auto prev = sim.robotPose();
+    const auto start = prev;
+    double farthest = 0;  // [m] from the start: a timeout standing there is said
     const double r = world.robot.radius;
     while (true) {
         const double t = sim.time();
         const auto p = sim.robotPose();
         res.path_length += std::hypot(p.x - prev.x, p.y - prev.y);
+        farthest = std::max(farthest, std::hypot(p.x - start.x, p.y - start.y));
         prev = p;
         for (const auto& o : statics)
             res.min_clearance_static =
@@ -129,7 +170,10 @@ EpisodeResult runEpisode(const WorldSpec& world, const mrpt::config::CConfigFile
         }
         if (t >= world.timeout) {
             res.outcome = Outcome::Timeout;
-            res.reason = "not at the goal after " + std::to_string(world.timeout) + " s";
+            std::ostringstream why;  // "60 s", not to_string's "60.000000 s"
+            why << "not at the goal after " << world.timeout << " s"
+                << standingReason(farthest, {start.x, start.y}, r, statics, secure);
+            res.reason = why.str();
             break;
         }
         if (t + 1e-9 >= next_nav) {
