@@ -14,9 +14,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <string>
 #include <vector>
-#include <sstream>
 
 namespace devslam::sim {
 
