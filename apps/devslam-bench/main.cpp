@@ -467,9 +467,11 @@ Runs runSlam(const Bench& b, const Args& a) {
     std::size_t done = 0;
     std::map<std::string, std::string> hashes;  // file -> content hash, for command.txt
     for (const auto& q : b.sequences)
-        for (const auto& m : b.modes)
+        for (const auto& m : b.modes) {
+            // Once per sequence and mode, not per run: for mode truth it reads persons.txt.
+            if (!runsMode(q, b.out_dir, m)) continue;
             for (const auto& in : inputsOf(q, b.out_dir))
-                for (int r = 0; r < repeatsOf(b, q) && runsMode(q, b.out_dir, m); ++r) {
+                for (int r = 0; r < repeatsOf(b, q); ++r) {
                     const std::string seed = in.seed ? std::to_string(*in.seed) : std::string();
                     const fs::path dir = fs::path(b.out_dir) / "runs" / q.name / m / runLeaf(in, r);
                     fs::create_directories(dir);
@@ -533,6 +535,7 @@ Runs runSlam(const Bench& b, const Args& a) {
                     runs.of[{q.name, m}].push_back(f);
                     runs.csv += csvRow(q, m, seed, r, f);
                 }
+        }
     return runs;
 }
 
