@@ -50,14 +50,9 @@ std::string standingReason(double farthest, const mrpt::math::TPoint2D& start, d
     if (farthest > 0.02) return "";
     std::ostringstream why;
     why.precision(2);
-    why << std::fixed << ": the robot never left its start (it moved " << farthest * 100
-        << " cm)";
-    const Obstacle* nearest = nullptr;
-    double edge = 0;  // [m] robot edge to the nearest obstacle at the start
-    for (const auto& o : statics) {
-        const double d = distanceToObstacle(o, start) - radius;
-        if (!nearest || d < edge) nearest = &o, edge = d;
-    }
+    why << std::fixed << ": the robot never left its start (it moved " << farthest * 100 << " cm)";
+    const Obstacle* nearest = nearestObstacle(statics, start);
+    const double edge = nearest ? distanceToObstacle(*nearest, start) - radius : 0;  // [m]
     if (nearest && edge < secure)
         why << "; its edge starts " << edge * 100 << " cm from obstacle '" << nearest->name
             << "', less than the navigator's secure distance (secure_distance_start x "

@@ -376,9 +376,7 @@ void validateEndpoints(const WorldSpec& w, const std::vector<Obstacle>& statics)
               std::tuple{"start", "robot", "start_x", start}}) {
             const double c = planner.clearance(p);
             if (c >= w.robot.radius) continue;
-            const Obstacle* nearest = &statics.front();
-            for (const auto& o : statics)
-                if (distanceToObstacle(o, p) < distanceToObstacle(*nearest, p)) nearest = &o;
+            const Obstacle* nearest = nearestObstacle(statics, p);  // statics is not empty
             std::ostringstream m;
             m << "the " << what << " is " << distanceToObstacle(*nearest, p) << " m from obstacle '"
               << nearest->name << "', but on the planner's " << w.grid_resolution
@@ -518,6 +516,17 @@ double distanceToObstacle(const Obstacle& o, const mrpt::math::TPoint2D& p) {
     const double qx = std::abs(lx) - o.sx / 2, qy = std::abs(ly) - o.sy / 2;
     const double outside = std::hypot(std::max(qx, 0.0), std::max(qy, 0.0));
     return outside + std::min(std::max(qx, qy), 0.0);
+}
+
+const Obstacle* nearestObstacle(const std::vector<Obstacle>& obstacles,
+                                const mrpt::math::TPoint2D& p) {
+    const Obstacle* nearest = nullptr;
+    double d_min = 0;
+    for (const auto& o : obstacles) {
+        const double d = distanceToObstacle(o, p);
+        if (!nearest || d < d_min) nearest = &o, d_min = d;
+    }
+    return nearest;
 }
 
 mrpt::maps::COccupancyGridMap2D rasterize(const WorldSpec& w) {

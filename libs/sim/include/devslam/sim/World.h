@@ -97,5 +97,8 @@ void validateWorld(const WorldSpec& w);
 [[nodiscard]] std::vector<Obstacle> staticObstacles(const WorldSpec& w);
 /// [m] distance from p to the surface of obstacle o (negative inside).
 [[nodiscard]] double distanceToObstacle(const Obstacle& o, const mrpt::math::TPoint2D& p);
+/// The obstacle whose surface is nearest p (the first of equals); nullptr when there is none.
+[[nodiscard]] const Obstacle* nearestObstacle(const std::vector<Obstacle>& obstacles,
+                                              const mrpt::math::TPoint2D& p);
 
 }  // namespace devslam::sim
