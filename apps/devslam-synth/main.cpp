@@ -52,6 +52,9 @@ const std::string kSynthDir = std::string(DEVSLAM_SOURCE_DIR) + "/sim_worlds/syn
 
 std::string resolveScenario(const std::string& arg) {
     if (fs::is_regular_file(arg)) return arg;
+    // A path is not a name ("no '.../synth//tmp/x.ini.ini'" was no help).
+    if (arg.find('/') != std::string::npos || core::endsWithNoCase(arg, ".ini"))
+        throw std::invalid_argument("no scenario file '" + arg + "'");
     const std::string p = kSynthDir + "/" + arg + ".ini";
     if (fs::is_regular_file(p)) return p;
     throw std::invalid_argument("no scenario file '" + arg + "' and no '" + p +
@@ -232,6 +235,9 @@ int main(int argc, char** argv) {
     int rc = 1;
     try {
         rc = run(argc, argv);
+    } catch (const std::bad_alloc&) {  // (it said only "std::bad_alloc")
+        std::cerr << "devslam-synth: out of memory (the scenario's image size, or its "
+                     "texture photos: each wall panel keeps its own crop)\n";
     } catch (const std::exception& e) {
         std::cerr << "devslam-synth: " << e.what() << "\n";
     }

@@ -715,6 +715,25 @@ TEST(RenderGeometry, ATinyTextureIsRefusedNamingTheFile) {
                   "render: texture '" + tiny + "' is 4x4 px; at least 8x8 needed");
 }
 
+// A 24 MP wall photo took 7.7 GB and 10 s a frame (each panel keeps its own crop), and a
+// 144 MP one ran out of memory naming no file; a person photo that large, the same.
+TEST(RenderGeometry, AHugeTextureIsRefusedNamingTheFile) {
+    TempDir tmp;
+    const std::string huge = tmp.str("huge.png");
+    ASSERT_TRUE(cv::imwrite(huge, cv::Mat(8, kMaxTextureSide + 1, CV_8UC3, cv::Scalar(1, 2, 3))));
+    auto sc = bareRoom({1.0, 2.0, 1.5}, {4.0, 2.0, 1.5});
+    sc.room.floor_textures = {huge};
+    expectMessage([&] { SequenceRenderer r(sc); },
+                  "render: texture '" + huge + "' is 2049x8 px; at most 2048 px per side");
+    const std::string person = tmp.str("person.png");
+    ASSERT_TRUE(cv::imwrite(person, cv::Mat(kMaxTextureSide + 1, 8, CV_8UC4, cv::Scalar::all(255))));
+    expectMessage([&] { (void)loadPersonTexture(person); },
+                  "person texture '" + person + "' is 8x2049 px; at most 2048 px per side");
+    // The largest allowed side still loads.
+    ASSERT_TRUE(cv::imwrite(person, cv::Mat(kMaxTextureSide, 8, CV_8UC4, cv::Scalar::all(255))));
+    EXPECT_EQ(loadPersonTexture(person).bgr.rows, kMaxTextureSide);
+}
+
 TEST(RenderSequence, PersonTruthIsConsistent) {
     SequenceRenderer r(smallShort());
     const auto f = r.render(30);
@@ -1131,7 +1150,7 @@ TEST(Scenario, ShippedFilesLoadAndTyposAreReported) {
     expectMessage([&] { (void)gesture("[0.7,0.2,1,0.6]", "[0.8,1.2]"); },
                   "[person_2] gesture_pivot: must be [across down]");
     expectMessage([&] { (void)loadScenario(base, {"person_2.gesture_period=0"}); },
-                  "[person_2] gesture_period: must be > 0 [s]");
+                  "[person_2] gesture_period: must be in [0.1, 1e5] [s]");
     // Given without a gesture (gesture_deg 0), a region or pivot is checked all the same.
     expectMessage([&] { (void)loadScenario(base, {"person_2.gesture_region=bogus"}); },
                   "[person_2] gesture_region: 'bogus' is not a number");
@@ -1139,11 +1158,27 @@ TEST(Scenario, ShippedFilesLoadAndTyposAreReported) {
                   "[person_2] gesture_pivot: must be [across down]");
     EXPECT_NO_THROW((void)loadScenario(base, {"person_2.gesture_pivot=[0.8,0.2]"}));
     // A bob or sway no person makes.
-    expectMessage([&] { (void)loadScenario(base, {"person_2.bob=-5"}); },
-                  tmp.str("s.ini") + " with --set [person_2] bob: must be in [0, 0.3] [m]");
-    expectMessage([&] { (void)loadScenario(base, {"person_2.bob=1e9"}); }, "bob: must be in");
+    expectMessage([&] { (void)loadScenario(base, {"person_1.bob=-5"}); },
+                  tmp.str("s.ini") + " with --set [person_1] bob: must be in [0, 0.3] [m]");
+    expectMessage([&] { (void)loadScenario(base, {"person_1.bob=1e9"}); }, "bob: must be in");
     expectMessage([&] { (void)loadScenario(base, {"person_2.sway_deg=90"}); },
                   "[person_2] sway_deg: must be in [-45, 45] [deg]");
+    // Periods and offsets no person comes near: 1e-7 s made the sitter jump about from frame
+    // to frame while labelled static; 1e300 m along the path, the walker stood still while
+    // labelled moving.
+    expectMessage([&] { (void)loadScenario(base, {"person_2.sway_period=1e-7"}); },
+                  "[person_2] sway_period: must be in [0.1, 1e5] [s]");
+    expectMessage([&] { (void)loadScenario(base, {"person_1.start_offset=1e300"}); },
+                  "[person_1] start_offset: must be in [-1e4, 1e4] [m]");
+    // Keys of the other kind of person, and a sitter's second point, were ignored without a
+    // word (the renders were byte-identical).
+    expectMessage([&] { (void)loadScenario(base, {"person_1.sway_deg=20"}); },
+                  tmp.str("s.ini") +
+                      " with --set [person_1] sway_deg: is not used by a walking person");
+    expectMessage([&] { (void)loadScenario(base, {"person_2.speed=1.2"}); },
+                  "[person_2] speed: is not used by a sitting person");
+    expectMessage([&] { (void)loadScenario(base, {"person_2.path=[3.5 2.9 1 1]"}); },
+                  "[person_2] path: a sitting person stays at one point: give one x y pair");
     // The camera's sections name the file too, and are checked when loaded, not at the render.
     expectMessage([&] { (void)loadScenario(base, {"trajectory.typ=xyz"}); },
                   tmp.str("s.ini") + " with --set [trajectory]: unknown key 'typ'");

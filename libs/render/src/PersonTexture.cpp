@@ -40,9 +40,19 @@ cv::Mat cutPersonTexture(const cv::Mat& bgr, const cv::Rect& box, int iterations
     return bgra;
 }
 
+std::string textureTooLarge(const cv::Mat& img, const std::string& path) {
+    if (img.cols <= kMaxTextureSide && img.rows <= kMaxTextureSide) return "";
+    return "texture '" + path + "' is " + std::to_string(img.cols) + "x" +
+           std::to_string(img.rows) + " px; at most " + std::to_string(kMaxTextureSide) +
+           " px per side (the frames are 640x480, and larger photos cost gigabytes): "
+           "downscale it";
+}
+
 PersonTexture loadPersonTexture(const std::string& path, int cell_px) {
     const cv::Mat img = cv::imread(path, cv::IMREAD_UNCHANGED);
     if (img.empty()) throw std::runtime_error("person texture '" + path + "': cannot read");
+    if (const auto big = textureTooLarge(img, path); !big.empty())
+        throw std::runtime_error("person " + big);
     if (img.type() != CV_8UC4)
         throw std::runtime_error("person texture '" + path +
                                  "': need an RGBA PNG (alpha = person)");

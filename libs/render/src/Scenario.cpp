@@ -197,6 +197,21 @@ PersonSpec loadPerson(const mrpt::config::CConfigFileBase& cfg, const std::strin
         if (m.rfind('[', 0) == 0) throw;  // requiredText's own: "[section] key: missing"
         throw std::invalid_argument("[" + s + "] kind: " + m);  // the file is added to "[..."
     }
+    // Keys of the other kind were ignored without a word (sway_deg = 20 on a walker, speed
+    // on a sitter: byte-identical renders); refused, as the detector refuses another
+    // type's keys.
+    {
+        const bool walks = p.kind == PersonKind::Walking;
+        const std::vector<std::string> other =
+            walks ? std::vector<std::string>{"sway_deg", "sway_period", "sway_pivot"}
+                  : std::vector<std::string>{"speed", "start_offset", "bob"};
+        for (const auto& k : other)
+            core::requireValue(!cfg.keyExists(s, k), s, k,
+                               "is not used by a " + toString(p.kind) + " person (" +
+                                   (walks ? "sway_* are for sitting and standing people"
+                                          : "speed, start_offset and bob are for walkers") +
+                                   "): remove it");
+    }
     const auto tex =
         resolveImages(requiredText(cfg, s, "texture"), dirOf(path), where + " texture");
     if (tex.size() != 1) throw std::invalid_argument(where + " texture: need exactly one file");
@@ -244,18 +259,27 @@ PersonSpec loadPerson(const mrpt::config::CConfigFileBase& cfg, const std::strin
     for (std::size_t i = 0; i < xy.size(); i += 2) p.path.emplace_back(xy[i], xy[i + 1]);
     core::requireValue(p.height > 0.2 && p.height < 3.0, s, "height", "must be in (0.2, 3) [m]");
     core::requireValue(p.speed >= 0 && p.speed < 5, s, "speed", "must be in [0, 5) [m/s]");
-    core::requireValue(p.sway_period > 0, s, "sway_period", "must be > 0 [s]");
+    // As the camera's periods: 1e-7 s made a sitter jump about from frame to frame while
+    // labelled static; a walker 1e300 m along its path stood still while labelled moving.
+    core::requireValue(p.sway_period >= 0.1 && p.sway_period <= 1e5, s, "sway_period",
+                       "must be in [0.1, 1e5] [s]");
+    core::requireValue(std::abs(p.start_offset) <= 1e4, s, "start_offset",
+                       "must be in [-1e4, 1e4] [m]");
     // (A person bobbing 1e9 m, or swaying over, rendered without a word.)
     core::requireValue(std::abs(p.sway_deg) <= 45, s, "sway_deg", "must be in [-45, 45] [deg]");
     core::requireValue(p.bob >= 0 && p.bob <= 0.3, s, "bob", "must be in [0, 0.3] [m]");
     core::requireValue(std::abs(p.gesture_deg) <= 90, s, "gesture_deg",
                        "must be in [-90, 90] [deg]");
-    core::requireValue(p.gesture_period > 0, s, "gesture_period", "must be > 0 [s]");
+    core::requireValue(p.gesture_period >= 0.1 && p.gesture_period <= 1e5, s, "gesture_period",
+                       "must be in [0.1, 1e5] [s]");
     core::requireValue(p.sway_pivot >= 0 && p.sway_pivot <= p.height, s, "sway_pivot",
                        "must be in [0, height] [m]");
     if (p.kind == PersonKind::Walking)
         core::requireValue(p.path.size() >= 2 && pathLength(p.path) > 0.1, s, "path",
                            "a walker needs at least two points 0.1 m apart");
+    else  // (the points after the first were ignored)
+        core::requireValue(p.path.size() == 1, s, "path",
+                           "a " + toString(p.kind) + " person stays at one point: give one x y pair");
     return p;
 }
 

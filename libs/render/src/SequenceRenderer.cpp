@@ -176,6 +176,8 @@ struct SequenceRenderer::Impl {
             throw std::runtime_error("render: texture '" + path + "' is " +
                                      std::to_string(img.cols) + "x" + std::to_string(img.rows) +
                                      " px; at least 8x8 needed");
+        if (const auto big = textureTooLarge(img, path); !big.empty())
+            throw std::runtime_error("render: " + big);
         if (blur > 0) cv::GaussianBlur(img, img, cv::Size(), blur);
         return photos.emplace(key, img).first->second;
     }

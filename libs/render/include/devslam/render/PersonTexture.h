@@ -22,6 +22,14 @@ namespace devslam::render {
 /// or the cut leaves fewer than 5% of the box.
 [[nodiscard]] cv::Mat cutPersonTexture(const cv::Mat& bgr, const cv::Rect& box, int iterations = 5);
 
+/// The largest side a texture photo may have [px]. The frames are 640x480, and every wall
+/// panel keeps its own crop of half to nine tenths of its photo: a 6000x4000 wall photo took
+/// 7.7 GB and 10 s a frame, a 12000x12000 one ran out of memory.
+inline constexpr int kMaxTextureSide = 2048;
+
+/// "texture '<path>' is WxH px; at most 2048 px per side ..." when `img` is larger, else "".
+[[nodiscard]] std::string textureTooLarge(const cv::Mat& img, const std::string& path);
+
 struct PersonTexture {
     cv::Mat bgr;        ///< CV_8UC3 colour, background pixels filled with the nearest person colour
     cv::Mat cell_mask;  ///< CV_8UC1, one entry per cell_px x cell_px cell: 255 = solid
@@ -31,7 +39,7 @@ struct PersonTexture {
 
 /// Loads an RGBA PNG and builds its cell mask (a cell is solid when more than half of its
 /// texels are opaque). Throws std::runtime_error naming the file when it cannot be read or
-/// has no alpha channel.
+/// has no alpha channel, or is larger than kMaxTextureSide.
 [[nodiscard]] PersonTexture loadPersonTexture(const std::string& path, int cell_px = 4);
 
 }  // namespace devslam::render
