@@ -46,6 +46,7 @@
 #include <iterator>
 #include <map>
 #include <mutex>
+#include <set>
 #include <sstream>
 #include <string>
 #include <thread>
@@ -321,8 +322,13 @@ std::optional<Args> parseArgs(int argc, char** argv) {
             a.repeats = int(core::parseInteger(value(), "--repeats", 1, 100));
         else if (k == "--max-frames")
             a.max_frames = std::size_t(core::parseInteger(value(), "--max-frames", 0));
-        else if (k == "--out")
+        else if (k == "--out") {
             a.out_override = value();
+            // (a script's unset variable: the bench wrote into the INI's out_dir instead)
+            if (a.out_override.empty())
+                throw std::invalid_argument("--out '': give a folder (without --out the INI's "
+                                            "[bench] out_dir is used)");
+        }
         else if (k == "--results") {
             a.results = value();
             if (a.results.empty() || a.results == "none") a.results.clear();
@@ -370,6 +376,32 @@ Bench benchOf(const Args& a) {
 
 int repeatsOf(const Bench& b, const Sequence& q) {
     return q.repeats > 0 ? q.repeats : b.repeats;
+}
+
+/// 0. Each SLAM INI as devslam-run reads it, in each mode the bench runs (devslam-run
+/// --check-config, a tenth of a second): loadBench read the INIs and made their filters, but
+/// devslam-run's own sections and keys ([run], [orb], [tracker], ...) were found wrong only
+/// by the runs, after every render (up to an hour of them).
+void checkSlamConfigs(const Bench& b, const Args& a) {
+    std::set<std::pair<std::string, std::string>> checked;  // (INI, mode)
+    const std::string log = (fs::path(b.out_dir) / "check_config.log").string();
+    for (const auto& q : b.sequences)
+        for (const auto& m : b.modes) {
+            if (!checked.insert({q.slam_config, m}).second) continue;
+            const std::string cmd = quote(a.bin + "/devslam-run") + " --check-config --config " +
+                                    quote(q.slam_config) + " --mode " + m;
+            const int rc = core::runCommand(cmd + " > " + quote(log) + " 2>&1");
+            if (const int sig = stopAfter(rc))
+                throw Interrupted(sig, "interrupted (" + core::signalName(sig) +
+                                           ") while checking the SLAM INIs; nothing was run");
+            if (rc != 0)
+                throw std::invalid_argument(q.where + ": devslam-run refuses its SLAM INI '" +
+                                            q.slam_config + "' in mode " + m + " (" +
+                                            endedBy(rc) + "):\n" + lastLines(log, 5) +
+                                            "(command: " + cmd + ")");
+        }
+    std::error_code ec;
+    fs::remove(log, ec);
 }
 
 /// 1. Synthetic sequences: renders the missing ones, and those whose scenario, room, seed,
@@ -996,6 +1028,7 @@ int run(int argc, char** argv) {
     if (!a.compare.empty()) return compareRuns(b, a.compare);
     // Before hours of work (after the output folder is made: the results may go in it).
     if (!a.results.empty()) core::checkResultsSection(a.results, "bench");
+    checkSlamConfigs(b, a);
     renderSequences(b, a);
     const Runs runs = runSlam(b, a);
     const Tables t = makeTables(b, runs, a.results);

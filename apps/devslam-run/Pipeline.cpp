@@ -125,16 +125,39 @@ void checkOutputFolder(const std::string& dir) {
     }
 }
 
+namespace {
+/// What a run is made of before its first frame, read from its INIs.
+struct RunParts {
+    slam::SlamOptions slam;
+    slam::GridMapOptions grid;
+    std::unique_ptr<MaskSource> masks;
+};
+
+RunParts readRunParts(const RunConfig& rc, const mrpt::config::CConfigFileBase& cfg,
+                      const mrpt::config::CConfigFileBase& filter_cfg, const std::string& mode) {
+    RunParts p;
+    p.slam = core::namingSource(rc.config_source,
+                                [&] { return slam::SlamOptions::fromConfig(cfg); });
+    core::namingSource(rc.config_source, [&] { p.grid.loadFromConfig(cfg, "grid_map"); });
+    p.masks = core::namingSource(rc.filter_source,
+                                 [&] { return makeMaskSource(mode, filter_cfg, rc.input); });
+    return p;
+}
+}  // namespace
+
+void checkConfig(const RunConfig& rc, const mrpt::config::CConfigFileBase& cfg,
+                 const mrpt::config::CConfigFileBase& filter_cfg) {
+    (void)readRunParts(rc, cfg, filter_cfg, rc.mode == "truth" ? "dynamic" : rc.mode);
+}
+
 RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
                       const mrpt::config::CConfigFileBase& cfg,
                       const mrpt::config::CConfigFileBase& filter_cfg) {
     resetPeakRss();
-    const auto slam_opts = core::namingSource(rc.config_source,
-                                              [&] { return slam::SlamOptions::fromConfig(cfg); });
-    slam::GridMapOptions grid_opts;
-    core::namingSource(rc.config_source, [&] { grid_opts.loadFromConfig(cfg, "grid_map"); });
-    auto masks = core::namingSource(rc.filter_source,
-                                    [&] { return makeMaskSource(rc.mode, filter_cfg, rc.input); });
+    RunParts parts = readRunParts(rc, cfg, filter_cfg, rc.mode);
+    const slam::SlamOptions& slam_opts = parts.slam;
+    const slam::GridMapOptions& grid_opts = parts.grid;
+    std::unique_ptr<MaskSource> masks = std::move(parts.masks);
     slam::Slam slam(slam_opts);
 
     RunReport rep;

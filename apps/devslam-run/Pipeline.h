@@ -122,8 +122,6 @@ struct RunReport {
     std::vector<LoopReport> loop_reports;  ///< every closed loop (loops.txt)
 };
 
-/// Runs the pipeline over `reader` with the INI `cfg` (SLAM sections) and `filter_cfg`
-/// ([detector], [dynamic_filter]). Throws on setup errors (bad INI, unknown mode).
 /// The files a run writes into its --out folder (an earlier run's are removed first).
 inline constexpr const char* kOutputFiles[] = {
     "run.json",        "run.json.part",    "trajectory.txt", "keyframes.txt",
@@ -135,6 +133,15 @@ inline constexpr const char* kOutputFiles[] = {
 /// all removed).
 void checkOutputFolder(const std::string& dir);
 
+/// Reads every setting a run in `rc.mode` reads from `cfg` and `filter_cfg` and makes its
+/// filter and detector, as runSequence does before the first frame, throwing what it would
+/// throw; reads no input (mode truth, whose mask is the input's person truth, is checked as
+/// dynamic: it reads the same sections). devslam-run --check-config.
+void checkConfig(const RunConfig& rc, const mrpt::config::CConfigFileBase& cfg,
+                 const mrpt::config::CConfigFileBase& filter_cfg);
+
+/// Runs the pipeline over `reader` with the INI `cfg` (SLAM sections) and `filter_cfg`
+/// ([detector], [dynamic_filter]). Throws on setup errors (bad INI, unknown mode).
 [[nodiscard]] RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
                                     const mrpt::config::CConfigFileBase& cfg,
                                     const mrpt::config::CConfigFileBase& filter_cfg);

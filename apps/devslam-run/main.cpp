@@ -31,6 +31,8 @@ const char* kUsage =
     "usage: devslam-run [--input PATH] [--mode none|all_persons|dynamic|truth] [--config INI]\n"
     "                   [--out DIR] [--max-frames N] [--quiet] [--set SECTION.KEY=VALUE]...\n"
     "                   [--replay N]  (play the input forward/backward N times)\n"
+    "                   [--check-config]  (read the INIs as a run would, make the filter,\n"
+    "                                      print 'ok' and stop; reads no input)\n"
     "                   [--allow-damaged]  (a rawlog cut short, a TUM folder missing images,\n"
     "                                       frames that do not decode: run on what is intact)\n"
     "       devslam-run --bench N [--input PATH] [--config INI] [--results FILE]\n"
@@ -59,6 +61,7 @@ struct Args {
     std::string section = "slam";   ///< RESULTS.md section written by --bench
     bool modes_only = false;        ///< --bench without the ablation and the long run
     bool allow_damaged = false;     ///< a damaged input: run on what is intact
+    bool check_config = false;      ///< --check-config: the INIs only, no run
     bool out_given = false;         ///< --out was on the command line
     bool results_given = false;     ///< --results was on the command line
     bool section_given = false;     ///< --section was on the command line
@@ -99,17 +102,21 @@ Args parse(int argc, char** argv) {
             a.sets.push_back(value(i));
         else if (k == "--allow-damaged")
             a.allow_damaged = true;
+        else if (k == "--check-config")
+            a.check_config = true;
         else if (k == "-h" || k == "--help") {
             std::cout << kUsage;
             std::exit(0);
         } else
             throw std::invalid_argument("unknown argument '" + k + "'\n" + kUsage);
     }
+    if (a.check_config && a.bench > 0)
+        throw std::invalid_argument("--check-config does not go with --bench");
     // Found now, not when the run's results are written (after the whole run): a file where
     // the folder or one above it goes, or a folder it cannot be made in. Nothing is created.
     // (--bench writes no run folder: its default --out, relative to where it was started,
     // refused a bench started in a folder it cannot write in)
-    if (a.bench == 0 && !a.out.empty()) {
+    if (a.bench == 0 && !a.out.empty() && !a.check_config) {
         namespace fs = std::filesystem;
         const fs::path full = fs::absolute(a.out).lexically_normal();
         if (fs::exists(full) && !fs::is_directory(full))
@@ -192,13 +199,19 @@ Loaded loadConfig(const Args& a, const std::vector<std::string>& extra_sets = {}
             l.filter_source.find(" with ") == std::string::npos ? " with --set" : " and --set";
     l.async_filter = core::namingSource(
         l.config_source, [&] { return core::readBool(*l.cfg, "run", "async_filter", true); });
-    l.mode = a.mode.empty() ? l.cfg->read_string("run", "mode", "dynamic") : a.mode;
-    try {
-        run::requireMode(l.mode);
-    } catch (const std::invalid_argument& e) {
-        throw std::invalid_argument((a.mode.empty() ? l.config_source + " [run] mode" : "--mode") +
-                                    ": " + e.what());
+    // The INI's mode is checked when --mode overrides it too: "dynamik" there went unnoticed
+    // by every devslam-bench run (which always passes --mode) until a run without --mode.
+    const std::string ini_mode = l.cfg->read_string("run", "mode", "dynamic");
+    for (const auto& [mode, where] : {std::pair{ini_mode, l.config_source + " [run] mode"},
+                                      std::pair{a.mode, std::string("--mode")}}) {
+        if (mode.empty()) continue;  // no --mode
+        try {
+            run::requireMode(mode);
+        } catch (const std::invalid_argument& e) {
+            throw std::invalid_argument(where + ": " + e.what());
+        }
     }
+    l.mode = a.mode.empty() ? ini_mode : a.mode;
     // [run] filter_config / filter_overrides: the filter's INI, with "section.key=value ..."
     // overrides (so a SLAM config can pick e.g. the detection interval without copying it).
     // (Its errors name a.config, which filter_config is relative to; a value --set gave is
@@ -237,6 +250,16 @@ run::RunConfig runConfig(const Args& a, const Loaded& l, const std::string& mode
     rc.max_frames = a.max_frames;
     rc.async_filter = l.async_filter;
     return rc;
+}
+
+/// --check-config: every setting of the INIs read and the filter made, as before a run's
+/// first frame (devslam-bench asks this of each SLAM INI before its renders).
+int checkOnly(const Args& a) {
+    const auto l = loadConfig(a);
+    run::checkConfig(runConfig(a, l, l.mode), *l.cfg, *l.filter_cfg);
+    std::cout << "ok: " << l.config_source << " (filter: " << l.filter_source << "), mode "
+              << l.mode << "\n";
+    return 0;
 }
 
 int runOnce(const Args& a) {
@@ -493,6 +516,7 @@ int runBench(const Args& a) {
 int runMain(int argc, char** argv) {
     try {
         const Args a = parse(argc, argv);
+        if (a.check_config) return checkOnly(a);
         return a.bench > 0 ? runBench(a) : runOnce(a);
     } catch (const io::DamagedInput& e) {
         std::cerr << "devslam-run: " << e.what() << "\n";

@@ -608,6 +608,11 @@ TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
     // that detect, after the renders and the runs of mode none.
     std::ofstream(tmp / "baddet_filter.ini") << "[detector]\ndetector = yolov9\n";
     std::ofstream(tmp / "baddet.ini") << "[run]\nfilter_config = baddet_filter.ini\n";
+    // devslam-run's own keys, and the INI's mode (which the bench's --mode overrides): a typo
+    // there failed every run, after every render.
+    const std::string filter = "filter_config = " + root + "/config_ini/dynamic_filter.ini\n";
+    std::ofstream(tmp / "badrun.ini") << "[run]\n" << filter << "async_filtre = true\n";
+    std::ofstream(tmp / "badmode.ini") << "[run]\n" << filter << "mode = dynamik\n";
     const std::string fr1 = "path = " + root + "/data/tum/fr1_xyz_first37\n";
     const std::string synth = "[sequence_a]\nscenario = short_walking\n";
     const std::string real = "[sequence_a]\n" + fr1;
@@ -638,6 +643,12 @@ TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
         {"[sequence_a]\npath = " + root + "/data/tum/no_such_folder\n",
          "bench.ini [sequence_a] path: no such file or folder '"},
         {real + "slam_config = nowhere.ini\n", "bench.ini [sequence_a] slam_config: no such file"},
+        {synth + "slam_config = " + (tmp / "badrun.ini").string() + "\n",
+         "bench.ini [sequence_a]: devslam-run refuses its SLAM INI '" +
+             (tmp / "badrun.ini").string() + "' in mode none (exit 1):\n  devslam-run: " +
+             (tmp / "badrun.ini").string() + " [run]: unknown key 'async_filtre'"},
+        {synth + "slam_config = " + (tmp / "badmode.ini").string() + "\n",
+         "badmode.ini [run] mode: unknown mode 'dynamik'"},
         // A broken SLAM INI, or the filter INI it names, is read before any run too.
         {real + "slam_config = " + (tmp / "dup.ini").string() + "\n", "dup.ini"},
         {real + "slam_config = " + (tmp / "nofilter.ini").string() + "\n", "nowhere_filter.ini"},
@@ -675,9 +686,14 @@ TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
         {real + "[targets]\nx,y = a dynamic ate <= 1\n",
          "[targets] x,y: a target's name is letters, digits"},
     };
-    for (const auto& [ini, msg] : cases)
-        EXPECT_NE(refused(ini).find(msg), std::string::npos) << ini << "\n"
-                                                             << readFile(tmp / "log.txt");
+    for (const auto& [ini, msg] : cases) {
+        const std::string said = refused(ini);
+        EXPECT_NE(said.find(msg), std::string::npos) << ini << "\n" << said;
+        // A SLAM INI is refused before the renders (their logs are under --out).
+        if (ini.find("badrun.ini") != std::string::npos) {
+            EXPECT_EQ(said.find("render (if changed)"), std::string::npos) << said;
+        }
+    }
     // --out onto a file, --results onto the bench's own INI: refused naming the option, the
     // INI left as it was (it got a Markdown section appended and no longer parsed).
     std::ofstream(tmp / "bench.ini") << real;
@@ -689,7 +705,10 @@ TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
         EXPECT_NE(std::system(cmd.c_str()), 0) << cmd;
         return readFile(tmp / "log.txt");
     };
-    std::string said = ran("--out '" + (tmp / "a_file").string() + "' --results none");
+    // An empty --out (a script's unset variable) wrote into the INI's out_dir.
+    std::string said = ran("--out '' --results none");
+    EXPECT_NE(said.find("--out '': give a folder"), std::string::npos) << said;
+    said = ran("--out '" + (tmp / "a_file").string() + "' --results none");
     EXPECT_NE(said.find("--out '" + (tmp / "a_file").string() + "': cannot make the folder"),
               std::string::npos)
         << said;

@@ -62,6 +62,32 @@ std::string readText(const fs::path& p) {
 }
 }  // namespace
 
+// --check-config reads the INIs as a run does and stops (devslam-bench asks it before its
+// renders): every shipped SLAM INI passes in every mode; a bad key in a SLAM section (read
+// only when the run starts, not with [run]) or in the filter INI fails; no input is read.
+TEST(DevslamRun, CheckConfigReadsTheInisAsARunDoesAndNoInput) {
+    const std::string root = DEVSLAM_SOURCE_DIR;
+    for (const char* ini : {"slam_tum_fr1.ini", "slam_tum_fr3.ini", "slam_synthetic.ini"})
+        for (const char* mode : {"none", "all_persons", "dynamic", "truth"}) {
+            const auto r = run("--check-config --input /nonexistent --config " + root +
+                               "/config_ini/" + ini + " --mode " + mode);
+            EXPECT_EQ(r.rc, 0) << ini << " " << mode << ": " << r.out;
+            EXPECT_NE(r.out.find(std::string("ok: ") + root + "/config_ini/" + ini),
+                      std::string::npos)
+                << r.out;
+        }
+    auto r = run("--check-config --set local_ba.max_iteratons=3");
+    EXPECT_EQ(r.rc, 1);
+    EXPECT_NE(r.out.find("with --set [local_ba]: unknown key 'max_iteratons'"), std::string::npos)
+        << r.out;
+    r = run("--check-config --set dynamic_filter.lk_levels=-1");
+    EXPECT_EQ(r.rc, 1);
+    EXPECT_NE(r.out.find("[dynamic_filter] lk_levels"), std::string::npos) << r.out;
+    r = run("--check-config --bench 1");
+    EXPECT_EQ(r.rc, 1);
+    EXPECT_NE(r.out.find("--check-config does not go with --bench"), std::string::npos) << r.out;
+}
+
 TEST(DevslamRun, WritesEveryOutputAndPrintsTheSummary) {
     const fs::path out = devslam::test::scratchPath("devslam_run_smoke");
     fs::remove_all(out);
@@ -194,6 +220,11 @@ TEST(DevslamRun, BadInputIsReported) {
     // the INI's mode, its camera preset, a folder given as the INI: named with the key or file
     std::ofstream(ini) << "[run]\nmode = dynamc\n";
     r = run("--config " + ini.string() + " --quiet --out ''");
+    EXPECT_EQ(r.rc, 1);
+    EXPECT_NE(r.out.find(ini.string() + " [run] mode: unknown mode 'dynamc'"), std::string::npos)
+        << r.out;
+    // ... also when --mode overrides it (devslam-bench always gives --mode: no run said it).
+    r = run("--config " + ini.string() + " --mode none --quiet --out ''");
     EXPECT_EQ(r.rc, 1);
     EXPECT_NE(r.out.find(ini.string() + " [run] mode: unknown mode 'dynamc'"), std::string::npos)
         << r.out;
