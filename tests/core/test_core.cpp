@@ -162,6 +162,17 @@ TEST(Config, UnknownKeyIsNamed) {
     EXPECT_THROW((void)loadIni("/nonexistent/file.ini"), std::runtime_error);
 }
 
+/// The message of the std::invalid_argument `f` throws ("" when it throws none).
+template <class F>
+std::string invalidArgument(F&& f) {
+    try {
+        f();
+    } catch (const std::invalid_argument& e) {
+        return e.what();
+    }
+    return "";
+}
+
 TEST(Config, FilterIniFollowsRunFilterConfigWithOverrides) {
     // The shipped SLAM INI names dynamic_filter.ini and overrides its detection interval.
     const std::string slam_ini = std::string(DEVSLAM_SOURCE_DIR) + "/config_ini/slam_tum_fr1.ini";
@@ -230,18 +241,20 @@ TEST(Config, FilterIniFollowsRunFilterConfigWithOverrides) {
     }
     std::ofstream(dir + "/empty.ini") << "[detector]\n";  // one of them is enough
     EXPECT_NO_THROW((void)loadFilterIni(*loadIni(missing), missing));
+    // What devslam-bench, devslam-overlay and devslam-filter-bench read: a SLAM INI that lost
+    // its filter_config line passed, because its filter_overrides make the section they set,
+    // and the filter ran on the code's defaults.
+    std::ofstream(own) << "[run]\nfilter_overrides = dynamic_filter.detect_every=3\n";
+    EXPECT_EQ(invalidArgument([&] { (void)loadFilterConfig(own); }),
+              own + ": no [detector] or [dynamic_filter] section, and no [run] filter_config "
+                    "naming an INI that has them ([run] filter_overrides only changes keys of "
+                    "one)");
+    std::ofstream(own) << "[run]\nfilter_config = empty.ini\n"
+                          "filter_overrides = dynamic_filter.detect_every=3\n";
+    std::string source;
+    EXPECT_EQ(loadFilterConfig(own, &source)->read_int("dynamic_filter", "detect_every", 0), 3);
+    EXPECT_EQ(source, dir + "/empty.ini with " + own + " [run] filter_overrides");
     std::filesystem::remove_all(dir);
-}
-
-/// The message of the std::invalid_argument `f` throws ("" when it throws none).
-template <class F>
-std::string invalidArgument(F&& f) {
-    try {
-        f();
-    } catch (const std::invalid_argument& e) {
-        return e.what();
-    }
-    return "";
 }
 
 TEST(Parse, NumbersAreReadInFullOrRejected) {

@@ -1179,6 +1179,11 @@ TEST(Scenario, ShippedFilesLoadAndTyposAreReported) {
                   "[person_2] speed: is not used by a sitting person");
     expectMessage([&] { (void)loadScenario(base, {"person_2.path=[3.5 2.9 1 1]"}); },
                   "[person_2] path: a sitting person stays at one point: give one x y pair");
+    // The room's sections are the room file's: --set says where they go.
+    expectMessage([&] { (void)loadScenario(base, {"room.wall_blur=3"}); },
+                  tmp.str("s.ini") +
+                      " with --set: [room] is a section of the room file; the scenario sets it "
+                      "with [scenario] room_set (--set \"scenario.room_set=room.KEY=VALUE\")");
     // The camera's sections name the file too, and are checked when loaded, not at the render.
     expectMessage([&] { (void)loadScenario(base, {"trajectory.typ=xyz"}); },
                   tmp.str("s.ini") + " with --set [trajectory]: unknown key 'typ'");

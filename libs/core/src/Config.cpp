@@ -305,12 +305,18 @@ std::unique_ptr<mrpt::config::CConfigFileMemory> loadFilterConfig(const std::str
     // A SLAM INI's own sections are devslam-run's to check; loadFilterIni checks the file
     // its [run] filter_config names.
     if (!ini->sectionExists("run")) requireKnownSections(*ini, filterSections(), path);
-    auto out = loadFilterIni(*ini, path);
-    if (!out->sectionExists("detector") && !out->sectionExists("dynamic_filter"))
+    // Asked of the file itself (loadFilterIni checks a filter_config's): after [run]
+    // filter_overrides, which make the sections they set, a SLAM INI whose filter_config line
+    // was lost passed, and the filter ran on the code's defaults with the overrides on top.
+    if (ini->read_string("run", "filter_config", "").empty() && !ini->sectionExists("detector") &&
+        !ini->sectionExists("dynamic_filter"))
         throw std::invalid_argument(path +
                                     ": no [detector] or [dynamic_filter] section, and no [run] "
-                                    "filter_config naming an INI that has them");
-    return out;
+                                    "filter_config naming an INI that has them" +
+                                    (ini->read_string("run", "filter_overrides", "").empty()
+                                         ? std::string()
+                                         : " ([run] filter_overrides only changes keys of one)"));
+    return loadFilterIni(*ini, path);
 }
 
 std::vector<std::string> unknownKeys(const mrpt::config::CConfigFileBase& cfg,

@@ -436,8 +436,18 @@ Scenario readScenario(const std::string& path, const std::vector<std::string>& o
         core::requireValue(false, "trajectory", "position", m.str());
     }
 
+    const std::string source = overrides.empty() ? path : path + " with --set";
+    // The room's sections belong to the room file (--set room.wall_blur=3 was "unknown
+    // section [room]", which did not say where it goes).
+    auto room_sections = sectionsWithPrefix(*cfg, "box_");
+    if (cfg->sectionExists("room")) room_sections.insert(room_sections.begin(), "room");
+    for (const auto& r : room_sections)
+        throw std::invalid_argument(source + ": [" + r +
+                                    "] is a section of the room file; the scenario sets it with "
+                                    "[scenario] room_set (--set \"scenario.room_set=" +
+                                    r + ".KEY=VALUE\")");
     core::requireKnownSections(
-        *cfg, {"scenario", "camera", "trajectory", "depth_noise", "person_*"}, path);
+        *cfg, {"scenario", "camera", "trajectory", "depth_noise", "person_*"}, source);
     return sc;
 }
 
