@@ -479,6 +479,10 @@ TEST(Config, RepeatedKeysAndSectionsAreRefused) {
     EXPECT_EQ(error("[orb] junk\nk = 1\n"),
               path + " line 1: '[orb] junk': text after the section's ']'");
     EXPECT_EQ(error("[orb] # the features\n[b] // more\n[c] ; and\nk = 1\n"), "");
+    // A key before any section, or under "[]", was named without its line.
+    EXPECT_EQ(error("# a room\nsize = 1\n[room]\n"),
+              path + " line 2: key 'size' before the first [section]");
+    EXPECT_EQ(error("[a]\nk = 1\n [ ] \nj = 2\n"), path + " line 3: '[ ]' names no section");
     // A comment ending in '\' takes the next line into it: a key there is lost (here MRPT
     // read the default instead of n = 20); a comment there is not.
     EXPECT_EQ(error("[orb]\n# see C:\\docs\\\nn = 20\n"),

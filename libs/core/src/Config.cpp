@@ -100,6 +100,11 @@ void refuseMisreadLines(const std::string& text, const std::string& path) {
                 throw std::invalid_argument(path + " line " + std::to_string(n) + ": '" +
                                             trimmed(line) + "': text after the section's ']'");
             section = trimmed(expand(line.substr(a + 1, b - a - 1)));  // MRPT trims the name
+            // MRPT files the keys after "[]" with those before any section, and the checks
+            // then named the key but not the line.
+            if (section.empty())
+                throw std::invalid_argument(path + " line " + std::to_string(n) + ": '" +
+                                            trimmed(line) + "' names no section");
             const auto [at, fresh] = sections.emplace(lowercase(section), n);
             if (!fresh)
                 throw std::invalid_argument(
@@ -114,6 +119,9 @@ void refuseMisreadLines(const std::string& text, const std::string& path) {
                                         "' is neither a [section] nor a key = value");
         const std::string key = trimmed(expand(line.substr(a, eq - a)));
         if (key.empty() || key.find("${") != std::string::npos) continue;  // not resolvable here
+        if (section.empty())  // (requireKnownSections would name the key, not the line)
+            throw std::invalid_argument(path + " line " + std::to_string(n) + ": key '" + key +
+                                        "' before the first [section]");
         const auto [at, fresh] = keys.emplace(std::pair{lowercase(section), lowercase(key)}, n);
         if (!fresh)
             throw std::invalid_argument(path + " line " + std::to_string(n) + ": [" + section +
