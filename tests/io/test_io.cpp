@@ -7,6 +7,8 @@
 #include <devslam/io/VideoReader.h>
 
 #include <gtest/gtest.h>
+
+#include <sys/stat.h>
 #include <mrpt/img/CImage.h>
 #include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/io/CFileGZOutputStream.h>
@@ -177,6 +179,27 @@ TEST(TumReader, MalformedListsNameFileAndLine) {
     expectError([&] { io::TumReader r(d.str("s")); }, "rgb\\.txt line 5: unsorted timestamp");
     writeText(rgb, header + l1 + "\n" + l1 + "\n");
     expectError([&] { io::TumReader r(d.str("s")); }, "rgb\\.txt line 5: duplicate timestamp");
+    // One image under two stamps (two frames of one picture), stamps no clock gives (they
+    // only left their frame unpaired), a line of megabytes (read whole into memory).
+    const std::string l1_file = l1.substr(l1.find(' ') + 1);
+    writeText(rgb, header + l1 + "\n" + "1305031102.9 " + l1_file + "\n");
+    expectError([&] { io::TumReader r(d.str("s")); },
+                "rgb\\.txt line 5: '" + l1_file + "' is listed again \\(first at line 4\\)");
+    writeText(rgb, header + "-1 rgb/x.png\n");
+    expectError([&] { io::TumReader r(d.str("s")); },
+                "rgb\\.txt line 4: timestamp -1 is not in \\[0, 1e11\\] s");
+    writeText(rgb, header + l1 + "\n" + std::string(100000, '1') + " rgb/x.png\n");
+    expectError([&] { io::TumReader r(d.str("s")); },
+                "rgb\\.txt line 5: longer than 64 KiB \\(not a text file of lines\\?\\)");
+    // A folder, or a pipe (which blocked the reader for ever at its opening), where a list is.
+    fs::remove(rgb);
+    fs::create_directory(rgb);
+    expectError([&] { io::TumReader r(d.str("s")); }, "rgb\\.txt: file is a folder, not a file");
+    fs::remove(rgb);
+    ASSERT_EQ(::mkfifo(rgb.c_str(), 0600), 0);
+    expectError([&] { io::TumReader r(d.str("s")); },
+                "rgb\\.txt: file is a pipe or device, not a file");
+    fs::remove(rgb);
     // Lists that share no stamp (10 s apart): what each holds, to tell two recordings apart
     writeText(rgb, header + "1305031112.2 rgb/x.png\n");
     expectError([&] { io::TumReader r(d.str("s")); },

@@ -7,19 +7,45 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
 
 namespace devslam::io::detail {
 
+namespace {
+/// std::getline with a bound on the line's length: /dev/zero, or a 100 MB file of one line,
+/// was read whole into memory (4.6 GB in 10 s) before any check saw it.
+bool readLineCapped(std::istream& in, std::string& line, const std::string& path, int n) {
+    line.clear();
+    for (std::streambuf* sb = in.rdbuf();;) {
+        const int c = sb->sbumpc();
+        if (c == std::char_traits<char>::eof()) {
+            in.setstate(std::ios::eofbit);
+            return !line.empty();
+        }
+        if (c == '\n') return true;
+        if (line.size() == kMaxLineBytes)
+            throw std::runtime_error(lineError(path, n, "longer than " +
+                                                            std::to_string(kMaxLineBytes >> 10) +
+                                                            " KiB (not a text file of lines?)"));
+        line.push_back(char(c));
+    }
+}
+}  // namespace
+
 void forEachDataLine(const std::string& path,
                      const std::function<void(int, const std::vector<std::string>&)>& fn) {
+    // (an ifstream opens a folder and then fails to read: "error reading '<folder>'")
+    if (std::filesystem::is_directory(path))
+        throw std::runtime_error("'" + path + "' is a folder, not a file");
     std::ifstream in(path);
     if (!in) throw std::runtime_error("cannot open '" + path + "'");
     std::string line;
     int n = 0;
-    while (std::getline(in, line)) {
+    std::size_t data_lines = 0;
+    while (readLineCapped(in, line, path, n + 1)) {
         ++n;
         // A UTF-8 byte-order mark (Windows editors write one) is not part of the first line.
         if (n == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0) line.erase(0, 3);
@@ -46,7 +72,12 @@ void forEachDataLine(const std::string& path,
         std::istringstream ss(line);
         std::vector<std::string> tokens;
         for (std::string t; ss >> t;) tokens.push_back(t);
-        if (!tokens.empty()) fn(n, tokens);
+        if (tokens.empty()) continue;
+        if (++data_lines > kMaxDataLines)
+            throw std::runtime_error(lineError(path, n,
+                                               "more than " + std::to_string(kMaxDataLines) +
+                                                   " data lines (28 hours at 100 Hz)"));
+        fn(n, tokens);
     }
     if (in.bad()) throw std::runtime_error("error reading '" + path + "'");
 }

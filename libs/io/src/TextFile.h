@@ -4,6 +4,7 @@
 
 #include <opencv2/core/mat.hpp>
 
+#include <cstddef>
 #include <cstdio>
 #include <functional>
 #include <memory>
@@ -12,8 +13,15 @@
 
 namespace devslam::io::detail {
 
+/// The longest line forEachDataLine reads [bytes]: a TUM line is under 100.
+inline constexpr std::size_t kMaxLineBytes = std::size_t(64) << 10;
+/// The most data lines forEachDataLine reads: 28 hours of ground truth at 100 Hz.
+inline constexpr std::size_t kMaxDataLines = 10'000'000;
+
 /// Calls fn(line_number, tokens) for each non-empty, non-comment line. Throws
-/// std::runtime_error "cannot open '<path>'" if the file cannot be read.
+/// std::runtime_error "cannot open '<path>'" if the file cannot be read, naming the line of
+/// one longer than kMaxLineBytes or past kMaxDataLines data lines. (A pipe is read as a
+/// file: devslam-eval <(...) works.)
 void forEachDataLine(const std::string& path,
                      const std::function<void(int, const std::vector<std::string>&)>& fn);
 

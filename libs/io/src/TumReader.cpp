@@ -11,6 +11,7 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <regex>
 #include <stdexcept>
 
@@ -18,20 +19,45 @@ namespace fs = std::filesystem;
 
 namespace devslam::io {
 
+namespace {
+/// A file of a TUM folder: a pipe there blocked the reader, for ever, at its opening (a
+/// signal only asks for a stop after the current frame), and a folder read as empty.
+void requireFileInFolder(const std::string& path, const std::string& what) {
+    const auto st = fs::status(path);
+    if (!fs::exists(st)) throw std::runtime_error(path + ": " + what + " not found");
+    if (!fs::is_regular_file(st))
+        throw std::runtime_error(path + ": " + what + " is " +
+                                 (fs::is_directory(st) ? "a folder" : "a pipe or device") +
+                                 ", not a file");
+}
+}  // namespace
+
 std::vector<TumListEntry> readTumList(const std::string& path) {
-    if (!fs::exists(path)) throw std::runtime_error(path + ": file not found");
+    requireFileInFolder(path, "file");
     std::vector<TumListEntry> out;
+    std::map<std::string, int> listed;  // file -> its line
     detail::forEachDataLine(path, [&](int line, const std::vector<std::string>& tok) {
         if (tok.size() != 2)
             throw std::runtime_error(detail::lineError(
                 path, line,
                 "expected 'timestamp filename', got " + std::to_string(tok.size()) + " fields"));
         const double t = detail::parseNumber(tok[0], path, line, "timestamp");
+        // Seconds since 1970 (TUM's) or since a start: -1 or 1e300 only left the frame unpaired.
+        if (t < 0 || t > 1e11)
+            throw std::runtime_error(detail::lineError(
+                path, line, "timestamp " + tok[0] + " is not in [0, 1e11] s"));
         if (!out.empty() && t <= out.back().t)
             throw std::runtime_error(detail::lineError(
                 path, line,
                 detail::stampNotAfter(t, out.back().t, tok[0]) + " (previous entry at line " +
                     std::to_string(out.back().line) + ")"));
+        // One image under two stamps is two frames of one picture (the ATE went from 0.0059
+        // to 0.0077 m on fr1_xyz_first37).
+        if (const auto [at, fresh] = listed.emplace(tok[1], line); !fresh)
+            throw std::runtime_error(detail::lineError(
+                path, line,
+                "'" + tok[1] + "' is listed again (first at line " + std::to_string(at->second) +
+                    ")"));
         out.push_back({t, tok[1], line});
     });
     if (out.empty()) throw std::runtime_error(path + ": no entries");
@@ -51,8 +77,8 @@ std::optional<std::string> tumPresetFromName(const std::string& folder) {
 
 void loadTumImages(const std::string& rgb_path, const std::string& depth_path, double depth_scale,
                    core::Frame& f) {
-    if (!fs::exists(rgb_path)) throw std::runtime_error(rgb_path + ": colour image not found");
-    if (!fs::exists(depth_path)) throw std::runtime_error(depth_path + ": depth image not found");
+    requireFileInFolder(rgb_path, "colour image");
+    requireFileInFolder(depth_path, "depth image");
     cv::Mat rgb = cv::imread(rgb_path, cv::IMREAD_UNCHANGED);
     if (rgb.empty()) throw std::runtime_error(rgb_path + ": cannot decode colour image");
     if (rgb.depth() != CV_8U)
@@ -93,9 +119,14 @@ TumReader::TumReader(std::string folder, ReaderOptions opts)
         bool complete = true;
         for (const auto* e : {&rgb[i], &depth[j]}) {
             const std::string list = e == &rgb[i] ? "/rgb.txt" : "/depth.txt";
-            if (fs::exists(imagePath(e->file))) continue;
-            missing.push_back(
-                detail::lineError(folder_ + list, e->line, "image '" + e->file + "' not found"));
+            const auto st = fs::status(imagePath(e->file));
+            if (fs::is_regular_file(st)) continue;
+            missing.push_back(detail::lineError(
+                folder_ + list, e->line,
+                "image '" + e->file + "' " +
+                    (!fs::exists(st)          ? "not found"
+                     : fs::is_directory(st) ? "is a folder, not a file"
+                                              : "is a pipe or device, not a file")));
             complete = false;
         }
         if (complete) pairs_.emplace_back(rgb[i], depth[j]);
@@ -129,6 +160,7 @@ TumReader::TumReader(std::string folder, ReaderOptions opts)
         K_ = core::CameraIntrinsics::fromPreset(opts_.camera);
         camera_source_ = "preset " + opts_.camera;
     } else if (fs::exists(camera_ini)) {
+        requireFileInFolder(camera_ini, "camera file");
         const auto cfg = core::loadIni(camera_ini);
         try {
             core::requireKnownSections(*cfg, {"camera"});
@@ -145,6 +177,7 @@ TumReader::TumReader(std::string folder, ReaderOptions opts)
     }
     const std::string gt = folder_ + "/groundtruth.txt";
     if (fs::exists(gt)) {
+        requireFileInFolder(gt, "ground truth");
         try {
             gt_ = readTumTrajectory(gt);
         } catch (const std::runtime_error& e) {
