@@ -15,6 +15,7 @@
 #include <devslam/core/Results.h>
 #include <devslam/core/Stats.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <iostream>
 #include <optional>
@@ -185,6 +186,13 @@ Loaded loadConfig(const Args& a, const std::vector<std::string>& extra_sets = {}
     core::requireKnownSections(
         *l.cfg, l.cfg->read_string("run", "filter_config", "").empty() ? with_filter : sections,
         a.config);
+    // An empty file, or the filter's INI given for the SLAM's, ran on the code's defaults.
+    if (std::none_of(sections.begin(), sections.end(),
+                     [&](const std::string& s) { return l.cfg->sectionExists(s); }))
+        throw std::invalid_argument(a.config +
+                                    ": none of a SLAM INI's sections ([run], [dataset], [orb], "
+                                    "[tracker], ...): is it one? (the shipped ones are "
+                                    "config_ini/slam_*.ini)");
     applySets(*l.cfg, a.sets);
     applySets(*l.cfg, extra_sets);
     core::requireKnownSections(*l.cfg, with_filter, "--set");

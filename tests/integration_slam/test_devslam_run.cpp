@@ -223,6 +223,16 @@ TEST(DevslamRun, BadInputIsReported) {
     EXPECT_EQ(r.rc, 1);
     EXPECT_NE(r.out.find(ini.string() + " [run] mode: unknown mode 'dynamc'"), std::string::npos)
         << r.out;
+    // An empty INI, or the filter's given for the SLAM's, ran on the code's defaults.
+    for (const std::string& not_slam :
+         {ini.string(), std::string(DEVSLAM_SOURCE_DIR) + "/config_ini/dynamic_filter.ini"}) {
+        if (not_slam == ini.string()) std::ofstream(ini) << "# nothing\n";
+        r = run("--config " + not_slam + " --mode none --quiet --out ''");
+        EXPECT_EQ(r.rc, 1);
+        EXPECT_NE(r.out.find(not_slam + ": none of a SLAM INI's sections"), std::string::npos)
+            << r.out;
+    }
+    std::ofstream(ini) << "[run]\nmode = dynamc\n";
     // ... also when --mode overrides it (devslam-bench always gives --mode: no run said it).
     r = run("--config " + ini.string() + " --mode none --quiet --out ''");
     EXPECT_EQ(r.rc, 1);
@@ -719,10 +729,10 @@ TEST(DevslamRun, WithoutAnAteTheRunSaysWhy) {
     const std::string js = readText(dir / "run" / "run.json");
     EXPECT_NE(js.find("\"ate_missing\": \"ATE: " + why), std::string::npos) << js;
     EXPECT_EQ(js.find("\"ate\":"), std::string::npos) << js;
-    // Nor is there an ATE when no frame was tracked (depth read in the wrong units: no
-    // keypoint has depth): it scored the untracked identity poses against the truth (0.12 m).
+    // Nor is there an ATE when no frame was tracked (depth read in the wrong units, all of it
+    // under 6.6 cm: no keypoint has depth): it scored the untracked identity poses against the truth (0.12 m).
     // Each lost frame says why, in the summary, lost_frames.txt and run.json.
-    const auto lost = run("--mode none --max-frames 5 --set dataset.tum_depth_scale=1e300 --out " +
+    const auto lost = run("--mode none --max-frames 5 --set dataset.tum_depth_scale=1e6 --out " +
                           (dir / "lost").string());
     EXPECT_EQ(lost.rc, 0) << lost.out;
     EXPECT_NE(lost.out.find("ATE        : not computed (0 of 5 frames tracked (the ATE needs 3))"),

@@ -21,8 +21,11 @@ void ReaderOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, const
     max_dt = core::readDouble(c, s, "max_dt", max_dt);
     tum_depth_scale = core::readDouble(c, s, "tum_depth_scale", tum_depth_scale);
     sensor_label = c.read_string(s, "sensor_label", sensor_label);
-    core::requireValue(max_dt > 0, s, "max_dt", "must be > 0 s");
-    core::requireValue(tum_depth_scale > 0, s, "tum_depth_scale", "must be > 0");
+    // (1e9 s paired every colour image with some depth image; a scale of 1e-9 put every
+    // depth beyond range: nothing tracked, and no setting was blamed)
+    core::requireValue(max_dt > 0 && max_dt <= 1, s, "max_dt", "must be in (0, 1] s");
+    core::requireValue(tum_depth_scale >= 1 && tum_depth_scale <= 1e6, s, "tum_depth_scale",
+                       "must be in [1, 1e6] units per metre (TUM: 5000, millimetres: 1000)");
     try {
         if (camera != "auto") (void)core::CameraIntrinsics::fromPreset(camera);
     } catch (const std::invalid_argument& e) {
