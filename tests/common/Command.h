@@ -49,10 +49,13 @@ inline CommandResult runApp(const std::string& app, const std::string& args) {
 
 /// `<app> <args>` with no file it writes allowed past `bytes` (RLIMIT_FSIZE, with SIGXFSZ
 /// ignored, so the write past it fails with EFBIG, "File too large"): a disk that fills, where
-/// CI cannot mount a small one. r.out: its stdout and stderr.
+/// CI cannot mount a small one. r.out: its stdout and stderr. `ignore_xfsz` false leaves the
+/// signal's default action (the process is killed) to a program that ignores it itself
+/// (core::installStopHandler does).
 inline CommandResult runAppWithFileLimit(const std::string& app, const std::string& args,
-                                         unsigned long bytes) {
-    return runShell("trap '' XFSZ; exec prlimit --fsize=" + std::to_string(bytes) + " " +
+                                         unsigned long bytes, bool ignore_xfsz = true) {
+    return runShell(std::string(ignore_xfsz ? "trap '' XFSZ; " : "trap - XFSZ; ") +
+                    "exec prlimit --fsize=" + std::to_string(bytes) + " " +
                     std::string(DEVSLAM_BIN_DIR) + "/" + app + " " + args + " 2>&1");
 }
 

@@ -19,6 +19,8 @@ namespace devslam::core {
 
 /// Installs the handler for SIGINT and SIGTERM, except for one ignored at start (a background
 /// job's SIGINT); `program` prefixes its message (kept as a pointer: pass a string literal).
+/// Also ignores SIGXFSZ: past a file-size limit a write fails (EFBIG) and is reported like a
+/// full disk, instead of the process being killed (the programs runCommand starts inherit it).
 void installStopHandler(const char* program);
 /// 0 while no stop was asked for, else the first signal's number.
 [[nodiscard]] int stopSignal();
