@@ -121,7 +121,7 @@ TEST(Camera, ConfigRoundTripAndErrors) {
     EXPECT_EQ(B.problem(), "principal point (640, 255.3) lies outside the 640x480 image");
     B = CameraIntrinsics::fromPreset("fr1");
     B.dist[2] = std::nan("");
-    EXPECT_EQ(B.problem(), "a distortion coefficient is nan");
+    EXPECT_EQ(B.problem(), "a distortion coefficient is nan: must be in [-100, 100]");
 }
 
 // Every key of [camera], from a preset (saved as its values): read back, at full precision.

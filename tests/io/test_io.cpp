@@ -487,6 +487,30 @@ TEST(Rawlog, TruncatedFileReportsWhatWasRead) {
         io::TumReader tum(d.str("s"));
         while (auto f = tum.next()) w.write(*f);
     }
+    // Bytes changed inside the file (not cut): gzip finds it only by its checksum at the end,
+    // so frames before the break may hold changed pixels (3 bytes at 5 MB changed frame 6 of
+    // 32, and the 31 before the break were called intact). None is used, even when asked.
+    const std::string flipped = d.str("flipped.rawlog");
+    fs::copy_file(path, flipped);
+    {
+        std::fstream f(flipped, std::ios::in | std::ios::out | std::ios::binary);
+        f.seekp(std::streamoff(fs::file_size(flipped) / 3));
+        f.write("\xff\x00\x55", 3);
+    }
+    for (const bool allow_damaged : {false, true}) {
+        io::ReaderOptions o;
+        o.allow_damaged = allow_damaged;
+        try {
+            (void)io::openRgbd(flipped, o);
+            ADD_FAILURE() << "a rawlog with changed bytes opened";
+        } catch (const io::DamagedInput& e) {
+            EXPECT_EQ(e.intact(), 0u) << e.what();
+            EXPECT_TRUE(std::regex_search(
+                e.what(), std::regex("flipped\\.rawlog: its gzip data is corrupt \\(zlib: [^)]+\\), "
+                                     "not cut short: no frame of it can be told intact")))
+                << e.what();
+        }
+    }
     // Cut the file in the middle of the 4th observation (observations are similar in size).
     const auto size = fs::file_size(path);
     fs::resize_file(path, size * 7 / 12);
@@ -728,9 +752,23 @@ TEST(Rawlog, ImpossibleCamerasAndDepthUnitsAreErrors) {
     const auto depth_cam = written([](auto& o) { o.cameraParams.cy(-5); });
     expectError([&] { io::RawlogReader r(depth_cam); },
                 R"(observation 0: depth camera: principal point \(.*, -5\) lies outside)");
-    const auto no_unit = written([](auto& o) { o.rangeUnits = 0; });
-    expectError([&] { io::RawlogReader r(no_unit); },
-                R"(observation 0: depth_scale must be finite and > 0)");
+    // A depth unit of 0, 1 m or 1e-9 m, a NaN or 1e10 m offset between the cameras, a k1 of
+    // 1e6: each left frames without depth, without a word.
+    for (const float unit : {0.0f, 1.0f, 1e-9f}) {
+        const auto path = written([&](auto& o) { o.rangeUnits = unit; });
+        expectError([&] { io::RawlogReader r(path); },
+                    R"(observation 0: depth unit \(rangeUnits\) .* m: must be in \[1e-6, 0\.1\] m)");
+    }
+    for (const double x : {std::nan(""), 1e10}) {
+        const auto path = written([&](auto& o) { o.relativePoseIntensityWRTDepth.x(x); });
+        expectError([&] { io::RawlogReader r(path); },
+                    R"(observation 0: the colour camera's pose relative to the depth camera )"
+                    R"(\(relativePoseIntensityWRTDepth\) is .*: must be finite and within 1 m)");
+    }
+    const auto folded = written([](auto& o) { o.cameraParamsIntensity.dist[0] = 1e6; });
+    expectError([&] { io::RawlogReader r(folded); },
+                R"(observation 0: colour camera: a distortion coefficient is 1e\+06: must be in )"
+                R"(\[-100, 100\])");
 }
 
 namespace {

@@ -76,8 +76,10 @@ std::string CameraIntrinsics::problem() const {
     if (!(cx >= 0 && cx < width && cy >= 0 && cy < height))
         return "principal point (" + str(cx) + ", " + str(cy) + ") lies outside the " +
                std::to_string(width) + "x" + std::to_string(height) + " image";
+    // (k1 = 1e6 folded every depth pixel out of the colour image: a frame without depth,
+    // without a word; real lenses, fisheyes included, stay well inside 100)
     for (const double d : dist)
-        if (!std::isfinite(d)) return "a distortion coefficient is " + str(d);
+        if (!(std::abs(d) <= 100)) return "a distortion coefficient is " + str(d) + ": must be in [-100, 100]";
     return {};
 }
 

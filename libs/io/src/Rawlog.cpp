@@ -249,6 +249,23 @@ core::Frame frameFromObservation(const CObservation3DRangeScan& o, const std::st
             what + ": depth values are at most " + std::to_string(max_raw) + " units of " +
             std::to_string(o.rangeUnits) +
             " m: metres truncated to integers (MRPT rgbd_dataset2rawlog bug)?");
+    // A unit of 1 m, 1e6 m or 1e-9 m (a damaged file) put every depth beyond range or under
+    // a millimetre: frames without depth, without a word. As [dataset] tum_depth_scale.
+    if (!(o.rangeUnits >= 1e-6f && o.rangeUnits <= 0.1f))
+        throw std::runtime_error(what + ": depth unit (rangeUnits) " + std::to_string(o.rangeUnits) +
+                                 " m: must be in [1e-6, 0.1] m");
+    {  // A NaN or 1e10 m offset between the two cameras registered no depth pixel at all.
+        const auto& T = o.relativePoseIntensityWRTDepth;
+        const double t = std::sqrt(T.x() * T.x() + T.y() * T.y() + T.z() * T.z());
+        bool finite = std::isfinite(t);
+        for (int r = 0; r < 3; ++r)
+            for (int c = 0; c < 3; ++c) finite = finite && std::isfinite(T.getRotationMatrix()(r, c));
+        if (!finite || t > 1.0)
+            throw std::runtime_error(what +
+                                     ": the colour camera's pose relative to the depth camera "
+                                     "(relativePoseIntensityWRTDepth) is " +
+                                     T.asString() + ": must be finite and within 1 m");
+    }
     f.depth_scale = roundedScale(o.rangeUnits);
     // Both cameras' models before any pixel is projected with them: a focal length of 0 or
     // inf (a damaged file) made the SLAM's grid map loop forever, with no error on the way.
@@ -339,10 +356,14 @@ struct RawlogReader::Stream {
             } catch (const std::exception& e) {
                 // Cut inside an object's data: MRPT's archive says "Truncated data stream"
                 // (no EOF exception); at byte 0 that read as "not a rawlog?".
+                // (A file cut inside its first object, at the image's bytes, gets "Cannot read
+                // requested number of bytes" instead, which read as "cannot decode".)
                 const std::string why = core::innermostMessage(e.what());
-                if (why.find("Truncated data stream") != std::string::npos)
+                if (why.find("Truncated data stream") != std::string::npos ||
+                    why.find("Cannot read requested number of bytes") != std::string::npos)
                     throw std::runtime_error(
-                        "truncated object at byte " + std::to_string(pos) + " (object " +
+                        "truncated object at byte " + std::to_string(pos) +
+                        (objects == 0 && pos == 0 ? notARawlog() : "") + " (object " +
                         std::to_string(objects) +
                         " of the uncompressed stream ends early: " + printable(why) + ")");
                 throw std::runtime_error("cannot decode object " + std::to_string(objects) +
@@ -446,10 +467,25 @@ RawlogReader::RawlogReader(std::string path, ReaderOptions opts)
     } catch (const std::exception& e) {
         damage_ =
             path_ + ": " + e.what() + " after " + std::to_string(n_frames_) + " RGB-D observations";
+        // A file cut short keeps the frames before the cut whole. Bytes changed inside a gzip
+        // file are found only by its checksum, at its end (or where the decoder trips, later
+        // than the change): 3 bytes changed at 5 MB damaged frame 6's pixels, and the break
+        // was blamed on the last object, the 31 before it called intact.
+        std::string gz = core::gzipDamage(path_);
+        if (gz.rfind(path_ + ": ", 0) == 0) gz.erase(0, path_.size() + 2);  // zlib names it
+        if (!gz.empty() && gz.find("unexpected end of file") == std::string::npos)
+            throw DamagedInput(path_ + ": its gzip data is corrupt (zlib: " + gz +
+                                   "), not cut short: no frame of it can be told intact, so "
+                                   "none is used (the reading broke with: " +
+                                   e.what() + ", after " + std::to_string(n_frames_) +
+                                   " RGB-D observations)",
+                               0);
         if (!opts_.allow_damaged || n_frames_ == 0) throw DamagedInput(damage_, n_frames_);
     }
     n_skipped_ = skipped;
     format_ = saw_sf ? "action/sensory-frame" : "observations-only";
+    if (n_frames_ == 0 && fs::file_size(path_) == 0)
+        throw std::runtime_error(path_ + ": an empty file (0 bytes), no rawlog");
     if (n_frames_ == 0)
         throw std::runtime_error(path_ + ": no CObservation3DRangeScan" +
                                  (opts_.sensor_label.empty()

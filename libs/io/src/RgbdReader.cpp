@@ -24,8 +24,8 @@ void ReaderOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, const
     // (1e9 s paired every colour image with some depth image; a scale of 1e-9 put every
     // depth beyond range: nothing tracked, and no setting was blamed)
     core::requireValue(max_dt > 0 && max_dt <= 1, s, "max_dt", "must be in (0, 1] s");
-    core::requireValue(tum_depth_scale >= 1 && tum_depth_scale <= 1e6, s, "tum_depth_scale",
-                       "must be in [1, 1e6] units per metre (TUM: 5000, millimetres: 1000)");
+    core::requireValue(tum_depth_scale >= 10 && tum_depth_scale <= 1e6, s, "tum_depth_scale",
+                       "must be in [10, 1e6] units per metre (TUM: 5000, millimetres: 1000)");
     try {
         if (camera != "auto") (void)core::CameraIntrinsics::fromPreset(camera);
     } catch (const std::invalid_argument& e) {
