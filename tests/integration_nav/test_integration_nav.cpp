@@ -316,6 +316,21 @@ TEST(IntegrationNav, MrptErrorsEndTheRunNamingTheIni) {
                   std::string::npos)
             << e.what();
     }
+
+    // An obstacle band above the laser's plane: the robot saw nothing and drove into the
+    // first wall (a collision, no word on why). Refused before the run, naming both files.
+    mrpt::config::CConfigFileMemory blind(text.str());
+    blind.write("CReactiveNavigationSystem", "min_obstacles_height", "0.5");
+    const auto b = devslam::nav::NavigatorOptions::fromConfig(blind, "blind.ini");
+    try {
+        (void)devslam::sim::runEpisode(world, blind, b, {});
+        ADD_FAILURE() << "ran with the laser's points outside the obstacle band";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_EQ(std::string(e.what()),
+                  "blind.ini [CReactiveNavigationSystem] min_obstacles_height 0.5 m, "
+                  "max_obstacles_height 2 m: the band leaves out the laser's plane at 0.3 m (" +
+                      world.source + " [laser] height), so the robot would see no obstacle");
+    }
 }
 
 // A navlog on a full disk (a file-size limit stands in for one: CI cannot mount a small

@@ -175,6 +175,10 @@ void checkMrptSections(const mrpt::config::CConfigFileBase& c, const std::string
         for (const char* k : {"robotMax_V_mps", "robotMax_W_degps"})
             if (c.keyExists(ptg, k))
                 core::requireValue(core::readDouble(c, ptg, k, 0.0) > 0, ptg, k, "must be > 0");
+        // (below 0 MRPT's speed filter divided by a negative sum: NaN commands, path -nan m)
+        if (c.keyExists(ptg, "speedfilter_tau"))
+            core::requireValue(core::readDouble(c, ptg, "speedfilter_tau", 0.0) >= 0, ptg,
+                               "speedfilter_tau", "must be >= 0 s");
         // MRPT asserts end > start in every step (a run of stack traces, ended as an error).
         {
             const CAbstractPTGBasedReactive::TAbstractPTGNavigatorParams d;
@@ -283,6 +287,19 @@ void checkMrptSections(const mrpt::config::CConfigFileBase& c, const std::string
                 if (c.keyExists(s, prefix + k))
                     core::requireValue(core::readDouble(c, s, prefix + k, 0.0) > 0, s, prefix + k,
                                        "must be > 0");
+            // Bounds on what MRPT builds at the start, silently: 10000 paths ran for minutes
+            // (1000: 7 s), a collision grid of 0.0001 m cells or a 1000 m reference distance
+            // ran out of memory ("std::bad_alloc", no key named).
+            if (c.keyExists(s, prefix + "num_paths"))
+                core::requireValue(core::readDouble(c, s, prefix + "num_paths", 0.0) <= 1000, s,
+                                   prefix + "num_paths", "must be at most 1000");
+            const double res = core::readDouble(c, s, prefix + "resolution", 0.05);
+            const double ref = core::readDouble(c, s, prefix + "refDistance", 2.5);
+            const double side = 2 * ref / res;
+            std::ostringstream m;
+            m << "with " << prefix << "refDistance " << ref << " m, a collision grid of " << res
+              << " m cells has " << side << " x " << side << " cells (at most 3000 x 3000)";
+            core::requireValue(side <= 3000, s, prefix + "resolution", m.str());
         });
         try {
             (void)CParameterizedTrajectoryGenerator::CreatePTG(

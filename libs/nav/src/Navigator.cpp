@@ -418,8 +418,17 @@ NavState Navigator::step(double t) {
     if (const auto& why = nav_->getErrorReason();
         why.error_code == mrpt::nav::CAbstractNavigator::ERR_EMERGENCY_STOP ||
         why.error_code == mrpt::nav::CAbstractNavigator::ERR_OTHER) {
-        last_error_ = "MRPT's navigation step failed (settings in " + opts_.source +
-                      "?): " + core::innermostMessage(why.error_msg);
+        const std::string msg = core::innermostMessage(why.error_msg);
+        last_error_ = "MRPT's navigation step failed (settings in " + opts_.source + "?): " + msg;
+        // Both come from MRPT's scoring of a candidate motion whose PTG path does not reach
+        // the distance asked (its assertion leaves the candidate without the formulas'
+        // variables): with the shipped PTGs, measured at robotMax_V_mps 1.7 m/s and above
+        // (1.6 runs), and robotMax_W_degps 360 (200 runs). docs/nav.md.
+        if (msg.find("pt_in_range") != std::string::npos ||
+            msg.find("Undefined symbol: 'target_d_norm'") != std::string::npos)
+            last_error_ += " (MRPT 2.5's PTGs fail so at high speed limits: with the shipped "
+                           "PTGs robotMax_V_mps 1.7 m/s and robotMax_W_degps 360 deg/s did, "
+                           "1.6 and 200 ran; lower ROBOT_MAX_V / ROBOT_MAX_W)";
         active_ = false;
         return NavState::Error;
     }

@@ -9,12 +9,14 @@
 
 #include <mrpt/core/Clock.h>
 #include <mrpt/nav/reactive/CAbstractPTGBasedReactive.h>
+#include <mrpt/nav/reactive/CReactiveNavigationSystem.h>
 
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
 #include <cmath>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -90,6 +92,26 @@ EpisodeResult runEpisode(const WorldSpec& world, const mrpt::config::CConfigFile
     SimRobot robot(sim, nav_opts.person_margin);
     const auto grid = rasterize(world);
     const auto statics = staticObstacles(world);
+    {  // A band above the laser's plane (min_obstacles_height 0.5) left the robot blind: it
+       // drove into the first wall, and nothing said why.
+        const mrpt::nav::CReactiveNavigationSystem::TReactiveNavigatorParams d;
+        const std::string s = "CReactiveNavigationSystem";
+        const double lo = core::namingSource(nav_opts.source, [&] {
+            return core::readDouble(nav_ini, s, "min_obstacles_height", d.min_obstacles_height);
+        });
+        const double hi = core::namingSource(nav_opts.source, [&] {
+            return core::readDouble(nav_ini, s, "max_obstacles_height", d.max_obstacles_height);
+        });
+        const double h = world.laser.height;
+        if (!(h >= lo && h <= hi)) {
+            std::ostringstream m;
+            m << nav_opts.source << " [" << s << "] min_obstacles_height " << lo
+              << " m, max_obstacles_height " << hi << " m: the band leaves out the laser's plane at "
+              << h << " m (" << (world.source.empty() ? world.name : world.source)
+              << " [laser] height), so the robot would see no obstacle";
+            throw std::invalid_argument(m.str());
+        }
+    }
     nav::Navigator navigator(robot, nav_ini, nav_opts);
     res.holonomic_method = navigator.holonomicMethod();
     // [m] the free path MRPT's navigator needs to move at all (its default where unset).

@@ -52,18 +52,21 @@ bool SimRobot::senseObstacles(mrpt::maps::CSimplePointsMap& obstacles,
     // blocks every motion; the person's real points still stop it touching them.
     constexpr int kRing = 12;  // chord 0.5 x margin: no gap the robot fits through
     const double keep_out = sim_.world().robot.radius + 0.02;
+    // At the laser's height, which MRPT's [CReactiveNavigationSystem] min/max_obstacles_height
+    // band must hold (runEpisode checks it).
+    const auto z = static_cast<float>(sim_.world().laser.height);
     for (size_t i = 0; i < s.ranges.size(); i++) {
         if (!s.hit[i]) continue;
         const double x = s.ranges[i] * std::cos(s.angles[i]);
         const double y = s.ranges[i] * std::sin(s.angles[i]);
-        obstacles.insertPoint(static_cast<float>(x), static_cast<float>(y), 0.2f);
+        obstacles.insertPoint(static_cast<float>(x), static_cast<float>(y), z);
         if (person_margin_ <= 0 || !s.person[i]) continue;
         for (int k = 0; k < kRing; k++) {
             const double a = 2 * M_PI * k / kRing;
             const double rx = x + person_margin_ * std::cos(a);
             const double ry = y + person_margin_ * std::sin(a);
             if (std::hypot(rx, ry) < keep_out) continue;
-            obstacles.insertPoint(static_cast<float>(rx), static_cast<float>(ry), 0.2f);
+            obstacles.insertPoint(static_cast<float>(rx), static_cast<float>(ry), z);
         }
     }
     timestamp = mrpt::Clock::now();
