@@ -174,11 +174,14 @@ void writeChart(const std::string& path, const std::vector<devslam::sim::Categor
 /// --help, 2 for a bad argument, said on stderr with the usage).
 std::optional<int> parseArgs(int argc, char** argv, Args& a) {
     bool results_given = false, per_category_given = false, png_dir_given = false;
+    std::vector<std::string> changed;  // options that make another bench than the published one
     try {
         devslam::core::refuseRepeatedOptions(argc, argv);
         for (int i = 1; i < argc; i++) {
             const std::string s = argv[i];
             auto next = [&] { return devslam::core::optionValue(argc, argv, i); };
+            if (s != "--results" && s != "--quick" && s != "-h" && s != "--help")
+                changed.push_back(s);
             if (s == "--per-category") {
                 a.per_category =
                     int(devslam::core::parseInteger(next(), "--per-category", 1, 100000));
@@ -240,8 +243,18 @@ std::optional<int> parseArgs(int argc, char** argv, Args& a) {
         usage();
         return 2;
     }
-    if (!results_given && !a.quick)
+    // The published section is the default bench's: a run of 1 world per category replaced
+    // its 200-world tables, linking pictures outside the repository. Another bench writes a
+    // results file only when named.
+    if (!results_given && !a.quick && changed.empty())
         a.results = std::string(DEVSLAM_SOURCE_DIR) + "/docs/RESULTS.md";
+    else if (!results_given && !a.quick) {
+        std::string list;
+        for (const auto& o : changed) list += (list.empty() ? "" : ", ") + o;
+        std::cerr << "devslam-nav-bench: " << list
+                  << " make another bench than docs/RESULTS.md's: the tables are printed only "
+                     "(--results FILE writes them)\n";
+    }
     return std::nullopt;
 }
 
@@ -330,10 +343,15 @@ Episodes runEpisodes(const Args& a, const mrpt::config::CConfigFileBase& ini,
             for (double s : r.step_seconds) ep.step_ms[g.method].push_back(1e3 * s);
             if (g.index == 0 && g.method == a.methods.front())  // pictured after the results
                 ep.pictures.push_back({*g.world, r, g.method});
-            if (!g.error.empty())
+            // An exception out of the episode, or a run the navigator ended by an error (MRPT
+            // refusing a setting mid-run): not results.
+            const std::string error = !g.error.empty() ? g.error
+                                      : r.outcome == devslam::sim::Outcome::Error ? r.reason
+                                                                                 : std::string();
+            if (!error.empty())
                 ep.errors.push_back(std::string(devslam::sim::toString(cats[g.category])) +
                                     " world " + std::to_string(a.seed + g.index) + " / " +
-                                    shortName(g.method) + ": " + g.error);
+                                    shortName(g.method) + ": " + error);
             if (!r.navlog_error.empty() && ep.navlogs_cut++ == 0)
                 ep.first_navlog_error = r.navlog_error;
             bar.update(++ep.done, std::string(devslam::sim::toString(cats[g.category])) + " " +
@@ -491,6 +509,10 @@ int appMain(int argc, char** argv) {
                << ep.done << " of " << ep.total
                << " episodes: the tables below cover those only.**\n\n";
         md << categoryTables(a, cats, ep);
+        // Episodes ended by an error (a setting MRPT refuses mid-run, a formula that does not
+        // compile) are not results: a bench of them printed 0 % success everywhere, exit 0,
+        // and wrote that into the results file.
+        const bool all_failed = !ep.errors.empty() && ep.errors.size() == std::size_t(ep.done);
         if (!ep.errors.empty()) {
             // Counted in the tables as "no path or error"; said here, as they are not results.
             md << "**" << ep.errors.size() << " episode" << (ep.errors.size() == 1 ? "" : "s")
@@ -511,6 +533,16 @@ int appMain(int argc, char** argv) {
         }
         md << timingMarkdown(a, ep);
         std::cout << md.str();
+        if (!ep.errors.empty()) {
+            std::cerr << "devslam-nav-bench: "
+                      << (all_failed ? "every episode" : std::to_string(ep.errors.size()) +
+                                                             " of " + std::to_string(ep.done) +
+                                                             " episodes")
+                      << " ended by an error (the first: " << ep.errors.front() << "); "
+                      << (a.results.empty() ? std::string() : a.results + " and ")
+                      << "the pictures were left as they were\n";
+            return 1;
+        }
         // The table first: pictures of a table that could not be written would not match it.
         if (!a.results.empty()) {
             devslam::core::replaceResultsSection(a.results, "nav", md.str());

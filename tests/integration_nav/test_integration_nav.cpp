@@ -41,6 +41,12 @@ namespace {
 const std::string kSrc = DEVSLAM_SOURCE_DIR;
 const std::string kIni = kSrc + "/config_ini/nav_reactive.ini";
 
+/// The whole of a file ("" when it is not there).
+std::string readFile(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), {}};
+}
+
 /// MRPT's kinematic diff-drive simulator + a laser simulated on the occupancy grid.
 class KinematicRobot : public mrpt::nav::CRobot2NavInterfaceForSimulator_DiffDriven {
   public:
@@ -565,6 +571,44 @@ TEST(IntegrationNav, AppsSmokeTest) {
         EXPECT_EQ(rows, 4u) << md;
         // The pictures are linked where they are, relative to the results file (both in out).
         EXPECT_NE(md.find("![success rates](./nav_bench_success.png)"), std::string::npos) << md;
+    }
+    // Episodes that all end by an error (a score formula exprtk cannot compile) are no
+    // results: the bench printed 0 % success everywhere, exit 0, and wrote that into the
+    // results file. Now it fails, and the file and pictures stay as they were.
+    {
+        std::ifstream in(kIni);
+        std::string ini((std::istreambuf_iterator<char>(in)), {});
+        const std::string good = "score3_formula  = 1/(1+dist_eucl_min^2)";
+        ASSERT_NE(ini.find(good), std::string::npos);
+        ini.replace(ini.find(good), good.size(), "score3_formula  = 1/(1+dist_eucl_min^");
+        std::ofstream(out + "/bad_formula.ini") << ini;
+        const std::string before = readFile(out + "/RESULTS.md");
+        r = devslam::test::runApp("devslam-nav-bench", "--per-category 1 --methods "
+                                                       "CHolonomicVFHPlus --config " +
+                                                           out + "/bad_formula.ini --results " +
+                                                           out + "/RESULTS.md --png-dir " + out +
+                                                           "/bad_formula");
+        EXPECT_EQ(r.rc, 1) << r.out;
+        EXPECT_NE(r.out.find("devslam-nav-bench: every episode ended by an error (the first: "),
+                  std::string::npos)
+            << r.out;
+        EXPECT_EQ(readFile(out + "/RESULTS.md"), before);
+        EXPECT_FALSE(mrpt::system::directoryExists(out + "/bad_formula"));
+    }
+    // Another bench than the published one (here: one world per category) leaves
+    // docs/RESULTS.md alone unless --results names a file: it replaced the 200-world tables.
+    {
+        const std::string results = std::string(DEVSLAM_SOURCE_DIR) + "/docs/RESULTS.md";
+        const std::string before = readFile(results);
+        r = devslam::test::runApp("devslam-nav-bench",
+                                  "--per-category 1 --methods CHolonomicVFHPlus --png-dir " + out +
+                                      "/other");
+        EXPECT_EQ(r.rc, 0) << r.out;
+        EXPECT_NE(r.out.find("devslam-nav-bench: --per-category, --methods, --png-dir make another "
+                             "bench than docs/RESULTS.md's: the tables are printed only"),
+                  std::string::npos)
+            << r.out;
+        EXPECT_EQ(readFile(results), before);
     }
     // Refused before any run: a method twice, --quick with a count, a results file whose
     // section markers are broken (no pictures are written for a table that is not).
