@@ -152,6 +152,13 @@ TEST(World, BadEntriesNameTheKey) {
               "w.ini [pedestrians] p: its path from (2, 3) to (4, 1.5) runs through obstacle "
               "'b1'");
     EXPECT_EQ(errorOf(head + box + "[pedestrians]\np = scripted 0.5 0.2 0 2 2.5 4 2.5\n"), "");
+    // Nor stand still on the goal (the run waited out its timeout, saying only "not at the
+    // goal"); one who walks past it, or stands beside it, may.
+    EXPECT_EQ(errorOf(head + "[pedestrians]\np = random 0 0.2 0 4 4.1\n"),
+              "w.ini [pedestrians] p: stands still (speed 0) at (4, 4.1), on the goal: no place "
+              "within the goal's tolerance (0.3 m) keeps the robot clear of them");
+    EXPECT_EQ(errorOf(head + "[pedestrians]\np = scripted 0.5 0.2 0 3 4 4.5 4\n"), "");
+    EXPECT_EQ(errorOf(head + "[pedestrians]\np = random 0 0.2 0 4 4.6\n"), "");
     // A mistyped section would drop all of its keys without a word.
     EXPECT_EQ(errorOf(head + "[obstacle]\nbox_1 = box 2 2 0.5 0.5 0\n"),
               "w.ini: unknown section [obstacle] (known: world, robot, goal, laser, obstacles, "

@@ -455,6 +455,16 @@ void validatePedestrians(const WorldSpec& w, const std::vector<Obstacle>& static
         if (std::hypot(p0.x - w.robot.start.x, p0.y - w.robot.start.y) < p.radius + w.robot.radius)
             fail(src, "pedestrians", p.name,
                  "starts at " + at(p0) + ", on the robot (its start is within the two radii)");
+        // A person who never moves, standing where the robot would have to stand to arrive:
+        // the run waited out its timeout, saying only "not at the goal".
+        if (p.speed == 0 &&
+            std::hypot(p0.x - w.goal.x, p0.y - w.goal.y) + w.goal_tolerance <
+                p.radius + w.robot.radius) {
+            std::ostringstream m;
+            m << "stands still (speed 0) at " << at(p0) << ", on the goal: no place within the "
+              << "goal's tolerance (" << w.goal_tolerance << " m) keeps the robot clear of them";
+            fail(src, "pedestrians", p.name, m.str());
+        }
         // The simulated people are kinematic: a scripted one walks through whatever lies on
         // its path (brushing past an edge is allowed), and a random walker never leaves an
         // obstacle it starts in. Both are mistakes in the world file.
