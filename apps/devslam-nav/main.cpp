@@ -13,6 +13,7 @@
 
 #include <mrpt/system/filesystem.h>
 
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -208,6 +209,18 @@ static int appMain(int argc, char** argv) {
             nav_opts.log_file = true;
             nav_opts.log_directory = navlog;
         }
+        // A line every 5 s of wall time (none for a run shorter than that): a long world
+        // (a timeout of hours, thousands of people) ran for minutes without a word.
+        const auto wall_start = std::chrono::steady_clock::now();
+        auto next_line = wall_start + std::chrono::seconds(5);
+        eo.on_step = [&](double t, double to_goal) {
+            const auto now = std::chrono::steady_clock::now();
+            if (now < next_line) return;
+            next_line = now + std::chrono::seconds(5);
+            std::fprintf(stderr, "devslam-nav: %.0f of %.0f s simulated (%.0f s wall), %.2f m to the goal\n",
+                         t, world.timeout,
+                         std::chrono::duration<double>(now - wall_start).count(), to_goal);
+        };
         const auto r = devslam::sim::runEpisode(world, *ini, nav_opts, eo);
         if (png.empty()) png = kDefaultDir + "/nav_" + world.name + ".png";
         // The result first: a picture that cannot be written must not lose it.

@@ -339,6 +339,23 @@ TEST(IntegrationNav, MrptErrorsEndTheRunNamingTheIni) {
     }
 }
 
+// devslam-nav's progress line is fed after every navigator step: the simulated time rising,
+// the distance to the goal falling to the goal's tolerance on a run that arrives.
+TEST(IntegrationNav, EpisodeReportsEachStepForProgress) {
+    const auto world = devslam::sim::loadWorld(kSrc + "/sim_worlds/obstacle_near_goal.ini");
+    const auto ini = devslam::core::loadIni(kIni);
+    const auto opts = devslam::nav::NavigatorOptions::fromConfig(*ini, kIni);
+    std::vector<std::pair<double, double>> steps;
+    devslam::sim::EpisodeOptions eo;
+    eo.on_step = [&](double t, double to_goal) { steps.emplace_back(t, to_goal); };
+    const auto r = devslam::sim::runEpisode(world, *ini, opts, eo);
+    ASSERT_EQ(r.outcome, devslam::sim::Outcome::Success) << r.reason;
+    ASSERT_EQ(steps.size(), r.step_seconds.size());
+    for (std::size_t i = 1; i < steps.size(); ++i) EXPECT_GT(steps[i].first, steps[i - 1].first);
+    EXPECT_GT(steps.front().second, 5.0);
+    EXPECT_LT(steps.back().second, 1.0);
+}
+
 // A navlog on a full disk (a file-size limit stands in for one: CI cannot mount a small
 // disk): MRPT writes the log inside navigationStep(), and its handler of its own stream's
 // exception stopped the robot at every step (a 60 s timeout standing at the start, 12000

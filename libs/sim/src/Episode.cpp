@@ -203,6 +203,7 @@ EpisodeResult runEpisode(const WorldSpec& world, const mrpt::config::CConfigFile
                 res.reason = "navigator error: " + navigator.lastError();
                 break;
             }
+            if (opts.on_step) opts.on_step(t, std::hypot(p.x - world.goal.x, p.y - world.goal.y));
         }
         sim.step();
         clock.set(sim.time());

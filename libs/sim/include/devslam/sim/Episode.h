@@ -14,6 +14,7 @@
 #include <devslam/nav/Navigator.h>
 #include <devslam/sim/World.h>
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -23,6 +24,9 @@ struct EpisodeOptions {
     /// MRPT class name; empty: the navigator options' own ([navigator] holonomic_method)
     std::string holonomic_method;
     double record_period = 0.1;  ///< [s] trajectory / tracks sampling
+    /// Called after each navigator step with the simulated time [s] and the robot's distance
+    /// to the goal [m] (devslam-nav's progress line); empty: none.
+    std::function<void(double t, double to_goal)> on_step;
 };
 
 /// NoPath: no global route at the start; Error: the navigator stopped on an error (the
