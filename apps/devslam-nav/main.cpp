@@ -169,6 +169,16 @@ static int appMain(int argc, char** argv) {
         std::cerr << "devslam-nav: give a world or --map, not both\n";
         return 2;
     }
+    // --map plans only (no robot drives): these were ignored without a word.
+    if (!map.empty())
+        for (const auto& [given, option] : {std::pair{!method.empty(), "--method"},
+                                            {!navlog.empty(), "--navlog"},
+                                            {verbose, "--verbose"}})
+            if (given) {
+                std::cerr << "devslam-nav: " << option
+                          << " does not go with --map, which plans a path and drives no robot\n";
+                return 2;
+            }
     // A world file has its own start and goal: --from and --to were ignored without a word.
     if (map.empty() && (from_given || !to.empty())) {
         std::cerr << "devslam-nav: " << (from_given ? "--from" : "--to")

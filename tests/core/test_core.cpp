@@ -709,6 +709,25 @@ TEST(Results, SectionsAreReplacedInPlaceAndBrokenMarkersRefused) {
     EXPECT_THROW(checkResultsSection(std::filesystem::path(path).parent_path().string(), "b"),
                  std::runtime_error);
     EXPECT_EQ(read(), broken);
+    // A binary file named .md got a section appended; a section there twice had only its
+    // first replaced, the second keeping old figures.
+    for (const std::string& bad :
+         {std::string("# R\n\x01\x02garbage\n"),
+          std::string("<!-- BEGIN b -->\nold\n<!-- END b -->\n<!-- BEGIN b -->\nolder\n"
+                      "<!-- END b -->\n")}) {
+        std::ofstream(path, std::ios::trunc) << bad;
+        try {
+            replaceResultsSection(path, "b", "new");
+            ADD_FAILURE() << "no error for " << bad;
+        } catch (const std::runtime_error& e) {
+            const std::string m = e.what();
+            EXPECT_TRUE(m.find("holds control bytes: not a Markdown text file") !=
+                            std::string::npos ||
+                        m.find("section 'b' is there twice; remove one") != std::string::npos)
+                << m;
+        }
+        EXPECT_EQ(read(), bad);
+    }
     std::filesystem::remove(path);
 }
 

@@ -553,6 +553,10 @@ TEST(IntegrationNav, AppsSmokeTest) {
     EXPECT_EQ(r.rc, 2);
     EXPECT_NE(r.out.find("--to needs --map"), std::string::npos) << r.out;
     EXPECT_EQ(r.out.find("result="), std::string::npos) << r.out;
+    // ... and the options of a drive do not go with --map, which plans only.
+    r = devslam::test::runApp("devslam-nav", "--map " + out + "/none.gridmap --method CHolonomicND");
+    EXPECT_EQ(r.rc, 2);
+    EXPECT_NE(r.out.find("--method does not go with --map"), std::string::npos) << r.out;
     // A --navlog that cannot be a folder is named as the option (it was blamed on the INI's
     // [navigator] log_directory).
     std::ofstream(out + "/not_a_folder") << "x";

@@ -397,6 +397,12 @@ TEST(NavConfig, MrptSectionsAreReadStrictly) {
     EXPECT_EQ(errorOf("replan", "blocked_margin", "-0.5"),
               "x.ini [replan] blocked_margin: must be >= 0 m");
     EXPECT_EQ(errorOf("replan", "sensed_range", "0"), "x.ini [replan] sensed_range: must be > 0 m");
+    // Values no robot needs, which silently disabled what they set (the replans fell back
+    // to the static map; VFH+ blocked every sector).
+    EXPECT_EQ(errorOf("replan", "obstacle_inflation", "1e9"),
+              "x.ini [replan] obstacle_inflation: must be in [0, 2] m");
+    EXPECT_EQ(errorOf("CHolonomicVFHPlus", "enlargement_radius", "1e9"),
+              "x.ini [CHolonomicVFHPlus] enlargement_radius: must be in [0, 5] m");
     EXPECT_EQ(errorOf("CAbstractPTGBasedReactive", "robotMax_V_mps", "fast"),
               "x.ini [CAbstractPTGBasedReactive] robotMax_V_mps: expected a number, got 'fast'");
     EXPECT_EQ(errorOf("CAbstractNavigator", "alarm_seems_not_approaching_target_timeout", "15s"),

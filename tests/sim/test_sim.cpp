@@ -129,6 +129,8 @@ TEST(World, BadEntriesNameTheKey) {
               "w.ini [robot] start_y: start is outside the world bounds");
     EXPECT_EQ(errorOf(head + "[laser]\nfov_deg = 400\n"),
               "w.ini [laser] fov_deg: must be in (0, 360]");
+    EXPECT_EQ(errorOf(head + "[laser]\nnoise_std = 100\n"),
+              "w.ini [laser] noise_std: must be in [0, range / 10] m");
     // A goal the exact distance allows (0.298 m from the box, robot radius 0.25 m) but the
     // planner's grid does not (clearance between cell centres): refused in the file's terms.
     const std::string near =

@@ -63,7 +63,20 @@ std::string withSection(const std::string& path, const std::string& name,
                 "it; do not edit by hand.\n";
         }
     }
+    // A binary file named .md (a NUL or other control byte) got a section appended to it.
+    for (const char ch : text) {
+        const auto c = static_cast<unsigned char>(ch);
+        if (c < 0x20 && c != '\n' && c != '\r' && c != '\t')
+            throw std::runtime_error("results file '" + path +
+                                     "' holds control bytes: not a Markdown text file; nothing "
+                                     "was written");
+    }
     const std::string begin = "<!-- BEGIN " + name + " -->", end = "<!-- END " + name + " -->";
+    // Two sections of one name: only the first was replaced, the second kept old figures.
+    if (const auto first = text.find(begin);
+        first != std::string::npos && text.find(begin, first + 1) != std::string::npos)
+        throw std::runtime_error("results file '" + path + "': section '" + name +
+                                 "' is there twice; remove one (nothing was written)");
     const std::string block =
         begin + "\n" + markdown + (markdown.empty() || markdown.back() == '\n' ? "" : "\n") + end;
     const auto b = text.find(begin);

@@ -26,7 +26,9 @@ void ReplanOptions::loadFromConfigFile(const mrpt::config::CConfigFileBase& c, c
     core::requireValue(min_interval >= 0, s, "min_interval", "must be >= 0 s");
     core::requireValue(blocked_lookahead > 0, s, "blocked_lookahead", "must be > 0 m");
     core::requireValue(blocked_margin >= 0, s, "blocked_margin", "must be >= 0 m");
-    core::requireValue(obstacle_inflation >= 0, s, "obstacle_inflation", "must be >= 0 m");
+    // (1e9 m covered the whole map: every replan fell back to the static map, without a word)
+    core::requireValue(obstacle_inflation >= 0 && obstacle_inflation <= 2, s,
+                       "obstacle_inflation", "must be in [0, 2] m");
     core::requireValue(sensed_range > 0, s, "sensed_range", "must be > 0 m");
 }
 

@@ -71,7 +71,9 @@ void VfhPlusOptions::validate() const {
     const std::string sec = "CHolonomicVFHPlus";
     core::requireValue(window > 0 && window <= 1.0, sec, "window", "must be in (0, 1]");
     core::requireValue(certainty > 0 && certainty <= 1.0, sec, "certainty", "must be in (0, 1]");
-    core::requireValue(enlargement_radius >= 0, sec, "enlargement_radius", "must be >= 0 m");
+    // (1e9 m blocked every sector: a timeout standing, no hint)
+    core::requireValue(enlargement_radius >= 0 && enlargement_radius <= 5, sec,
+                       "enlargement_radius", "must be in [0, 5] m");
     core::requireValue(tau_low >= 0 && tau_low <= tau_high, sec, "tau_low",
                        "must satisfy 0 <= tau_low <= tau_high");
     core::requireValue(min_free_distance >= 0 && min_free_distance < 1, sec, "min_free_distance",

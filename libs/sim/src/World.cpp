@@ -284,7 +284,9 @@ void validateRobotAndLaser(const WorldSpec& w) {
     // robot was blind to them while its planner steered round them.
     if (!(w.laser.height > 0 && w.laser.height < 0.4))
         fail(src, "laser", "height", "must be in (0, 0.4) m, below the top of the lowest obstacle");
-    if (!(w.laser.noise_std >= 0)) fail(src, "laser", "noise_std", "must be >= 0 m");
+    // (100 m of noise on a 6 m laser was accepted)
+    if (!(w.laser.noise_std >= 0 && w.laser.noise_std <= 0.1 * w.laser.range))
+        fail(src, "laser", "noise_std", "must be in [0, range / 10] m");
     if (!(w.laser.fov > 0) || w.laser.fov > 2 * M_PI + 1e-9)
         fail(src, "laser", "fov_deg", "must be in (0, 360]");
     // Each ray is a Bullet ray cast (about 1 us): 1e8 of them are a minute and a half.
