@@ -39,7 +39,7 @@ options:
 
 /// Whether the output is a rawlog (else a TUM folder), by its name as given.
 bool isRawlog(const std::string& out) {
-    return devslam::core::endsWith(out, ".rawlog");
+    return devslam::core::endsWithNoCase(out, ".rawlog");  // (out.RAWLOG made a folder)
 }
 
 /// The writers open their output before the first frame is read: an output that is the
@@ -98,8 +98,10 @@ std::variant<Args, int> parseArgs(int argc, char** argv) {
         else
             pos.push_back(a);
     }
-    if (pos.size() != 2) {
-        std::cerr << kUsage;
+    if (pos.size() != 2) {  // (the usage alone did not say what was wrong)
+        std::cerr << "devslam-convert: expected two files, INPUT and OUTPUT, got " << pos.size()
+                  << (pos.size() > 2 ? " (the third: '" + pos[2] + "')" : std::string()) << "\n"
+                  << kUsage;
         return 2;
     }
     args.input = pos[0];

@@ -85,8 +85,10 @@ static int appMain(int argc, char** argv) {
             else
                 pos.push_back(a);
         }
-        if (pos.size() != 2) {
-            std::cerr << kUsage;
+        if (pos.size() != 2) {  // (the usage alone did not say what was wrong)
+            std::cerr << "devslam-eval: expected two files, GROUNDTRUTH and ESTIMATE, got " << pos.size()
+                      << (pos.size() > 2 ? " (the third: '" + pos[2] + "')" : std::string()) << "\n"
+                      << kUsage;
             return 2;
         }
         if (!plot.empty() && !devslam::core::endsWithNoCase(plot, ".png"))

@@ -43,7 +43,8 @@ const char* kUsage =
     "/data/tum/fr1_xyz_first37\n"
     "          --config " DEVSLAM_SOURCE_DIR
     "/config_ini/slam_tum_fr1.ini\n"
-    "          --mode from the INI's [run] mode (dynamic), --out ./out/devslam-run\n"
+    "          --mode from the INI's [run] mode (dynamic), --out ./out/devslam-run,\n"
+    "          --max-frames 0 (every frame)\n"
     "          (--out '' writes no files: the summary only)\n"
     "mode truth (diagnostic, devslam-synth folders only): the mask is the renderer's\n"
     "walking people, dilated by [dynamic_filter] mask_margin - a perfect filter.\n";

@@ -449,6 +449,29 @@ TEST(DevslamConvert, SaysWhatARawlogDoesNotKeep) {
 }
 
 // A conversion that stops midway leaves a partial rawlog: it must never replace a good one.
+// Two files each: a count that is wrong says so (the usage alone did not); a rawlog named in
+// capitals is a rawlog (out.RAWLOG made a TUM folder of that name).
+TEST(DevslamConvert, FileCountAndRawlogNameInAnyCase) {
+    auto r = devslam::test::runApp("devslam-eval", "gt.txt");
+    EXPECT_EQ(r.rc, 2);
+    EXPECT_NE(r.out.find("devslam-eval: expected two files, GROUNDTRUTH and ESTIMATE, got 1"),
+              std::string::npos)
+        << r.out;
+    r = devslam::test::runApp("devslam-convert", "a b c");
+    EXPECT_EQ(r.rc, 2);
+    EXPECT_NE(r.out.find("devslam-convert: expected two files, INPUT and OUTPUT, got 3 (the "
+                         "third: 'c')"),
+              std::string::npos)
+        << r.out;
+    const devslam::test::TempDir d("devslam_");
+    const fs::path out = fs::path(d.str()) / "upper.RAWLOG";
+    r = devslam::test::runApp("devslam-convert", std::string(DEVSLAM_SOURCE_DIR) +
+                                                     "/data/tum/fr1_xyz_first37 " + out.string() +
+                                                     " --max-frames 2");
+    ASSERT_EQ(r.rc, 0) << r.out;
+    EXPECT_TRUE(fs::is_regular_file(out)) << "a folder was made";
+}
+
 TEST(DevslamConvert, RefusesToWriteOverAnExistingRawlog) {
     const devslam::test::TempDir d("devslam_");
     const fs::path dir = d.str();

@@ -447,7 +447,7 @@ RawlogReader::RawlogReader(std::string path, ReaderOptions opts)
             last_t = t;
             if (n_frames_ == 0) {
                 o->load();
-                K_ = frameFromObservation(*o, path_ + " observation 0").K;
+                K_ = frameFromObservation(*o, "observation 0").K;  // (the catch below names the file)
                 o->unload();
                 first_cam = o->cameraParamsIntensity;
                 first_calibration = core::CameraIntrinsics::fromMrpt(first_cam);
