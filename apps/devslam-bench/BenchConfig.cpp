@@ -102,10 +102,16 @@ Bench readBench(const std::string& path) {
         q.slam_config = resolve(cfg->read_string(s, "slam_config", ""), base);
         if (q.slam_config.empty()) q.slam_config = b.slam_config;
         // Found now, not as every run of the sequence failing after minutes of work.
-        if (!fs::is_regular_file(q.slam_config))
+        if (!fs::is_regular_file(q.slam_config)) {
+            const std::string given = cfg->read_string(s, "slam_config", "");
             throw std::invalid_argument(
                 path + " [" + (cfg->keyExists(s, "slam_config") ? s : std::string("bench")) +
-                "] slam_config: no such file '" + q.slam_config + "'");
+                "] slam_config: no such file '" + q.slam_config + "'" +
+                // (a relative name is looked for beside the INI first: say so)
+                (!given.empty() && fs::path(given).is_relative()
+                     ? " (nor '" + (fs::path(base) / given).lexically_normal().string() + "')"
+                     : std::string()));
+        }
         // ... and read, with the filter INI it names: a syntax error in the last sequence's
         // INI stopped the bench there, hours into it, with no table. The filter and its
         // detector are made from them too: a mistyped [detector] key or a missing weights
@@ -141,9 +147,11 @@ Bench readBench(const std::string& path) {
                 "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789"
                 "_.-") != std::string::npos ||
             q.name == "." || q.name == "..")
-            throw std::invalid_argument(path + " [" + s + "] name: '" + q.name +
-                                        "' (letters, digits, '_', '.', '-' only: it names "
-                                        "folders, files and a CSV column)");
+            throw std::invalid_argument(
+                path + " [" + s + "] name: '" + q.name + "' (" +
+                (q.name == "." || q.name == ".." ? "'.' and '..' are taken by every folder"
+                                                 : "letters, digits, '_', '.', '-' only") +
+                ": it names folders, files and a CSV column)");
         if (q.scenario.empty() && q.path.empty())
             throw std::invalid_argument(path + " [" + s +
                                         "]: give 'path' (a TUM folder) or 'scenario' (synthetic)");

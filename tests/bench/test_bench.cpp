@@ -643,6 +643,8 @@ TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
         {"[sequence_a]\npath = " + root + "/data/tum/no_such_folder\n",
          "bench.ini [sequence_a] path: no such file or folder '"},
         {real + "slam_config = nowhere.ini\n", "bench.ini [sequence_a] slam_config: no such file"},
+        {real + "slam_config = nowhere.ini\n", "' (nor '" + (tmp / "nowhere.ini").string() + "')"},
+        {real + "name = ..\n", "[sequence_a] name: '..' ('.' and '..' are taken by every folder"},
         {synth + "slam_config = " + (tmp / "badrun.ini").string() + "\n",
          "bench.ini [sequence_a]: devslam-run refuses its SLAM INI '" +
              (tmp / "badrun.ini").string() + "' in mode none (exit 1):\n  devslam-run: " +
