@@ -2,12 +2,15 @@
 // kinematic simulator (laser simulated on the grid), then in a small Bullet world; and a
 // smoke test of both apps.
 #include <devslam/core/Config.h>
+#include <devslam/core/GzFile.h>
 #include <devslam/nav/CHolonomicVFHPlus.h>
 #include <devslam/nav/Navigator.h>
 #include <devslam/sim/Episode.h>
 #include <devslam/sim/World.h>
 
 #include <gtest/gtest.h>
+#include <unistd.h>
+#include <fcntl.h>
 
 #include "Command.h"
 #include "Scratch.h"
@@ -354,6 +357,40 @@ TEST(IntegrationNav, EpisodeReportsEachStepForProgress) {
     for (std::size_t i = 1; i < steps.size(); ++i) EXPECT_GT(steps[i].first, steps[i - 1].first);
     EXPECT_GT(steps.front().second, 5.0);
     EXPECT_LT(steps.back().second, 1.0);
+}
+
+// A PTG cache file cut short (a full disk, a run killed while writing it) is removed before
+// MRPT reads it: MRPT printed its read exception with a stack trace, naming no file, and then
+// built it again. It is built again, whole, and the run is the same.
+TEST(IntegrationNav, ADamagedPtgCacheFileIsBuiltAgain) {
+    const devslam::test::TempDir dir("devslam_");
+    const auto world = devslam::sim::loadWorld(kSrc + "/sim_worlds/obstacle_near_goal.ini");
+    const auto ini = devslam::core::loadIni(kIni);
+    auto opts = devslam::nav::NavigatorOptions::fromConfig(*ini, kIni);
+    opts.ptg_cache_directory = dir.str("cache");
+    const auto first = devslam::sim::runEpisode(world, *ini, opts, {});
+    const std::string file = dir.str("cache/ReacNavGrid_000.dat.gz");
+    ASSERT_TRUE(std::filesystem::is_regular_file(file));
+    const auto size = std::filesystem::file_size(file);
+    std::filesystem::resize_file(file, size / 2);
+    ASSERT_FALSE(devslam::core::gzipDamage(file).empty());
+    // The standard error of the second run, where MRPT printed its exception.
+    const std::string err_file = dir.str("stderr.txt");
+    std::fflush(stderr);
+    const int saved = ::dup(STDERR_FILENO);
+    const int fd = ::open(err_file.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0600);
+    ::dup2(fd, STDERR_FILENO);
+    ::close(fd);
+    const auto again = devslam::sim::runEpisode(world, *ini, opts, {});
+    std::fflush(stderr);
+    ::dup2(saved, STDERR_FILENO);
+    ::close(saved);
+    EXPECT_EQ(readFile(err_file).find("Cannot read requested number of bytes"), std::string::npos)
+        << readFile(err_file);
+    EXPECT_EQ(devslam::core::gzipDamage(file), "");
+    EXPECT_EQ(std::filesystem::file_size(file), size);
+    EXPECT_EQ(again.outcome, first.outcome) << again.reason;
+    EXPECT_DOUBLE_EQ(again.time, first.time);
 }
 
 // A navlog on a full disk (a file-size limit stands in for one: CI cannot mount a small

@@ -1,5 +1,6 @@
 #include <devslam/core/Config.h>
 #include <devslam/core/GzFile.h>
+#include <devslam/core/Parse.h>
 #include <devslam/nav/CHolonomicVFHPlus.h>
 #include <devslam/nav/Navigator.h>
 
@@ -16,6 +17,7 @@
 #include <ctime>
 #include <filesystem>
 #include <functional>
+#include <iostream>
 #include <sstream>
 
 namespace devslam::nav {
@@ -262,6 +264,20 @@ Navigator::Navigator(mrpt::nav::CRobot2NavInterface& robot,
                     .string();
     }
     mrpt::system::createDirectory(cache);
+    // A cache file cut short (a full disk, a run killed while writing it): MRPT printed its
+    // read exception with a stack trace, naming no file, then rebuilt it. Removed first, it
+    // is rebuilt without the noise.
+    {
+        std::error_code ec;
+        for (const auto& e : std::filesystem::directory_iterator(cache, ec)) {
+            const std::string f = e.path().string();
+            if (!core::endsWithNoCase(f, ".dat.gz") || core::gzipDamage(f).empty()) continue;
+            std::filesystem::remove(e.path(), ec);
+            if (opts_.verbose)
+                std::cerr << "navigator: removed the damaged PTG cache file " << f
+                          << " (MRPT builds it again)\n";
+        }
+    }
     nav_->params_abstract_ptg_navigator.ptg_cache_files_directory = cache;
     // What only MRPT itself can tell (a motion decider class it does not know, a holonomic
     // method's section that is missing, a FullEval phase without its factors) it throws here,
