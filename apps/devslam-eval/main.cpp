@@ -6,9 +6,11 @@
 #include <devslam/eval/Report.h>
 #include <devslam/io/TrajectoryIO.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -90,6 +92,12 @@ static int appMain(int argc, char** argv) {
                       << (pos.size() > 2 ? " (the third: '" + pos[2] + "')" : std::string()) << "\n"
                       << kUsage;
             return 2;
+        }
+        // Before the inputs are read (it came after the ATE, with a hint that did not fit).
+        if (ro.delta_in_frames && ro.delta != std::floor(ro.delta)) {
+            std::ostringstream m;
+            m << "--delta: in frames (--delta-unit f) a whole number, got " << ro.delta;
+            throw std::invalid_argument(m.str());
         }
         if (!plot.empty() && !devslam::core::endsWithNoCase(plot, ".png"))
             throw std::invalid_argument("--plot '" + plot + "': the plot's name must end in .png");

@@ -559,7 +559,8 @@ std::string formatSummary(const RunReport& r) {
     if (const auto e = loopErrors(r.loop_reports); !e.empty()) {
         const auto s = core::summarize(e);
         o << "loops      : measured relative poses vs truth: median " << num(1000 * s.median, 1)
-          << " mm, max " << num(1000 * s.max, 1) << " mm (loops.txt)\n";
+          << " mm, max " << num(1000 * s.max, 1) << " mm"
+          << (r.out_dir.empty() ? "" : " (loops.txt)") << "\n";  // (--out '' writes none)
     }
     o << "lost frames: " << r.lost.size();
     if (!r.lost.empty()) {

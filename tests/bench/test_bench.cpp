@@ -676,7 +676,7 @@ TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
         {synth + "set = person_1.sped=1\n",
          "devslam-synth failed for a of " + (tmp / "bench.ini").string() +
              " [sequence_a] (exit 1):\n  devslam-synth: " + root +
-             "/sim_worlds/synth/short_walking.ini [person_1]: unknown key 'sped'"},
+             "/sim_worlds/synth/short_walking.ini with --set [person_1]: unknown key 'sped'"},
         {real + "[targets]\nx = a dynamic ate <=\n",
          "[targets] x: expected 'SEQUENCE MODE FIGURE OP VALUE'"},
         {real + "[targets]\nx = b dynamic ate <= 1\n", "unknown sequence 'b'"},

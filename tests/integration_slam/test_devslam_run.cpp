@@ -463,6 +463,17 @@ TEST(DevslamConvert, FileCountAndRawlogNameInAnyCase) {
                          "third: 'c')"),
               std::string::npos)
         << r.out;
+    // A frame delta that is no whole number, before the inputs are read (it came after the
+    // ATE, with a hint about short runs); a camera preset named with the choices --help gives.
+    r = devslam::test::runApp("devslam-eval", "gt.txt est.txt --delta 0.5 --delta-unit f");
+    EXPECT_NE(r.out.find("--delta: in frames (--delta-unit f) a whole number, got 0.5"),
+              std::string::npos)
+        << r.out;
+    EXPECT_EQ(r.out.find("ATE"), std::string::npos) << r.out;
+    r = devslam::test::runApp("devslam-convert", "in out --camera bogus");
+    EXPECT_NE(r.out.find("--camera: unknown camera preset 'bogus' (known: "), std::string::npos)
+        << r.out;
+    EXPECT_NE(r.out.find(") or auto"), std::string::npos) << r.out;
     const devslam::test::TempDir d("devslam_");
     const fs::path out = fs::path(d.str()) / "upper.RAWLOG";
     r = devslam::test::runApp("devslam-convert", std::string(DEVSLAM_SOURCE_DIR) +

@@ -1029,8 +1029,12 @@ TEST(Scenario, ShippedFilesLoadAndTyposAreReported) {
     EXPECT_DOUBLE_EQ(fast.people.at(0).speed, 0.9);
     EXPECT_EQ(fast.seed, 7u);
     EXPECT_EQ(fast.overrides.size(), 2u);
+    // A key --set wrote is named as such (the scenario's and people's sections said only
+    // the file).
     expectMessage([&] { (void)loadScenario(base, {"person_1.sped=0.9"}); },
-                  "[person_1]: unknown key 'sped'");
+                  base + " with --set [person_1]: unknown key 'sped'");
+    expectMessage([&] { (void)loadScenario(base, {"scenario.zzz=1"}); },
+                  base + " with --set [scenario]: unknown key 'zzz'");
     expectMessage([&] { (void)loadScenario(base, {"person_1speed=0.9"}); },
                   "expected SECTION.KEY=VALUE");
     expectMessage([&] { (void)loadScenario(base, {"persn_1.speed=0.9"}); },

@@ -185,8 +185,8 @@ PersonSpec loadPerson(const mrpt::config::CConfigFileBase& cfg, const std::strin
     core::requireKnownKeys(cfg, s,
                            {"kind", "texture", "height", "path", "speed", "start_offset", "base_z",
                             "sway_deg", "sway_period", "sway_pivot", "bob", "gesture_deg",
-                            "gesture_period", "gesture_region", "gesture_pivot"},
-                           path);
+                            "gesture_period", "gesture_region", "gesture_pivot"});
+    // (no source: loadScenario's namingSource names the file, "with --set" where it applies)
     PersonSpec p;
     p.name = s;
     const std::string where = path + " [" + s + "]";
@@ -297,8 +297,7 @@ Scenario readScenario(const std::string& path, const std::vector<std::string>& o
     core::requireKnownKeys(
         *cfg, s,
         {"name", "room", "duration", "n_frames", "rate_hz", "t0", "seed", "rgb_noise_sigma",
-         "near_clip", "far_clip", "texture_filter", "room_set"},
-        path);
+         "near_clip", "far_clip", "texture_filter", "room_set"});  // (named by namingSource)
     sc.name = cfg->read_string(s, "name", fs::path(path).stem().string());
     core::requireValue(!sc.name.empty() && sc.name.find('/') == std::string::npos &&
                            sc.name != "." && sc.name != "..",

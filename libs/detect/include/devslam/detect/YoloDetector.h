@@ -30,7 +30,7 @@ class YoloDetector final : public PersonDetector {
         double conf_threshold = 0.35;  ///< min score (objectness * class score)
         double nms_threshold = 0.45;   ///< IoU above which the weaker box is suppressed
         std::vector<std::string> classes{"person"};  ///< classes reported (potentially dynamic)
-        bool validate_on_load = true;  ///< run one forward pass at load to catch bad weights
+        bool validate_on_load = true;  ///< two forward passes at load catch bad weights
         /// Depthwise and 1x1 convolutions by detect::withFastConvolutions (AVX2 kernels, same
         /// output to float rounding); false: all of them by OpenCV's own layer.
         bool fast_convolutions = true;
