@@ -391,7 +391,7 @@ TEST(Report, TableJsonPlotAndApp) {
              {"--max-dt 0", "--max-dt: must be > 0, got '0'"},
              {"--delta -1", "--delta: must be > 0, got '-1'"},
              {"--delta 0.5 --delta-unit f",
-              "RPE: a delta in frames must be a whole number, got 0.5"},
+              "--delta: in frames (--delta-unit f) a whole number, got 0.5"},
              {"--plot x.jpgx", "--plot 'x.jpgx': the plot's name must end in .png"}}) {
         const std::string c = std::string(DEVSLAM_BIN_DIR) + "/devslam-eval " +
                               (dir / "gt.txt").string() + " " + (dir / "est.txt").string() + " " +
