@@ -103,13 +103,18 @@ Bench readBench(const std::string& path) {
         if (q.slam_config.empty()) q.slam_config = b.slam_config;
         // Found now, not as every run of the sequence failing after minutes of work.
         if (!fs::is_regular_file(q.slam_config)) {
-            const std::string given = cfg->read_string(s, "slam_config", "");
+            const std::string section =
+                cfg->keyExists(s, "slam_config") ? s : std::string("bench");
+            const std::string given = cfg->read_string(section, "slam_config", "");
+            const std::string beside =
+                given.empty() ? "" : (fs::path(base) / given).lexically_normal().string();
             throw std::invalid_argument(
-                path + " [" + (cfg->keyExists(s, "slam_config") ? s : std::string("bench")) +
-                "] slam_config: no such file '" + q.slam_config + "'" +
+                path + " [" + section + "] slam_config: " +
+                (fs::is_directory(q.slam_config) ? "'" + q.slam_config + "' is a folder, not a file"
+                                                 : "no such file '" + q.slam_config + "'") +
                 // (a relative name is looked for beside the INI first: say so)
-                (!given.empty() && fs::path(given).is_relative()
-                     ? " (nor '" + (fs::path(base) / given).lexically_normal().string() + "')"
+                (!given.empty() && fs::path(given).is_relative() && beside != q.slam_config
+                     ? " (nor '" + beside + "')"
                      : std::string()));
         }
         // ... and read, with the filter INI it names: a syntax error in the last sequence's

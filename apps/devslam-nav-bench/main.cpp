@@ -180,8 +180,6 @@ std::optional<int> parseArgs(int argc, char** argv, Args& a) {
         for (int i = 1; i < argc; i++) {
             const std::string s = argv[i];
             auto next = [&] { return devslam::core::optionValue(argc, argv, i); };
-            if (s != "--results" && s != "--quick" && s != "-h" && s != "--help")
-                changed.push_back(s);
             if (s == "--per-category") {
                 a.per_category =
                     int(devslam::core::parseInteger(next(), "--per-category", 1, 100000));
@@ -243,17 +241,33 @@ std::optional<int> parseArgs(int argc, char** argv, Args& a) {
         usage();
         return 2;
     }
-    // The published section is the default bench's: a run of 1 world per category replaced
-    // its 200-world tables, linking pictures outside the repository. Another bench writes a
-    // results file only when named.
+    // The published section and pictures are the default bench's: a run of 1 world per
+    // category replaced its 200-world tables, linking pictures outside the repository.
+    // Another bench (by its values: the published command line spelled out is the same
+    // bench) writes a results file only when named, and its pictures where the smoke test's go.
+    {
+        const Args d;
+        namespace fs = std::filesystem;
+        const auto same = [](const std::string& x, const std::string& y) {
+            return fs::weakly_canonical(x) == fs::weakly_canonical(y);
+        };
+        if (a.per_category != d.per_category) changed.push_back("--per-category");
+        if (a.methods != d.methods) changed.push_back("--methods");
+        if (!same(a.config, d.config)) changed.push_back("--config");
+        if (a.seed != d.seed) changed.push_back("--seed");
+        if (a.person_margin) changed.push_back("--person-margin");
+        if (!same(a.png_dir, d.png_dir)) changed.push_back("--png-dir");
+    }
     if (!results_given && !a.quick && changed.empty())
         a.results = std::string(DEVSLAM_SOURCE_DIR) + "/docs/RESULTS.md";
     else if (!results_given && !a.quick) {
         std::string list;
         for (const auto& o : changed) list += (list.empty() ? "" : ", ") + o;
+        if (!png_dir_given) a.png_dir = "out/devslam-nav-bench";
         std::cerr << "devslam-nav-bench: " << list
                   << " make another bench than docs/RESULTS.md's: the tables are printed only "
-                     "(--results FILE writes them)\n";
+                     "(--results FILE writes them), the pictures go to "
+                  << a.png_dir << "\n";
     }
     return std::nullopt;
 }

@@ -340,6 +340,11 @@ TEST(IntegrationNav, MrptErrorsEndTheRunNamingTheIni) {
                   "max_obstacles_height 2 m: the band leaves out the laser's plane at 0.3 m (" +
                       world.source + " [laser] height), so the robot would see no obstacle");
     }
+    // A band that ends at the laser's 0.3 m: MRPT is given the points at 0.3f, 0.30000001 m,
+    // above it (the check in doubles passed it, and the robot drove blind into a wall).
+    blind.write("CReactiveNavigationSystem", "min_obstacles_height", "0.0");
+    blind.write("CReactiveNavigationSystem", "max_obstacles_height", "0.3");
+    EXPECT_THROW((void)devslam::sim::runEpisode(world, blind, b, {}), std::invalid_argument);
 }
 
 // devslam-nav's progress line is fed after every navigator step: the simulated time rising,
@@ -373,6 +378,10 @@ TEST(IntegrationNav, ADamagedPtgCacheFileIsBuiltAgain) {
     ASSERT_TRUE(std::filesystem::is_regular_file(file));
     const auto size = std::filesystem::file_size(file);
     std::filesystem::resize_file(file, size / 2);
+    // Left by an earlier run (one written in the last minute may be another process's, still
+    // being written, and is left alone).
+    std::filesystem::last_write_time(
+        file, std::filesystem::file_time_type::clock::now() - std::chrono::minutes(2));
     ASSERT_FALSE(devslam::core::gzipDamage(file).empty());
     // The standard error of the second run, where MRPT printed its exception.
     const std::string err_file = dir.str("stderr.txt");
@@ -666,6 +675,21 @@ TEST(IntegrationNav, AppsSmokeTest) {
                              "bench than docs/RESULTS.md's: the tables are printed only"),
                   std::string::npos)
             << r.out;
+        EXPECT_EQ(readFile(results), before);
+        // ... and without --png-dir its pictures do not replace the published ones (they go
+        // where the smoke test's go, relative to the working folder: here the test's own).
+        const std::string picture =
+            std::string(DEVSLAM_SOURCE_DIR) + "/docs/images/nav_bench_success.png";
+        const std::string published = readFile(picture);
+        r = devslam::test::runShell("cd " + out + " && " + std::string(DEVSLAM_BIN_DIR) +
+                                    "/devslam-nav-bench --per-category 1 --methods "
+                                    "CHolonomicVFHPlus 2>&1");
+        EXPECT_EQ(r.rc, 0) << r.out;
+        EXPECT_NE(r.out.find("the pictures go to out/devslam-nav-bench"), std::string::npos)
+            << r.out;
+        EXPECT_TRUE(std::filesystem::is_regular_file(out + "/out/devslam-nav-bench/"
+                                                           "nav_bench_success.png"));
+        EXPECT_EQ(readFile(picture), published);
         EXPECT_EQ(readFile(results), before);
     }
     // Refused before any run: a method twice, --quick with a count, a results file whose

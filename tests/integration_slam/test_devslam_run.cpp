@@ -470,6 +470,10 @@ TEST(DevslamConvert, FileCountAndRawlogNameInAnyCase) {
               std::string::npos)
         << r.out;
     EXPECT_EQ(r.out.find("ATE"), std::string::npos) << r.out;
+    // A read error names the file (the line reader's own read lost it: "basic_filebuf::
+    // underflow error reading the file").
+    r = devslam::test::runApp("devslam-eval", "/proc/self/mem /proc/self/mem");
+    EXPECT_NE(r.out.find("error reading '/proc/self/mem'"), std::string::npos) << r.out;
     r = devslam::test::runApp("devslam-convert", "in out --camera bogus");
     EXPECT_NE(r.out.find("--camera: unknown camera preset 'bogus' (known: "), std::string::npos)
         << r.out;

@@ -497,8 +497,9 @@ TEST(NavConfig, MrptSectionsAreReadStrictly) {
     EXPECT_EQ(errorOf("CReactiveNavigationSystem", "PTG0_num_paths", "10000"),
               "x.ini [CReactiveNavigationSystem] PTG0_num_paths: must be at most 1000");
     EXPECT_EQ(errorOf("CReactiveNavigationSystem", "PTG1_resolution", "0.0001"),
-              "x.ini [CReactiveNavigationSystem] PTG1_resolution: with PTG1_refDistance 2.5 m, a "
-              "collision grid of 0.0001 m cells has 50000 x 50000 cells (at most 3000 x 3000)");
+              "x.ini [CReactiveNavigationSystem] PTG1_resolution: with PTG1_refDistance 2.5 m "
+              "and PTG1_resolution 0.0001 m, the collision grid has 50000 x 50000 cells (at most "
+              "3000 x 3000)");
     EXPECT_EQ(errorOf("CAbstractPTGBasedReactive", "speedfilter_tau", "-1"),
               "x.ini [CAbstractPTGBasedReactive] speedfilter_tau: must be >= 0 s");
     // MRPT's other differential-drive PTGs read the same keys as C (K included): accepted.

@@ -20,7 +20,12 @@ namespace {
 bool readLineCapped(std::istream& in, std::string& line, const std::string& path, int n) {
     line.clear();
     for (std::streambuf* sb = in.rdbuf();;) {
-        const int c = sb->sbumpc();
+        int c = 0;
+        try {  // (libstdc++'s filebuf throws on a read error, which getline turned into badbit)
+            c = sb->sbumpc();
+        } catch (const std::exception& e) {
+            throw std::runtime_error("error reading '" + path + "': " + e.what());
+        }
         if (c == std::char_traits<char>::eof()) {
             in.setstate(std::ios::eofbit);
             return !line.empty();

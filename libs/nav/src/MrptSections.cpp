@@ -293,13 +293,21 @@ void checkMrptSections(const mrpt::config::CConfigFileBase& c, const std::string
             if (c.keyExists(s, prefix + "num_paths"))
                 core::requireValue(core::readDouble(c, s, prefix + "num_paths", 0.0) <= 1000, s,
                                    prefix + "num_paths", "must be at most 1000");
+            // (the differential-drive PTGs keep a collision grid; a holonomic one has none)
+            if (c.read_string(s, prefix + "Type", "").rfind("CPTG_DiffDrive", 0) != 0) return;
             const double res = core::readDouble(c, s, prefix + "resolution", 0.05);
             const double ref = core::readDouble(c, s, prefix + "refDistance", 2.5);
             const double side = 2 * ref / res;
             std::ostringstream m;
-            m << "with " << prefix << "refDistance " << ref << " m, a collision grid of " << res
-              << " m cells has " << side << " x " << side << " cells (at most 3000 x 3000)";
-            core::requireValue(side <= 3000, s, prefix + "resolution", m.str());
+            m << "with " << prefix << "refDistance " << ref << " m and " << prefix
+              << "resolution " << res << " m, the collision grid has " << side << " x " << side
+              << " cells (at most 3000 x 3000)";
+            // (blamed on the key the file gives, resolution when it gives both)
+            const std::string key =
+                c.keyExists(s, prefix + "resolution") || !c.keyExists(s, prefix + "refDistance")
+                    ? prefix + "resolution"
+                    : prefix + "refDistance";
+            core::requireValue(side <= 3000, s, key, m.str());
         });
         try {
             (void)CParameterizedTrajectoryGenerator::CreatePTG(

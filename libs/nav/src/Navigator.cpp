@@ -271,7 +271,12 @@ Navigator::Navigator(mrpt::nav::CRobot2NavInterface& robot,
         std::error_code ec;
         for (const auto& e : std::filesystem::directory_iterator(cache, ec)) {
             const std::string f = e.path().string();
-            if (!core::endsWithNoCase(f, ".dat.gz") || core::gzipDamage(f).empty()) continue;
+            // (one written in the last minute may be another process's, still being written)
+            const auto age = std::filesystem::file_time_type::clock::now() -
+                             std::filesystem::last_write_time(e.path(), ec);
+            if (ec || age < std::chrono::minutes(1) || !core::endsWithNoCase(f, ".dat.gz") ||
+                core::gzipDamage(f).empty())
+                continue;
             std::filesystem::remove(e.path(), ec);
             if (opts_.verbose)
                 std::cerr << "navigator: removed the damaged PTG cache file " << f

@@ -102,12 +102,14 @@ EpisodeResult runEpisode(const WorldSpec& world, const mrpt::config::CConfigFile
         const double hi = core::namingSource(nav_opts.source, [&] {
             return core::readDouble(nav_ini, s, "max_obstacles_height", d.max_obstacles_height);
         });
-        const double h = world.laser.height;
+        // As SimRobot gives the points to MRPT: a float (0.3f is 0.30000001, above a band
+        // that ends at 0.3, which passed as a double and left the robot blind).
+        const double h = static_cast<float>(world.laser.height);
         if (!(h >= lo && h <= hi)) {
             std::ostringstream m;
             m << nav_opts.source << " [" << s << "] min_obstacles_height " << lo
               << " m, max_obstacles_height " << hi << " m: the band leaves out the laser's plane at "
-              << h << " m (" << (world.source.empty() ? world.name : world.source)
+              << world.laser.height << " m (" << (world.source.empty() ? world.name : world.source)
               << " [laser] height), so the robot would see no obstacle";
             throw std::invalid_argument(m.str());
         }
