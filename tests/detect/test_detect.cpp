@@ -120,6 +120,52 @@ TEST(DetectYolo, Yolov4TinyCfgParsesIntoANetwork) {
     }
 }
 
+// What OpenCV's darknet reader does not check: a `groups` of 0 (a floating-point exception
+// that killed the process without a word), a [route] or [shortcut] reference outside the
+// layers before it (a bare "vector::_M_range_check"), a [yolo] mask index past its anchors
+// (read past the list: extra boxes of no anchor). Each is named by file, line, section and
+// key; every shipped cfg passes.
+TEST(DetectYolo, DarknetCfgReferencesAndGroupsAreChecked) {
+    for (const char* cfg :
+         {"models/yolo-fastest-1.1/yolo-fastest-1.1-xl.cfg", "models/yolo-fastest-1.1/yolo-fastest-1.1.cfg",
+          "models/yolo-fastest-1.1/yolo-fastest-1.1_body.cfg", "models/yolov4-tiny.cfg"})
+        EXPECT_NO_THROW(detect::checkDarknetCfg(kRoot + "/" + cfg)) << cfg;
+    const std::string xl = kRoot + "/models/yolo-fastest-1.1/yolo-fastest-1.1-xl.cfg";
+    std::string text;
+    {
+        std::ifstream in(xl);
+        text.assign(std::istreambuf_iterator<char>(in), {});
+    }
+    const fs::path dir = devslam::test::scratchPath("yolo_cfg_check");
+    fs::create_directories(dir);
+    // The first occurrence of `from` replaced by `to`; the error of loading that cfg.
+    const auto errorOf = [&](const std::string& from, const std::string& to) {
+        std::string t = text;
+        const auto at = t.find(from);
+        EXPECT_NE(at, std::string::npos) << from;
+        if (at != std::string::npos) t.replace(at, from.size(), to);
+        const std::string path = (dir / "bad.cfg").string();
+        std::ofstream(path) << t;
+        try {
+            detect::checkDarknetCfg(path);
+        } catch (const std::runtime_error& e) {
+            return std::string(e.what());
+        }
+        return std::string();
+    };
+    const std::string bad = "darknet cfg '" + (dir / "bad.cfg").string() + "' line ";
+    std::string m = errorOf("groups=16", "groups=0");
+    EXPECT_EQ(m.rfind(bad, 0), 0u) << m;
+    EXPECT_NE(m.find(": [convolutional] groups: must be an integer >= 1"), std::string::npos) << m;
+    m = errorOf("\nlayers=-", "\nlayers=-999\n#");
+    EXPECT_NE(m.find("[route] layers: -999 is not one of the "), std::string::npos) << m;
+    m = errorOf("\nfrom=-", "\nfrom=999\n#");
+    EXPECT_NE(m.find("[shortcut] from: 999 is not one of the "), std::string::npos) << m;
+    m = errorOf("\nmask = ", "\nmask = 99,");
+    EXPECT_NE(m.find("[yolo] mask: 99 is not one of its 6 anchors (0..5)"), std::string::npos) << m;
+    fs::remove_all(dir);
+}
+
 TEST(DetectYolo, OnnxOutputIsDecoded) {
     // tests/detect/data/constant_yolo.onnx (written by make_constant_yolo_onnx.py next to
     // it) outputs four fixed YOLOv5-style rows in input pixels whatever the image: a person
@@ -387,7 +433,11 @@ TEST(DetectHog, ResizeOrMinScoreOutOfRangeIsRejected) {
         {"resize", 0.0, "[detector] resize: must be in [0.1, 4]"},
         {"resize", 100.0, "[detector] resize: must be in [0.1, 4]"},
         {"min_score", 7.0, "[detector] min_score: must be in [0, 1]"},
-        {"min_score", -3.0, "[detector] min_score: must be in [0, 1]"}};
+        {"min_score", -3.0, "[detector] min_score: must be in [0, 1]"},
+        // (one window a frame, or one pyramid level: nobody found, no word)
+        {"win_stride", 128, "[detector] win_stride: must be a positive multiple of 8 (HOG cell "
+                            "size), at most 64 (the window's width)"},
+        {"scale", 1e9, "[detector] scale: must be in (1, 2]"}};
     for (const auto& [key, value, message] : cases) {
         mrpt::config::CConfigFileMemory cfg;
         cfg.write("detector", "detector", std::string("hog"));
@@ -409,7 +459,6 @@ TEST(DetectHog, ImageSmallerThanTheWindowHasNoPerson) {
                                        {cv::Size(32, 24), 1.0},
                                        {cv::Size(32, 24), 0.5},
                                        {cv::Size(1, 1), 0.1},
-                                       {cv::Size(640, 480), 0.2},
                                        {cv::Size(63, 300), 1.0}}) {
         detect::HogDetector::Options o;
         o.resize = resize;
@@ -417,6 +466,23 @@ TEST(DetectHog, ImageSmallerThanTheWindowHasNoPerson) {
         cv::Mat img;
         cv::resize(person, img, size);
         EXPECT_TRUE(hog.detect(img).empty()) << size << " at resize " << resize;
+    }
+    // ... but a frame the window fits, shrunk under it by `resize`, is a setting that finds
+    // nobody in any frame (it ran, "detect 0.0 ms", no box): an error naming the key.
+    {
+        detect::HogDetector::Options o;
+        o.resize = 0.2;
+        detect::HogDetector hog(o);
+        cv::Mat img;
+        cv::resize(person, img, cv::Size(640, 480));
+        try {
+            (void)hog.detect(img);
+            ADD_FAILURE() << "resize 0.2 on 640x480 found nobody without a word";
+        } catch (const std::invalid_argument& e) {
+            EXPECT_EQ(std::string(e.what()),
+                      "[detector] resize: 0.2 makes a 640x480 frame 128x96 px, smaller than "
+                      "HOG's 64x128 window: no person could be found; raise it");
+        }
     }
     // The smallest image it scans: the window itself.
     detect::HogDetector hog({});

@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 #include <stdexcept>
 
 namespace devslam::detect {
@@ -22,9 +23,12 @@ void HogDetector::Options::loadFromConfig(const mrpt::config::CConfigFileBase& c
     group_threshold = core::readInt(c, s, "group_threshold", group_threshold);
     min_score = core::readDouble(c, s, "min_score", min_score);
     resize = core::readDouble(c, s, "resize", resize);
-    core::requireValue(win_stride > 0 && win_stride % 8 == 0, s, "win_stride",
-                       "must be a positive multiple of 8 (HOG cell size)");
-    core::requireValue(scale > 1.0, s, "scale", "must be > 1");
+    // (1e9 left one window a frame, or one pyramid level: nobody found, no word)
+    core::requireValue(win_stride > 0 && win_stride % 8 == 0 && win_stride <= 64, s,
+                       "win_stride",
+                       "must be a positive multiple of 8 (HOG cell size), at most 64 (the "
+                       "window's width)");
+    core::requireValue(scale > 1.0 && scale <= 2.0, s, "scale", "must be in (1, 2]");
     core::requireValue(group_threshold >= 0, s, "group_threshold", "must be >= 0");
     // A box's score is the logistic of its SVM margin, in (0, 1): 7 would drop every box.
     core::requireValue(min_score >= 0 && min_score <= 1, s, "min_score", "must be in [0, 1]");
@@ -59,7 +63,20 @@ std::vector<Detection> HogDetector::detect(const cv::Mat& bgr) {
     // detectMultiScale does not check: it scans a negative window count and reads out of
     // bounds (a segfault on a 200x100 image, or at resize 0.2 on 640x480).
     const cv::Size scaled(cvRound(bgr.cols * opts_.resize), cvRound(bgr.rows * opts_.resize));
-    if (scaled.width < hog_.winSize.width || scaled.height < hog_.winSize.height) return {};
+    if (scaled.width < hog_.winSize.width || scaled.height < hog_.winSize.height) {
+        // ... but a frame the window fits that `resize` shrinks under it is a setting that
+        // finds nobody in any frame (resize 0.2 on 640x480 ran, "detect 0.0 ms", no box).
+        if (opts_.resize < 1.0 && bgr.cols >= hog_.winSize.width &&
+            bgr.rows >= hog_.winSize.height) {
+            std::ostringstream m;
+            m << "[detector] resize: " << opts_.resize << " makes a " << bgr.cols << "x"
+              << bgr.rows << " frame " << scaled.width << "x" << scaled.height
+              << " px, smaller than HOG's " << hog_.winSize.width << "x" << hog_.winSize.height
+              << " window: no person could be found; raise it";
+            throw std::invalid_argument(m.str());
+        }
+        return {};
+    }
     cv::Mat img = bgr;
     if (opts_.resize != 1.0) cv::resize(bgr, img, scaled);
     std::vector<cv::Rect> rects;

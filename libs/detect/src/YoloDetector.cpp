@@ -16,6 +16,7 @@
 #include <limits>
 #include <sstream>
 #include <stdexcept>
+#include <tuple>
 
 namespace devslam::detect {
 namespace fs = std::filesystem;
@@ -100,8 +101,87 @@ float darknetScoreFloor(const std::string& cfg_path) {
     return highest;
 }
 
+void checkDarknetCfg(const std::string& cfg_path) {
+    std::ifstream in(cfg_path);
+    if (!in) throw std::runtime_error("cannot open darknet cfg '" + cfg_path + "'");
+    // Hand-written: OpenCV's reader asserts none of these (see the header).
+    struct Layer {
+        std::string type;
+        int line = 0;
+        std::vector<std::tuple<std::string, std::string, int>> keys;  // key, value, line
+    };
+    std::vector<Layer> layers;  // [net] left out: darknet's layer indices count the others
+    int n = 0;
+    for (std::string line; std::getline(in, line);) {
+        ++n;
+        line = trim(line.substr(0, line.find_first_of("#;")));
+        if (line.empty()) continue;
+        if (line.front() == '[') {
+            const std::string type = trim(line.substr(1, line.find(']') - 1));
+            if (type != "net" && type != "network") layers.push_back({type, n, {}});
+        } else if (!layers.empty() && line.find('=') != std::string::npos) {
+            layers.back().keys.emplace_back(trim(line.substr(0, line.find('='))),
+                                            trim(line.substr(line.find('=') + 1)), n);
+        }
+    }
+    const auto fail = [&](int line, const Layer& l, const std::string& key, const std::string& why) {
+        throw std::runtime_error("darknet cfg '" + cfg_path + "' line " + std::to_string(line) +
+                                 ": [" + l.type + "] " + key + ": " + why);
+    };
+    const auto integers = [&](const std::string& text, const std::string& key, int line,
+                              const Layer& l) {
+        std::vector<int> v;
+        std::istringstream ss(text);
+        for (std::string item; std::getline(ss, item, ',');) {
+            item = trim(item);
+            if (item.empty()) continue;
+            try {
+                v.push_back(static_cast<int>(core::parseInteger(item, key, -1000000, 1000000)));
+            } catch (const std::invalid_argument&) {
+                fail(line, l, key, "'" + item + "' is not an integer");
+            }
+        }
+        return v;
+    };
+    for (std::size_t i = 0; i < layers.size(); ++i) {
+        const auto& l = layers[i];
+        int anchors = -1, num = -1, mask_line = 0;
+        std::vector<int> mask;
+        for (const auto& [key, value, line] : l.keys) {
+            if (l.type == "convolutional" && key == "groups") {
+                const auto g = integers(value, key, line, l);
+                if (g.size() != 1 || g[0] < 1) fail(line, l, key, "must be an integer >= 1");
+            } else if ((l.type == "route" && key == "layers") ||
+                       (l.type == "shortcut" && key == "from")) {
+                for (const int k : integers(value, key, line, l)) {
+                    const long at = k < 0 ? static_cast<long>(i) + k : k;
+                    if (at < 0 || at >= static_cast<long>(i))
+                        fail(line, l, key,
+                             std::to_string(k) + " is not one of the " + std::to_string(i) +
+                                 " layers before this one (layer " + std::to_string(i) + ")");
+                }
+            } else if (l.type == "yolo" && key == "anchors") {
+                anchors = static_cast<int>(integers(value, key, line, l).size()) / 2;
+            } else if (l.type == "yolo" && key == "num") {
+                const auto v = integers(value, key, line, l);
+                num = v.size() == 1 ? v[0] : -1;
+            } else if (l.type == "yolo" && key == "mask") {
+                mask = integers(value, key, line, l);
+                mask_line = line;
+            }
+        }
+        const int have = anchors >= 0 ? anchors : num;
+        for (const int m : mask)
+            if (have >= 0 && (m < 0 || m >= have))
+                fail(mask_line, l, "mask",
+                     std::to_string(m) + " is not one of its " + std::to_string(have) +
+                         " anchors (0.." + std::to_string(have - 1) + ")");
+    }
+}
+
 cv::dnn::Net readDarknetCfg(const std::string& cfg_path) {
     const std::string path = resolveModelPath(cfg_path, "darknet cfg");
+    checkDarknetCfg(path);
     try {
         cv::dnn::Net net = cv::dnn::readNetFromDarknet(path);
         if (net.empty()) throw std::runtime_error("empty network");
@@ -194,6 +274,7 @@ YoloDetector::YoloDetector(const Options& opts) : opts_(opts) {
                        "scoring at or under it";
                 throw std::invalid_argument(msg.str());
             }
+            checkDarknetCfg(model);
             net_ = read([&] { return cv::dnn::readNetFromDarknet(model, weights); });
             // cv::dnn reads a truncated weights file without complaint (missing values
             // stay uninitialised): compare the file size with the parameters the cfg needs.
@@ -293,7 +374,9 @@ std::vector<Detection> YoloDetector::detect(const cv::Mat& bgr) {
         if (out.dims != 2 || out.cols != 5 + n_classes)
             throw std::runtime_error("yolo: output of " + std::to_string(out.cols) +
                                      " columns, expected 5 + " + std::to_string(n_classes) +
-                                     " (class names file does not match the model?)");
+                                     " (the " + std::to_string(n_classes) +
+                                     " class names of '" + opts_.names +
+                                     "': does that file match the model?)");
         for (int r = 0; r < out.rows; ++r) {
             const float* row = out.ptr<float>(r);
             const float obj = row[4];

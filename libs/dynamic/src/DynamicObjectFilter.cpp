@@ -245,7 +245,9 @@ void DynamicObjectFilter::Options::loadFromConfig(const mrpt::config::CConfigFil
 }
 
 void DynamicObjectFilter::Options::validate(const std::string& s) const {
-    core::requireValue(mask_border_snap >= 0, s, "mask_border_snap", "must be >= 0");
+    // (1e9 snapped every box to every border: the whole frame masked, nothing tracked)
+    core::requireValue(mask_border_snap >= 0 && mask_border_snap <= 100, s, "mask_border_snap",
+                       "must be in [0, 100] [px]");
     core::requireValue(detect_every >= 1, s, "detect_every", "must be >= 1");
     core::requireValue(flow_scale > 0.1 && flow_scale <= 1.0, s, "flow_scale",
                        "must be in (0.1, 1]");

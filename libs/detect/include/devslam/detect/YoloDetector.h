@@ -72,6 +72,13 @@ class YoloDetector final : public PersonDetector {
 /// Throws std::runtime_error naming the file on a parse error.
 [[nodiscard]] cv::dnn::Net readDarknetCfg(const std::string& cfg_path);
 
+/// Throws std::runtime_error "darknet cfg '<path>' line N: [section] key: ..." for layer
+/// references and sizes OpenCV's darknet reader does not check: a convolution's `groups`
+/// below 1 (a floating-point exception, no message), a [route] `layers` or [shortcut] `from`
+/// outside the layers before it (a bare vector::_M_range_check), a [yolo] `mask` index past
+/// its anchors (read past the list: boxes of no anchor). Called before every darknet load.
+void checkDarknetCfg(const std::string& cfg_path);
+
 /// The lowest score a darknet cfg's network returns: the largest `thresh` of its [yolo]
 /// layers (OpenCV's default 0.2 where one sets none), at or under which OpenCV zeroes every
 /// class score; 0 for a cfg without [yolo] layers.
