@@ -241,10 +241,10 @@ TEST(World, ValuesBulletAndTheGridCannotHoldAreErrors) {
     EXPECT_EQ(errorOf("[world]\nx_min=1000000\nx_max=1000020\ny_min=0\ny_max=10\n"
                       "[robot]\nstart_x=1000002\nstart_y=1\n[goal]\nx=1000018\ny=9\n"),
               "w.ini [world] x_min: must be within +-10000 m (Bullet's single precision)");
-    for (const char* name : {"../../x", "a/b", "..", ""})
+    for (const char* name : {"../../x", "a/b", "..", "", "my world"})
         EXPECT_EQ(errorOf(world + "name = " + name + "\n" + robot + goal),
-                  "w.ini [world] name: must be a file name: not empty, '.' or '..', no '/' or "
-                  "'\\'")
+                  "w.ini [world] name: must be a file name: not empty, '.' or '..', no '/', "
+                  "'\\' or blank")
             << name;
     // MRPT's grid holds the bounds in whole cells: 10.02 m at 0.05 m is 200 cells, 10.0 m.
     EXPECT_EQ(errorOf("[world]\nx_min=0\nx_max=10.02\ny_min=0\ny_max=10\nboundary_walls=false\n" +

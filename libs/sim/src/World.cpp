@@ -219,10 +219,11 @@ void validateBoundsAndTiming(const WorldSpec& w) {
     // The name makes the default picture's file name (out/nav_<name>.png): "../../x" wrote
     // outside out/, "a/b" into a folder.
     // An empty one named the picture "nav_.png" and left the result line's world= blank.
+    // A blank split the result line's world= field ("world=my world").
     if (w.name.empty() || w.name == "." || w.name == ".." ||
-        w.name.find_first_of("/\\") != std::string::npos)
+        w.name.find_first_of("/\\ \t") != std::string::npos)
         fail(src, "world", "name",
-             "must be a file name: not empty, '.' or '..', no '/' or '\\'");
+             "must be a file name: not empty, '.' or '..', no '/', '\\' or blank");
     // Bullet simulates in single precision: at 1e6 m one float step is 6 cm, more than the
     // robot moves in a physics step, and it never moved.
     constexpr double kMaxCoordinate = 1e4;
