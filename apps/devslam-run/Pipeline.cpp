@@ -1,7 +1,10 @@
 #include "Pipeline.h"
 
+#include <devslam/core/Association.h>
+
 #include "MaskSource.h"
 
+#include <devslam/core/Association.h>
 #include <devslam/core/Config.h>
 #include <devslam/core/GzFile.h>
 #include <devslam/core/Interrupt.h>
@@ -368,11 +371,30 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
     // scored its identity poses against the truth and printed that as its ATE.
     const std::size_t tracked =
         rep.trajectory.size() - std::min(rep.lost.size(), rep.trajectory.size());
+    // ... and among the poses the truth pairs with: a truth that covered only lost frames
+    // scored their held poses, and printed that as the run's ATE.
+    std::size_t paired = 0, paired_tracked = 0;
+    if (rep.ground_truth) {
+        std::vector<bool> lost(rep.trajectory.size(), false);
+        for (const std::size_t i : rep.lost)
+            if (i < lost.size()) lost[i] = true;
+        std::vector<double> te, tg;
+        for (const auto& p : rep.trajectory) te.push_back(p.t);
+        for (const auto& p : *rep.ground_truth) tg.push_back(p.t);
+        for (const auto& [i, j] : core::associate(te, tg, eval::AteOptions{}.max_dt)) {
+            ++paired;
+            paired_tracked += lost[i] ? 0 : 1;
+        }
+    }
     if (rep.ground_truth && rep.trajectory.size() < 3)
         rep.ate_missing = std::to_string(rep.trajectory.size()) + " poses (the ATE needs 3)";
     else if (rep.ground_truth && tracked < 3)
         rep.ate_missing = std::to_string(tracked) + " of " + std::to_string(rep.trajectory.size()) +
                           " frames tracked (the ATE needs 3)";
+    else if (rep.ground_truth && paired >= 3 && paired_tracked < 3)
+        rep.ate_missing = std::to_string(paired_tracked) + " of the " + std::to_string(paired) +
+                          " poses the ground truth covers are tracked (the ATE needs 3; the "
+                          "others are lost frames' held poses)";
     if (rep.ground_truth && rep.ate_missing.empty()) {
         try {
             rep.ate = eval::computeAte(*rep.ground_truth, rep.trajectory);

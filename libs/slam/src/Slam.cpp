@@ -160,7 +160,10 @@ TrackResult Slam::track(const core::Frame& frame, const FrameFeatures& features,
             rec.valid = true;
         } else {
             res.state = TrackingState::NotInitialized;
-            res.reason = "not initialized: " + std::to_string(n_depth) + " keypoints with depth";
+            // (of how many: a black frame has no keypoint at all, which read as a depth
+            // problem)
+            res.reason = "not initialized: " + std::to_string(n_depth) + " of " +
+                         std::to_string(features.size()) + " keypoints with depth";
         }
         records_.push_back(rec);
         return res;
