@@ -405,6 +405,7 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
             // ATE the reason is kept (ground truth of another sequence, stamps in other
             // units): run.json alone did not tell it from a folder without ground truth.
             if (!rep.ate) rep.ate_missing = e.what();
+            else rep.rpe_missing = e.what();  // (the RPE line vanished without a word)
         }
         try {
             eval::RpeOptions per_frame;
@@ -515,6 +516,11 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
         } catch (const std::invalid_argument& e) {
             std::cerr << "devslam-run: map_grid not written: " << e.what() << "\n";
         }
+        // (it was left out without a word)
+        if (!grid && rep.output_errors.empty() &&
+            (rep.keyframes == 0 || slam.map().landmarks().empty()))
+            std::cerr << "devslam-run: map_grid not written: the map has no "
+                      << (rep.keyframes == 0 ? "keyframe" : "landmark") << "\n";
         if (grid) {
             const std::string stem = (fs::path(rep.out_dir) / "map_grid").string();
             const std::size_t errors = rep.output_errors.size();
@@ -635,7 +641,11 @@ std::string formatSummary(const RunReport& r) {
         o << "ATE        : RMSE " << num(r.ate->trans.rmse, 4) << " m, mean "
           << num(r.ate->trans.mean, 4) << " m, median " << num(r.ate->trans.median, 4) << " m, max "
           << num(r.ate->trans.max, 4) << " m (" << r.ate->trans.count
-          << " poses, lost frames included)\n";
+          << (r.ate->trans.count < r.trajectory.size()
+                  ? " of " + std::to_string(r.trajectory.size()) +
+                        " poses: the others have no ground truth near them;"
+                  : std::string(" poses,"))
+          << " lost frames included)\n";
     } else if (r.ground_truth) {
         o << "ATE        : not computed (" << r.ate_missing << ")\n";
     } else {
@@ -644,6 +654,8 @@ std::string formatSummary(const RunReport& r) {
     if (r.rpe_1s)
         o << "RPE (1 s)  : trans RMSE " << num(r.rpe_1s->trans.rmse, 4) << " m, rot RMSE "
           << num(r.rpe_1s->rot.rmse, 3) << " deg (" << r.rpe_1s->n_pairs << " pairs)\n";
+    else if (!r.rpe_missing.empty())
+        o << "RPE (1 s)  : not computed (" << r.rpe_missing << ")\n";
     if (r.rpe_frame)
         o << "RPE (1 f)  : trans RMSE " << num(r.rpe_frame->trans.rmse, 4) << " m, rot RMSE "
           << num(r.rpe_frame->rot.rmse, 3) << " deg (" << r.rpe_frame->n_pairs << " pairs)\n";
@@ -727,6 +739,8 @@ std::string toJson(const RunReport& r) {
       << ",\n  \"bytes_per_keyframe\": " << num(r.bytes_per_keyframe, 0);
     if (r.ate) o << ",\n  \"ate\": " << summaryJson(r.ate->trans);
     if (!r.ate && r.ground_truth) o << ",\n  \"ate_missing\": \"" << esc(r.ate_missing) << "\"";
+    if (!r.rpe_missing.empty())
+        o << ",\n  \"rpe_1s_missing\": \"" << esc(r.rpe_missing) << "\"";
     if (const auto e = loopErrors(r.loop_reports); !e.empty())
         o << ",\n  \"loop_error_m\": " << summaryJson(core::summarize(e));
     if (r.mask_score) {

@@ -101,6 +101,7 @@ struct RunReport {
     /// Why there is no `ate` though there is ground truth (too few poses, no pose associated
     /// with the ground truth's stamps); "" otherwise.
     std::string ate_missing;
+    std::string rpe_missing;  ///< why there is an ATE but no RPE (1 s), e.g. a run under 1 s
     std::optional<eval::RpeResult> rpe_1s, rpe_frame;
     double median_fps = 0, mean_fps = 0, median_ms = 0;
     double median_cpu_ms = 0;  ///< process CPU time per frame, all threads (load-independent)
