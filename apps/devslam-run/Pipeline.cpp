@@ -517,8 +517,7 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
             std::cerr << "devslam-run: map_grid not written: " << e.what() << "\n";
         }
         // (it was left out without a word)
-        if (!grid && rep.output_errors.empty() &&
-            (rep.keyframes == 0 || slam.map().landmarks().empty()))
+        if (!grid && (rep.keyframes == 0 || slam.map().landmarks().empty()))
             std::cerr << "devslam-run: map_grid not written: the map has no "
                       << (rep.keyframes == 0 ? "keyframe" : "landmark") << "\n";
         if (grid) {
@@ -643,7 +642,7 @@ std::string formatSummary(const RunReport& r) {
           << num(r.ate->trans.max, 4) << " m (" << r.ate->trans.count
           << (r.ate->trans.count < r.trajectory.size()
                   ? " of " + std::to_string(r.trajectory.size()) +
-                        " poses: the others have no ground truth near them;"
+                        " poses: the others have no ground-truth pose left to pair with;"
                   : std::string(" poses,"))
           << " lost frames included)\n";
     } else if (r.ground_truth) {

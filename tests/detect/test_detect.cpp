@@ -163,6 +163,11 @@ TEST(DetectYolo, DarknetCfgReferencesAndGroupsAreChecked) {
     EXPECT_NE(m.find("[shortcut] from: 999 is not one of the "), std::string::npos) << m;
     m = errorOf("\nmask = ", "\nmask = 99,");
     EXPECT_NE(m.find("[yolo] mask: 99 is not one of its 6 anchors (0..5)"), std::string::npos) << m;
+    // Anchors are numbers, not always whole (k-means anchors): only counted.
+    EXPECT_EQ(errorOf("anchors = 12, 18,", "anchors = 12.5, 18.25,"), "");
+    m = errorOf("\nfrom=-", "\nfrom=x\n#");
+    EXPECT_NE(m.find("[shortcut] from: 'x' is not an integer in [-1e6, 1e6]"), std::string::npos)
+        << m;
     fs::remove_all(dir);
 }
 

@@ -138,7 +138,7 @@ void checkDarknetCfg(const std::string& cfg_path) {
             try {
                 v.push_back(static_cast<int>(core::parseInteger(item, key, -1000000, 1000000)));
             } catch (const std::invalid_argument&) {
-                fail(line, l, key, "'" + item + "' is not an integer");
+                fail(line, l, key, "'" + item + "' is not an integer in [-1e6, 1e6]");
             }
         }
         return v;
@@ -152,7 +152,8 @@ void checkDarknetCfg(const std::string& cfg_path) {
                 const auto g = integers(value, key, line, l);
                 if (g.size() != 1 || g[0] < 1) fail(line, l, key, "must be an integer >= 1");
             } else if ((l.type == "route" && key == "layers") ||
-                       (l.type == "shortcut" && key == "from")) {
+                       ((l.type == "shortcut" || l.type == "scale_channels" || l.type == "sam") &&
+                        key == "from")) {
                 for (const int k : integers(value, key, line, l)) {
                     const long at = k < 0 ? static_cast<long>(i) + k : k;
                     if (at < 0 || at >= static_cast<long>(i))
@@ -161,7 +162,12 @@ void checkDarknetCfg(const std::string& cfg_path) {
                                  " layers before this one (layer " + std::to_string(i) + ")");
                 }
             } else if (l.type == "yolo" && key == "anchors") {
-                anchors = static_cast<int>(integers(value, key, line, l).size()) / 2;
+                // Counted only: they are numbers, not always whole (k-means anchors).
+                int items = 0;
+                std::istringstream ss(value);
+                for (std::string item; std::getline(ss, item, ',');)
+                    items += trim(item).empty() ? 0 : 1;
+                anchors = items / 2;
             } else if (l.type == "yolo" && key == "num") {
                 const auto v = integers(value, key, line, l);
                 num = v.size() == 1 ? v[0] : -1;
