@@ -1,10 +1,8 @@
 #include "Pipeline.h"
 
-#include <devslam/core/Association.h>
 
 #include "MaskSource.h"
 
-#include <devslam/core/Association.h>
 #include <devslam/core/Config.h>
 #include <devslam/core/GzFile.h>
 #include <devslam/core/Interrupt.h>
@@ -25,6 +23,7 @@
 #include <functional>
 #include <future>
 #include <iostream>
+#include <set>
 #include <sstream>
 
 namespace devslam::run {
@@ -371,42 +370,47 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
     // scored its identity poses against the truth and printed that as its ATE.
     const std::size_t tracked =
         rep.trajectory.size() - std::min(rep.lost.size(), rep.trajectory.size());
-    // ... and among the poses the truth pairs with: a truth that covered only lost frames
-    // scored their held poses, and printed that as the run's ATE.
-    std::size_t paired = 0, paired_tracked = 0;
-    if (rep.ground_truth) {
-        std::vector<bool> lost(rep.trajectory.size(), false);
-        for (const std::size_t i : rep.lost)
-            if (i < lost.size()) lost[i] = true;
-        std::vector<double> te, tg;
-        for (const auto& p : rep.trajectory) te.push_back(p.t);
-        for (const auto& p : *rep.ground_truth) tg.push_back(p.t);
-        for (const auto& [i, j] : core::associate(te, tg, eval::AteOptions{}.max_dt)) {
-            ++paired;
-            paired_tracked += lost[i] ? 0 : 1;
-        }
-    }
     if (rep.ground_truth && rep.trajectory.size() < 3)
         rep.ate_missing = std::to_string(rep.trajectory.size()) + " poses (the ATE needs 3)";
     else if (rep.ground_truth && tracked < 3)
         rep.ate_missing = std::to_string(tracked) + " of " + std::to_string(rep.trajectory.size()) +
                           " frames tracked (the ATE needs 3)";
-    else if (rep.ground_truth && paired >= 3 && paired_tracked < 3)
-        rep.ate_missing = std::to_string(paired_tracked) + " of the " + std::to_string(paired) +
-                          " poses the ground truth covers are tracked (the ATE needs 3; the "
-                          "others are lost frames' held poses)";
-    if (rep.ground_truth && rep.ate_missing.empty()) {
+    bool scored = rep.ground_truth && rep.ate_missing.empty();
+    if (scored) {
         try {
             rep.ate = eval::computeAte(*rep.ground_truth, rep.trajectory);
-            eval::RpeOptions one_s;
-            rep.rpe_1s = eval::computeRpe(*rep.ground_truth, rep.trajectory, one_s);
         } catch (const std::invalid_argument& e) {
-            // Too short for a 1 s delta (or no association): reported as absent. Without an
-            // ATE the reason is kept (ground truth of another sequence, stamps in other
-            // units): run.json alone did not tell it from a folder without ground truth.
-            if (!rep.ate) rep.ate_missing = e.what();
-            else rep.rpe_missing = e.what();  // (the RPE line vanished without a word)
+            // (no association: ground truth of another sequence, stamps in other units) The
+            // reason is kept: run.json alone did not tell it from a folder without ground truth.
+            rep.ate_missing = e.what();
         }
+        // ... and 3 tracked among the poses the ATE paired with the truth: a truth that
+        // covered only lost frames scored their held poses, and printed that as the ATE.
+        if (rep.ate) {
+            std::set<double> lost_stamps;
+            for (const std::size_t i : rep.lost)
+                if (i < rep.trajectory.size()) lost_stamps.insert(rep.trajectory[i].t);
+            const std::size_t paired = rep.ate->stamps.size();
+            const auto paired_tracked = static_cast<std::size_t>(
+                std::count_if(rep.ate->stamps.begin(), rep.ate->stamps.end(),
+                              [&](double t) { return lost_stamps.count(t) == 0; }));
+            if (paired_tracked < 3) {
+                rep.ate_missing = std::to_string(paired_tracked) + " of the " +
+                                  std::to_string(paired) +
+                                  " poses the ground truth covers are tracked (the ATE needs 3; "
+                                  "the others are lost frames' held poses)";
+                rep.ate.reset();
+                scored = false;
+            }
+        }
+    }
+    if (scored) {
+        if (rep.ate) try {
+                eval::RpeOptions one_s;
+                rep.rpe_1s = eval::computeRpe(*rep.ground_truth, rep.trajectory, one_s);
+            } catch (const std::invalid_argument& e) {
+                rep.rpe_missing = e.what();  // (a run under 1 s: the line vanished without a word)
+            }
         try {
             eval::RpeOptions per_frame;
             per_frame.delta = 1;
