@@ -1,7 +1,6 @@
 // devslam-convert: TUM RGB-D folder <-> MRPT rawlog of CObservation3DRangeScan.
 // Depth keeps the source's raw 16-bit units and colour is stored losslessly, so a
 // TUM -> rawlog -> TUM round trip is bit-exact in both images.
-#include <devslam/core/Camera.h>
 #include <devslam/core/Interrupt.h>
 #include <devslam/core/Parse.h>
 #include <devslam/core/Progress.h>
@@ -84,11 +83,7 @@ std::variant<Args, int> parseArgs(int argc, char** argv) {
             args.ro.camera = value();
             // Checked here, as devslam-run's [dataset] camera (the reader's message left out
             // "auto", which --help lists).
-            if (args.ro.camera != "auto") try {
-                    (void)devslam::core::CameraIntrinsics::fromPreset(args.ro.camera);
-                } catch (const std::invalid_argument& e) {
-                    throw std::invalid_argument(std::string("--camera: ") + e.what() + " or auto");
-                }
+            devslam::io::ReaderOptions::requireCameraName(args.ro.camera, "--camera");
         }
         else if (a == "--sensory-frames")
             args.wo.sensory_frames = true;

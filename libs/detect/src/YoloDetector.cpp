@@ -76,55 +76,61 @@ std::string resolveModelPath(const std::string& path, const std::string& what) {
     throw std::runtime_error(what + ": file not found (tried " + tried + ")");
 }
 
-float darknetScoreFloor(const std::string& cfg_path) {
-    std::ifstream in(cfg_path);
-    if (!in) throw std::runtime_error("cannot open darknet cfg '" + cfg_path + "'");
-    // OpenCV's darknet reader gives each [yolo] layer `thresh` (default 0.2) and sets every
-    // class score at or below it to 0: no box under it ever comes out.
-    constexpr float kOpenCvDefault = 0.2f;
-    float highest = 0.f, layer = 0.f;
-    bool in_yolo = false;
-    for (std::string line; std::getline(in, line);) {
-        line = trim(line.substr(0, line.find_first_of("#;")));
-        if (line.empty()) continue;
-        if (line.front() == '[') {
-            if (in_yolo) highest = std::max(highest, layer);
-            in_yolo = line == "[yolo]";
-            layer = kOpenCvDefault;
-        } else if (in_yolo && line.find('=') != std::string::npos &&
-                   trim(line.substr(0, line.find('='))) == "thresh") {
-            layer = static_cast<float>(core::parseNumber(trim(line.substr(line.find('=') + 1)),
-                                                         "darknet cfg '" + cfg_path + "' thresh"));
-        }
-    }
-    if (in_yolo) highest = std::max(highest, layer);
-    return highest;
-}
+namespace {
+/// A darknet cfg's sections in order ([net] included), each with its keys: type, the line of
+/// its header, and (key, value, line) per key; comments ('#', ';') and blanks dropped.
+/// (Hand-written: OpenCV parses the cfg only inside readNetFromDarknet.)
+struct CfgSection {
+    std::string type;
+    int line = 0;
+    std::vector<std::tuple<std::string, std::string, int>> keys;
+};
 
-void checkDarknetCfg(const std::string& cfg_path) {
+std::vector<CfgSection> readCfgSections(const std::string& cfg_path) {
     std::ifstream in(cfg_path);
     if (!in) throw std::runtime_error("cannot open darknet cfg '" + cfg_path + "'");
-    // Hand-written: OpenCV's reader asserts none of these (see the header).
-    struct Layer {
-        std::string type;
-        int line = 0;
-        std::vector<std::tuple<std::string, std::string, int>> keys;  // key, value, line
-    };
-    std::vector<Layer> layers;  // [net] left out: darknet's layer indices count the others
+    std::vector<CfgSection> sections;
     int n = 0;
     for (std::string line; std::getline(in, line);) {
         ++n;
         line = trim(line.substr(0, line.find_first_of("#;")));
         if (line.empty()) continue;
-        if (line.front() == '[') {
-            const std::string type = trim(line.substr(1, line.find(']') - 1));
-            if (type != "net" && type != "network") layers.push_back({type, n, {}});
-        } else if (!layers.empty() && line.find('=') != std::string::npos) {
-            layers.back().keys.emplace_back(trim(line.substr(0, line.find('='))),
-                                            trim(line.substr(line.find('=') + 1)), n);
-        }
+        if (line.front() == '[')  // the type as OpenCV takes it: between the brackets, as is
+            sections.push_back({line.substr(1, line.size() - 2), n, {}});
+        else if (!sections.empty() && line.find('=') != std::string::npos)
+            sections.back().keys.emplace_back(trim(line.substr(0, line.find('='))),
+                                              trim(line.substr(line.find('=') + 1)), n);
     }
-    const auto fail = [&](int line, const Layer& l, const std::string& key, const std::string& why) {
+    return sections;
+}
+}  // namespace
+
+float darknetScoreFloor(const std::string& cfg_path) {
+    // OpenCV's darknet reader gives each [yolo] layer `thresh` (default 0.2) and sets every
+    // class score at or below it to 0: no box under it ever comes out.
+    constexpr float kOpenCvDefault = 0.2f;
+    float highest = 0.f;
+    for (const auto& section : readCfgSections(cfg_path)) {
+        if (section.type != "yolo") continue;
+        float layer = kOpenCvDefault;
+        for (const auto& [key, value, line] : section.keys)
+            if (key == "thresh")
+                layer = static_cast<float>(
+                    core::parseNumber(value, "darknet cfg '" + cfg_path + "' thresh"));
+        highest = std::max(highest, layer);
+    }
+    return highest;
+}
+
+void checkDarknetCfg(const std::string& cfg_path) {
+    // OpenCV's reader asserts none of these (see the header).
+    using Layer = CfgSection;
+    std::vector<Layer> layers;  // [net] left out: darknet's layer indices count the others
+    for (auto& section : readCfgSections(cfg_path))
+        if (section.type != "net" && section.type != "network")
+            layers.push_back(std::move(section));
+    const auto fail = [&](int line, const Layer& l, const std::string& key,
+                          const std::string& why) {
         throw std::runtime_error("darknet cfg '" + cfg_path + "' line " + std::to_string(line) +
                                  ": [" + l.type + "] " + key + ": " + why);
     };

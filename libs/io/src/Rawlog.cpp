@@ -252,15 +252,12 @@ core::Frame frameFromObservation(const CObservation3DRangeScan& o, const std::st
     // A unit of 1 m, 1e6 m or 1e-9 m (a damaged file) put every depth beyond range or under
     // a millimetre: frames without depth, without a word. As [dataset] tum_depth_scale.
     if (!(o.rangeUnits >= 1e-6f && o.rangeUnits <= 0.1f))
-        throw std::runtime_error(what + ": depth unit (rangeUnits) " + std::to_string(o.rangeUnits) +
-                                 " m: must be in [1e-6, 0.1] m");
+        throw std::runtime_error(what + ": depth unit (rangeUnits) " +
+                                 std::to_string(o.rangeUnits) + " m: must be in [1e-6, 0.1] m");
     {  // A NaN or 1e10 m offset between the two cameras registered no depth pixel at all.
         const auto& T = o.relativePoseIntensityWRTDepth;
         const double t = std::sqrt(T.x() * T.x() + T.y() * T.y() + T.z() * T.z());
-        bool finite = std::isfinite(t);
-        for (int r = 0; r < 3; ++r)
-            for (int c = 0; c < 3; ++c) finite = finite && std::isfinite(T.getRotationMatrix()(r, c));
-        if (!finite || t > 1.0)
+        if (!std::isfinite(t) || !T.getRotationMatrix().asEigen().allFinite() || t > 1.0)
             throw std::runtime_error(what +
                                      ": the colour camera's pose relative to the depth camera "
                                      "(relativePoseIntensityWRTDepth) is " +
@@ -447,7 +444,8 @@ RawlogReader::RawlogReader(std::string path, ReaderOptions opts)
             last_t = t;
             if (n_frames_ == 0) {
                 o->load();
-                K_ = frameFromObservation(*o, "observation 0").K;  // (the catch below names the file)
+                // (the catch below names the file)
+                K_ = frameFromObservation(*o, "observation 0").K;
                 o->unload();
                 first_cam = o->cameraParamsIntensity;
                 first_calibration = core::CameraIntrinsics::fromMrpt(first_cam);

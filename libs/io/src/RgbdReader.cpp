@@ -26,10 +26,14 @@ void ReaderOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, const
     core::requireValue(max_dt > 0 && max_dt <= 1, s, "max_dt", "must be in (0, 1] s");
     core::requireValue(tum_depth_scale >= 10 && tum_depth_scale <= 1e6, s, "tum_depth_scale",
                        "must be in [10, 1e6] units per metre (TUM: 5000, millimetres: 1000)");
+    requireCameraName(camera, "[" + s + "] camera");
+}
+
+void ReaderOptions::requireCameraName(const std::string& camera, const std::string& what) {
     try {
         if (camera != "auto") (void)core::CameraIntrinsics::fromPreset(camera);
     } catch (const std::invalid_argument& e) {
-        throw std::invalid_argument("[" + s + "] camera: " + e.what() + " or auto");
+        throw std::invalid_argument(what + ": " + e.what() + " or auto");
     }
 }
 

@@ -20,15 +20,21 @@ namespace fs = std::filesystem;
 namespace devslam::io {
 
 namespace {
-/// A file of a TUM folder: a pipe there blocked the reader, for ever, at its opening (a
-/// signal only asks for a stop after the current frame), and a folder read as empty.
-void requireFileInFolder(const std::string& path, const std::string& what) {
+/// Why `path` is no file to read ("not found", "is a folder, not a file", "is a pipe or
+/// device, not a file"), "" for a regular file: a pipe in a TUM folder blocked the reader,
+/// for ever, at its opening (a signal only asks for a stop after the current frame), and a
+/// folder read as empty.
+std::string notAFile(const std::string& path) {
     const auto st = fs::status(path);
-    if (!fs::exists(st)) throw std::runtime_error(path + ": " + what + " not found");
-    if (!fs::is_regular_file(st))
-        throw std::runtime_error(path + ": " + what + " is " +
-                                 (fs::is_directory(st) ? "a folder" : "a pipe or device") +
-                                 ", not a file");
+    if (!fs::exists(st)) return "not found";
+    if (fs::is_regular_file(st)) return "";
+    return fs::is_directory(st) ? "is a folder, not a file" : "is a pipe or device, not a file";
+}
+
+/// Throws "<path>: <what> <notAFile's reason>" unless `path` is a regular file.
+void requireFileInFolder(const std::string& path, const std::string& what) {
+    if (const std::string why = notAFile(path); !why.empty())
+        throw std::runtime_error(path + ": " + what + " " + why);
 }
 }  // namespace
 
@@ -119,14 +125,10 @@ TumReader::TumReader(std::string folder, ReaderOptions opts)
         bool complete = true;
         for (const auto* e : {&rgb[i], &depth[j]}) {
             const std::string list = e == &rgb[i] ? "/rgb.txt" : "/depth.txt";
-            const auto st = fs::status(imagePath(e->file));
-            if (fs::is_regular_file(st)) continue;
-            missing.push_back(detail::lineError(
-                folder_ + list, e->line,
-                "image '" + e->file + "' " +
-                    (!fs::exists(st)          ? "not found"
-                     : fs::is_directory(st) ? "is a folder, not a file"
-                                              : "is a pipe or device, not a file")));
+            const std::string why = notAFile(imagePath(e->file));
+            if (why.empty()) continue;
+            missing.push_back(
+                detail::lineError(folder_ + list, e->line, "image '" + e->file + "' " + why));
             complete = false;
         }
         if (complete) pairs_.emplace_back(rgb[i], depth[j]);

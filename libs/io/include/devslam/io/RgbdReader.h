@@ -40,6 +40,9 @@ struct ReaderOptions {
     bool allow_damaged = false;
 
     void loadFromConfig(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
+    /// Throws std::invalid_argument "<what>: unknown camera preset '...' (known: ...) or auto"
+    /// unless `camera` is "auto" or a preset ([dataset] camera, devslam-convert --camera).
+    static void requireCameraName(const std::string& camera, const std::string& what);
 };
 
 /// A damaged input of which `intact()` frames could still be read (with
