@@ -88,7 +88,8 @@ static int appMain(int argc, char** argv) {
                 pos.push_back(a);
         }
         if (pos.size() != 2) {  // (the usage alone did not say what was wrong)
-            std::cerr << "devslam-eval: expected two files, GROUNDTRUTH and ESTIMATE, got " << pos.size()
+            std::cerr << "devslam-eval: expected two files, GROUNDTRUTH and ESTIMATE, got "
+                      << pos.size()
                       << (pos.size() > 2 ? " (the third: '" + pos[2] + "')" : std::string()) << "\n"
                       << kUsage;
             return 2;

@@ -227,9 +227,9 @@ static int appMain(int argc, char** argv) {
             const auto now = std::chrono::steady_clock::now();
             if (now < next_line) return;
             next_line = now + std::chrono::seconds(5);
-            std::fprintf(stderr, "devslam-nav: %.0f of %.0f s simulated (%.0f s wall), %.2f m to the goal\n",
-                         t, world.timeout,
-                         std::chrono::duration<double>(now - wall_start).count(), to_goal);
+            std::fprintf(
+                stderr, "devslam-nav: %.0f of %.0f s simulated (%.0f s wall), %.2f m to the goal\n",
+                t, world.timeout, std::chrono::duration<double>(now - wall_start).count(), to_goal);
         };
         const auto r = devslam::sim::runEpisode(world, *ini, nav_opts, eo);
         if (png.empty()) png = kDefaultDir + "/nav_" + world.name + ".png";

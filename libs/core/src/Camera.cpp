@@ -79,7 +79,8 @@ std::string CameraIntrinsics::problem() const {
     // (k1 = 1e6 folded every depth pixel out of the colour image: a frame without depth,
     // without a word; real lenses, fisheyes included, stay well inside 100)
     for (const double d : dist)
-        if (!(std::abs(d) <= 100)) return "a distortion coefficient is " + str(d) + ": must be in [-100, 100]";
+        if (!(std::abs(d) <= 100))
+            return "a distortion coefficient is " + str(d) + ": must be in [-100, 100]";
     return {};
 }
 

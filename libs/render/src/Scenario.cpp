@@ -278,8 +278,9 @@ PersonSpec loadPerson(const mrpt::config::CConfigFileBase& cfg, const std::strin
         core::requireValue(p.path.size() >= 2 && pathLength(p.path) > 0.1, s, "path",
                            "a walker needs at least two points 0.1 m apart");
     else  // (the points after the first were ignored)
-        core::requireValue(p.path.size() == 1, s, "path",
-                           "a " + toString(p.kind) + " person stays at one point: give one x y pair");
+        core::requireValue(
+            p.path.size() == 1, s, "path",
+            "a " + toString(p.kind) + " person stays at one point: give one x y pair");
     return p;
 }
 

@@ -108,8 +108,9 @@ EpisodeResult runEpisode(const WorldSpec& world, const mrpt::config::CConfigFile
         if (!(h >= lo && h <= hi)) {
             std::ostringstream m;
             m << nav_opts.source << " [" << s << "] min_obstacles_height " << lo
-              << " m, max_obstacles_height " << hi << " m: the band leaves out the laser's plane at "
-              << world.laser.height << " m (" << (world.source.empty() ? world.name : world.source)
+              << " m, max_obstacles_height " << hi
+              << " m: the band leaves out the laser's plane at " << world.laser.height << " m ("
+              << (world.source.empty() ? world.name : world.source)
               << " [laser] height), so the robot would see no obstacle";
             throw std::invalid_argument(m.str());
         }
