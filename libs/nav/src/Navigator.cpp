@@ -14,15 +14,52 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdint>
 #include <ctime>
 #include <filesystem>
 #include <functional>
 #include <iostream>
+#include <map>
+#include <mutex>
 #include <sstream>
+#include <utility>
 
 namespace devslam::nav {
 
 namespace {
+/// A PTG cache file cut short (a full disk, a run killed while writing it): MRPT printed its
+/// read exception with a stack trace, naming no file, then rebuilt it. Removed first, it is
+/// rebuilt without the noise. A file found whole is not read again in this process while its
+/// size and time stay the same: a bench makes a navigator per episode, and MRPT reads each
+/// file whole after this anyway.
+void removeDamagedCacheFiles(const std::string& dir, bool verbose) {
+    namespace fs = std::filesystem;
+    static std::mutex mu;
+    static std::map<std::string, std::pair<std::uintmax_t, fs::file_time_type>> whole;
+    const std::lock_guard<std::mutex> lock(mu);
+    std::error_code ec;
+    for (const auto& e : fs::directory_iterator(dir, ec)) {
+        const std::string f = e.path().string();
+        if (!core::endsWithNoCase(f, ".dat.gz")) continue;
+        const auto time = fs::last_write_time(e.path(), ec);
+        if (ec) continue;
+        const auto size = fs::file_size(e.path(), ec);
+        // (one written in the last minute may be another process's, still being written)
+        if (ec || fs::file_time_type::clock::now() - time < std::chrono::minutes(1)) continue;
+        if (const auto it = whole.find(f); it != whole.end() && it->second == std::pair{size, time})
+            continue;
+        if (core::gzipDamage(f).empty()) {
+            whole[f] = {size, time};
+            continue;
+        }
+        fs::remove(e.path(), ec);
+        whole.erase(f);
+        if (verbose)
+            std::cerr << "navigator: removed the damaged PTG cache file " << f
+                      << " (MRPT builds it again)\n";
+    }
+}
+
 /// CPU time of the calling thread [s]: step timings that do not depend on machine load.
 double threadCpuSeconds() {
     timespec ts{};
@@ -264,25 +301,7 @@ Navigator::Navigator(mrpt::nav::CRobot2NavInterface& robot,
                     .string();
     }
     mrpt::system::createDirectory(cache);
-    // A cache file cut short (a full disk, a run killed while writing it): MRPT printed its
-    // read exception with a stack trace, naming no file, then rebuilt it. Removed first, it
-    // is rebuilt without the noise.
-    {
-        std::error_code ec;
-        for (const auto& e : std::filesystem::directory_iterator(cache, ec)) {
-            const std::string f = e.path().string();
-            // (one written in the last minute may be another process's, still being written)
-            const auto age = std::filesystem::file_time_type::clock::now() -
-                             std::filesystem::last_write_time(e.path(), ec);
-            if (ec || age < std::chrono::minutes(1) || !core::endsWithNoCase(f, ".dat.gz") ||
-                core::gzipDamage(f).empty())
-                continue;
-            std::filesystem::remove(e.path(), ec);
-            if (opts_.verbose)
-                std::cerr << "navigator: removed the damaged PTG cache file " << f
-                          << " (MRPT builds it again)\n";
-        }
-    }
+    removeDamagedCacheFiles(cache, opts_.verbose);
     nav_->params_abstract_ptg_navigator.ptg_cache_files_directory = cache;
     // What only MRPT itself can tell (a motion decider class it does not know, a holonomic
     // method's section that is missing, a FullEval phase without its factors) it throws here,
