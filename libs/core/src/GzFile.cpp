@@ -103,6 +103,9 @@ std::string gzipDamage(const std::string& path) {
     const char* msg = gzerror(f, &err);
     std::string out = (n < 0 || (err != Z_OK && err != Z_STREAM_END)) ? msg : "";
     gzclose(f);
+    // zlib puts the file's name in front ("<path>: unexpected end of file"): the callers name
+    // it themselves, and it came out twice.
+    if (out.rfind(path + ": ", 0) == 0) out.erase(0, path.size() + 2);
     return out;
 }
 

@@ -469,8 +469,7 @@ RawlogReader::RawlogReader(std::string path, ReaderOptions opts)
         // file are found only by its checksum, at its end (or where the decoder trips, later
         // than the change): 3 bytes changed at 5 MB damaged frame 6's pixels, and the break
         // was blamed on the last object, the 31 before it called intact.
-        std::string gz = core::gzipDamage(path_);
-        if (gz.rfind(path_ + ": ", 0) == 0) gz.erase(0, path_.size() + 2);  // zlib names it
+        const std::string gz = core::gzipDamage(path_);
         if (!gz.empty() && gz.find("unexpected end of file") == std::string::npos)
             throw DamagedInput(path_ + ": its gzip data is corrupt (zlib: " + gz +
                                    "), not cut short: no frame of it can be told intact, so "
@@ -540,9 +539,8 @@ std::optional<core::Frame> RawlogReader::next() {
                                        : std::string();
     const auto depth_file_damage = [&]() -> std::string {
         if (depth_file.empty()) return "";
-        std::string gz = core::gzipDamage(depth_file);
+        const std::string gz = core::gzipDamage(depth_file);
         if (gz.empty()) return "";
-        if (gz.rfind(depth_file + ": ", 0) == 0) gz.erase(0, depth_file.size() + 2);  // zlib's
         return what + ": external depth file '" + depth_file + "' is damaged (" + gz + ")";
     };
     try {
