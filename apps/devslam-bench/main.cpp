@@ -394,10 +394,11 @@ void checkSlamConfigs(const Bench& b, const Args& a) {
             if (const int sig = stopAfter(rc))
                 throw Interrupted(sig, "interrupted (" + core::signalName(sig) +
                                            ") while checking the SLAM INIs; nothing was run");
+            if (rc == 0) continue;
+            const std::string said = lastLines(log, 5);
             // A devslam-run of an older build (--bin) has no --check-config: its runs find
             // what this would have.
-            if (rc != 0 && lastLines(log, 5).find("unknown argument '--check-config'") !=
-                               std::string::npos) {
+            if (said.find("unknown argument '--check-config'") != std::string::npos) {
                 std::cout << "(" << a.bin
                           << "/devslam-run has no --check-config: the SLAM INIs are checked by "
                              "its runs)\n";
@@ -405,11 +406,9 @@ void checkSlamConfigs(const Bench& b, const Args& a) {
                 fs::remove(log, ec);
                 return;
             }
-            if (rc != 0)
-                throw std::invalid_argument(q.where + ": devslam-run refuses its SLAM INI '" +
-                                            q.slam_config + "' in mode " + m + " (" +
-                                            endedBy(rc) + "):\n" + lastLines(log, 5) +
-                                            "(command: " + cmd + ")");
+            throw std::invalid_argument(q.where + ": devslam-run refuses its SLAM INI '" +
+                                        q.slam_config + "' in mode " + m + " (" + endedBy(rc) +
+                                        "):\n" + said + "(command: " + cmd + ")");
         }
     std::error_code ec;
     fs::remove(log, ec);
