@@ -324,6 +324,8 @@ int appMain(int argc, char** argv) {
                                     : " (removed " + std::to_string(stale.size()) +
                                           " of an earlier run)")
                   << "\n";
+        if (in.reader && !in.reader->damage().empty())
+            std::cerr << "devslam-overlay: warning: " << in.reader->damage() << "\n";
     } catch (const std::exception& e) {
         std::cerr << "devslam-overlay: " << e.what() << "\n";
         return 1;

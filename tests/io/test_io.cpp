@@ -1259,6 +1259,30 @@ TEST(VideoReader, ReadsVtestAsFixedCameraFramesWithAPlaneOfDepth) {
         ++n;
     }
     EXPECT_EQ(n, 795u);
+    EXPECT_EQ(video.damage(), "");
+}
+
+// A video cut short decodes what is there, and says that the rest is missing once read.
+TEST(VideoReader, AVideoCutShortSaysHowManyOfItsFramesDecoded) {
+    const std::string vtest = "/usr/share/doc/opencv-doc/examples/data/vtest.avi";  // opencv-doc
+    ASSERT_TRUE(fs::exists(vtest)) << "installed by Debian's opencv-doc (./devslam.sh setup)";
+    TempDir tmp;
+    {
+        std::ifstream in(vtest, std::ios::binary);
+        std::string head(800000, '\0');  // a tenth of the file
+        in.read(head.data(), static_cast<std::streamsize>(head.size()));
+        std::ofstream(tmp.str("cut.avi"), std::ios::binary) << head;
+    }
+    io::VideoReader video(tmp.str("cut.avi"), {});
+    ASSERT_EQ(video.size(), std::optional<std::size_t>(795));  // the header's count
+    std::size_t n = 0;
+    while (video.next()) ++n;
+    EXPECT_GT(n, 10u);
+    EXPECT_LT(n, 200u);
+    EXPECT_EQ(video.damage(), tmp.str("cut.avi") + ": " + std::to_string(n) +
+                                  " of the 795 frames the container states decoded; the file "
+                                  "may be cut short or damaged after frame " +
+                                  std::to_string(n - 1));
 }
 
 TEST(VideoReader, BadFilesAndOptionsNameTheFile) {

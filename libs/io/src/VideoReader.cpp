@@ -3,6 +3,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
 
+#include <algorithm>
 #include <filesystem>
 #include <sstream>
 #include <stdexcept>
@@ -48,7 +49,17 @@ std::optional<core::Frame> VideoReader::next() {
 
 std::optional<core::Frame> VideoReader::readFrame() {
     cv::Mat img;
-    if (!cap_->read(img) || img.empty()) return std::nullopt;
+    if (!cap_->read(img) || img.empty()) {
+        // The stated count is the header's for AVI and MP4, an estimate from the duration
+        // for some other containers (off by a frame or two): a few frames short is not news.
+        if (size_ && index_ + std::max<std::size_t>(2, *size_ / 50) < *size_)
+            damage_ = path_ + ": " + std::to_string(index_) + " of the " +
+                      std::to_string(*size_) +
+                      " frames the container states decoded; the file may be cut short or "
+                      "damaged after frame " +
+                      std::to_string(index_ == 0 ? 0 : index_ - 1);
+        return std::nullopt;
+    }
     if (img.type() == CV_8UC1) cv::cvtColor(img, img, cv::COLOR_GRAY2BGR);
     if (img.type() != CV_8UC3)
         throw std::runtime_error(path_ + " frame " + std::to_string(index_) +

@@ -45,6 +45,9 @@ class VideoReader final : public RgbdReader {
     [[nodiscard]] std::optional<std::size_t> size() const override { return size_; }
     [[nodiscard]] core::CameraIntrinsics intrinsics() const override { return K_; }
     [[nodiscard]] std::string describe() const override;
+    /// Once next() has ended: what was not decoded when the decoder stopped well before the
+    /// frame count the container states (a file cut short); "" otherwise.
+    [[nodiscard]] std::string damage() const override { return damage_; }
 
   private:
     [[nodiscard]] std::optional<core::Frame> readFrame();
@@ -55,6 +58,7 @@ class VideoReader final : public RgbdReader {
     core::CameraIntrinsics K_;
     double fps_ = 10.0;
     std::optional<std::size_t> size_;
+    std::string damage_;
     std::optional<core::Frame> pending_;  // the first frame, read by the constructor
     std::size_t index_ = 0;
 };
