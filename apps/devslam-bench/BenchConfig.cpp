@@ -138,13 +138,6 @@ Bench readBench(const std::string& path) {
             } catch (const std::exception& e) {
                 throw std::invalid_argument(path + " [" + s + "] path: " + e.what());
             }
-        // The scenario as devslam-synth finds it (a file, or a name in sim_worlds/synth): a
-        // name it does not know failed at the render, naming no INI.
-        if (!q.scenario.empty() && !fs::is_regular_file(q.scenario) &&
-            !fs::is_regular_file(kRoot + "/sim_worlds/synth/" + q.scenario + ".ini"))
-            throw std::invalid_argument(path + " [" + s + "] scenario: no scenario file '" +
-                                        q.scenario + "' and no sim_worlds/synth/" + q.scenario +
-                                        ".ini (devslam-synth --list shows the shipped ones)");
         q.where = path + " [" + s + "]";
         // The name is a folder and a file name prefix, and a cell of runs.csv.
         if (q.name.empty() ||
@@ -177,7 +170,7 @@ Bench readBench(const std::string& path) {
             throw std::invalid_argument(where +
                                         " seeds: only a synthetic sequence (scenario) has renders");
         // Whitespace-separated, as [run] filter_overrides; the format is checked here, the
-        // sections and keys by devslam-synth, which renders before any run starts.
+        // sections and keys by devslam-synth --check before any render (devslam-bench).
         q.sets = core::overrideItems(cfg->read_string(s, "set", ""), where + " set");
         if (!q.sets.empty() && q.scenario.empty())
             throw std::invalid_argument(where + " set: only a synthetic sequence (scenario) " +

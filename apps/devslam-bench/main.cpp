@@ -378,38 +378,67 @@ int repeatsOf(const Bench& b, const Sequence& q) {
     return q.repeats > 0 ? q.repeats : b.repeats;
 }
 
-/// 0. Each SLAM INI as devslam-run reads it, in each mode the bench runs (devslam-run
-/// --check-config, a tenth of a second): loadBench read the INIs and made their filters, but
-/// devslam-run's own sections and keys ([run], [orb], [tracker], ...) were found wrong only
-/// by the runs, after every render (up to an hour of them).
-void checkSlamConfigs(const Bench& b, const Args& a) {
+/// Runs one program's check of an input (`cmd` ends in its --check option) with its output
+/// in `log`: "" when it passes, what it said when it refuses, nothing when the program has
+/// no such option (an older build given by --bin: its runs find what the check would have).
+std::optional<std::string> askCheck(const std::string& cmd, const std::string& option,
+                                    const std::string& log) {
+    const int rc = core::runCommand(cmd + " > " + quote(log) + " 2>&1");
+    if (const int sig = stopAfter(rc))
+        throw Interrupted(sig, "interrupted (" + core::signalName(sig) +
+                                   ") while checking the bench's inputs; nothing was run");
+    if (rc == 0) return std::string();
+    const std::string said = lastLines(log, 5);
+    if (said.find("unknown argument '" + option + "'") != std::string::npos ||
+        said.find("unknown option '" + option + "'") != std::string::npos)
+        return std::nullopt;
+    return endedBy(rc) + "):\n" + said + "(command: " + cmd + ")";
+}
+
+/// 0. What each run and render will read, before any of them: each SLAM INI as devslam-run
+/// reads it, in each mode the bench runs (devslam-run --check-config), and each synthetic
+/// sequence's scenario with its `set` items (devslam-synth --check); a tenth of a second
+/// each. loadBench read the INIs and made their filters, but devslam-run's own sections and
+/// keys ([run], [orb], [tracker], ...) were found wrong only by the runs, after every render
+/// (up to an hour of them), and a scenario's `set` key only by its render, after the
+/// earlier sequences' renders.
+void checkInputs(const Bench& b, const Args& a) {
+    const std::string log = (fs::path(b.out_dir) / "check_inputs.log").string();
     std::set<std::pair<std::string, std::string>> checked;  // (INI, mode)
-    const std::string log = (fs::path(b.out_dir) / "check_config.log").string();
+    bool run_checks = true;
     for (const auto& q : b.sequences)
         for (const auto& m : b.modes) {
-            if (!checked.insert({q.slam_config, m}).second) continue;
+            if (!run_checks || !checked.insert({q.slam_config, m}).second) continue;
             const std::string cmd = quote(a.bin + "/devslam-run") + " --check-config --config " +
                                     quote(q.slam_config) + " --mode " + m;
-            const int rc = core::runCommand(cmd + " > " + quote(log) + " 2>&1");
-            if (const int sig = stopAfter(rc))
-                throw Interrupted(sig, "interrupted (" + core::signalName(sig) +
-                                           ") while checking the SLAM INIs; nothing was run");
-            if (rc == 0) continue;
-            const std::string said = lastLines(log, 5);
-            // A devslam-run of an older build (--bin) has no --check-config: its runs find
-            // what this would have.
-            if (said.find("unknown argument '--check-config'") != std::string::npos) {
+            const auto refused = askCheck(cmd, "--check-config", log);
+            if (!refused) {
                 std::cout << "(" << a.bin
                           << "/devslam-run has no --check-config: the SLAM INIs are checked by "
                              "its runs)\n";
-                std::error_code ec;
-                fs::remove(log, ec);
-                return;
+                run_checks = false;
+            } else if (!refused->empty()) {
+                throw std::invalid_argument(q.where + ": devslam-run refuses its SLAM INI '" +
+                                            q.slam_config + "' in mode " + m + " (" + *refused);
             }
-            throw std::invalid_argument(q.where + ": devslam-run refuses its SLAM INI '" +
-                                        q.slam_config + "' in mode " + m + " (" + endedBy(rc) +
-                                        "):\n" + said + "(command: " + cmd + ")");
         }
+    for (const auto& q : b.sequences) {
+        if (q.scenario.empty()) continue;
+        std::string cmd = quote(a.bin + "/devslam-synth") + " " + quote(q.scenario);
+        for (const auto& item : q.sets) cmd += " --set " + quote(item);
+        const auto refused = askCheck(cmd + " --check", "--check", log);
+        if (!refused) {
+            std::cout << "(" << a.bin
+                      << "/devslam-synth has no --check: the scenarios are checked by their "
+                         "renders)\n";
+            break;
+        }
+        if (!refused->empty())
+            throw std::invalid_argument(q.where + ": devslam-synth refuses its scenario '" +
+                                        q.scenario + "'" +
+                                        (q.sets.empty() ? "" : " with its set items") + " (" +
+                                        *refused);
+    }
     std::error_code ec;
     fs::remove(log, ec);
 }
@@ -1038,7 +1067,7 @@ int run(int argc, char** argv) {
     if (!a.compare.empty()) return compareRuns(b, a.compare);
     // Before hours of work (after the output folder is made: the results may go in it).
     if (!a.results.empty()) core::checkResultsSection(a.results, "bench");
-    checkSlamConfigs(b, a);
+    checkInputs(b, a);
     renderSequences(b, a);
     const Runs runs = runSlam(b, a);
     const Tables t = makeTables(b, runs, a.results);

@@ -638,8 +638,9 @@ TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
         {"[sequence_a]\npath = " + root + "/data/tum\n",
          "bench.ini [sequence_a] path: " + root + "/data/tum"},
         {"[sequence_a]\nscenario = no_such_scenario\n",
-         "bench.ini [sequence_a] scenario: no scenario file 'no_such_scenario' and no "
-         "sim_worlds/synth/no_such_scenario.ini"},
+         "bench.ini [sequence_a]: devslam-synth refuses its scenario 'no_such_scenario' (exit "
+         "1):\n  devslam-synth: no scenario file 'no_such_scenario' and no '" +
+             root + "/sim_worlds/synth/no_such_scenario.ini'"},
         {"[sequence_a]\npath = " + root + "/data/tum/no_such_folder\n",
          "bench.ini [sequence_a] path: no such file or folder '"},
         {real + "slam_config = nowhere.ini\n", "bench.ini [sequence_a] slam_config: no such file"},
@@ -671,12 +672,12 @@ TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
          "[sequence_a] set item 'speed=2': expected SECTION.KEY=VALUE"},
         {synth + "set = person_2.path=[3.5 2.8\n",
          "[sequence_a] set 'person_2.path=[3.5 2.8': a '[' is not closed"},
-        // A key the scenario does not know stops the bench at the render, before any run.
-        // devslam-synth's own message reaches the bench's output (its log holds all of it).
+        // A key the scenario does not know stops the bench before any render (devslam-synth
+        // --check), in the words of devslam-synth.
         {synth + "set = person_1.sped=1\n",
-         "devslam-synth failed for a of " + (tmp / "bench.ini").string() +
-             " [sequence_a] (exit 1):\n  devslam-synth: " + root +
-             "/sim_worlds/synth/short_walking.ini with --set [person_1]: unknown key 'sped'"},
+         "bench.ini [sequence_a]: devslam-synth refuses its scenario 'short_walking' with its "
+         "set items (exit 1):\n  devslam-synth: " +
+             root + "/sim_worlds/synth/short_walking.ini with --set [person_1]: unknown key 'sped'"},
         {real + "[targets]\nx = a dynamic ate <=\n",
          "[targets] x: expected 'SEQUENCE MODE FIGURE OP VALUE'"},
         {real + "[targets]\nx = b dynamic ate <= 1\n", "unknown sequence 'b'"},
@@ -691,8 +692,9 @@ TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
     for (const auto& [ini, msg] : cases) {
         const std::string said = refused(ini);
         EXPECT_NE(said.find(msg), std::string::npos) << ini << "\n" << said;
-        // A SLAM INI is refused before the renders (their logs are under --out).
-        if (ini.find("badrun.ini") != std::string::npos) {
+        // A SLAM INI or a scenario is refused before the renders (their logs are under --out).
+        if (ini.find("badrun.ini") != std::string::npos ||
+            ini.find("sped") != std::string::npos) {
             EXPECT_EQ(said.find("render (if changed)"), std::string::npos) << said;
         }
     }

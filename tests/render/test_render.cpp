@@ -650,6 +650,35 @@ TEST(DevslamSynth, RefusesOutputsThatAreNotItsOwnAndMissingValues) {
     EXPECT_FALSE(fs::exists("--frames"));
 }
 
+// --check reads the scenario, its room and photos with the --set items, says what it would
+// render and writes nothing (devslam-bench asks it of each synthetic sequence before any
+// render); what a render would refuse it refuses, and it takes no output option.
+TEST(DevslamSynth, CheckReadsTheScenarioAndRendersNothing) {
+    TempDir tmp;
+    auto r = devslam::test::runApp("devslam-synth", "sitting_xyz --check --frames 10 --seed 3");
+    ASSERT_EQ(r.rc, 0) << r.out;
+    EXPECT_NE(r.out.find("scenario sitting_xyz (" + kRoot +
+                         "/sim_worlds/synth/sitting_xyz.ini): 10 frames at 30 Hz, trajectory "
+                         "xyz, 2 people; checked, nothing rendered"),
+              std::string::npos)
+        << r.out;
+    for (const auto& [args, says] : std::vector<std::pair<std::string, std::string>>{
+             {"short_walking --check --set person_1.sped=1",
+              "short_walking.ini with --set [person_1]: unknown key 'sped'"},
+             {"no_such_scenario --check", "no scenario file 'no_such_scenario' and no '"},
+             {"short_walking --check --set person_1.texture=" + tmp.str("nowhere.png"),
+              tmp.str("nowhere.png")},
+             {"short_walking --check -o " + tmp.str("o"),
+              "-o does not go with --check (it renders nothing)"},
+             {"short_walking --check --if-changed",
+              "--if-changed does not go with --check (it renders nothing)"}}) {
+        r = devslam::test::runApp("devslam-synth", args);
+        EXPECT_EQ(r.rc, 1) << args << "\n" << r.out;
+        EXPECT_NE(r.out.find(says), std::string::npos) << args << "\n" << r.out;
+    }
+    EXPECT_FALSE(fs::exists(tmp.str("o")));
+}
+
 // A seated person who moves a hand: the labelled pixels follow the hand (they differ between
 // the swing's two extremes only near the hand, and lie on the photo's plane), the person stays
 // static in the truth, and a person whose gesture_deg is 0 renders exactly as one without.
