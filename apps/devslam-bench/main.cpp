@@ -434,10 +434,9 @@ void checkInputs(const Bench& b, const Args& a) {
             break;
         }
         if (!refused->empty())
-            throw std::invalid_argument(q.where + ": devslam-synth refuses its scenario '" +
-                                        q.scenario + "'" +
-                                        (q.sets.empty() ? "" : " with its set items") + " (" +
-                                        *refused);
+            throw std::invalid_argument(
+                q.where + ": devslam-synth refuses its scenario '" + q.scenario + "'" +
+                (q.sets.empty() ? "" : " with its set items") + " (" + *refused);
     }
     std::error_code ec;
     fs::remove(log, ec);

@@ -677,7 +677,8 @@ TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
         {synth + "set = person_1.sped=1\n",
          "bench.ini [sequence_a]: devslam-synth refuses its scenario 'short_walking' with its "
          "set items (exit 1):\n  devslam-synth: " +
-             root + "/sim_worlds/synth/short_walking.ini with --set [person_1]: unknown key 'sped'"},
+             root +
+             "/sim_worlds/synth/short_walking.ini with --set [person_1]: unknown key 'sped'"},
         {real + "[targets]\nx = a dynamic ate <=\n",
          "[targets] x: expected 'SEQUENCE MODE FIGURE OP VALUE'"},
         {real + "[targets]\nx = b dynamic ate <= 1\n", "unknown sequence 'b'"},
@@ -693,8 +694,7 @@ TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
         const std::string said = refused(ini);
         EXPECT_NE(said.find(msg), std::string::npos) << ini << "\n" << said;
         // A SLAM INI or a scenario is refused before the renders (their logs are under --out).
-        if (ini.find("badrun.ini") != std::string::npos ||
-            ini.find("sped") != std::string::npos) {
+        if (ini.find("badrun.ini") != std::string::npos || ini.find("sped") != std::string::npos) {
             EXPECT_EQ(said.find("render (if changed)"), std::string::npos) << said;
         }
     }
