@@ -53,8 +53,7 @@ std::optional<core::Frame> VideoReader::readFrame() {
         // The stated count is the header's for AVI and MP4, an estimate from the duration
         // for some other containers (off by a frame or two): a few frames short is not news.
         if (size_ && index_ + std::max<std::size_t>(2, *size_ / 50) < *size_)
-            damage_ = path_ + ": " + std::to_string(index_) + " of the " +
-                      std::to_string(*size_) +
+            damage_ = path_ + ": " + std::to_string(index_) + " of the " + std::to_string(*size_) +
                       " frames the container states decoded; the file may be cut short or "
                       "damaged after frame " +
                       std::to_string(index_ == 0 ? 0 : index_ - 1);
