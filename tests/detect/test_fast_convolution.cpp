@@ -128,6 +128,33 @@ TEST_F(FastConvolution, DepthwiseAndPointwiseMatchOpenCv) {
     }
 }
 
+// A network set up again (another input size: OpenCV allocates and fuses its layers anew)
+// gives the same output as OpenCV's own layer: the batch norm fused into the weights the
+// first time was fused a second time, or, with a ReLU, run again after them.
+TEST_F(FastConvolution, AnotherInputSizeFusesTheBatchNormOnce) {
+    const std::vector<ConvCase> cases{{16, 16, 3, 1, 1, 16, 20, 20, false, true, -1.f},
+                                      {16, 16, 3, 1, 1, 16, 20, 20, true, true, 0.1f},
+                                      {8, 24, 1, 1, 0, 1, 20, 20, false, true, -1.f},
+                                      {8, 24, 1, 1, 0, 1, 20, 20, true, true, 0.f}};
+    for (const auto& c : cases) {
+        SCOPED_TRACE(describe(c));
+        cv::dnn::Net reference = makeNet(c);
+        cv::dnn::Net fast = detect::withFastConvolutions([&] { return makeNet(c); });
+        ConvCase other = c;
+        other.h = 24;
+        other.w = 32;
+        for (const ConvCase& size : {c, other, c}) {
+            SCOPED_TRACE("input " + std::to_string(size.h) + "x" + std::to_string(size.w));
+            const cv::Mat x = randomInput(size);
+            const cv::Mat a = run(reference, x);
+            const cv::Mat b = run(fast, x);
+            ASSERT_EQ(a.size, b.size);
+            const double scale = 1.0 + cv::norm(a, cv::NORM_INF);
+            EXPECT_LE(cv::norm(a, b, cv::NORM_INF), 1e-5 * scale);
+        }
+    }
+}
+
 // The ONNX importer's convolutions: a bias blob and no "bias_term" key. OpenCV's layer
 // adds the blob (hasBias() is blobs.size() >= 2); so must ours (it dropped the bias).
 TEST_F(FastConvolution, ABiasBlobWithoutTheBiasTermKeyIsAdded) {

@@ -311,13 +311,14 @@ class FastConvolutionLayer final : public cv::dnn::Layer {
   public:
     FastConvolutionLayer(const LayerParams& params, const Shape& shape)
         : Layer(params), shape_(shape) {
-        const cv::Mat& w = params.blobs[0];
-        weights_.assign(w.ptr<float>(), w.ptr<float>() + w.total());
-        bias_.assign(static_cast<std::size_t>(shape_.cout), 0.f);
-        if (shape_.bias)
-            std::copy_n(params.blobs[1].ptr<float>(), shape_.cout, bias_.begin());
-        pack();
+        resetWeights();
     }
+
+    // OpenCV calls this each time it sets the network up (a first forward, another input
+    // size), before it fuses layers into this one again: what the last fusion folded in
+    // goes, as OpenCV's own convolution rebuilds its weights from its blobs. (The batch norm
+    // was fused twice; with a ReLU, fusion was refused and the batch norm ran again.)
+    void finalize(cv::InputArrayOfArrays, cv::OutputArrayOfArrays) override { resetWeights(); }
 
     bool getMemoryShapes(const std::vector<cv::dnn::MatShape>& inputs, int /*requiredOutputs*/,
                          std::vector<cv::dnn::MatShape>& outputs,
@@ -383,6 +384,16 @@ class FastConvolutionLayer final : public cv::dnn::Layer {
     }
 
   private:
+    // The weights and bias as read (Layer::blobs keeps them), no activation fused.
+    void resetWeights() {
+        const cv::Mat& w = blobs[0];
+        weights_.assign(w.ptr<float>(), w.ptr<float>() + w.total());
+        bias_.assign(static_cast<std::size_t>(shape_.cout), 0.f);
+        if (shape_.bias) std::copy_n(blobs[1].ptr<float>(), shape_.cout, bias_.begin());
+        act_ = {};
+        pack();
+    }
+
     // Weights in the kernels' layouts, zeros past the last channel: see each branch.
     void pack() {
         if (shape_.kind == Shape::Depthwise) {  // [channel / 8][tap][channel % 8]
