@@ -910,6 +910,24 @@ TEST(Slam, DepthStampAndCompensation) {
     compensateDepthTime(ff, v, 0.03, 10.0, 9.985);
     EXPECT_NEAR(ff.points_c[0].z(), 2.0 - 0.015, 1e-9);
     EXPECT_NEAR(ff.depth[0], 1.985f, 1e-6);
+    // Sideways at 0.5 m/s, depth 20 ms earlier, a wall 2 m ahead: the wall's depth stays,
+    // and each point stays on its keypoint's ray (moved whole, the one at the centre went
+    // 1 cm, 2.6 px, off its keypoint).
+    ff.keypoints.resize(2);
+    ff.depth = {2.0f, 2.0f};
+    ff.points_c = {Eigen::Vector3d(0, 0, 2.0), Eigen::Vector3d(0.4, -0.3, 2.0)};
+    compensateDepthTime(ff, makePose(0.015, 0, 0, 0, 0, 0), 0.03, 10.0, 9.98);
+    EXPECT_NEAR((ff.points_c[0] - Eigen::Vector3d(0, 0, 2.0)).norm(), 0.0, 1e-12);
+    EXPECT_NEAR((ff.points_c[1] - Eigen::Vector3d(0.4, -0.3, 2.0)).norm(), 0.0, 1e-12);
+    EXPECT_FLOAT_EQ(ff.depth[1], 2.0f);
+    // Forward and turning: the new depth is that of the moved point, along the same ray.
+    const Eigen::Vector3d p(0.4, -0.3, 2.0);
+    ff.points_c = {p, p};
+    const Eigen::Isometry3d turn = makePose(0.01, 0, 0.03, 0.02, 0.01, 0);
+    compensateDepthTime(ff, turn, 0.03, 10.0, 9.985);
+    EXPECT_NEAR(ff.points_c[1].normalized().dot(p.normalized()), 1.0, 1e-12);
+    EXPECT_NEAR(ff.points_c[1].z(), ff.depth[1], 1e-6);
+    EXPECT_GT(std::abs(ff.depth[1] - 2.0), 0.005);
 }
 
 TEST(Config, EveryShippedSlamIniLoadsAndUnknownKeysAreRejected) {

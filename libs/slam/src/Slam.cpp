@@ -81,8 +81,10 @@ void compensateDepthTime(FrameFeatures& f, const Eigen::Isometry3d& T_prev_cur, 
     T.translation() = T_prev_cur.translation() * a;
     for (std::size_t i = 0; i < f.size(); ++i) {
         if (f.depth[i] <= 0) continue;
-        f.points_c[i] = T * f.points_c[i];
-        f.depth[i] = static_cast<float>(f.points_c[i].z());
+        const double z = (T * f.points_c[i]).z();  // the new depth; the ray stays
+        if (!(z > 0)) continue;
+        f.points_c[i] *= z / f.points_c[i].z();
+        f.depth[i] = static_cast<float>(z);
     }
 }
 

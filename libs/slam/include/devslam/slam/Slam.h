@@ -73,9 +73,13 @@ struct MappingOptions {
 /// whose stamps were shifted (names kept) lost the compensation without a word.
 [[nodiscard]] std::optional<double> depthStamp(const core::Frame& frame);
 
-/// Moves the back-projected points of `f` from the depth image's time to the colour
-/// image's: p <- T_cur_depth * p, with T_cur_depth interpolated from the motion
-/// `T_prev_cur` over `dt_prev` [s] (constant velocity). Depths follow the points.
+/// Moves the depths of `f` from the depth image's time to the colour image's: each point
+/// keeps its keypoint's ray and takes the depth z of T_cur_depth * p, with T_cur_depth
+/// interpolated from the motion `T_prev_cur` over `dt_prev` [s] (constant velocity). (The
+/// depth pixel under a keypoint saw another point of the surface; moved whole, that point
+/// left its keypoint by as far as the image moved in between: 2.6 px for 0.5 m/s sideways
+/// at 2 m and 20 ms. Its depth is the surface's along the keypoint's ray, exactly so for a
+/// plane facing the camera or a motion along the ray.)
 void compensateDepthTime(FrameFeatures& f, const Eigen::Isometry3d& T_prev_cur, double dt_prev,
                          double t_rgb, double t_depth);
 
