@@ -784,6 +784,17 @@ TEST(Map, RedundancyAndKeyframeRemoval) {
     EXPECT_EQ(map.landmark(a)->ref_kf, k[0]);
     EXPECT_EQ(map.landmarksOf({k[0], k[2], k[3]}), (std::vector<LandmarkId>{a, b}));
     EXPECT_THROW((void)map.removeKeyframe(k[1]), std::out_of_range);
+
+    // A landmark whose observation in its anchor local BA dropped (removeObservation) is
+    // re-anchored when that keyframe goes too: it kept the culled anchor, and a loop
+    // correction (which moves a landmark with its anchor) left it where it was.
+    const LandmarkId e = map.addLandmark({1, 1, 1}, d, {}, k[2], 1);
+    map.addObservation(e, k[3], 1);
+    map.removeObservation(e, k[2], 1);
+    EXPECT_EQ(map.landmark(e)->ref_kf, k[2]);  // kept while keyframe 2 is there
+    EXPECT_EQ(map.removeKeyframe(k[2]), 0);
+    ASSERT_NE(map.landmark(e), nullptr);
+    EXPECT_EQ(map.landmark(e)->ref_kf, k[3]);
 }
 
 /// 4 keyframes looking at 300 points (noise-free keypoints and depths); keyframes 1..3

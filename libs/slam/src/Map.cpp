@@ -73,14 +73,18 @@ int Map::removeKeyframe(KeyframeId id) {
         Landmark* l = landmark(lm);
         if (!l) continue;
         removeObservation(lm, id, static_cast<int>(kp));
-        const auto& obs = l->observations;
-        if (obs.empty()) {
+        if (l->observations.empty()) {
             landmarks_.erase(lm);
             ++orphans;
-        } else if (l->ref_kf == id) {
-            l->ref_kf = std::min_element(obs.begin(), obs.end())->first;  // the oldest observer
         }
     }
+    // Re-anchored: every landmark it anchored, also one whose observation there local BA
+    // dropped as an outlier (the keyframe no longer lists it). Such a landmark kept the
+    // culled keyframe as its anchor, and a loop correction then left it where it was.
+    for (auto& [lid, l] : landmarks_)
+        if (l.ref_kf == id && !l.observations.empty())
+            l.ref_kf = std::min_element(l.observations.begin(), l.observations.end())
+                           ->first;  // the oldest observer
     keyframes_.erase(id);
     return orphans;
 }

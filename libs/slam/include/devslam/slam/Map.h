@@ -27,8 +27,8 @@ class Map {
     /// Removes one observation (keyframe kf, keypoint kp), if present.
     void removeObservation(LandmarkId lm, KeyframeId kf, int kp);
     /// Removes a keyframe (which must exist) and its observations. A landmark no other
-    /// keyframe observes goes with it; one it anchored (ref_kf) is anchored to its oldest
-    /// remaining observer. Returns the number of landmarks removed.
+    /// keyframe observes goes with it; one it anchored (ref_kf), observed there or not, is
+    /// anchored to its oldest remaining observer. Returns the number of landmarks removed.
     int removeKeyframe(KeyframeId id);
     /// Fraction of the landmarks keyframe `id` observes that at least `min_observers` other
     /// keyframes observe at the same pyramid level, one coarser, or finer (ORB-SLAM2's
