@@ -773,6 +773,35 @@ TEST(DynamicFilter, EachCornerIsTrackedOnce) {
     EXPECT_GT(checked, 50u) << "points in the boxes were tracked";
 }
 
+// Corners found on the image scaled by flow_scale are put back at the full image's pixel
+// centres: a square's corners average to its centre (p / flow_scale put them half a pixel up
+// and left at 0.5).
+TEST(DynamicFilter, FlowPointsScaledBackToFullPixelCentres) {
+    core::Frame f;
+    f.bgr = cv::Mat(480, 640, CV_8UC3, cv::Scalar(0, 0, 0));
+    f.bgr(cv::Rect(100, 80, 40, 40)).setTo(cv::Scalar(255, 255, 255));  // centre (119.5, 99.5)
+    f.depth = cv::Mat(480, 640, CV_32FC1, cv::Scalar(2.f));
+    f.K = core::CameraIntrinsics{};
+    for (const double scale : {1.0, 0.5}) {
+        auto fo = testOptions();
+        fo.flow_scale = scale;
+        auto det = std::make_unique<ScriptedDetector>();
+        det->next = {{cv::Rect2f(400, 200, 100, 200), 0, "person", 0.9f}};  // (on black)
+        DynamicObjectFilter filter(fo, std::move(det));
+        (void)filter.step(f, std::nullopt);
+        core::Frame g = f;
+        g.index = 1;
+        g.timestamp = f.timestamp + 0.033;
+        const auto out = filter.step(g, Eigen::Isometry3d::Identity());
+        ASSERT_GE(out.flow.size(), 4u) << "flow_scale " << scale;
+        cv::Point2f mean(0, 0);
+        for (const auto& p : out.flow) mean += p.prev;
+        mean *= 1.f / static_cast<float>(out.flow.size());
+        EXPECT_NEAR(mean.x, 119.5, 0.05) << "flow_scale " << scale;
+        EXPECT_NEAR(mean.y, 99.5, 0.05) << "flow_scale " << scale;
+    }
+}
+
 TEST(DynamicFilter, StageTimesAddUpToTheFilterTime) {
     // stage_ms splits filter_ms (the detector excluded) into the stages devslam-filter-bench
     // reports: they do not overlap (their sum is within filter_ms), and a first frame has no
@@ -1290,6 +1319,23 @@ TEST(DynamicFilter, SilhouetteGrowsBeyondTheBoxOnlyThroughThePerson) {
     EXPECT_EQ(maskedFraction(grown, head), 1.0) << "the head is connected to the silhouette";
     EXPECT_EQ(maskedFraction(grown, desk), 0.0) << "the desk is at the person's depth but apart";
     EXPECT_EQ(cv::countNonZero(grown), person.area()) << "nothing of the wall";
+}
+
+// The margin reaches past the region the silhouette is sought in: where silhouette_grow x
+// box height passes mask_margin, a head near the grown box's edge lost its margin there
+// (session 32, fixed 2026-12-06).
+TEST(DynamicFilter, SilhouetteMarginReachesPastTheGrownBox) {
+    // The grown box (grow 0.25 of 300 px) starts at y = 25; the head's top is at 30.
+    const cv::Rect person(200, 30, 100, 370);
+    const core::Frame f = wallWithNearRegions({person});
+    const cv::Rect2f box(200.f, 100.f, 100.f, 300.f);
+    const cv::Mat m = silhouetteMask(f, box, [](auto& fo) {
+        fo.silhouette_grow = 0.25;
+        fo.mask_margin = 10;
+    });
+    EXPECT_EQ(maskedFraction(m, cv::Rect(190, 20, 120, 390)), 1.0)
+        << "the person and 10 px around them";
+    EXPECT_EQ(cv::countNonZero(m), 120 * 390) << "and nothing more";
 }
 
 TEST(DynamicFilter, SilhouetteDepthSlopeNarrowsAFarPersonsBand) {

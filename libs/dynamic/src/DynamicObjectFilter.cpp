@@ -658,9 +658,15 @@ PointFlow DynamicObjectFilter::Impl::trackCorners(const Options& o, const cv::Re
                              cv::OPTFLOW_USE_INITIAL_FLOW);
     std::size_t n = 0;
     const auto inv = static_cast<float>(1.0 / sc);
+    // Pixel centres: the scaled image's pixel i averages (INTER_AREA) the full image's
+    // pixels i/sc .. (i+1)/sc - 1, whose centre is (i + 0.5)/sc - 0.5 (p/sc put every point
+    // half a pixel up and left at flow_scale 0.5).
+    const auto full = [&](const cv::Point2f& p) {
+        return (p + cv::Point2f(0.5f, 0.5f)) * inv - cv::Point2f(0.5f, 0.5f);
+    };
     for (std::size_t i = 0; i < p0.size(); ++i) {
         const float fb = static_cast<float>(cv::norm(back[i] - p0[i])) * inv;
-        const cv::Point2f a = p0[i] * inv, b = p1[i] * inv;
+        const cv::Point2f a = full(p0[i]), b = full(p1[i]);
         if (!st[i] || !st_back[i] || fb > o.fb_max_error || !image.contains(b)) continue;
         p0[n] = a;
         p1[n] = b;
@@ -1193,7 +1199,10 @@ void DynamicObjectFilter::Impl::drawMask(const core::Frame& frame, bool have_pre
         if (snap_r) outer.width = size.width - outer.x;
         if (snap_b) outer.height = size.height - outer.y;
         const cv::Mat sil = silhouetteIn(frame.depth, outer, inner, *t.depth, o);
-        const cv::Rect region = r | outer;
+        // Room for the margin on every side of the silhouette: where silhouette_grow x box
+        // height passed mask_margin the margin was cut at the grown box's edge (the top of
+        // a head lost up to mask_margin px of it, session 32).
+        const cv::Rect region = grownClipped(outer, o.mask_margin, o.mask_margin, size) | r;
         cv::Mat big = cv::Mat::zeros(region.size(), CV_8UC1);
         sil.copyTo(big(outer - region.tl()));
         if (o.mask_margin > 0)
