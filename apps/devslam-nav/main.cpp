@@ -8,6 +8,7 @@
 #include <devslam/core/Results.h>
 #include <devslam/nav/CHolonomicVFHPlus.h>
 #include <devslam/nav/MapPlan.h>
+#include <devslam/nav/Navigator.h>
 #include <devslam/sim/Episode.h>
 #include <devslam/sim/RandomWorlds.h>
 
@@ -72,7 +73,12 @@ int planOnSlamMap(const std::string& map, const std::string& from, const std::st
                   const std::string& config, std::string png) {
     if (to.empty()) throw std::invalid_argument("--map needs --to X,Y (the goal, in metres)");
     const auto ini = devslam::core::loadIni(config);
-    const auto opts = devslam::nav::NavigatorOptions::fromConfig(*ini, config).planner;
+    auto opts = devslam::nav::NavigatorOptions::fromConfig(*ini, config).planner;
+    // The waypoints as the navigator would get them (its spacing was not capped here).
+    opts.waypoint_spacing = devslam::core::namingSource(config, [&] {
+        return devslam::nav::waypointSpacing(opts.waypoint_spacing,
+                                             devslam::nav::refDistanceOf(*ini));
+    });
     const auto grid = devslam::nav::loadGridMap(map);
     const auto plan = devslam::nav::planOnMap(grid, parsePoint(from, "--from"),
                                               parsePoint(to, "--to"), opts);

@@ -345,6 +345,26 @@ TEST(IntegrationNav, MrptErrorsEndTheRunNamingTheIni) {
     blind.write("CReactiveNavigationSystem", "min_obstacles_height", "0.0");
     blind.write("CReactiveNavigationSystem", "max_obstacles_height", "0.3");
     EXPECT_THROW((void)devslam::sim::runEpisode(world, blind, b, {}), std::invalid_argument);
+
+    // A robot slower than the navigator plans for drove other arcs than it checked (each
+    // speed clamped on its own turned a command twice as tight). Refused, naming both files.
+    const auto nav = devslam::core::loadIni(kIni);
+    const auto fast = devslam::nav::NavigatorOptions::fromConfig(*nav, "nav.ini");
+    auto slow = world;
+    slow.robot.max_v = 0.3;
+    try {
+        (void)devslam::sim::runEpisode(slow, *nav, fast, {});
+        ADD_FAILURE() << "ran a 0.3 m/s robot with a 0.6 m/s navigator";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_EQ(std::string(e.what()),
+                  world.source +
+                      " [robot] max_v 0.3 m/s is below nav.ini "
+                      "[CAbstractPTGBasedReactive] robotMax_V_mps 0.6: the navigator "
+                      "would plan arcs the robot cannot drive; give them the same value");
+    }
+    slow = world;
+    slow.robot.max_w = 1.0;
+    EXPECT_THROW((void)devslam::sim::runEpisode(slow, *nav, fast, {}), std::invalid_argument);
 }
 
 // devslam-nav's progress line is fed after every navigator step: the simulated time rising,

@@ -259,7 +259,7 @@ Navigator::Navigator(mrpt::nav::CRobot2NavInterface& robot,
         throw std::invalid_argument("Navigator: the navigation INI lacks [" + sec_ptg + "] or [" +
                                     sec_rns + "]");
     cfg.write(sec_ptg, "holonomic_method", opts_.holonomic_method);
-    ref_distance_ = core::readDouble(cfg, sec_ptg, "ref_distance", 0.0, true);
+    ref_distance_ = refDistanceOf(cfg);
     // robot polygon: 16-gon circumscribing the robot circle
     std::vector<double> xs, ys;
     const int nv = 16;
@@ -353,13 +353,21 @@ bool Navigator::start(const mrpt::maps::COccupancyGridMap2D& map, const mrpt::ma
     return true;
 }
 
+double refDistanceOf(const mrpt::config::CConfigFileBase& nav_ini) {
+    return core::readDouble(nav_ini, "CAbstractPTGBasedReactive", "ref_distance", 0.0, true);
+}
+
+double waypointSpacing(double waypoint_spacing, double ref_distance) {
+    return std::min(waypoint_spacing, 0.9 * ref_distance);
+}
+
 void Navigator::setPath(const GridPath& p) {
     path_ = p;
     path_segment_ = 0;
     // planner_ holds the map the path was planned on: a replanned path's shortcuts are checked
     // against the sensed obstacles it went round, not only the static map's walls.
-    const double spacing = std::min(opts_.planner.waypoint_spacing, 0.9 * ref_distance_);
-    waypoint_path_index_ = decimateWaypointIndices(planner_, path_, spacing);
+    waypoint_path_index_ = decimateWaypointIndices(
+        planner_, path_, waypointSpacing(opts_.planner.waypoint_spacing, ref_distance_));
     waypoints_.clear();
     for (const std::size_t i : waypoint_path_index_) waypoints_.push_back(path_.points[i]);
 }

@@ -8,6 +8,7 @@
 #include <devslam/nav/RoutePicture.h>
 
 #include <mrpt/core/Clock.h>
+#include <mrpt/core/bits_math.h>
 #include <mrpt/nav/reactive/CAbstractPTGBasedReactive.h>
 #include <mrpt/nav/reactive/CReactiveNavigationSystem.h>
 
@@ -112,6 +113,28 @@ EpisodeResult runEpisode(const WorldSpec& world, const mrpt::config::CConfigFile
               << " m: the band leaves out the laser's plane at " << world.laser.height << " m ("
               << (world.source.empty() ? world.name : world.source)
               << " [laser] height), so the robot would see no obstacle";
+            throw std::invalid_argument(m.str());
+        }
+    }
+    {  // MRPT plans its arcs at the INI's speeds: a robot slower than that drove other arcs
+       // (a command over max_v, clamped, turned twice as tight) than the ones it checked.
+        const std::string s = "CAbstractPTGBasedReactive";
+        const double v = core::namingSource(nav_opts.source, [&] {
+            return core::readDouble(nav_ini, s, "robotMax_V_mps", 0.0, true);
+        });
+        const double w = core::namingSource(nav_opts.source, [&] {
+            return core::readDouble(nav_ini, s, "robotMax_W_degps", 0.0, true);
+        });
+        const bool slow_v = world.robot.max_v < v * (1 - 1e-9);
+        if (slow_v || world.robot.max_w < mrpt::DEG2RAD(w) * (1 - 1e-9)) {
+            std::ostringstream m;
+            m << (world.source.empty() ? world.name : world.source) << " [robot] "
+              << (slow_v ? "max_v " : "max_w_deg ")
+              << (slow_v ? world.robot.max_v : mrpt::RAD2DEG(world.robot.max_w))
+              << (slow_v ? " m/s" : " deg/s") << " is below " << nav_opts.source << " [" << s
+              << "] " << (slow_v ? "robotMax_V_mps " : "robotMax_W_degps ") << (slow_v ? v : w)
+              << ": the navigator would plan arcs the robot cannot drive; give them the "
+                 "same value";
             throw std::invalid_argument(m.str());
         }
     }

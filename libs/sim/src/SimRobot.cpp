@@ -3,6 +3,7 @@
 #include <mrpt/core/Clock.h>
 #include <mrpt/kinematics/CVehicleVelCmd_DiffDriven.h>
 #include <mrpt/maps/CSimplePointsMap.h>
+#include <mrpt/poses/CPose2D.h>
 
 #include <cmath>
 
@@ -55,18 +56,28 @@ bool SimRobot::senseObstacles(mrpt::maps::CSimplePointsMap& obstacles,
     // At the laser's height, which MRPT's [CReactiveNavigationSystem] min/max_obstacles_height
     // band must hold (runEpisode checks it).
     const auto z = static_cast<float>(sim_.world().laser.height);
+    // The points in the robot's frame now, which MRPT and the navigator take them in: a scan
+    // older than this step (a laser slower than the navigator) was taken from another pose,
+    // and its points were placed as if from this one (0.5 m off turning at 1.2 rad/s with a
+    // 5 Hz laser).
+    const bool moved = s.t != sim_.time();
+    // (a - b: a seen from b)
+    const mrpt::poses::CPose2D now_from_scan =
+        mrpt::poses::CPose2D(s.pose) - mrpt::poses::CPose2D(sim_.robotPose());
+    const auto insert = [&](double x, double y, bool ring) {
+        if (moved) now_from_scan.composePoint(x, y, x, y);
+        if (ring && std::hypot(x, y) < keep_out) return;
+        obstacles.insertPoint(static_cast<float>(x), static_cast<float>(y), z);
+    };
     for (size_t i = 0; i < s.ranges.size(); i++) {
         if (!s.hit[i]) continue;
         const double x = s.ranges[i] * std::cos(s.angles[i]);
         const double y = s.ranges[i] * std::sin(s.angles[i]);
-        obstacles.insertPoint(static_cast<float>(x), static_cast<float>(y), z);
+        insert(x, y, false);
         if (person_margin_ <= 0 || !s.person[i]) continue;
         for (int k = 0; k < kRing; k++) {
             const double a = 2 * M_PI * k / kRing;
-            const double rx = x + person_margin_ * std::cos(a);
-            const double ry = y + person_margin_ * std::sin(a);
-            if (std::hypot(rx, ry) < keep_out) continue;
-            obstacles.insertPoint(static_cast<float>(rx), static_cast<float>(ry), z);
+            insert(x + person_margin_ * std::cos(a), y + person_margin_ * std::sin(a), true);
         }
     }
     timestamp = mrpt::Clock::now();

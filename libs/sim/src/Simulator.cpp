@@ -1,5 +1,6 @@
 #include <devslam/sim/Simulator.h>
 
+#include <BulletCollision/NarrowPhaseCollision/btRaycastCallback.h>
 #include <btBulletDynamicsCommon.h>
 
 #include <algorithm>
@@ -189,8 +190,11 @@ struct Simulator::Impl {
 
     void drive(double dt) {
         const auto& r = world.robot;
-        const double vc = std::clamp(v_cmd, -r.max_v, r.max_v);
-        const double wc = std::clamp(w_cmd, -r.max_w, r.max_w);
+        // Both scaled by one factor, which keeps the arc's curvature (MRPT's cmdVel_limits
+        // does the same): clamped each on its own, a command over max_v drove a tighter
+        // circle than the one the navigator had checked for collisions.
+        const double over = std::max({1.0, std::abs(v_cmd) / r.max_v, std::abs(w_cmd) / r.max_w});
+        const double vc = v_cmd / over, wc = w_cmd / over;
         v += std::clamp(vc - v, -r.max_acc * dt, r.max_acc * dt);
         w += std::clamp(wc - w, -r.max_ang_acc * dt, r.max_ang_acc * dt);
         const double yaw = pose().phi;
@@ -228,6 +232,7 @@ struct Simulator::Impl {
         const bool full = L.fov > 2 * M_PI - 1e-6;
         const int n = L.rays;
         scan.t = t;
+        scan.pose = p;
         scan.angles.resize(n);
         scan.ranges.resize(n);
         scan.hit.resize(n);
@@ -241,6 +246,10 @@ struct Simulator::Impl {
             const double ga = p.phi + a;
             const btVector3 to = from + btVector3(std::cos(ga), std::sin(ga), 0) * L.range;
             btCollisionWorld::ClosestRayResultCallback cb(from, to);
+            // Bullet's default ray test against convex shapes (a subsimplex convex cast)
+            // returned about one hit in 1800 up to 0.8 m away from every box and cylinder in
+            // open space; the GJK cast returned none, and missed no obstacle.
+            cb.m_flags |= btTriangleRaycastCallback::kF_UseGjkConvexCastRaytest;
             cb.m_collisionFilterGroup = btBroadphaseProxy::SensorTrigger;
             cb.m_collisionFilterMask = mask;
             dyn.rayTest(from, to, cb);

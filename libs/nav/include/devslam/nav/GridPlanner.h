@@ -82,8 +82,10 @@ class GridPlanner {
 
     /// Validation of one endpoint without planning.
     [[nodiscard]] EndpointStatus checkEndpoint(const mrpt::math::TPoint2D& p) const;
-    /// [m] distance from p to the nearest obstacle edge (0 inside an obstacle; a large
-    /// value if the map has no obstacle); p must be inside the map.
+    /// [m] the clearance of p's cell: the distance from its centre to the nearest obstacle
+    /// cell (0 inside an obstacle; a large value if the map has no obstacle), so up to 0.8
+    /// cells more than p's own exact distance, or about 1.7 less (docs/nav.md); p must be
+    /// inside the map.
     [[nodiscard]] double clearance(const mrpt::math::TPoint2D& p) const;
     /// The centre of the cell nearest to p (within `max_dist` [m] of it) that the robot may
     /// stand in (clearance >= robot_radius): where to plan from when the robot's own cell is

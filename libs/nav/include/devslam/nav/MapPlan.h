@@ -29,7 +29,9 @@ namespace devslam::nav {
 struct MapPlan {
     mrpt::math::TPoint2D from, to;
     std::optional<GridPath> path;                 ///< nullopt: the two are not connected
-    std::vector<mrpt::math::TPoint2D> waypoints;  ///< decimated, as the navigator gets them
+    /// Decimated at opts.waypoint_spacing; as the navigator gets them when that is
+    /// nav::waypointSpacing(...) (devslam-nav --map passes it).
+    std::vector<mrpt::math::TPoint2D> waypoints;
     double min_clearance = 0;                     ///< [m] smallest clearance along the path
     double unknown_fraction = 0;                  ///< of the path's cells with P(free) = 0.5
 };

@@ -53,6 +53,13 @@ struct NavigatorOptions {
                                                      const std::string& source = "INI");
 };
 
+/// [m] MRPT's TP-Space distance, [CAbstractPTGBasedReactive] ref_distance of a navigation
+/// INI (required): its PTGs see no farther.
+[[nodiscard]] double refDistanceOf(const mrpt::config::CConfigFileBase& nav_ini);
+/// [m] the spacing of the waypoints the navigator gets: `waypoint_spacing`, at most
+/// 0.9 x `ref_distance` (a waypoint beyond the PTGs' reach cannot be aimed at).
+[[nodiscard]] double waypointSpacing(double waypoint_spacing, double ref_distance);
+
 /// Outcome of one step.
 enum class NavState { Idle, Navigating, GoalReached, Error };
 [[nodiscard]] const char* toString(NavState s);

@@ -21,6 +21,7 @@ namespace devslam::sim {
 /// Latest laser scan: ranges along angles (robot frame), max range where nothing was hit.
 struct LaserScan {
     double t = -1;               ///< [s] sim time of the scan
+    mrpt::math::TPose2D pose;    ///< the robot's pose then (the ranges are from it)
     std::vector<double> angles;  ///< [rad] robot frame, increasing (right to left)
     std::vector<double> ranges;  ///< [m]
     std::vector<uint8_t> hit;    ///< 1 if the ray hit something
@@ -41,8 +42,9 @@ class Simulator {
     Simulator(const Simulator&) = delete;
     Simulator& operator=(const Simulator&) = delete;
 
-    /// Commanded velocities; the actual ones follow under the acceleration limits and are
-    /// clamped to the robot's max_v / max_w.
+    /// Commanded velocities; the actual ones follow under the acceleration limits. A command
+    /// over the robot's max_v or max_w is scaled down, both by one factor, so that the arc
+    /// keeps its curvature.
     void setCommand(double v, double w);
     /// One fixed physics step (world.time_step): people, robot, contacts, laser (at rate).
     void step();

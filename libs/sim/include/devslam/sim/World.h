@@ -11,6 +11,7 @@
 #include <mrpt/math/TPoint2D.h>
 #include <mrpt/math/TPose2D.h>
 
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -49,7 +50,7 @@ struct RobotSpec {
     mrpt::math::TPose2D start{0, 0, 0};  ///< [m, m, rad]
     double radius = 0.25;                ///< [m] cylinder radius
     double max_v = 0.6;                  ///< [m/s]
-    double max_w = 1.57;                 ///< [rad/s]
+    double max_w = M_PI / 2;             ///< [rad/s] (90 deg/s)
     double max_acc = 1.0;                ///< [m/s^2]
     double max_ang_acc = 3.0;            ///< [rad/s^2]
 };
