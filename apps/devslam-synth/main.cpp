@@ -24,6 +24,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <filesystem>
 #include <iostream>
 #include <optional>
@@ -125,9 +126,12 @@ int run(int argc, char** argv) {
         std::sort(names.begin(), names.end());
         for (const auto& n : names) {
             const auto sc = render::loadScenario(kSynthDir + "/" + n + ".ini");
+            const auto v = render::meanSpeeds(sc.trajectory, sc.n_frames, sc.rate_hz);
+            char speeds[64];
+            std::snprintf(speeds, sizeof speeds, "%.3f m/s, %.1f deg/s", v.m_per_s, v.deg_per_s);
             std::cout << n << ": " << sc.n_frames << " frames at " << sc.rate_hz
-                      << " Hz, trajectory " << render::toString(sc.trajectory.type) << ", "
-                      << sc.people.size() << " people\n";
+                      << " Hz, trajectory " << render::toString(sc.trajectory.type) << " ("
+                      << speeds << " on average), " << sc.people.size() << " people\n";
         }
         return 0;
     }

@@ -804,33 +804,32 @@ TEST(DepthNoise, RangesEdgesNoiseAndSeed) {
     EXPECT_EQ(cv::norm(d, applyDepthNoise(d, o, 535.4, 7), cv::NORM_INF), 0.0);
 }
 
+// The defaults' mean speeds over 25 s (meanSpeeds, which devslam-synth --list prints), and
+// TUM fr3's published ones: translation like TUM's, rotation of xyz and halfsphere 2-3x
+// below it (docs/render.md, "Camera speeds").
 TEST(CameraTrajectory, SpeedsLikeTumFr3AndHalfsphereRadius) {
-    const auto meanSpeed = [](const TrajectoryOptions& o, double& deg_s) {
-        double L = 0, A = 0;
-        const double dt = 1.0 / 30;
-        auto prev = cameraPoseAt(o, 0);
-        for (int i = 1; i <= 750; ++i) {
-            const auto p = cameraPoseAt(o, i * dt);
-            const auto d = p - prev;
-            L += d.norm();
-            A += core::rotationAngle(d);
-            prev = p;
-        }
-        deg_s = A * 180 / kPi / 25.0;
-        return L / 25.0;
+    const auto speeds = [](TrajectoryType t) {
+        TrajectoryOptions o;
+        o.setDefaultsFor(t);
+        return meanSpeeds(o, 751, 30.0);
     };
+    const auto xyz = speeds(TrajectoryType::Xyz);
+    EXPECT_GT(xyz.m_per_s, 0.12);  // TUM fr3 walking_xyz: 0.208 m/s, 5.5 deg/s
+    EXPECT_LT(xyz.m_per_s, 0.30);
+    EXPECT_NEAR(xyz.deg_per_s, 1.7, 0.1);
+    const auto still = speeds(TrajectoryType::Static);
+    EXPECT_LT(still.m_per_s, 0.03);  // fr3 walking_static: 0.012 m/s, 1.4 deg/s
+    EXPECT_NEAR(still.deg_per_s, 1.6, 0.1);
+    EXPECT_GT(speeds(TrajectoryType::Rpy).deg_per_s, 25.0);  // fr3 walking_rpy: 53 deg/s
+    EXPECT_NEAR(speeds(TrajectoryType::Halfsphere).deg_per_s, 10.7, 0.3);  // fr3: 18 deg/s
+    // Two frames at 1 Hz: the one step's length and angle.
     TrajectoryOptions o;
-    double deg_s = 0;
-    o.setDefaultsFor(TrajectoryType::Xyz);
-    const double v_xyz = meanSpeed(o, deg_s);
-    EXPECT_GT(v_xyz, 0.12);  // TUM fr3 walking_xyz: 0.208 m/s, 5.5 deg/s
-    EXPECT_LT(v_xyz, 0.30);
-    EXPECT_LT(deg_s, 10.0);
-    o.setDefaultsFor(TrajectoryType::Static);
-    EXPECT_LT(meanSpeed(o, deg_s), 0.03);  // fr3 walking_static: 0.012 m/s
     o.setDefaultsFor(TrajectoryType::Rpy);
-    (void)meanSpeed(o, deg_s);
-    EXPECT_GT(deg_s, 25.0);  // fr3 walking_rpy: 53 deg/s
+    const auto d = cameraPoseAt(o, 1.0) - cameraPoseAt(o, 0.0);
+    const auto one = meanSpeeds(o, 2, 1.0);
+    EXPECT_NEAR(one.m_per_s, d.norm(), 1e-12);
+    EXPECT_NEAR(one.deg_per_s, core::rotationAngle(d) * 180 / kPi, 1e-9);
+    EXPECT_EQ(meanSpeeds(o, 1, 30.0).m_per_s, 0.0);
     o.setDefaultsFor(TrajectoryType::Halfsphere);
     const double r0 = (o.position - o.look_at).norm();
     for (double t : {0.0, 3.3, 7.1, 12.0}) {

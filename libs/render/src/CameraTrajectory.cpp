@@ -1,5 +1,6 @@
 #include <devslam/core/Config.h>
 #include <devslam/core/Parse.h>
+#include <devslam/core/Pose.h>
 #include <devslam/render/CameraTrajectory.h>
 
 #include <mrpt/config/CConfigFileBase.h>
@@ -68,19 +69,19 @@ std::string toString(TrajectoryType t) {
 void TrajectoryOptions::setDefaultsFor(TrajectoryType t) {
     type = t;
     switch (t) {
-        case TrajectoryType::Xyz:  // mean speed ~0.2 m/s, ~5 deg/s (TUM fr3 walking_xyz: 0.21, 5.5)
+        case TrajectoryType::Xyz:  // 0.24 m/s, 1.7 deg/s (TUM fr3 walking_xyz: 0.21, 5.5)
             amplitude = {0.35, 0.15, 0.25};
             period = {7.0, 9.0, 11.0};
             rot_amplitude_deg = {1.0, 1.5, 2.0};
             rot_period = {5.0, 6.5, 8.0};
             break;
-        case TrajectoryType::Static:  // ~0.01 m/s, ~1.4 deg/s (fr3 walking_static: 0.012, 1.4)
+        case TrajectoryType::Static:  // 0.01 m/s, 1.6 deg/s (fr3 walking_static: 0.012, 1.4)
             amplitude = {0.006, 0.004, 0.005};
             period = {2.5, 3.1, 3.7};
             rot_amplitude_deg = {0.3, 0.4, 0.5};
             rot_period = {1.5, 1.9, 2.3};
             break;
-        case TrajectoryType::Halfsphere:  // ~0.22 m/s, ~15 deg/s at 1.5 m radius
+        case TrajectoryType::Halfsphere:  // 10.7 deg/s (fr3 walking_halfsphere: 0.22 m/s, 18)
             amplitude = {0.0, 0.0, 0.0};
             rot_amplitude_deg = {2.0, 1.0, 1.0};
             rot_period = {4.0, 5.0, 6.0};
@@ -156,6 +157,24 @@ void TrajectoryOptions::loadFromConfig(const mrpt::config::CConfigFileBase& cfg,
              "over";
         core::requireValue(reach < 89.0, s, "elevation_amplitude_deg", m.str());
     }
+}
+
+TrajectorySpeeds meanSpeeds(const TrajectoryOptions& o, std::size_t n_frames, double rate_hz) {
+    TrajectorySpeeds v;
+    if (n_frames < 2 || !(rate_hz > 0)) return v;
+    double length = 0, angle = 0;
+    mrpt::poses::CPose3D prev = cameraPoseAt(o, 0.0);
+    for (std::size_t i = 1; i < n_frames; ++i) {
+        const mrpt::poses::CPose3D p = cameraPoseAt(o, double(i) / rate_hz);
+        const mrpt::poses::CPose3D d = p - prev;
+        length += d.norm();
+        angle += core::rotationAngle(d);
+        prev = p;
+    }
+    const double duration = double(n_frames - 1) / rate_hz;
+    v.m_per_s = length / duration;
+    v.deg_per_s = angle * 180.0 / M_PI / duration;
+    return v;
 }
 
 mrpt::poses::CPose3D lookAtPose(const Eigen::Vector3d& eye, const Eigen::Vector3d& target) {

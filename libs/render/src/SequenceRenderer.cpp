@@ -218,7 +218,8 @@ struct SequenceRenderer::Impl {
                               const Eigen::Vector3d& down) {
             addPanelled(o, right, down, pw, ph, r.wall_textures, k, rng, r.wall_blur);
         };
-        // Walls seen from inside: origin = top-left corner as seen from the room.
+        // Walls: origin = the top corner on the right as seen from inside the room, so each
+        // photo runs right to left, mirrored (panelCrop mirrors half the crops anyway).
         wall({X, 0, Z}, {0, Y, 0}, {0, 0, -Z});   // x = X
         wall({0, Y, Z}, {0, -Y, 0}, {0, 0, -Z});  // x = 0
         wall({X, Y, Z}, {-X, 0, 0}, {0, 0, -Z});  // y = Y

@@ -2,9 +2,11 @@
 /// Camera trajectory generators shaped like the TUM fr3 hand-held sequences:
 /// `xyz` (translation along the three axes), `static` (a few mm of jitter), `halfsphere`
 /// (orbit on a half sphere around a point), `rpy` (rotation about the three axes).
-/// Amplitudes and periods default to values whose mean speeds match TUM fr3
-/// (walking_xyz 0.21 m/s, walking_static 0.01 m/s, walking_halfsphere 0.22 m/s and
-/// 18 deg/s, walking_rpy 53 deg/s). Pure functions of time.
+/// Amplitudes and periods default to values whose mean translation speeds are TUM fr3's
+/// (walking_xyz 0.21 m/s, walking_static 0.01 m/s); their rotation is slower than TUM's
+/// for xyz (1.7 against 5.5 deg/s), halfsphere (10.7 against 18) and rpy (38 against 53):
+/// docs/render.md, "Camera speeds" (`devslam-synth --list` prints each scenario's). Pure
+/// functions of time.
 ///
 /// Usage:
 ///   devslam::render::TrajectoryOptions o; o.type = TrajectoryType::Xyz;
@@ -51,6 +53,16 @@ struct TrajectoryOptions {
 
 /// Pose T_wc of the optical centre (x right, y down, z forward) at time t [s] since start.
 [[nodiscard]] mrpt::poses::CPose3D cameraPoseAt(const TrajectoryOptions& o, double t);
+
+/// The camera's mean speeds over `n_frames` frames at `rate_hz` from time 0, as TUM's
+/// dataset tables give theirs: the path's length and its frame-to-frame rotation angles
+/// summed, over the duration.
+struct TrajectorySpeeds {
+    double m_per_s = 0;
+    double deg_per_s = 0;
+};
+[[nodiscard]] TrajectorySpeeds meanSpeeds(const TrajectoryOptions& o, std::size_t n_frames,
+                                          double rate_hz);
 
 /// Optical-frame orientation looking from `eye` towards `target` with world z up
 /// (the image's "down" is world -z). Throws std::invalid_argument if they coincide or
