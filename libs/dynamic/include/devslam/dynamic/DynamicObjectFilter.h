@@ -49,8 +49,10 @@ struct TrackedBox {
     cv::Rect2f box;  ///< [px] in the current frame
     BoxState state = BoxState::Unknown;
     float score = 0.f;                 ///< detector score of the last detection
-    int n_points = 0;                  ///< flow points inside the box this step
-    int n_dynamic_points = 0;          ///< of which residual > threshold1
+    int n_points = 0;  ///< flow points inside the box (in the person's depth band) this step
+    /// of which residual > the box's threshold: threshold1, or more where the background's
+    /// or the ring around the box's residual flow is larger (docs/dynamic.md)
+    int n_dynamic_points = 0;
     bool detected_this_frame = false;  ///< false: box carried by LK flow (or kept) this step
 };
 
