@@ -388,11 +388,12 @@ std::optional<std::string> askCheck(const std::string& cmd, const std::string& o
         throw Interrupted(sig, "interrupted (" + core::signalName(sig) +
                                    ") while checking the bench's inputs; nothing was run");
     if (rc == 0) return std::string();
-    const std::string said = lastLines(log, 5);
-    if (said.find("unknown argument '" + option + "'") != std::string::npos ||
-        said.find("unknown option '" + option + "'") != std::string::npos)
+    // (the whole log: a program that does not know the option prints its usage after it)
+    const std::string all = lastLines(log, 1000);
+    if (all.find("unknown argument '" + option + "'") != std::string::npos ||
+        all.find("unknown option '" + option + "'") != std::string::npos)
         return std::nullopt;
-    return endedBy(rc) + "):\n" + said + "(command: " + cmd + ")";
+    return endedBy(rc) + "):\n" + lastLines(log, 5) + "(command: " + cmd + ")";
 }
 
 /// 0. What each run and render will read, before any of them: each SLAM INI as devslam-run

@@ -587,6 +587,42 @@ TEST(DevslamBench, CompareSetsEachRunBesideTheSameRenderBefore) {
     EXPECT_NE(r.out.find("have no run of this bench in common"), std::string::npos) << r.out;
 }
 
+// An older build given by --bin, whose devslam-run and devslam-synth know no --check-config
+// and --check (they print the usage after saying so): the checks are skipped, said once each,
+// and the bench goes on to the renders (here a fake devslam-synth that fails them).
+TEST(DevslamBench, AnOlderBuildWithoutTheChecksIsRunWithoutThem) {
+    const fs::path tmp = devslam::test::scratchPath("devslam_bench_oldbin");
+    fs::remove_all(tmp);
+    fs::create_directories(tmp / "bin");
+    for (const auto& [name, option] : std::vector<std::pair<std::string, std::string>>{
+             {"devslam-run", "unknown argument '--check-config'"},
+             {"devslam-synth", "unknown option '--check'"}}) {
+        std::ofstream(tmp / "bin" / name) << "#!/bin/sh\necho \"" << name << ": " << option
+                                          << "\"\nfor i in 1 2 3 4 5 6 7 8; do echo \"usage line "
+                                             "$i\"; done\nexit 1\n";
+        fs::permissions(tmp / "bin" / name, fs::perms::owner_all);
+    }
+    std::ofstream(tmp / "bench.ini") << "[sequence_a]\nscenario = short_walking\n";
+    const std::string cmd = "'" + std::string(DEVSLAM_BIN_DIR) + "/devslam-bench' --config '" +
+                            (tmp / "bench.ini").string() + "' --out '" + (tmp / "out").string() +
+                            "' --results none --bin '" + (tmp / "bin").string() + "' > '" +
+                            (tmp / "log.txt").string() + "' 2>&1";
+    EXPECT_NE(std::system(cmd.c_str()), 0);
+    const std::string said = readFile(tmp / "log.txt");
+    const auto count = [&](const std::string& what) {
+        std::size_t n = 0;
+        for (auto at = said.find(what); at != std::string::npos; at = said.find(what, at + 1)) ++n;
+        return n;
+    };
+    EXPECT_EQ(count("/devslam-run has no --check-config: the SLAM INIs are checked by its runs"),
+              1u)
+        << said;
+    EXPECT_EQ(count("/devslam-synth has no --check: the scenarios are checked by their renders"),
+              1u)
+        << said;
+    EXPECT_NE(said.find("devslam-synth failed for a of "), std::string::npos) << said;
+}
+
 TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {
     const std::string root = DEVSLAM_SOURCE_DIR, bin = DEVSLAM_BIN_DIR;
     const fs::path tmp = devslam::test::scratchPath("devslam_bench_bad");

@@ -346,8 +346,8 @@ TEST(IntegrationNav, MrptErrorsEndTheRunNamingTheIni) {
     blind.write("CReactiveNavigationSystem", "max_obstacles_height", "0.3");
     EXPECT_THROW((void)devslam::sim::runEpisode(world, blind, b, {}), std::invalid_argument);
 
-    // A robot slower than the navigator plans for drove other arcs than it checked (each
-    // speed clamped on its own turned a command twice as tight). Refused, naming both files.
+    // A robot slower than the navigator commands (each speed clamped on its own, a command
+    // over max_v turned twice as tight as the arc MRPT checked). Refused, naming both files.
     const auto nav = devslam::core::loadIni(kIni);
     const auto fast = devslam::nav::NavigatorOptions::fromConfig(*nav, "nav.ini");
     auto slow = world;
@@ -360,7 +360,7 @@ TEST(IntegrationNav, MrptErrorsEndTheRunNamingTheIni) {
                   world.source +
                       " [robot] max_v 0.3 m/s is below nav.ini "
                       "[CAbstractPTGBasedReactive] robotMax_V_mps 0.6: the navigator "
-                      "would plan arcs the robot cannot drive; give them the same value");
+                      "would command speeds the robot cannot reach; give them the same value");
     }
     slow = world;
     slow.robot.max_w = 1.0;

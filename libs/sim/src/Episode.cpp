@@ -116,8 +116,9 @@ EpisodeResult runEpisode(const WorldSpec& world, const mrpt::config::CConfigFile
             throw std::invalid_argument(m.str());
         }
     }
-    {  // MRPT plans its arcs at the INI's speeds: a robot slower than that drove other arcs
-       // (a command over max_v, clamped, turned twice as tight) than the ones it checked.
+    {  // MRPT commands up to the INI's speeds and predicts the robot's motion from them: a
+       // slower robot is not the robot it navigates (the simulator scales such a command
+       // down, keeping its arc, so the robot lags MRPT's predictions).
         const std::string s = "CAbstractPTGBasedReactive";
         const double v = core::namingSource(nav_opts.source, [&] {
             return core::readDouble(nav_ini, s, "robotMax_V_mps", 0.0, true);
@@ -133,7 +134,7 @@ EpisodeResult runEpisode(const WorldSpec& world, const mrpt::config::CConfigFile
               << (slow_v ? world.robot.max_v : mrpt::RAD2DEG(world.robot.max_w))
               << (slow_v ? " m/s" : " deg/s") << " is below " << nav_opts.source << " [" << s
               << "] " << (slow_v ? "robotMax_V_mps " : "robotMax_W_degps ") << (slow_v ? v : w)
-              << ": the navigator would plan arcs the robot cannot drive; give them the "
+              << ": the navigator would command speeds the robot cannot reach; give them the "
                  "same value";
             throw std::invalid_argument(m.str());
         }
