@@ -35,6 +35,26 @@ WorldSpec room() {
     w.laser.rays = 360;
     return w;
 }
+
+/// room() with a 1 x 1 m box "b" centred at (5, 3), 2.5 m ahead of the robot.
+WorldSpec roomWithBox() {
+    auto w = room();
+    Obstacle box;
+    box.name = "b";
+    box.cx = 5;
+    box.cy = 3;
+    box.sx = 1;
+    box.sy = 1;
+    w.obstacles.push_back(box);
+    return w;
+}
+
+/// [m] the exact distance from (x, y) to the nearest of `statics`.
+double nearestObstacle(const std::vector<Obstacle>& statics, double x, double y) {
+    double d = 1e9;
+    for (const auto& o : statics) d = std::min(d, distanceToObstacle(o, {x, y}));
+    return d;
+}
 }  // namespace
 
 TEST(World, EveryShippedWorldLoads) {
@@ -288,14 +308,7 @@ TEST(World, DistanceToRotatedBox) {
 }
 
 TEST(Simulator, LaserMeasuresKnownRanges) {
-    auto w = room();  // boundary walls 0.1 thick: inner faces at x=0.1, 9.9, y=0.1, 5.9
-    Obstacle box;
-    box.name = "b";
-    box.cx = 5;
-    box.cy = 3;
-    box.sx = 1;
-    box.sy = 1;
-    w.obstacles.push_back(box);
+    auto w = roomWithBox();  // boundary walls 0.1 thick: inner faces at x=0.1, 9.9, y=0.1, 5.9
     Simulator sim(w);
     const auto& s = sim.scan();
     auto rangeAt = [&](double a) {
@@ -353,17 +366,12 @@ TEST(Simulator, LaserHitsLieOnObstaclesButForAFewPhantoms) {
             w.laser.noise_std = 0;
             w.laser.rays = 720;
             const auto statics = staticObstacles(w);
-            const auto clearance = [&](double x, double y) {
-                double d = 1e9;
-                for (const auto& o : statics) d = std::min(d, distanceToObstacle(o, {x, y}));
-                return d;
-            };
             std::mt19937 g(static_cast<unsigned>(seed));
             std::uniform_real_distribution<double> ux(w.x_min + 0.5, w.x_max - 0.5),
                 uy(w.y_min + 0.5, w.y_max - 0.5), ua(-M_PI, M_PI);
             for (int k = 0; k < 6;) {
                 const double x = ux(g), y = uy(g);
-                if (clearance(x, y) < 0.4) continue;
+                if (nearestObstacle(statics, x, y) < 0.4) continue;
                 ++k;
                 w.robot.start = {x, y, ua(g)};
                 Simulator sim(w);
@@ -373,11 +381,12 @@ TEST(Simulator, LaserHitsLieOnObstaclesButForAFewPhantoms) {
                     const double c = std::cos(a), sn = std::sin(a);
                     if (s.hit[i]) {
                         ++hits;
-                        phantoms += clearance(x + s.ranges[i] * c, y + s.ranges[i] * sn) > 0.02;
+                        phantoms += nearestObstacle(statics, x + s.ranges[i] * c,
+                                                    y + s.ranges[i] * sn) > 0.02;
                     }
                     // nothing real before the reported range (20 cm steps, 5 cm inside)
                     for (double r = 0.2; r < s.ranges[i] - 0.05; r += 0.2)
-                        EXPECT_GT(clearance(x + r * c, y + r * sn), 0.0)
+                        EXPECT_GT(nearestObstacle(statics, x + r * c, y + r * sn), 0.0)
                             << toString(cat) << " seed " << seed << " ray " << i << " at " << r;
                 }
             }
@@ -561,14 +570,7 @@ TEST(SimRobot, PeopleGetARingOfPointsTheMarginOut) {
 // points are given from where it is now (they were placed as if taken there: 0.5 m off
 // turning at 1.2 rad/s with a 5 Hz laser).
 TEST(SimRobot, AnOldScanIsGivenFromTheRobotsPoseNow) {
-    auto w = room();
-    Obstacle box;
-    box.name = "b";
-    box.cx = 5;
-    box.cy = 3;
-    box.sx = 1;
-    box.sy = 1;
-    w.obstacles.push_back(box);
+    auto w = roomWithBox();
     w.laser.range = 15.0;
     w.laser.rate = 5.0;
     const auto statics = staticObstacles(w);
@@ -590,9 +592,7 @@ TEST(SimRobot, AnOldScanIsGivenFromTheRobotsPoseNow) {
             pts.getPoint(k, x, y);
             double gx, gy;
             now.composePoint(x, y, gx, gy);
-            double d = 1e9;
-            for (const auto& o : statics) d = std::min(d, distanceToObstacle(o, {gx, gy}));
-            worst = std::max(worst, d);
+            worst = std::max(worst, nearestObstacle(statics, gx, gy));
         }
     }
     EXPECT_GE(old_scans, 9u) << "every other navigator step sees the scan of 0.1 s before";
