@@ -1,6 +1,5 @@
 #include "Pipeline.h"
 
-
 #include "MaskSource.h"
 
 #include <devslam/core/Config.h>

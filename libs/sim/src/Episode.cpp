@@ -126,18 +126,20 @@ EpisodeResult runEpisode(const WorldSpec& world, const mrpt::config::CConfigFile
         const double w = core::namingSource(nav_opts.source, [&] {
             return core::readDouble(nav_ini, s, "robotMax_W_degps", 0.0, true);
         });
-        const bool slow_v = world.robot.max_v < v * (1 - 1e-9);
-        if (slow_v || world.robot.max_w < mrpt::DEG2RAD(w) * (1 - 1e-9)) {
+        const auto refuse = [&](const std::string& key, double have, const std::string& unit,
+                                const std::string& ini_key, double ini) {
             std::ostringstream m;
-            m << (world.source.empty() ? world.name : world.source) << " [robot] "
-              << (slow_v ? "max_v " : "max_w_deg ")
-              << (slow_v ? world.robot.max_v : mrpt::RAD2DEG(world.robot.max_w))
-              << (slow_v ? " m/s" : " deg/s") << " is below " << nav_opts.source << " [" << s
-              << "] " << (slow_v ? "robotMax_V_mps " : "robotMax_W_degps ") << (slow_v ? v : w)
+            m << (world.source.empty() ? world.name : world.source) << " [robot] " << key << " "
+              << have << unit << " is below " << nav_opts.source << " [" << s << "] " << ini_key
+              << " " << ini
               << ": the navigator would command speeds the robot cannot reach; give them the "
                  "same value";
             throw std::invalid_argument(m.str());
-        }
+        };
+        if (world.robot.max_v < v * (1 - 1e-9))
+            refuse("max_v", world.robot.max_v, " m/s", "robotMax_V_mps", v);
+        if (world.robot.max_w < mrpt::DEG2RAD(w) * (1 - 1e-9))
+            refuse("max_w_deg", mrpt::RAD2DEG(world.robot.max_w), " deg/s", "robotMax_W_degps", w);
     }
     nav::Navigator navigator(robot, nav_ini, nav_opts);
     res.holonomic_method = navigator.holonomicMethod();
