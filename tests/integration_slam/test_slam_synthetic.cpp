@@ -131,7 +131,7 @@ TEST(SlamSynthetic, AFinalWindowAdjustsTheOlderKeyframesAtTheEnd) {
         auto opts =
             slam::SlamOptions::fromConfig(*core::loadIni(kRoot + "/config_ini/slam_synthetic.ini"));
         opts.local_ba.final_window = final_window;
-        opts.local_ba.window = 3;  // 30 frames make about 6 keyframes
+        opts.local_ba.window = 2;  // 30 frames make about 8 keyframes
         slam::Slam s(opts);
         for (std::size_t i = 0; i < r.frames.size(); ++i) {
             cv::Mat m;

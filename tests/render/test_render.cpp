@@ -22,6 +22,7 @@
 #include "Command.h"
 #include "Scratch.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -813,15 +814,31 @@ TEST(CameraTrajectory, SpeedsLikeTumFr3AndHalfsphereRadius) {
         o.setDefaultsFor(t);
         return meanSpeeds(o, 751, 30.0);
     };
+    // The defaults: TUM fr3's published mean speeds (m/s, deg/s) within 10 %.
     const auto xyz = speeds(TrajectoryType::Xyz);
-    EXPECT_GT(xyz.m_per_s, 0.12);  // TUM fr3 walking_xyz: 0.208 m/s, 5.5 deg/s
-    EXPECT_LT(xyz.m_per_s, 0.30);
-    EXPECT_NEAR(xyz.deg_per_s, 1.7, 0.1);
+    EXPECT_NEAR(xyz.m_per_s, 0.208, 0.021);  // walking_xyz: 0.208, 5.49
+    EXPECT_NEAR(xyz.deg_per_s, 5.49, 0.55);
     const auto still = speeds(TrajectoryType::Static);
-    EXPECT_LT(still.m_per_s, 0.03);  // fr3 walking_static: 0.012 m/s, 1.4 deg/s
-    EXPECT_NEAR(still.deg_per_s, 1.6, 0.1);
-    EXPECT_GT(speeds(TrajectoryType::Rpy).deg_per_s, 25.0);  // fr3 walking_rpy: 53 deg/s
-    EXPECT_NEAR(speeds(TrajectoryType::Halfsphere).deg_per_s, 10.7, 0.3);  // fr3: 18 deg/s
+    EXPECT_LT(still.m_per_s, 0.03);  // walking_static: 0.012, 1.39
+    EXPECT_NEAR(still.deg_per_s, 1.39, 0.3);
+    EXPECT_NEAR(speeds(TrajectoryType::Rpy).deg_per_s, 53.0, 5.3);         // walking_rpy
+    EXPECT_NEAR(speeds(TrajectoryType::Halfsphere).deg_per_s, 18.3, 1.8);  // walking_halfsphere
+    // The shipped scenarios, as rendered, against the TUM sequence each imitates.
+    struct Tum {
+        const char* scenario;
+        double m_per_s, deg_per_s;  // < 0: not compared (walking_rpy's translation is a few cm)
+    };
+    for (const Tum& tum : {Tum{"walking_xyz", 0.208, 5.49}, Tum{"walking_towards", 0.208, 5.49},
+                           Tum{"sitting_xyz", 0.132, 3.56}, Tum{"sitting_bare", 0.132, 3.56},
+                           Tum{"walking_static", -1, 1.39}, Tum{"walking_halfsphere", 0.221, 18.3},
+                           Tum{"walking_rpy", -1, 53.0}}) {
+        const auto sc = loadScenario(kSynth + "/" + tum.scenario + ".ini");
+        const auto v = meanSpeeds(sc.trajectory, sc.n_frames, sc.rate_hz);
+        if (tum.m_per_s > 0) {
+            EXPECT_NEAR(v.m_per_s, tum.m_per_s, 0.1 * tum.m_per_s) << tum.scenario;
+        }
+        EXPECT_NEAR(v.deg_per_s, tum.deg_per_s, std::max(0.3, 0.1 * tum.deg_per_s)) << tum.scenario;
+    }
     // Two frames at 1 Hz: the one step's length and angle.
     TrajectoryOptions o;
     o.setDefaultsFor(TrajectoryType::Rpy);

@@ -69,11 +69,13 @@ std::string toString(TrajectoryType t) {
 void TrajectoryOptions::setDefaultsFor(TrajectoryType t) {
     type = t;
     switch (t) {
-        case TrajectoryType::Xyz:  // 0.24 m/s, 1.7 deg/s (TUM fr3 walking_xyz: 0.21, 5.5)
+        case TrajectoryType::Xyz:  // 0.21 m/s, 5.5 deg/s (TUM fr3 walking_xyz: 0.21, 5.5)
+            // The view direction is held, as in TUM's *_xyz: the rotation is a hand's
+            // few-degree wobble, faster than the translation.
             amplitude = {0.35, 0.15, 0.25};
-            period = {7.0, 9.0, 11.0};
-            rot_amplitude_deg = {1.0, 1.5, 2.0};
-            rot_period = {5.0, 6.5, 8.0};
+            period = {8.0, 10.5, 13.0};
+            rot_amplitude_deg = {2.0, 3.0, 4.0};
+            rot_period = {3.0, 4.0, 5.0};
             break;
         case TrajectoryType::Static:  // 0.01 m/s, 1.6 deg/s (fr3 walking_static: 0.012, 1.4)
             amplitude = {0.006, 0.004, 0.005};
@@ -81,20 +83,22 @@ void TrajectoryOptions::setDefaultsFor(TrajectoryType t) {
             rot_amplitude_deg = {0.3, 0.4, 0.5};
             rot_period = {1.5, 1.9, 2.3};
             break;
-        case TrajectoryType::Halfsphere:  // 10.7 deg/s (fr3 walking_halfsphere: 0.22 m/s, 18)
+        case TrajectoryType::Halfsphere:  // 18 deg/s (fr3 walking_halfsphere: 0.22 m/s, 18)
+            // The view turns at the orbit's angular rate whatever its radius; the radius
+            // sets the speed (0.21 m/s at TUM's 0.7 m: walking_halfsphere.ini).
             amplitude = {0.0, 0.0, 0.0};
             rot_amplitude_deg = {2.0, 1.0, 1.0};
             rot_period = {4.0, 5.0, 6.0};
-            azimuth_amplitude_deg = 45.0;
-            elevation_amplitude_deg = 15.0;
-            azimuth_period = 20.0;
-            elevation_period = 13.0;
+            azimuth_amplitude_deg = 30.0;
+            elevation_amplitude_deg = 10.0;
+            azimuth_period = 8.0;
+            elevation_period = 5.5;
             break;
-        case TrajectoryType::Rpy:  // ~38 deg/s (fr3 walking_rpy: 53)
+        case TrajectoryType::Rpy:  // 53 deg/s (fr3 walking_rpy: 53)
             amplitude = {0.02, 0.02, 0.02};
             period = {6.0, 7.0, 8.0};
             rot_amplitude_deg = {24.0, 19.0, 32.0};
-            rot_period = {4.0, 5.0, 6.0};
+            rot_period = {2.9, 3.6, 4.3};
             break;
     }
 }
@@ -122,8 +126,8 @@ void TrajectoryOptions::loadFromConfig(const mrpt::config::CConfigFileBase& cfg,
         core::readDouble(cfg, s, "elevation_amplitude_deg", elevation_amplitude_deg);
     azimuth_period = core::readDouble(cfg, s, "azimuth_period", azimuth_period);
     elevation_period = core::readDouble(cfg, s, "elevation_period", elevation_period);
-    // Bounds no camera comes near (the shipped scenes: 2 deg, 5-20 s), so that a typo fails
-    // here: a period of 1e-300 s sampled its sine at random, a rotation of 1e6 deg spun the
+    // Bounds no camera comes near (the shipped scenes: at most 32 deg, 2.9-16 s), so that a typo
+    // fails here: a period of 1e-300 s sampled its sine at random, a rotation of 1e6 deg spun the
     // view from frame to frame, both without a word. (An amplitude that takes the camera
     // out of the room is refused by loadScenario, which checks every frame's position.)
     const auto period_ok = [](double p) { return p >= 0.1 && p <= 1e5; };

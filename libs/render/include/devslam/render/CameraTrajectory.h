@@ -2,11 +2,10 @@
 /// Camera trajectory generators shaped like the TUM fr3 hand-held sequences:
 /// `xyz` (translation along the three axes), `static` (a few mm of jitter), `halfsphere`
 /// (orbit on a half sphere around a point), `rpy` (rotation about the three axes).
-/// Amplitudes and periods default to values whose mean translation speeds are TUM fr3's
-/// (walking_xyz 0.21 m/s, walking_static 0.01 m/s); their rotation is slower than TUM's
-/// for xyz (1.7 against 5.5 deg/s), halfsphere (10.7 against 18) and rpy (38 against 53):
-/// docs/render.md, "Camera speeds" (`devslam-synth --list` prints each scenario's). Pure
-/// functions of time.
+/// Amplitudes and periods default to values whose mean speeds are TUM fr3's: xyz 0.21 m/s
+/// and 5.5 deg/s (walking_xyz), static 0.01 m/s and 1.6 deg/s (walking_static: 1.4),
+/// halfsphere 18 deg/s, rpy 53 deg/s: docs/render.md, "Camera speeds" (`devslam-synth
+/// --list` prints each scenario's). Pure functions of time.
 ///
 /// Usage:
 ///   devslam::render::TrajectoryOptions o; o.type = TrajectoryType::Xyz;
@@ -36,14 +35,14 @@ struct TrajectoryOptions {
     /// xyz/static: translation amplitude along camera right, down, forward [m].
     Eigen::Vector3d amplitude{0.35, 0.15, 0.25};
     /// xyz/static: periods of the three translation sines [s].
-    Eigen::Vector3d period{7.0, 9.0, 11.0};
+    Eigen::Vector3d period{8.0, 10.5, 13.0};
     /// rpy/all: rotation amplitude about camera forward (roll), right (pitch), down (yaw) [deg].
-    Eigen::Vector3d rot_amplitude_deg{1.0, 1.5, 2.0};
+    Eigen::Vector3d rot_amplitude_deg{2.0, 3.0, 4.0};
     /// periods of the three rotation sines [s].
-    Eigen::Vector3d rot_period{5.0, 6.5, 8.0};
+    Eigen::Vector3d rot_period{3.0, 4.0, 5.0};
     /// halfsphere: azimuth and elevation swing around the mean direction [deg], their periods [s].
-    double azimuth_amplitude_deg = 45.0, elevation_amplitude_deg = 15.0;
-    double azimuth_period = 20.0, elevation_period = 13.0;
+    double azimuth_amplitude_deg = 30.0, elevation_amplitude_deg = 10.0;
+    double azimuth_period = 8.0, elevation_period = 5.5;
 
     /// Reads `[section]` (all keys optional, defaults for the chosen type; unknown keys rejected).
     void loadFromConfig(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
