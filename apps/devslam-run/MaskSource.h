@@ -40,6 +40,8 @@ class MaskSource {
                                         const std::optional<Eigen::Isometry3d>& prior) = 0;
     virtual void reset() = 0;
     [[nodiscard]] virtual std::string describe() const = 0;
+    /// The smallest frame width and height step() takes [px] (0: any).
+    [[nodiscard]] virtual int minFrameSide() const { return 0; }
 };
 
 /// Throws std::invalid_argument "unknown mode 'x' (known: none, all_persons, dynamic, truth)"

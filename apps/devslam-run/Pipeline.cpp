@@ -147,8 +147,18 @@ RunParts readRunParts(const RunConfig& rc, const mrpt::config::CConfigFileBase& 
 }  // namespace
 
 void checkConfig(const RunConfig& rc, const mrpt::config::CConfigFileBase& cfg,
-                 const mrpt::config::CConfigFileBase& filter_cfg) {
-    (void)readRunParts(rc, cfg, filter_cfg, rc.mode == "truth" ? "dynamic" : rc.mode);
+                 const mrpt::config::CConfigFileBase& filter_cfg,
+                 const std::optional<core::CameraIntrinsics>& camera) {
+    const RunParts parts =
+        readRunParts(rc, cfg, filter_cfg, rc.mode == "truth" ? "dynamic" : rc.mode);
+    if (!camera || rc.mode == "truth") return;
+    const int need = parts.masks->minFrameSide();
+    if (camera->width < need || camera->height < need)
+        throw std::invalid_argument(
+            rc.filter_source +
+            ": [dynamic_filter] lk_window / flow_scale: the flow needs frames of at least " +
+            std::to_string(need) + "x" + std::to_string(need) + " px; the input '" + rc.input +
+            "' has " + std::to_string(camera->width) + "x" + std::to_string(camera->height));
 }
 
 RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,

@@ -137,9 +137,12 @@ void checkOutputFolder(const std::string& dir);
 /// Reads every setting a run in `rc.mode` reads from `cfg` and `filter_cfg` and makes its
 /// filter and detector, as runSequence does before the first frame, throwing what it would
 /// throw; reads no input (mode truth, whose mask is the input's person truth, is checked as
-/// dynamic: it reads the same sections). devslam-run --check-config.
+/// dynamic: it reads the same sections). Given the input's `camera`, also refuses frames
+/// smaller than the filter's flow window ([dynamic_filter] lk_window / flow_scale), which a
+/// run would refuse at its first frame. devslam-run --check-config.
 void checkConfig(const RunConfig& rc, const mrpt::config::CConfigFileBase& cfg,
-                 const mrpt::config::CConfigFileBase& filter_cfg);
+                 const mrpt::config::CConfigFileBase& filter_cfg,
+                 const std::optional<core::CameraIntrinsics>& camera = std::nullopt);
 
 /// Runs the pipeline over `reader` with the INI `cfg` (SLAM sections) and `filter_cfg`
 /// ([detector], [dynamic_filter]). Throws on setup errors (bad INI, unknown mode).

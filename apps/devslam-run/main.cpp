@@ -262,10 +262,13 @@ run::RunConfig runConfig(const Args& a, const Loaded& l, const std::string& mode
 }
 
 /// --check-config: every setting of the INIs read and the filter made, as before a run's
-/// first frame (devslam-bench asks this of each SLAM INI before its renders).
+/// first frame (devslam-bench asks this of each SLAM INI before its renders), and the
+/// frame size of an input that exists (its camera, no frame read) against the filter's.
 int checkOnly(const Args& a) {
     const auto l = loadConfig(a);
-    run::checkConfig(runConfig(a, l, l.mode), *l.cfg, *l.filter_cfg);
+    std::optional<core::CameraIntrinsics> camera;
+    if (fs::exists(a.input)) camera = openInput(a.input, l.reader, 0)->intrinsics();
+    run::checkConfig(runConfig(a, l, l.mode), *l.cfg, *l.filter_cfg, camera);
     std::cout << "ok: " << l.config_source << " (filter: " << l.filter_source << "), mode "
               << l.mode << "\n";
     return 0;

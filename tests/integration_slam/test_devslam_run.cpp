@@ -64,7 +64,8 @@ std::string readText(const fs::path& p) {
 
 // --check-config reads the INIs as a run does and stops (devslam-bench asks it before its
 // renders): every shipped SLAM INI passes in every mode; a bad key in a SLAM section (read
-// only when the run starts, not with [run]) or in the filter INI fails; no input is read.
+// only when the run starts, not with [run]) or in the filter INI fails; no frame is read,
+// but an input that exists is opened for its frame size.
 TEST(DevslamRun, CheckConfigReadsTheInisAsARunDoesAndNoInput) {
     const std::string root = DEVSLAM_SOURCE_DIR;
     for (const char* ini : {"slam_tum_fr1.ini", "slam_tum_fr3.ini", "slam_synthetic.ini"})
@@ -83,6 +84,19 @@ TEST(DevslamRun, CheckConfigReadsTheInisAsARunDoesAndNoInput) {
     r = run("--check-config --set dynamic_filter.lk_levels=-1");
     EXPECT_EQ(r.rc, 1);
     EXPECT_NE(r.out.find("[dynamic_filter] lk_levels"), std::string::npos) << r.out;
+    // A flow window the shipped 640x480 frames cannot hold (255 px at flow_scale 0.5) is
+    // refused for the input that exists, as its run would refuse the first frame; mode none
+    // runs no flow, and an input that is not there is not checked.
+    const std::string huge = " --set dynamic_filter.lk_window=255";
+    r = run("--check-config" + huge);
+    EXPECT_EQ(r.rc, 1);
+    EXPECT_NE(r.out.find("[dynamic_filter] lk_window / flow_scale: the flow needs frames of at "
+                         "least 510x510 px; the input '"),
+              std::string::npos)
+        << r.out;
+    EXPECT_NE(r.out.find("' has 640x480"), std::string::npos) << r.out;
+    EXPECT_EQ(run("--check-config --mode none" + huge).rc, 0);
+    EXPECT_EQ(run("--check-config --input /nonexistent" + huge).rc, 0);
     r = run("--check-config --bench 1");
     EXPECT_EQ(r.rc, 1);
     EXPECT_NE(r.out.find("--check-config does not go with --bench"), std::string::npos) << r.out;

@@ -503,16 +503,20 @@ void DynamicObjectFilter::reset() {
     impl_->next_id = next_id;
 }
 
+int DynamicObjectFilter::Options::minFrameSide() const {
+    // The flow runs on the image scaled by flow_scale, with an lk_window-sized window.
+    return static_cast<int>(std::ceil(lk_window / std::min(flow_scale, 1.0)));
+}
+
 FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
                                        const std::optional<Eigen::Isometry3d>& T_prev_cur_prior) {
     if (frame.bgr.type() != CV_8UC3 || frame.depth.type() != CV_32FC1 ||
         frame.bgr.size() != frame.depth.size() || frame.bgr.empty())
         throw std::invalid_argument("dynamic filter: frame " + std::to_string(frame.index) +
                                     " needs CV_8UC3 colour and CV_32FC1 depth of equal size");
-    // The flow runs on the image scaled by flow_scale, with an lk_window-sized window: an
-    // image smaller than that window (a 1x1 frame gave cv::resize an empty size) is refused.
-    const int min_side =
-        static_cast<int>(std::ceil(opts_.lk_window / std::min(opts_.flow_scale, 1.0)));
+    // An image smaller than the flow's window (a 1x1 frame gave cv::resize an empty size) is
+    // refused.
+    const int min_side = opts_.minFrameSide();
     if (opts_.mode != MaskMode::None && (frame.bgr.cols < min_side || frame.bgr.rows < min_side))
         throw std::invalid_argument("dynamic filter: frame " + std::to_string(frame.index) +
                                     " is " + std::to_string(frame.bgr.cols) + "x" +

@@ -280,6 +280,9 @@ class DynamicObjectFilter {
         /// Throws std::invalid_argument "[section] key: must be ..." for the first value out
         /// of range (loadFromConfig and the filter's constructor call it).
         void validate(const std::string& section = "dynamic_filter") const;
+        /// The smallest frame side the flow can run on: lk_window at flow_scale, in full
+        /// image pixels (MaskMode::None needs none).
+        [[nodiscard]] int minFrameSide() const;
         void saveToConfig(mrpt::config::CConfigFileBase& cfg,
                           const std::string& section = "dynamic_filter") const;
     };
