@@ -136,7 +136,7 @@ void checkOutputFolder(const std::string& dir);
 
 /// Reads every setting a run in `rc.mode` reads from `cfg` and `filter_cfg` and makes its
 /// filter and detector, as runSequence does before the first frame, throwing what it would
-/// throw; reads no input (mode truth, whose mask is the input's person truth, is checked as
+/// throw; reads no frame (mode truth, whose mask is the input's person truth, is checked as
 /// dynamic: it reads the same sections). Given the input's `camera`, also refuses frames
 /// smaller than the filter's flow window ([dynamic_filter] lk_window / flow_scale), which a
 /// run would refuse at its first frame. devslam-run --check-config.
