@@ -5,6 +5,8 @@
 #include "RunJson.h"
 #include "Targets.h"
 
+#include <devslam/core/Config.h>
+
 #include <gtest/gtest.h>
 
 #include "Command.h"
@@ -17,6 +19,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <map>
 #include <optional>
@@ -928,4 +931,43 @@ TEST(DevslamSynth, SeedOptionGivesAnotherRenderOfTheSameScene) {
     EXPECT_NE(readFile(tmp / "e.log").find("got '7x'"), std::string::npos)
         << readFile(tmp / "e.log");
     fs::remove_all(tmp);
+}
+
+// bench_short.ini is bench.ini cut down, not another bench: the same [bench] settings and
+// targets, and each of its sequences one of bench.ini's with the same keys but for `seeds`,
+// whose renders are some of bench.ini's (the first ones, so that its runs are bench.ini's).
+TEST(DevslamBench, TheShortBenchIsTheShippedBenchCutDown) {
+    const std::string dir = std::string(DEVSLAM_SOURCE_DIR) + "/config_ini/";
+    const auto full = devslam::core::loadIni(dir + "bench.ini");
+    const auto part = devslam::core::loadIni(dir + "bench_short.ini");
+    std::vector<std::string> sections;
+    part->getAllSections(sections);
+    ASSERT_FALSE(sections.empty());
+    for (const auto& s : sections) {
+        std::vector<std::string> keys, full_keys;
+        part->getAllKeys(s, keys);
+        full->getAllKeys(s, full_keys);
+        ASSERT_FALSE(full_keys.empty()) << "[" << s << "] is not in bench.ini";
+        const bool sequence = s.rfind("sequence_", 0) == 0;
+        if (!sequence) EXPECT_EQ(keys, full_keys) << "[" << s << "]";
+        for (const auto& k : full_keys) {
+            const std::string a = part->read_string(s, k, "<none>"),
+                              b = full->read_string(s, k, "<none>");
+            if (k != "seeds") {
+                EXPECT_EQ(a, b) << "[" << s << "] " << k;
+            } else {
+                const auto words = [](const std::string& t) {
+                    std::istringstream in(t);
+                    return std::vector<std::string>{std::istream_iterator<std::string>(in), {}};
+                };
+                const auto mine = words(a), all = words(b);
+                EXPECT_TRUE(!mine.empty() && mine.size() <= all.size() &&
+                            std::equal(mine.begin(), mine.end(), all.begin()))
+                    << "[" << s << "] seeds: not bench.ini's first ones";
+            }
+        }
+    }
+    std::vector<std::string> full_sections;
+    full->getAllSections(full_sections);
+    EXPECT_LT(sections.size(), full_sections.size());
 }
