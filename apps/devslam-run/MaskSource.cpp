@@ -67,10 +67,7 @@ class FilterMask final : public MaskSource {
         return s;
     }
     void reset() override { filter_->reset(); }
-    int minFrameSide() const override {
-        const auto& o = filter_->options();
-        return o.mode == dynamic::MaskMode::None ? 0 : o.minFrameSide();
-    }
+    int minFrameSide() const override { return filter_->options().minFrameSide(); }
     std::string describe() const override {
         return "dynamic filter, mode " + dynamic::toString(filter_->options().mode);
     }

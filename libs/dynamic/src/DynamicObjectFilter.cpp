@@ -505,6 +505,7 @@ void DynamicObjectFilter::reset() {
 
 int DynamicObjectFilter::Options::minFrameSide() const {
     // The flow runs on the image scaled by flow_scale, with an lk_window-sized window.
+    if (mode == MaskMode::None) return 0;
     return static_cast<int>(std::ceil(lk_window / std::min(flow_scale, 1.0)));
 }
 
@@ -517,7 +518,7 @@ FilterOutput DynamicObjectFilter::step(const core::Frame& frame,
     // An image smaller than the flow's window (a 1x1 frame gave cv::resize an empty size) is
     // refused.
     const int min_side = opts_.minFrameSide();
-    if (opts_.mode != MaskMode::None && (frame.bgr.cols < min_side || frame.bgr.rows < min_side))
+    if (frame.bgr.cols < min_side || frame.bgr.rows < min_side)
         throw std::invalid_argument("dynamic filter: frame " + std::to_string(frame.index) +
                                     " is " + std::to_string(frame.bgr.cols) + "x" +
                                     std::to_string(frame.bgr.rows) +
