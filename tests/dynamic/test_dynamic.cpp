@@ -895,6 +895,64 @@ TEST(DynamicFilter, RefinedEgoMotionMatchesTruth) {
     }
 }
 
+TEST(DynamicFilter, BackgroundCornersAreSeededWhenPeopleFillTheView) {
+    // A still crowd: person boxes cover the image but for a low-contrast band along its
+    // top, so that the image's strongest corners lie in the boxes and too few are left away
+    // from them (nearAnyBox) for the ego-motion fit to refine the prior (here none, the
+    // identity, while the camera moves and turns). background_corners seeds corners in the
+    // band: the fit finds the camera's turn there, and the still people's points show no
+    // residual flow; without it the turn shows as their own motion.
+    dynamic::SyntheticOptions so;
+    so.person = dynamic::PersonMotion::None;
+    so.n_frames = kFrames;
+    const auto& full = sequence(so);
+    const std::vector<dynamic::SyntheticFrame> seq(full.begin(), full.begin() + 6);
+    const int band = 80;  // the boxes grown by mask_margin + 20 % reach up to y = 74
+    std::vector<detect::Detection> crowd;
+    for (int i = 0; i < 3; ++i)
+        crowd.push_back(
+            {cv::Rect2f(static_cast<float>(i * 214), 150.f, 213.f, 330.f), 0, "person", 0.9f});
+    struct Result {
+        int refined = 0, moving = 0;  // steps refined; steps with a box Moving
+        double worst_deg = 0;         // the refined rotation's largest error
+    };
+    const auto run = [&](int background_corners) {
+        auto fo = testOptions();
+        fo.background_corners = background_corners;
+        auto det = std::make_unique<ScriptedDetector>();
+        det->next = crowd;
+        DynamicObjectFilter filter(fo, std::move(det));
+        Result r;
+        for (const auto& s : seq) {
+            core::Frame f = s.frame;
+            f.bgr = f.bgr.clone();
+            cv::Mat top = f.bgr(cv::Rect(0, 0, f.bgr.cols, band));
+            top.convertTo(top, -1, 0.15, 0.85 * 128);  // a sixth of the contrast
+            const auto out = filter.step(f, std::nullopt);
+            if (s.frame.index == 0) continue;
+            r.moving += std::any_of(out.boxes.begin(), out.boxes.end(),
+                                    [](const auto& b) { return b.state == BoxState::Moving; });
+            if (!out.T_prev_cur_refined) continue;
+            ++r.refined;
+            const Eigen::Isometry3d err = out.T_prev_cur_refined->inverse() * s.T_prev_cur;
+            r.worst_deg =
+                std::max(r.worst_deg, Eigen::AngleAxisd(err.linear()).angle() * 180 / M_PI);
+        }
+        return r;
+    };
+    const auto seeded = run(testOptions().background_corners);
+    const auto unseeded = run(0);
+    std::printf("seeded: refined %d, moving %d, worst %.3f deg; unseeded: refined %d, moving %d\n",
+                seeded.refined, seeded.moving, seeded.worst_deg, unseeded.refined, unseeded.moving);
+    EXPECT_EQ(seeded.refined, 5);
+    EXPECT_LT(seeded.worst_deg, 0.2);  // (the turn is 0.5 deg a step)
+    EXPECT_EQ(seeded.moving, 0);
+    // The premise: without the seeding the fit has too few points and keeps the prior, and
+    // the still crowd looks as if it moved.
+    EXPECT_EQ(unseeded.refined, 0);
+    EXPECT_GE(unseeded.moving, 3);
+}
+
 TEST(DynamicFilter, ForwardBackwardCheckDropsTracksIntoOtherContent) {
     // The right half of the second frame shows other content (the wall turned upside down),
     // as where something enters the view: no point there has a true match, and LK's forward
@@ -1215,6 +1273,45 @@ TEST(DynamicFilter, DepthBandFindsAWalkerInABoxOfBackground) {
     EXPECT_GT(moving_band, moving_all) << "the background in the box outvotes the walker";
     EXPECT_GT(cover, 0.95) << "the silhouette covers the person";
     EXPECT_LT(masked, 0.6) << "and leaves the wall in the box";
+}
+
+TEST(DynamicFilter, AWalkerInTheCornerOfTheirBoxGetsTheirOwnDepth) {
+    // The detector's box reaches far past the walker on one side, as for a person the image
+    // border cuts: the walker fills only about a third of the box's torso region, where the
+    // person's depth is measured, and the median there is the wall's. The filter must take
+    // the nearer surface, the walker, as the person: their points then make the evidence
+    // and their silhouette the mask (with the wall's depth the box looked Static and
+    // nothing was masked).
+    dynamic::SyntheticOptions so;
+    so.person = dynamic::PersonMotion::Walking;
+    so.n_frames = kFrames;
+    const auto& seq = sequence(so);
+    auto fo = testOptions();
+    ASSERT_GT(fo.fg_depth_band, 0.0);
+    fo.mask_silhouette = true;
+    auto det = std::make_unique<ScriptedDetector>();
+    ScriptedDetector* script = det.get();
+    DynamicObjectFilter filter(fo, std::move(det));
+    int frames = 0, moving = 0;
+    double cover = 0;
+    const cv::Rect image(0, 0, 640, 480);
+    for (const auto& s : seq) {
+        script->next.clear();
+        if (!s.person_box) continue;
+        const cv::Rect2f p = *s.person_box;
+        const cv::Rect2f box(p.x, p.y, 2.3f * p.width, p.height);  // inside the image
+        ASSERT_LE(box.br().x, 640.f);
+        script->next.push_back({box & cv::Rect2f(image), 0, "person", 0.9f});
+        const auto out = filter.step(s.frame, s.T_prev_cur);
+        if (s.frame.index == 0) continue;
+        ++frames;
+        for (const auto& b : out.boxes) moving += b.state == BoxState::Moving ? 1 : 0;
+        const cv::Rect pr = cv::Rect(p) & image;
+        cover += cv::countNonZero(out.mask(pr)) / static_cast<double>(pr.area());
+    }
+    ASSERT_GE(frames, 10);
+    EXPECT_GE(moving, frames - 1);
+    EXPECT_GT(cover / frames, 0.9) << "the walker's silhouette is masked";
 }
 
 TEST(DynamicFilter, NarrowSilhouetteBandKeepsTheWallRightBehindAPerson) {

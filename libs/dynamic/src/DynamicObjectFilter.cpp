@@ -32,6 +32,7 @@ const std::vector<std::string> kKeys{"mode",
                                      "detect_every",
                                      "max_corners",
                                      "max_corners_per_box",
+                                     "background_corners",
                                      "corner_quality",
                                      "corner_min_distance",
                                      "lk_window",
@@ -82,6 +83,14 @@ cv::Rect2f shrink(const cv::Rect2f& b, double f) {
     return {b.x + dx, b.y + dy, b.width - 2 * dx, b.height - 2 * dy};
 }
 
+/// A person box grown by mask_margin plus 20 % of its size on each side (the detector's box
+/// may lag a walker's limbs): points in it are not background for the ego-motion fit.
+cv::Rect2f nearBox(const cv::Rect2f& b, const DynamicObjectFilter::Options& o) {
+    const float mx = static_cast<float>(o.mask_margin) + 0.2f * b.width;
+    const float my = static_cast<float>(o.mask_margin) + 0.2f * b.height;
+    return {b.x - mx, b.y - my, b.width + 2 * mx, b.height + 2 * my};
+}
+
 /// Depth at (u, v) if it is valid and not on a depth discontinuity (3x3 spread below 5%):
 /// corners on the silhouette of a person often sample the background's depth.
 std::optional<float> stableDepth(const cv::Mat& depth, const cv::Point2f& p, double max_depth) {
@@ -102,10 +111,22 @@ std::optional<float> stableDepth(const cv::Mat& depth, const cv::Point2f& p, dou
     return z;
 }
 
+/// Half-width [m] of the depth band around a person's depth z that belongs to them.
+float depthBand(double band, float z) {
+    return static_cast<float>(band) + 0.1f * z;
+}
+
 /// The person's depth in a box: median valid depth of its torso region (30-70 % of the
 /// width, 15-55 % of the height), where a detected person box is nearly always on the
 /// person even when the rest of the box shows background or a desk in front of the legs.
-std::optional<float> personDepth(const cv::Mat& depth, const cv::Rect2f& box, double max_depth) {
+/// Not so for a person the image's border cuts, entering at a corner: the detector's box
+/// reaches past them and the torso region shows mostly the background behind. So where
+/// the nearest quarter of the samples lies more than a depth band (band > 0) in front of
+/// the median, the person is that nearer surface: the median of the samples up to a band
+/// behind it. (A walker entering at walking_rpy's bottom-left corner got the wall's depth
+/// for six frames, and the flow test looked at the wall.)
+std::optional<float> personDepth(const cv::Mat& depth, const cv::Rect2f& box, double max_depth,
+                                 double band) {
     const cv::Rect torso = cv::Rect(cv::Rect2f(box.x + 0.3f * box.width, box.y + 0.15f * box.height,
                                                0.4f * box.width, 0.4f * box.height)) &
                            cv::Rect(0, 0, depth.cols, depth.rows);
@@ -120,12 +141,17 @@ std::optional<float> personDepth(const cv::Mat& depth, const cv::Rect2f& box, do
     if (z.size() < 8) return std::nullopt;
     const auto mid = z.begin() + static_cast<std::ptrdiff_t>(z.size() / 2);
     std::nth_element(z.begin(), mid, z.end());
-    return *mid;
-}
-
-/// Half-width [m] of the depth band around a person's depth z that belongs to them.
-float depthBand(double band, float z) {
-    return static_cast<float>(band) + 0.1f * z;
+    const float median = *mid;
+    if (band <= 0) return median;
+    const auto quarter = z.begin() + static_cast<std::ptrdiff_t>(z.size() / 4);
+    std::nth_element(z.begin(), quarter, mid);  // (z[0, mid) are the samples <= median)
+    const float near = *quarter;
+    if (median - near <= depthBand(band, near)) return median;
+    const float far = near + depthBand(band, near);
+    const auto end = std::partition(z.begin(), z.end(), [&](float v) { return v <= far; });
+    const auto m = z.begin() + (end - z.begin()) / 2;
+    std::nth_element(z.begin(), m, end);
+    return *m;
 }
 
 /// static_person_gate's INI names and the exponents (Options::static_person_gate) they stand
@@ -188,6 +214,7 @@ void DynamicObjectFilter::Options::loadFromConfig(const mrpt::config::CConfigFil
     flow_scale = core::readDouble(c, s, "flow_scale", flow_scale);
     max_corners = core::readInt(c, s, "max_corners", max_corners);
     max_corners_per_box = core::readInt(c, s, "max_corners_per_box", max_corners_per_box);
+    background_corners = core::readInt(c, s, "background_corners", background_corners);
     corner_quality = core::readDouble(c, s, "corner_quality", corner_quality);
     corner_min_distance = core::readDouble(c, s, "corner_min_distance", corner_min_distance);
     lk_window = core::readInt(c, s, "lk_window", lk_window);
@@ -253,6 +280,7 @@ void DynamicObjectFilter::Options::validate(const std::string& s) const {
                        "must be in (0.1, 1]");
     core::requireValue(max_corners > 0, s, "max_corners", "must be > 0");
     core::requireValue(max_corners_per_box >= 0, s, "max_corners_per_box", "must be >= 0");
+    core::requireValue(background_corners >= 0, s, "background_corners", "must be >= 0");
     core::requireValue(corner_quality > 0 && corner_quality < 1, s, "corner_quality",
                        "must be in (0, 1)");
     // A huge spacing overflowed the corner grid's cell count (a crash at 3e9); a huge window
@@ -316,6 +344,7 @@ void DynamicObjectFilter::Options::saveToConfig(mrpt::config::CConfigFileBase& c
     core::writeKey(c, s, "flow_scale", flow_scale);
     core::writeKey(c, s, "max_corners", max_corners);
     core::writeKey(c, s, "max_corners_per_box", max_corners_per_box);
+    core::writeKey(c, s, "background_corners", background_corners);
     core::writeKey(c, s, "corner_quality", corner_quality);
     core::writeKey(c, s, "corner_min_distance", corner_min_distance);
     core::writeKey(c, s, "lk_window", lk_window);
@@ -618,16 +647,35 @@ PointFlow DynamicObjectFilter::Impl::trackCorners(const Options& o, const cv::Re
     std::vector<cv::Point2f>& p1 = f.p1;
     // One eigenvalue map for the image and every box (see ShiTomasi.h).
     corner_map.update(prev_work);
-    p0 = selectShiTomasi(corner_map, cv::Rect(0, 0, work.cols, work.rows), o.max_corners,
-                         o.corner_quality, o.corner_min_distance);
+    const cv::Rect whole(0, 0, work.cols, work.rows);
+    p0 = selectShiTomasi(corner_map, whole, o.max_corners, o.corner_quality, o.corner_min_distance);
+    const auto scaled = [&](const cv::Rect2f& b) {
+        return cv::Rect(cv::Rect2f(static_cast<float>(b.x * sc), static_cast<float>(b.y * sc),
+                                   static_cast<float>(b.width * sc),
+                                   static_cast<float>(b.height * sc))) &
+               whole;
+    };
+    if (o.background_corners > 0 && !tracks.empty()) {
+        // People filling the view leave few of the image's strongest corners away from their
+        // boxes, where egoMotion takes its background: with fewer than min_background_points
+        // there it keeps the prior, whose error (a constant-velocity guess while the camera
+        // swings) then shows as residual flow everywhere and hides the walkers' own. On
+        // walking_rpy that left a walker crossing near the camera unmasked for ten frames.
+        cv::Mat away(work.size(), CV_8U, cv::Scalar(255));
+        for (const auto& t : tracks) away(scaled(nearBox(t.tb.box, o))).setTo(0);
+        const auto have = std::count_if(p0.begin(), p0.end(), [&](const cv::Point2f& p) {
+            return away.at<uchar>(cv::Point(p)) != 0;
+        });
+        if (have < o.background_corners) {
+            const auto pts =
+                selectShiTomasi(corner_map, whole, o.background_corners - static_cast<int>(have),
+                                o.corner_quality, o.corner_min_distance * 0.5, away, p0);
+            p0.insert(p0.end(), pts.begin(), pts.end());
+        }
+    }
     if (o.max_corners_per_box > 0) {
         for (const auto& t : tracks) {
-            const cv::Rect2f b = shrink(t.tb.box, o.box_shrink);
-            const cv::Rect roi =
-                cv::Rect(cv::Rect2f(static_cast<float>(b.x * sc), static_cast<float>(b.y * sc),
-                                    static_cast<float>(b.width * sc),
-                                    static_cast<float>(b.height * sc))) &
-                cv::Rect(0, 0, work.cols, work.rows);
+            const cv::Rect roi = scaled(shrink(t.tb.box, o.box_shrink));
             if (roi.width < 8 || roi.height < 8) continue;
             cv::Mat fg;  // the person's depth band in the ROI (empty: whole ROI)
             if (o.fg_depth_band > 0 && t.depth) {  // t.depth: the previous step's
@@ -762,17 +810,27 @@ void DynamicObjectFilter::Impl::measureBoxes(const cv::Mat& depth, const Options
                  tracks.end());
     const bool need_depth = o.fg_depth_band > 0 || o.mask_silhouette || o.depth_frames > 0 ||
                             (o.slow_frames > 0 && o.slow_speed > 0) || o.static_person_outline > 0;
-    for (auto& t : tracks)
-        t.depth = need_depth ? personDepth(depth, t.tb.box, o.max_depth) : std::nullopt;
+    for (auto& t : tracks) {
+        const auto z =
+            need_depth ? personDepth(depth, t.tb.box, o.max_depth, o.fg_depth_band) : std::nullopt;
+        // A jump past the band (the person's depth found on another surface: a walker who
+        // came to fill enough of their box at the border, or the wall behind one who left
+        // it) leaves the box's evidence histories about a surface it no longer looks at:
+        // the depth test's sum mixed the wall's residuals, of larger noise, with the
+        // bound of the nearer person's depth, and a still person went Moving.
+        if (z && t.depth && o.fg_depth_band > 0 &&
+            std::abs(*z - *t.depth) > depthBand(o.fg_depth_band, std::min(*z, *t.depth))) {
+            t.depth_history.clear();
+            t.slow_history.clear();
+        }
+        t.depth = z;
+    }
 }
 
 bool DynamicObjectFilter::Impl::nearAnyBox(const cv::Point2f& a, const cv::Point2f& b,
                                            const Options& o) const {
     for (const auto& t : tracks) {
-        const float mx = o.mask_margin + 0.2f * t.tb.box.width;
-        const float my = o.mask_margin + 0.2f * t.tb.box.height;
-        const cv::Rect2f grown(t.tb.box.x - mx, t.tb.box.y - my, t.tb.box.width + 2 * mx,
-                               t.tb.box.height + 2 * my);
+        const cv::Rect2f grown = nearBox(t.tb.box, o);
         if (grown.contains(a) || grown.contains(b)) return true;
     }
     return false;

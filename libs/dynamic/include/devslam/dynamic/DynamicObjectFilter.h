@@ -114,6 +114,10 @@ class DynamicObjectFilter {
         double flow_scale = 0.5;           ///< corners + LK run on the image scaled by this (speed)
         int max_corners = 200;             ///< corners in the whole image
         int max_corners_per_box = 40;      ///< extra corners seeded inside each person box
+        /// Fewer image-wide corners than this away from the person boxes (where the
+        /// ego-motion fit takes its points; see nearAnyBox): extra ones are seeded there, up
+        /// to this many. 0: none.
+        int background_corners = 40;
         double corner_quality = 0.01;      ///< Shi-Tomasi quality level (fraction of best)
         double corner_min_distance = 5.0;  ///< [px of the scaled image] between corners
         int lk_window = 11;                ///< [px of the scaled image] LK window side
@@ -137,7 +141,9 @@ class DynamicObjectFilter {
         int min_points = 6;                ///< fewer points in a box: no new evidence
         double box_shrink = 0.1;           ///< fraction of w/h ignored at each box side
         /// [m] only points within fg_depth_band + 10 % of the person's depth (median depth
-        /// of the box's torso region) are the person's evidence, and the per-box corners
+        /// of the box's torso region, or of its nearest quarter where that lies more than
+        /// this band in front: a person the border cuts) are the person's evidence, and the
+        /// per-box corners
         /// are sought there: a near person's low-contrast clothing otherwise loses the
         /// corners to the background seen inside the box, which votes "static".
         /// 0 = every point in the box counts.
