@@ -62,6 +62,8 @@ const std::vector<std::string> kKeys{"mode",
                                      "first_frame_as_static",
                                      "mask_border_snap",
                                      "fg_depth_band",
+                                     "narrow_vote_band",
+                                     "narrow_vote_slope",
                                      "mask_silhouette",
                                      "silhouette_depth_band",
                                      "silhouette_grow",
@@ -231,6 +233,8 @@ void DynamicObjectFilter::Options::loadFromConfig(const mrpt::config::CConfigFil
     min_points = core::readInt(c, s, "min_points", min_points);
     box_shrink = core::readDouble(c, s, "box_shrink", box_shrink);
     fg_depth_band = core::readDouble(c, s, "fg_depth_band", fg_depth_band);
+    narrow_vote_band = core::readDouble(c, s, "narrow_vote_band", narrow_vote_band);
+    narrow_vote_slope = core::readDouble(c, s, "narrow_vote_slope", narrow_vote_slope);
     mask_silhouette = core::readBool(c, s, "mask_silhouette", mask_silhouette);
     silhouette_depth_band = core::readDouble(c, s, "silhouette_depth_band", silhouette_depth_band);
     silhouette_grow = core::readDouble(c, s, "silhouette_grow", silhouette_grow);
@@ -302,6 +306,9 @@ void DynamicObjectFilter::Options::validate(const std::string& s) const {
     core::requireValue(min_points >= 1, s, "min_points", "must be >= 1");
     core::requireValue(box_shrink >= 0 && box_shrink < 0.5, s, "box_shrink", "must be in [0, 0.5)");
     core::requireValue(fg_depth_band >= 0, s, "fg_depth_band", "must be >= 0 (0 = off)");
+    core::requireValue(narrow_vote_band >= 0, s, "narrow_vote_band", "must be >= 0 (0 = off)");
+    core::requireValue(narrow_vote_slope >= 0 && narrow_vote_slope <= 1, s, "narrow_vote_slope",
+                       "must be in [0, 1] (m per m of depth)");
     core::requireValue(silhouette_depth_band >= 0, s, "silhouette_depth_band",
                        "must be >= 0 (0 = fg_depth_band's)");
     core::requireValue(silhouette_grow >= 0 && silhouette_grow <= 1, s, "silhouette_grow",
@@ -361,6 +368,8 @@ void DynamicObjectFilter::Options::saveToConfig(mrpt::config::CConfigFileBase& c
     core::writeKey(c, s, "min_points", min_points);
     core::writeKey(c, s, "box_shrink", box_shrink);
     core::writeKey(c, s, "fg_depth_band", fg_depth_band);
+    core::writeKey(c, s, "narrow_vote_band", narrow_vote_band);
+    core::writeKey(c, s, "narrow_vote_slope", narrow_vote_slope);
     core::writeKey(c, s, "mask_silhouette", mask_silhouette);
     core::writeKey(c, s, "silhouette_depth_band", silhouette_depth_band);
     core::writeKey(c, s, "silhouette_grow", silhouette_grow);
@@ -977,20 +986,28 @@ void DynamicObjectFilter::Impl::classifyBoxes(const Residuals& r, const core::Fr
         const double local_thr = localThreshold(t.tb.box, out, o);
         const bool use_band = o.fg_depth_band > 0 && t.depth.has_value();
         const float zp = t.depth.value_or(0.f);
-        int n = 0, n_dyn = 0;
+        // The narrow vote's points: those nearest the person's depth (see Options).
+        const bool use_narrow = use_band && o.narrow_vote_band > 0;
+        const auto narrow =
+            static_cast<float>(o.narrow_vote_band + o.narrow_vote_slope * static_cast<double>(zp));
+        int n = 0, n_dyn = 0, n_narrow = 0, n_narrow_dyn = 0;
         std::vector<float> rx, ry;  // residual vectors of the box's points (slow walkers)
         std::vector<float> rz;      // their depth residuals (walkers towards the camera)
         for (std::size_t i = 0; i < out.flow.size(); ++i) {
             auto& fp = out.flow[i];
             if (fp.residual < 0.f || !inner.contains(fp.cur)) continue;
             // (a point with a residual has a depth: r.X[i] is set)
-            if (use_band &&
-                std::abs(static_cast<float>(r.X[i]->z()) - zp) > depthBand(o.fg_depth_band, zp))
+            const float dz = use_band ? std::abs(static_cast<float>(r.X[i]->z()) - zp) : 0.f;
+            if (use_band && dz > depthBand(o.fg_depth_band, zp))
                 continue;  // background or foreground clutter seen inside the box
             fp.in_box = true;
             fp.dynamic = fp.residual > local_thr;
             ++n;
             if (fp.dynamic) ++n_dyn;
+            if (use_narrow && dz <= narrow) {
+                ++n_narrow;
+                if (fp.dynamic) ++n_narrow_dyn;
+            }
             if (o.slow_frames > 0) {
                 rx.push_back(r.vec[i].x);
                 ry.push_back(r.vec[i].y);
@@ -1015,8 +1032,14 @@ void DynamicObjectFilter::Impl::classifyBoxes(const Residuals& r, const core::Fr
             continue;
         }
         t.unseen = 0;
-        bool moving =
-            n_dyn >= o.threshold2_count && n_dyn >= o.threshold2_fraction * static_cast<double>(n);
+        const auto vote = [&o](int points, int dynamic) {
+            return dynamic >= o.threshold2_count &&
+                   dynamic >= o.threshold2_fraction * static_cast<double>(points);
+        };
+        bool moving = vote(n, n_dyn);
+        // The narrow vote: a walker passing a still desk or shelf at nearly their depth has
+        // the clutter's points in the wide band too, and they outvote the walker's.
+        if (use_narrow && n_narrow >= o.min_points) moving |= vote(n_narrow, n_narrow_dyn);
         if (o.slow_frames > 0) {
             // Slow walkers: the mean of the box's per-step median residual vectors. A
             // walker who stops keeps it above the threshold for up to slow_frames - 1

@@ -148,6 +148,14 @@ class DynamicObjectFilter {
         /// corners to the background seen inside the box, which votes "static".
         /// 0 = every point in the box counts.
         double fg_depth_band = 0.0;
+        /// [m] a second vote, with the same threshold2_count and threshold2_fraction, over
+        /// the box's points within narrow_vote_band + narrow_vote_slope x the person's depth
+        /// of that depth (when at least min_points lie there); either vote makes the box
+        /// moving. fg_depth_band has to be wide (a near person's depth spreads over their
+        /// body), and a still desk or shelf beside a walker at nearly their depth then
+        /// outvotes the walker's points. Needs fg_depth_band > 0. 0 = off.
+        double narrow_vote_band = 0.0;
+        double narrow_vote_slope = 0.03;  ///< [m per m of depth]
         /// Slow walkers: a box is also moving when the mean, over its last slow_frames
         /// steps with evidence, of its points' median residual flow vector exceeds
         /// max(slow_threshold, local threshold / 2) [px per frame]. A person walking at
