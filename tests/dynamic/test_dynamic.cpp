@@ -1328,7 +1328,7 @@ TEST(DynamicFilter, NarrowVoteFindsAWalkerBesideStillClutterAtTheirDepth) {
     constexpr double kPerson = 3.0;
     constexpr auto kDesk = static_cast<float>(kPerson + 0.35);
     const cv::Rect2f image(0, 0, 640, 480);
-    auto run = [&](dynamic::PersonMotion motion, double narrow) {
+    auto run = [&](dynamic::PersonMotion motion, double narrow, double wide_band = -1) {
         dynamic::SyntheticOptions so;
         so.person = motion;
         so.n_frames = kFrames;
@@ -1343,14 +1343,15 @@ TEST(DynamicFilter, NarrowVoteFindsAWalkerBesideStillClutterAtTheirDepth) {
         fo.depth_frames = 0;
         fo.narrow_vote_band = narrow;
         fo.narrow_vote_slope = 0.03;
+        if (wide_band >= 0) fo.fg_depth_band = wide_band;
         auto det = std::make_unique<ScriptedDetector>();
         ScriptedDetector* script = det.get();
         DynamicObjectFilter filter(fo, std::move(det));
         cv::Mat board(480, 640, CV_8UC3);  // the desk's clutter: a checkerboard
         for (int v = 0; v < board.rows; ++v)
             for (int u = 0; u < board.cols; ++u)
-                board.at<cv::Vec3b>(v, u) = ((u / 24 + v / 24) % 2) ? cv::Vec3b(200, 195, 190)
-                                                                    : cv::Vec3b(40, 45, 50);
+                board.at<cv::Vec3b>(v, u) =
+                    ((u / 24 + v / 24) % 2) ? cv::Vec3b(200, 195, 190) : cv::Vec3b(40, 45, 50);
         int frames = 0, moving = 0;
         for (const auto& s : seq) {
             script->next.clear();
@@ -1372,9 +1373,11 @@ TEST(DynamicFilter, NarrowVoteFindsAWalkerBesideStillClutterAtTheirDepth) {
             ++frames;
             for (const auto& b : out.boxes) moving += b.state == BoxState::Moving ? 1 : 0;
         }
-        std::printf("%s person beside a still desk, narrow_vote_band %.1f: moving in %d/%d\n",
-                    motion == dynamic::PersonMotion::Walking ? "walking" : "standing", narrow,
-                    moving, frames);
+        std::printf(
+            "%s person beside a still desk, fg_depth_band %.1f, narrow_vote_band %.1f: "
+            "moving in %d/%d\n",
+            motion == dynamic::PersonMotion::Walking ? "walking" : "standing", fo.fg_depth_band,
+            narrow, moving, frames);
         EXPECT_GE(frames, 10);
         return std::pair(moving, frames);
     };
@@ -1384,6 +1387,10 @@ TEST(DynamicFilter, NarrowVoteFindsAWalkerBesideStillClutterAtTheirDepth) {
     EXPECT_GE(with_narrow, frames2 - 1);
     const auto [standing, frames3] = run(dynamic::PersonMotion::Static, 0.1);
     EXPECT_EQ(standing, 0) << "in " << frames3 << " frames";
+    // Without the wide band every point in the box votes, the wall behind too; the narrow
+    // vote still counts the walker's alone.
+    const auto [no_band, frames4] = run(dynamic::PersonMotion::Walking, 0.1, 0.0);
+    EXPECT_GE(no_band, frames4 - 1);
 }
 
 TEST(DynamicFilter, NarrowSilhouetteBandKeepsTheWallRightBehindAPerson) {

@@ -817,8 +817,9 @@ void DynamicObjectFilter::Impl::measureBoxes(const cv::Mat& depth, const Options
     tracks.erase(std::remove_if(tracks.begin(), tracks.end(),
                                 [](const Track& t) { return t.tb.box.area() < 16.f; }),
                  tracks.end());
-    const bool need_depth = o.fg_depth_band > 0 || o.mask_silhouette || o.depth_frames > 0 ||
-                            (o.slow_frames > 0 && o.slow_speed > 0) || o.static_person_outline > 0;
+    const bool need_depth = o.fg_depth_band > 0 || o.narrow_vote_band > 0 || o.mask_silhouette ||
+                            o.depth_frames > 0 || (o.slow_frames > 0 && o.slow_speed > 0) ||
+                            o.static_person_outline > 0;
     for (auto& t : tracks) {
         const auto z =
             need_depth ? personDepth(depth, t.tb.box, o.max_depth, o.fg_depth_band) : std::nullopt;
@@ -987,7 +988,7 @@ void DynamicObjectFilter::Impl::classifyBoxes(const Residuals& r, const core::Fr
         const bool use_band = o.fg_depth_band > 0 && t.depth.has_value();
         const float zp = t.depth.value_or(0.f);
         // The narrow vote's points: those nearest the person's depth (see Options).
-        const bool use_narrow = use_band && o.narrow_vote_band > 0;
+        const bool use_narrow = o.narrow_vote_band > 0 && t.depth.has_value();
         const auto narrow =
             static_cast<float>(o.narrow_vote_band + o.narrow_vote_slope * static_cast<double>(zp));
         int n = 0, n_dyn = 0, n_narrow = 0, n_narrow_dyn = 0;
@@ -997,7 +998,7 @@ void DynamicObjectFilter::Impl::classifyBoxes(const Residuals& r, const core::Fr
             auto& fp = out.flow[i];
             if (fp.residual < 0.f || !inner.contains(fp.cur)) continue;
             // (a point with a residual has a depth: r.X[i] is set)
-            const float dz = use_band ? std::abs(static_cast<float>(r.X[i]->z()) - zp) : 0.f;
+            const float dz = t.depth ? std::abs(static_cast<float>(r.X[i]->z()) - zp) : 0.f;
             if (use_band && dz > depthBand(o.fg_depth_band, zp))
                 continue;  // background or foreground clutter seen inside the box
             fp.in_box = true;

@@ -153,7 +153,7 @@ class DynamicObjectFilter {
         /// of that depth (when at least min_points lie there); either vote makes the box
         /// moving. fg_depth_band has to be wide (a near person's depth spreads over their
         /// body), and a still desk or shelf beside a walker at nearly their depth then
-        /// outvotes the walker's points. Needs fg_depth_band > 0. 0 = off.
+        /// outvotes the walker's points. 0 = off.
         double narrow_vote_band = 0.0;
         double narrow_vote_slope = 0.03;  ///< [m per m of depth]
         /// Slow walkers: a box is also moving when the mean, over its last slow_frames
