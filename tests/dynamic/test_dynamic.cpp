@@ -1328,6 +1328,11 @@ TEST(DynamicFilter, NarrowVoteFindsAWalkerBesideStillClutterAtTheirDepth) {
     constexpr double kPerson = 3.0;
     constexpr auto kDesk = static_cast<float>(kPerson + 0.35);
     const cv::Rect2f image(0, 0, 640, 480);
+    cv::Mat board(480, 640, CV_8UC3);  // the desk's clutter: a checkerboard
+    for (int v = 0; v < board.rows; ++v)
+        for (int u = 0; u < board.cols; ++u)
+            board.at<cv::Vec3b>(v, u) =
+                ((u / 24 + v / 24) % 2) ? cv::Vec3b(200, 195, 190) : cv::Vec3b(40, 45, 50);
     auto run = [&](dynamic::PersonMotion motion, double narrow, double wide_band = -1) {
         dynamic::SyntheticOptions so;
         so.person = motion;
@@ -1347,11 +1352,6 @@ TEST(DynamicFilter, NarrowVoteFindsAWalkerBesideStillClutterAtTheirDepth) {
         auto det = std::make_unique<ScriptedDetector>();
         ScriptedDetector* script = det.get();
         DynamicObjectFilter filter(fo, std::move(det));
-        cv::Mat board(480, 640, CV_8UC3);  // the desk's clutter: a checkerboard
-        for (int v = 0; v < board.rows; ++v)
-            for (int u = 0; u < board.cols; ++u)
-                board.at<cv::Vec3b>(v, u) =
-                    ((u / 24 + v / 24) % 2) ? cv::Vec3b(200, 195, 190) : cv::Vec3b(40, 45, 50);
         int frames = 0, moving = 0;
         for (const auto& s : seq) {
             script->next.clear();
