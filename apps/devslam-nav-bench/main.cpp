@@ -466,7 +466,7 @@ std::string categoryTables(const Args& a, const std::vector<devslam::sim::Catego
 
 /// The timings: one VFH+ step, each method's navigationStep(), A* on a 400x400 grid, and the
 /// whole benchmark's simulated and wall time.
-std::string timingMarkdown(const Args& a, const Episodes& ep) {
+std::string timingMarkdown(const Args& a, const Episodes& ep, int ptg_count) {
     double astar_len = 0;
     const double vfh_ms = timeVfhStep();
     const double astar_ms = timeAStar400(&astar_len);
@@ -478,7 +478,7 @@ std::string timingMarkdown(const Args& a, const Episodes& ep) {
        << num(vfh_ms * 1e3, 1) << " us |\n";
     for (const auto& m : a.methods)
         md << "| one MRPT `navigationStep()` with " << shortName(m)
-           << " (3 PTGs, 181-ray laser, all runs) | "
+           << " (" << ptg_count << " PTGs, 181-ray laser, all runs) | "
            << num(devslam::core::median(ep.stepsOf(m)), 3) << " ms |\n";
     md << "| A* on a 400x400 grid (20 m, 5 cm cells, 60 boxes, corner to corner, path "
        << num(astar_len, 1) << " m; 15 plans) | " << num(astar_ms, 1) << " ms |\n"
@@ -545,7 +545,7 @@ int appMain(int argc, char** argv) {
                       << "the pictures were left as they were\n";
             devslam::core::exitBySignal(ep.stopped);
         }
-        md << timingMarkdown(a, ep);
+        md << timingMarkdown(a, ep, ini->read_int("CReactiveNavigationSystem", "PTG_COUNT", 0));
         std::cout << md.str();
         if (!ep.errors.empty()) {
             std::cerr << "devslam-nav-bench: "

@@ -486,8 +486,8 @@ TEST(NavConfig, MrptSectionsAreReadStrictly) {
         EXPECT_NE(k.find(known), std::string::npos) << known;
     EXPECT_EQ(errorOf("CReactiveNavigationSystem", "PTG_COUNT", "0"),
               "x.ini [CReactiveNavigationSystem] PTG_COUNT: must be 1..32, got 0");
-    EXPECT_EQ(errorOf("CReactiveNavigationSystem", "PTG_COUNT", "4"),
-              "x.ini [CReactiveNavigationSystem] PTG3_Type: missing (PTG_COUNT is 4)");
+    EXPECT_EQ(errorOf("CReactiveNavigationSystem", "PTG_COUNT", "5"),
+              "x.ini [CReactiveNavigationSystem] PTG4_Type: missing (PTG_COUNT is 5)");
     EXPECT_EQ(errorOf("CReactiveNavigationSystem", "PTG0_Type", "CPTG_Spiral"),
               "x.ini [CReactiveNavigationSystem] PTG0_Type: unknown PTG class 'CPTG_Spiral'");
     EXPECT_EQ(errorOf("CReactiveNavigationSystem", "PTG0_num_paths", "0"),
