@@ -194,6 +194,31 @@ TEST(IntegrationNav, EveryTargetAroundTheRobotIsInSomePtgsDomain) {
     EXPECT_EQ(std::find(gap.begin(), gap.end(), "60cm@140"), gap.end());
 }
 
+// The one such target MRPT 2.5 cannot take even so: the first of a run, when PTG0 (forward
+// arcs) does not reach it. MRPT compiles its score formulas on PTG0's motion at the first step,
+// and without a PTG0 motion they lack their variables. The run ends as an error whose reason
+// says so, where it blamed speed limits alone.
+TEST(IntegrationNav, AFirstTargetBehindTheStartIsAnErrorThatSaysWhy) {
+    devslam::nav::registerNavClasses();
+    const auto ini = devslam::core::loadIni(kIni);
+    auto world = devslam::sim::loadWorld(kSrc + "/sim_worlds/corridor_people.ini");
+    world.pedestrians.clear();
+    world.timeout = 5;
+    world.goal = {8.0, 1.5};
+    const double d = 0.4, a = 140 * M_PI / 180;  // the goal 0.4 m away at 140 deg
+    world.robot.start = {world.goal.x - d * std::cos(a), world.goal.y - d * std::sin(a), 0.0};
+    const auto r = devslam::sim::runEpisode(world, *ini, navOptions(*ini), {});
+    ASSERT_EQ(r.outcome, devslam::sim::Outcome::Error) << r.reason;
+    EXPECT_NE(r.reason.find("Undefined symbol: 'target_d_norm'"), std::string::npos) << r.reason;
+    EXPECT_NE(r.reason.find("a goal close beside or behind the robot's start"), std::string::npos)
+        << r.reason;
+    // 1 m away at the same bearing, PTG0 reaches it: the robot gets there.
+    world.robot.start = {world.goal.x - std::cos(a), world.goal.y - std::sin(a), 0.0};
+    world.timeout = 20;
+    const auto far = devslam::sim::runEpisode(world, *ini, navOptions(*ini), {});
+    EXPECT_EQ(far.outcome, devslam::sim::Outcome::Success) << far.reason;
+}
+
 // A person stands on the route, 1.5 m ahead, where the map shows nothing: the replanned
 // route goes round them, and so must the straight legs between its waypoints. They were
 // shortened against the static map alone, and cut through the person again.

@@ -468,15 +468,24 @@ NavState Navigator::step(double t) {
         why.error_code == mrpt::nav::CAbstractNavigator::ERR_OTHER) {
         const std::string msg = core::innermostMessage(why.error_msg);
         last_error_ = "MRPT's navigation step failed (settings in " + opts_.source + "?): " + msg;
-        // Both come from MRPT's scoring of a candidate motion whose PTG path does not reach
-        // the distance asked (its assertion leaves the candidate without the formulas'
-        // variables): with the shipped PTGs, measured at robotMax_V_mps 1.7 m/s and above
-        // (1.6 runs), and robotMax_W_degps 360 (200 runs). docs/nav.md.
-        if (msg.find("pt_in_range") != std::string::npos ||
-            msg.find("Undefined symbol: 'target_d_norm'") != std::string::npos)
-            last_error_ += " (MRPT 2.5's PTGs fail so at high speed limits: with the shipped "
-                           "PTGs robotMax_V_mps 1.7 m/s and robotMax_W_degps 360 deg/s did, "
-                           "1.6 and 200 ran; lower ROBOT_MAX_V / ROBOT_MAX_W)";
+        // Both come from MRPT's scoring of candidate motions. pt_in_range: a PTG's path ends
+        // before the distance MRPT asks of it (measured with the shipped PTGs at
+        // robotMax_V_mps 1.7 m/s and robotMax_W_degps 360; 1.6 and 200 run). The undefined
+        // symbol: MRPT 2.5 compiles its score formulas on the first step's first candidate
+        // (PTG0's), whose variables are missing when PTG0 cannot reach the first target (a
+        // goal close beside or behind the start) or when its path fell short as above.
+        // docs/nav.md.
+        const std::string speeds =
+            "with the shipped PTGs robotMax_V_mps 1.7 m/s and robotMax_W_degps 360 deg/s did, "
+            "1.6 and 200 ran; lower ROBOT_MAX_V / ROBOT_MAX_W";
+        if (msg.find("pt_in_range") != std::string::npos)
+            last_error_ += " (a PTG's path ends before the distance MRPT 2.5 asks of it, as at "
+                           "high speed limits: " + speeds + ")";
+        else if (msg.find("Undefined symbol: 'target_d_norm'") != std::string::npos)
+            last_error_ += " (MRPT 2.5 compiles its score formulas on the first PTG's motion at "
+                           "the first step: they lack their variables when that PTG cannot "
+                           "reach the first target, e.g. a goal close beside or behind the "
+                           "robot's start, or at high speed limits: " + speeds + ")";
         active_ = false;
         return NavState::Error;
     }
