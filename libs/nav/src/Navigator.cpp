@@ -468,24 +468,25 @@ NavState Navigator::step(double t) {
         why.error_code == mrpt::nav::CAbstractNavigator::ERR_OTHER) {
         const std::string msg = core::innermostMessage(why.error_msg);
         last_error_ = "MRPT's navigation step failed (settings in " + opts_.source + "?): " + msg;
-        // Both come from MRPT's scoring of candidate motions. pt_in_range: a PTG's path ends
-        // before the distance MRPT asks of it (measured with the shipped PTGs at
-        // robotMax_V_mps 1.7 m/s and robotMax_W_degps 360; 1.6 and 200 run). The undefined
-        // symbol: MRPT 2.5 compiles its score formulas on the first step's first candidate
-        // (PTG0's), whose variables are missing when PTG0 cannot reach the first target (a
-        // goal close beside or behind the start) or when its path fell short as above.
-        // docs/nav.md.
-        const std::string speeds =
-            "with the shipped PTGs robotMax_V_mps 1.7 m/s and robotMax_W_degps 360 deg/s did, "
-            "1.6 and 200 ran; lower ROBOT_MAX_V / ROBOT_MAX_W";
+        // Both come from MRPT's scoring of candidate motions (docs/nav.md). pt_in_range:
+        // MRPT 2.5 asks every path for its point 1 (pseudo)metre along it, which a path of
+        // turning radius v / w under about 0.13 m never reaches (it ends after about 0.975 of
+        // a turn): the shipped PTGs at robotMax_W_degps 360. The undefined symbol: MRPT 2.5
+        // compiles its score formulas once, on PTG0's motion at the navigator's first step,
+        // and that motion has no variables when PTG0 cannot reach the first target: a goal
+        // close beside or behind the start, or any target near the robot when PTG0's
+        // smallest radius v / w grows (robotMax_V_mps 1.7 m/s with the shipped PTGs).
         if (msg.find("pt_in_range") != std::string::npos)
-            last_error_ += " (a PTG's path ends before the distance MRPT 2.5 asks of it, as at "
-                           "high speed limits: " + speeds + ")";
+            last_error_ += " (a PTG's paths end before the 1 m along them MRPT 2.5 asks for "
+                           "when their turning radius v_max / w_max is under about 0.13 m, as "
+                           "the shipped PTGs' at robotMax_W_degps 360 deg/s: lower that PTG's "
+                           "w_max or raise its v_max)";
         else if (msg.find("Undefined symbol: 'target_d_norm'") != std::string::npos)
             last_error_ += " (MRPT 2.5 compiles its score formulas on the first PTG's motion at "
-                           "the first step: they lack their variables when that PTG cannot "
-                           "reach the first target, e.g. a goal close beside or behind the "
-                           "robot's start, or at high speed limits: " + speeds + ")";
+                           "the navigator's first step: they lack their variables when that PTG "
+                           "cannot reach the first target, e.g. a goal close beside or behind "
+                           "the robot's start, or when its smallest turning radius v_max / "
+                           "w_max is large, as the shipped PTG0's at robotMax_V_mps 1.7 m/s)";
         active_ = false;
         return NavState::Error;
     }

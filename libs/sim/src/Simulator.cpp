@@ -249,9 +249,9 @@ struct Simulator::Impl {
             // returns about one hit in 1800 up to 0.8 m away from every box and cylinder in
             // open space (docs/sim.md). Its GJK cast (kF_UseGjkConvexCastRaytest) returns
             // none, but it is not switched on: with it devslam-nav-bench lost 3 of FullEval's
-            // 50 corridor_people runs (1 with this cast) and took about 1.2x the time. (VFH+'s
-            // 2 stalls of 50 with it were goals close behind the robot in no PTG's domain,
-            // since reached by nav_reactive.ini's fourth PTG: docs/sim.md.)
+            // 50 corridor_people runs (1 with this cast). Of VFH+'s 2 stalls of 50 with it,
+            // world 38's was a goal close behind the robot in no PTG's domain, since reached
+            // by nav_reactive.ini's fourth PTG (world 11's was not traced; docs/sim.md).
             cb.m_collisionFilterGroup = btBroadphaseProxy::SensorTrigger;
             cb.m_collisionFilterMask = mask;
             dyn.rayTest(from, to, cb);
