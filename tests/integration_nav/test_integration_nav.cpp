@@ -180,9 +180,8 @@ TEST(IntegrationNav, EveryTargetAroundTheRobotIsInSomePtgsDomain) {
     const auto missed = targetsNoPtgReaches(*ini);
     EXPECT_TRUE(missed.empty()) << missed.size() << " targets, the first " << missed.front();
     // Without it (the first three PTGs only) the gap is there.
-    std::string text, kept;
-    ini->getContent(text);
-    std::istringstream lines(text);
+    std::string kept;
+    std::istringstream lines(readFile(kIni));
     for (std::string line; std::getline(lines, line);)
         if (line.rfind("PTG3_", 0) != 0) kept += line + "\n";
     mrpt::config::CConfigFileMemory three(kept);
@@ -366,10 +365,7 @@ TEST(IntegrationNav, TheIniChoosesTheHolonomicMethod) {
                                        devslam::nav::NavigatorOptions::fromConfig(*ini, kIni), {})
                   .holonomic_method,
               "CHolonomicVFHPlus");
-    std::ifstream in(kIni);
-    std::stringstream text;
-    text << in.rdbuf();
-    mrpt::config::CConfigFileMemory nd(text.str());
+    mrpt::config::CConfigFileMemory nd(readFile(kIni));
     nd.write("navigator", "holonomic_method", "CHolonomicND");
     const auto opts = devslam::nav::NavigatorOptions::fromConfig(nd, "nd.ini");
     EXPECT_EQ(devslam::sim::runEpisode(world, nd, opts, {}).holonomic_method, "CHolonomicND");
@@ -385,10 +381,8 @@ TEST(IntegrationNav, TheIniChoosesTheHolonomicMethod) {
 // navigator is made (a section the chosen method needs is missing) names the INI too.
 TEST(IntegrationNav, MrptErrorsEndTheRunNamingTheIni) {
     auto world = devslam::sim::loadWorld(kSrc + "/sim_worlds/obstacle_near_goal.ini");
-    std::ifstream in(kIni);
-    std::stringstream text;
-    text << in.rdbuf();
-    mrpt::config::CConfigFileMemory bad(text.str());
+    const std::string text = readFile(kIni);
+    mrpt::config::CConfigFileMemory bad(text);
     bad.write("CMultiObjectiveMotionOptimizerBase", "score3_formula", "1/(1+dist_eucl_min^2");
     const auto opts = devslam::nav::NavigatorOptions::fromConfig(bad, "bad.ini");
     const auto r = devslam::sim::runEpisode(world, bad, opts, {});
@@ -404,7 +398,7 @@ TEST(IntegrationNav, MrptErrorsEndTheRunNamingTheIni) {
     // section is MRPT's to judge), MRPT refuses when the navigator is made.
     std::string without;
     {
-        std::istringstream lines(text.str());
+        std::istringstream lines(text);
         bool in_nd = false;
         for (std::string line; std::getline(lines, line);) {
             if (!line.empty() && line[0] == '[') in_nd = line.rfind("[CHolonomicND]", 0) == 0;
@@ -412,7 +406,7 @@ TEST(IntegrationNav, MrptErrorsEndTheRunNamingTheIni) {
         }
     }
     ASSERT_EQ(without.find("\n[CHolonomicND]"), std::string::npos);
-    ASSERT_NE(text.str().find("\n[CHolonomicND]"), std::string::npos);
+    ASSERT_NE(text.find("\n[CHolonomicND]"), std::string::npos);
     mrpt::config::CConfigFileMemory no_nd(without);
     no_nd.write("navigator", "holonomic_method", "CHolonomicND");
     const auto o = devslam::nav::NavigatorOptions::fromConfig(no_nd, "nond.ini");
@@ -427,7 +421,7 @@ TEST(IntegrationNav, MrptErrorsEndTheRunNamingTheIni) {
 
     // An obstacle band above the laser's plane: the robot saw nothing and drove into the
     // first wall (a collision, no word on why). Refused before the run, naming both files.
-    mrpt::config::CConfigFileMemory blind(text.str());
+    mrpt::config::CConfigFileMemory blind(text);
     blind.write("CReactiveNavigationSystem", "min_obstacles_height", "0.5");
     const auto b = devslam::nav::NavigatorOptions::fromConfig(blind, "blind.ini");
     try {
@@ -647,8 +641,7 @@ TEST(IntegrationNav, AppsSmokeTest) {
     {
         // The INI's [navigator] log_file and log_directory work as --navlog does (the
         // episode's own default overrode them).
-        std::ifstream in(kIni);
-        std::string ini((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        std::string ini = readFile(kIni);
         const auto set = [&](const std::string& key, const std::string& value) {
             const std::regex line("\\n" + key + "( *)=[^\\n]*");
             ASSERT_TRUE(std::regex_search(ini, line)) << key;
@@ -762,8 +755,7 @@ TEST(IntegrationNav, AppsSmokeTest) {
     // results: the bench printed 0 % success everywhere, exit 0, and wrote that into the
     // results file. Now it fails, and the file and pictures stay as they were.
     {
-        std::ifstream in(kIni);
-        std::string ini((std::istreambuf_iterator<char>(in)), {});
+        std::string ini = readFile(kIni);
         const std::string good = "score3_formula  = 1/(1+dist_eucl_min^2)";
         ASSERT_NE(ini.find(good), std::string::npos);
         ini.replace(ini.find(good), good.size(), "score3_formula  = 1/(1+dist_eucl_min^");
