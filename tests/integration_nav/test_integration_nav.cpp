@@ -193,30 +193,35 @@ TEST(IntegrationNav, EveryTargetAroundTheRobotIsInSomePtgsDomain) {
     EXPECT_EQ(std::find(gap.begin(), gap.end(), "60cm@140"), gap.end());
 }
 
-// The one such target MRPT 2.5 cannot take even so: the first of a run, when PTG0 (forward
-// arcs) does not reach it. MRPT compiles its score formulas on PTG0's motion at the first step,
-// and without a PTG0 motion they lack their variables. The run ends as an error whose reason
-// says so, where it blamed speed limits alone.
-TEST(IntegrationNav, AFirstTargetBehindTheStartIsAnErrorThatSaysWhy) {
+// A first target PTG0 (forward arcs) does not reach: MRPT 2.5 compiles its score formulas on
+// PTG0's motion at the first step, and PTG0's motion has no variables when the target is out of
+// its domain (at 0.6 m: bearings of 60-120 deg either side): the run ended at its first step
+// ("Undefined symbol: 'target_d_norm'"). The navigator now compiles them when it is made, and
+// the robot gets to a goal beside its start.
+TEST(IntegrationNav, AFirstTargetPtg0DoesNotReachIsReached) {
     devslam::nav::registerNavClasses();
     const auto ini = devslam::core::loadIni(kIni);
+    mrpt::kinematics::CVehicleSimul_DiffDriven kin;
+    mrpt::maps::COccupancyGridMap2D grid;
+    grid.setSize(0, 4, 0, 4, 0.05f, 1.0f);
+    KinematicRobot still(kin, grid);
+    devslam::nav::Navigator nav(still, *ini, navOptions(*ini));
+    const auto* ptg0 = nav.reactive().getPTG(0);
     auto world = devslam::sim::loadWorld(kSrc + "/sim_worlds/corridor_people.ini");
     world.pedestrians.clear();
-    world.timeout = 5;
-    world.goal = {8.0, 1.5};
-    const double d = 0.4, a = 140 * M_PI / 180;  // the goal 0.4 m away at 140 deg
-    world.robot.start = {world.goal.x - d * std::cos(a), world.goal.y - d * std::sin(a), 0.0};
-    const auto r = devslam::sim::runEpisode(world, *ini, navOptions(*ini), {});
-    ASSERT_EQ(r.outcome, devslam::sim::Outcome::Error) << r.reason;
-    EXPECT_LT(r.time, 0.2);  // at the first step
-    EXPECT_NE(r.reason.find("Undefined symbol: 'target_d_norm'"), std::string::npos) << r.reason;
-    EXPECT_NE(r.reason.find("a goal close beside or behind the robot's start"), std::string::npos)
-        << r.reason;
-    // 1 m away at the same bearing, PTG0 reaches it: the robot gets there.
-    world.robot.start = {world.goal.x - std::cos(a), world.goal.y - std::sin(a), 0.0};
     world.timeout = 20;
-    const auto far = devslam::sim::runEpisode(world, *ini, navOptions(*ini), {});
-    EXPECT_EQ(far.outcome, devslam::sim::Outcome::Success) << far.reason;
+    world.goal = {8.0, 1.5};
+    const double d = 0.6;  // the goal tolerance is 0.3 m: the robot must travel
+    for (const int deg : {70, 90, 110, -90}) {
+        const double a = deg * M_PI / 180;
+        int k = 0;
+        double nd = 0;
+        ASSERT_FALSE(ptg0->inverseMap_WS2TP(d * std::cos(a), d * std::sin(a), k, nd)) << deg;
+        world.robot.start = {world.goal.x - d * std::cos(a), world.goal.y - d * std::sin(a), 0.0};
+        const auto r = devslam::sim::runEpisode(world, *ini, navOptions(*ini), {});
+        EXPECT_EQ(r.outcome, devslam::sim::Outcome::Success) << deg << " deg: " << r.reason;
+        EXPECT_GT(r.time, 0.5) << deg;
+    }
 }
 
 // The other failure of MRPT 2.5's scoring: paths too tight to reach 1 m (a turning radius
@@ -375,24 +380,28 @@ TEST(IntegrationNav, TheIniChoosesTheHolonomicMethod) {
               "CHolonomicFullEval");
 }
 
-// What MRPT finds wrong only while navigating (a score formula that does not compile) it
-// logged at every step, and the run went on to a 60 s timeout, the robot standing: it ends
-// the run now, on its first step, as an error naming the INI. What MRPT refuses when the
-// navigator is made (a section the chosen method needs is missing) names the INI too.
+// A score formula that does not compile MRPT found only while navigating: it logged it at
+// every step, and the run went on to a 60 s timeout, the robot standing (then it ended the run
+// at its first step). The navigator compiles the formulas when it is made now: refused before
+// the run, naming the INI and the formula, as what else MRPT refuses then (a section the
+// chosen method needs is missing). What MRPT finds only while navigating ends the run as an
+// error naming the INI (IntegrationNav.PathsTooTightForMrptsScoringAreAnErrorThatSaysWhy).
 TEST(IntegrationNav, MrptErrorsEndTheRunNamingTheIni) {
     auto world = devslam::sim::loadWorld(kSrc + "/sim_worlds/obstacle_near_goal.ini");
     const std::string text = readFile(kIni);
     mrpt::config::CConfigFileMemory bad(text);
     bad.write("CMultiObjectiveMotionOptimizerBase", "score3_formula", "1/(1+dist_eucl_min^2");
     const auto opts = devslam::nav::NavigatorOptions::fromConfig(bad, "bad.ini");
-    const auto r = devslam::sim::runEpisode(world, bad, opts, {});
-    EXPECT_EQ(r.outcome, devslam::sim::Outcome::Error) << r.reason;
-    EXPECT_LT(r.time, 1.0) << r.reason;
-    EXPECT_NE(
-        r.reason.find("navigator error: MRPT's navigation step failed (settings in bad.ini?)"),
-        std::string::npos)
-        << r.reason;
-    EXPECT_NE(r.reason.find("1/(1+dist_eucl_min^2"), std::string::npos) << r.reason;
+    try {
+        (void)devslam::sim::runEpisode(world, bad, opts, {});
+        ADD_FAILURE() << "ran with a score formula that does not compile";
+    } catch (const std::exception& e) {
+        const std::string what = e.what();
+        EXPECT_NE(what.find("bad.ini: MRPT's navigator refuses these settings: "),
+                  std::string::npos)
+            << what;
+        EXPECT_NE(what.find("1/(1+dist_eucl_min^2"), std::string::npos) << what;
+    }
 
     // The INI without its [CHolonomicND] section, and ND chosen: our checks pass (a missing
     // section is MRPT's to judge), MRPT refuses when the navigator is made.
@@ -751,23 +760,46 @@ TEST(IntegrationNav, AppsSmokeTest) {
         // The pictures are linked where they are, relative to the results file (both in out).
         EXPECT_NE(md.find("![success rates](./nav_bench_success.png)"), std::string::npos) << md;
     }
-    // Episodes that all end by an error (a score formula exprtk cannot compile) are no
-    // results: the bench printed 0 % success everywhere, exit 0, and wrote that into the
-    // results file. Now it fails, and the file and pictures stay as they were.
+    // Episodes that all end by an error are no results: the bench printed 0 % success
+    // everywhere, exit 0, and wrote that into the results file. Now it fails, and the file and
+    // pictures stay as they were. The error: a score that is always NaN (MRPT: "Undefined
+    // value evaluating score"), at the first step; it compiles, and the navigator's own
+    // compiling of the formulas before the run evaluates none. A score formula exprtk cannot
+    // compile is refused when the first navigator is made.
     {
         std::string ini = readFile(kIni);
+        const std::string priority = "score6_formula  = ptg_priority";
+        ASSERT_NE(ini.find(priority), std::string::npos);
+        ini.replace(ini.find(priority), priority.size(), "score6_formula  = 0/0");
+        std::ofstream(out + "/nan.ini") << ini;
+        const std::string before = readFile(out + "/RESULTS.md");
+        r = devslam::test::runApp("devslam-nav-bench",
+                                  "--per-category 1 --methods CHolonomicVFHPlus --config " + out +
+                                      "/nan.ini --results " + out + "/RESULTS.md --png-dir " +
+                                      out + "/nan");
+        EXPECT_EQ(r.rc, 1) << r.out;
+        EXPECT_NE(r.out.find("devslam-nav-bench: every episode ended by an error (the first: "),
+                  std::string::npos)
+            << r.out;
+        EXPECT_NE(r.out.find("Undefined value evaluating score `ptg_priority_score`"),
+                  std::string::npos)
+            << r.out;
+        EXPECT_EQ(readFile(out + "/RESULTS.md"), before);
+        EXPECT_FALSE(mrpt::system::directoryExists(out + "/nan"));
+
+        ini = readFile(kIni);
         const std::string good = "score3_formula  = 1/(1+dist_eucl_min^2)";
         ASSERT_NE(ini.find(good), std::string::npos);
         ini.replace(ini.find(good), good.size(), "score3_formula  = 1/(1+dist_eucl_min^");
         std::ofstream(out + "/bad_formula.ini") << ini;
-        const std::string before = readFile(out + "/RESULTS.md");
         r = devslam::test::runApp("devslam-nav-bench", "--per-category 1 --methods "
                                                        "CHolonomicVFHPlus --config " +
                                                            out + "/bad_formula.ini --results " +
                                                            out + "/RESULTS.md --png-dir " + out +
                                                            "/bad_formula");
-        EXPECT_EQ(r.rc, 1) << r.out;
-        EXPECT_NE(r.out.find("devslam-nav-bench: every episode ended by an error (the first: "),
+        EXPECT_EQ(r.rc, 2) << r.out;
+        EXPECT_NE(r.out.find("bad_formula.ini: MRPT's navigator refuses these settings: Error "
+                             "compiling expression (name=`score: euclidean_nearness`)"),
                   std::string::npos)
             << r.out;
         EXPECT_EQ(readFile(out + "/RESULTS.md"), before);

@@ -109,6 +109,48 @@ class ReactiveNav : public mrpt::nav::CReactiveNavigationSystem {
         return colon == std::string::npos ? name : name.substr(colon + 2);
     }
 
+    /// Compiles MRPT's score formulas before the first step. MRPT 2.5 compiles them on the
+    /// first candidate motion it scores, PTG0's, with that motion's variables only; a PTG
+    /// whose domain does not hold the target gives its motion none, so a first target that
+    /// PTG0 cannot reach (close beside or behind the start) ended the run at its first step
+    /// ("Undefined symbol: 'target_d_norm'"). Compiled once, the formulas stay, and a later
+    /// motion without variables scores 0, as every out-of-domain PTG's does at every step.
+    /// Here MRPT's own scorer gives one motion of PTG0, toward a point on its middle path, its
+    /// variables, so they are exactly those of a real step. A formula that does not compile is
+    /// found here, before the run.
+    void compileScoreFormulas() {
+        auto* ptg = getPTG(0);
+        ASSERT_(ptg != nullptr && ptg->isInitialized());
+        const uint16_t k = static_cast<uint16_t>(ptg->getPathCount() / 2);
+        const mrpt::math::TPose2D at = ptg->getPathPose(k, ptg->getPathStepCount(k) / 2);
+        PTGTarget tp;
+        tp.valid_TP = ptg->inverseMap_WS2TP(at.x, at.y, tp.target_k, tp.target_dist);
+        ASSERT_(tp.valid_TP);
+        tp.target_alpha = ptg->index2alpha(tp.target_k);
+        tp.TP_Target = {std::cos(tp.target_alpha) * tp.target_dist,
+                        std::sin(tp.target_alpha) * tp.target_dist};
+        std::vector<double> free_space;
+        ptg->initTPObstacles(free_space);
+        for (auto& d : free_space) d /= ptg->getRefDistance();  // normalised, as in a step
+        mrpt::nav::ClearanceDiagram clearance;
+        ptg->initClearanceDiagram(clearance);
+        std::vector<mrpt::nav::TCandidateMovementPTG> motion(1);
+        motion[0].PTG = ptg;
+        motion[0].direction = tp.target_alpha;
+        motion[0].speed = 1.0;
+        mrpt::nav::CLogFileRecord record;
+        mrpt::nav::CLogFileRecord::TInfoPerPTG info;
+        calc_move_candidate_scores(motion[0], free_space, clearance, {at}, {tp}, info, record,
+                                   false, mrpt::math::TPose2D(0, 0, 0), 0, mrpt::Clock::now(),
+                                   nullptr);
+        // Not evaluated (MRPT scores a motion of speed <= 0 as 0): compiling needs only the
+        // variables' names, and a formula evaluated with this made-up motion's values (the
+        // robot's pose is not known yet) could come out NaN, which MRPT throws on.
+        motion[0].speed = -1.0;
+        mrpt::nav::CMultiObjectiveMotionOptimizerBase::TResultInfo decided;
+        (void)m_multiobjopt->decide(motion, decided);
+    }
+
   private:
     std::vector<std::uint64_t> vfh_steps_;  // per PTG, at markVfhSteps()
 };
@@ -309,6 +351,7 @@ Navigator::Navigator(mrpt::nav::CRobot2NavInterface& robot,
     try {
         nav_->loadConfigFile(cfg);
         nav_->initialize();
+        static_cast<ReactiveNav&>(*nav_).compileScoreFormulas();
     } catch (const std::exception& e) {
         throw std::invalid_argument(opts_.source + ": MRPT's navigator refuses these settings: " +
                                     core::innermostMessage(e.what()));
@@ -468,25 +511,15 @@ NavState Navigator::step(double t) {
         why.error_code == mrpt::nav::CAbstractNavigator::ERR_OTHER) {
         const std::string msg = core::innermostMessage(why.error_msg);
         last_error_ = "MRPT's navigation step failed (settings in " + opts_.source + "?): " + msg;
-        // Both come from MRPT's scoring of candidate motions (docs/nav.md). pt_in_range:
-        // MRPT 2.5 asks every path for its point 1 (pseudo)metre along it, which a path of
-        // turning radius v / w under about 0.13 m never reaches (it ends after about 0.975 of
-        // a turn): the shipped PTGs at robotMax_W_degps 360. The undefined symbol: MRPT 2.5
-        // compiles its score formulas once, on PTG0's motion at the navigator's first step,
-        // and that motion has no variables when PTG0 cannot reach the first target: a goal
-        // close beside or behind the start, or any target near the robot when PTG0's
-        // smallest radius v / w grows (robotMax_V_mps 1.7 m/s with the shipped PTGs).
+        // pt_in_range comes from MRPT's scoring of candidate motions (docs/nav.md): MRPT 2.5
+        // asks every path for its point 1 (pseudo)metre along it, which a path of turning
+        // radius v / w under about 0.13 m never reaches (it ends after about 0.975 of a turn):
+        // the shipped PTGs at robotMax_W_degps 360.
         if (msg.find("pt_in_range") != std::string::npos)
             last_error_ += " (a PTG's paths end before the 1 m along them MRPT 2.5 asks for "
                            "when their turning radius v_max / w_max is under about 0.13 m, as "
                            "the shipped PTGs' at robotMax_W_degps 360 deg/s: lower that PTG's "
                            "w_max or raise its v_max)";
-        else if (msg.find("Undefined symbol: 'target_d_norm'") != std::string::npos)
-            last_error_ += " (MRPT 2.5 compiles its score formulas on the first PTG's motion at "
-                           "the navigator's first step: they lack their variables when that PTG "
-                           "cannot reach the first target, e.g. a goal close beside or behind "
-                           "the robot's start, or when its smallest turning radius v_max / "
-                           "w_max is large, as the shipped PTG0's at robotMax_V_mps 1.7 m/s)";
         active_ = false;
         return NavState::Error;
     }
