@@ -775,8 +775,8 @@ TEST(IntegrationNav, AppsSmokeTest) {
         const std::string before = readFile(out + "/RESULTS.md");
         r = devslam::test::runApp("devslam-nav-bench",
                                   "--per-category 1 --methods CHolonomicVFHPlus --config " + out +
-                                      "/nan.ini --results " + out + "/RESULTS.md --png-dir " +
-                                      out + "/nan");
+                                      "/nan.ini --results " + out + "/RESULTS.md --png-dir " + out +
+                                      "/nan");
         EXPECT_EQ(r.rc, 1) << r.out;
         EXPECT_NE(r.out.find("devslam-nav-bench: every episode ended by an error (the first: "),
                   std::string::npos)

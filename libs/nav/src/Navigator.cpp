@@ -516,10 +516,11 @@ NavState Navigator::step(double t) {
         // radius v / w under about 0.13 m never reaches (it ends after about 0.975 of a turn):
         // the shipped PTGs at robotMax_W_degps 360.
         if (msg.find("pt_in_range") != std::string::npos)
-            last_error_ += " (a PTG's paths end before the 1 m along them MRPT 2.5 asks for "
-                           "when their turning radius v_max / w_max is under about 0.13 m, as "
-                           "the shipped PTGs' at robotMax_W_degps 360 deg/s: lower that PTG's "
-                           "w_max or raise its v_max)";
+            last_error_ +=
+                " (a PTG's paths end before the 1 m along them MRPT 2.5 asks for "
+                "when their turning radius v_max / w_max is under about 0.13 m, as "
+                "the shipped PTGs' at robotMax_W_degps 360 deg/s: lower that PTG's "
+                "w_max or raise its v_max)";
         active_ = false;
         return NavState::Error;
     }
