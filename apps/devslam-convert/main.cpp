@@ -44,7 +44,7 @@ bool isRawlog(const std::string& out) {
 
 /// The writers open their output before the first frame is read: an output that is the
 /// input (or holds another sequence) would be emptied before it was read.
-void refuseOverwritingInput(const std::string& in, const std::string& out) {
+void refuseOverwritingInput(const std::string& in, const std::string& out, bool external) {
     namespace fs = std::filesystem;
     if (devslam::core::sameFile(in, out))
         throw std::invalid_argument("OUTPUT '" + out + "' is the input '" + in +
@@ -58,6 +58,23 @@ void refuseOverwritingInput(const std::string& in, const std::string& out) {
         throw std::invalid_argument("OUTPUT '" + out +
                                     "' already holds a TUM sequence (rgb.txt); remove it or name "
                                     "another folder");
+    // Nor what else the TUM writer writes there: a folder without rgb.txt had its ground
+    // truth, camera.ini and images replaced without a word (devslam-synth refuses them too).
+    if (!isRawlog(out))
+        for (const char* name : {"depth.txt", "groundtruth.txt", "camera.ini", "rgb", "depth"})
+            if (const auto p = fs::path(out) / name; fs::exists(p) || fs::is_symlink(p))
+                throw std::invalid_argument("OUTPUT '" + out + "' already holds " + name +
+                                            ", which the conversion would write over; remove "
+                                            "it or name another folder");
+    // A rawlog's external images go to <name>_Images/: one there (an older conversion's, or
+    // anyone's) had its images replaced and the rest left beside the new ones.
+    if (isRawlog(out) && external)
+        if (const auto images = devslam::io::rawlogImagesDir(out);
+            fs::is_symlink(images) || (fs::exists(images) && !fs::is_directory(images)) ||
+            (fs::is_directory(images) && !fs::is_empty(images)))
+            throw std::invalid_argument("OUTPUT '" + out + "': its images' folder '" + images +
+                                        "' is already there and not empty; remove it or name "
+                                        "another rawlog");
 }
 
 struct Args {
@@ -220,7 +237,7 @@ int convert(int argc, char** argv) {
         const auto parsed = parseArgs(argc, argv);
         if (const int* rc = std::get_if<int>(&parsed)) return *rc;
         const Args& args = std::get<Args>(parsed);
-        refuseOverwritingInput(args.input, args.output);
+        refuseOverwritingInput(args.input, args.output, args.wo.external_images);
         auto reader = devslam::io::openRgbd(args.input, args.ro);
         // Each observation of a rawlog carries its own camera: --camera was ignored, and the
         // output kept the rawlog's intrinsics without a word.

@@ -112,6 +112,21 @@ TEST(Camera, ConfigRoundTripAndErrors) {
     } catch (const std::invalid_argument& e) {
         EXPECT_EQ(std::string(e.what()), "[camera] fx/fy: must be in [1, 1e5] px");
     }
+    // problem()'s bound on the distortion, which the file's reader lacked: a TUM folder's
+    // camera.ini with k1 = 1e9 lost every frame after the first, naming no file.
+    mrpt::config::CConfigFileMemory wild("[camera]\npreset = fr1\ndist = [1e9 0 0 0 0]\n");
+    try {
+        (void)CameraIntrinsics::fromConfig(wild, "camera");
+        ADD_FAILURE() << "k1 = 1e9 accepted";
+    } catch (const std::invalid_argument& e) {
+        EXPECT_EQ(std::string(e.what()).rfind("[camera] dist: each coefficient must be in "
+                                              "[-100, 100]",
+                                              0),
+                  0u)
+            << e.what();
+    }
+    mrpt::config::CConfigFileMemory fisheye("[camera]\npreset = fr1\ndist = [-100 0 0 0 100]\n");
+    EXPECT_EQ(CameraIntrinsics::fromConfig(fisheye, "camera").dist[4], 100);
     EXPECT_EQ(CameraIntrinsics::fromPreset("fr3").problem(), "");
     auto B = CameraIntrinsics::fromPreset("fr1");
     B.fy = std::numeric_limits<double>::infinity();

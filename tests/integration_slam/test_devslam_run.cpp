@@ -977,6 +977,37 @@ TEST(DevslamRun, AnUndecodableFrameMidRunKeepsTheFramesBeforeIt) {
         EXPECT_NE(c.out.find("already holds a TUM sequence (rgb.txt)"), std::string::npos) << c.out;
     }
     EXPECT_EQ(lines(dir / "part" / "rgb.txt"), 5u);
+    // Nor a folder without rgb.txt that holds what the TUM writer writes: its ground truth and
+    // images were replaced without a word.
+    fs::create_directories(dir / "other" / "rgb");
+    std::ofstream(dir / "other" / "groundtruth.txt") << "# mine\n";
+    c = devslam::test::runApp("devslam-convert",
+                              (dir / "rest.rawlog").string() + " " + (dir / "other").string());
+    EXPECT_EQ(c.rc, 1) << c.out;
+    EXPECT_NE(c.out.find("OUTPUT '" + (dir / "other").string() +
+                         "' already holds groundtruth.txt, which the conversion would write over"),
+              std::string::npos)
+        << c.out;
+    EXPECT_EQ(fs::file_size(dir / "other" / "groundtruth.txt"), 7u);  // "# mine\n", kept
+    // ... nor a rawlog's images folder that holds images: they were replaced, an older
+    // conversion's extra frames left beside the new ones. An empty one is taken.
+    fs::create_directories(dir / "ext_Images");
+    std::ofstream(dir / "ext_Images" / "frame_0_rgb.png") << "mine";
+    c = devslam::test::runApp("devslam-convert", (dir / "rest.rawlog").string() + " " +
+                                                     (dir / "ext.rawlog").string() + " --external");
+    EXPECT_EQ(c.rc, 1) << c.out;
+    EXPECT_NE(c.out.find("its images' folder '" + (dir / "ext_Images").string() +
+                         "' is already there and not empty"),
+              std::string::npos)
+        << c.out;
+    EXPECT_FALSE(fs::exists(dir / "ext.rawlog"));
+    EXPECT_EQ(fs::file_size(dir / "ext_Images" / "frame_0_rgb.png"), 4u);
+    fs::remove_all(dir / "ext_Images");
+    fs::create_directories(dir / "ext_Images");
+    c = devslam::test::runApp("devslam-convert", (dir / "rest.rawlog").string() + " " +
+                                                     (dir / "ext.rawlog").string() + " --external");
+    EXPECT_EQ(c.rc, 0) << c.out;
+    EXPECT_TRUE(fs::exists(dir / "ext_Images" / "frame_0_rgb.png"));
     fs::remove_all(dir);
 }
 

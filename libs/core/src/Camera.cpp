@@ -107,6 +107,12 @@ CameraIntrinsics CameraIntrinsics::fromConfig(const mrpt::config::CConfigFileBas
     if (const auto dist_text = readTextIfPresent(c, s, "dist")) {
         const auto d = parseNumberList(*dist_text, "[" + s + "] dist");
         requireValue(d.size() == 5, s, "dist", "must have 5 values k1 k2 p1 p2 k3");
+        // problem()'s bound: a TUM folder's camera.ini with k1 = 1e9 was taken, and the run
+        // lost every frame after the first without a word on the file
+        for (const double v : d)
+            requireValue(std::abs(v) <= 100, s, "dist",
+                         "each coefficient must be in [-100, 100] (a real lens, a fisheye "
+                         "too, stays well inside)");
         std::copy(d.begin(), d.end(), K.dist.begin());
     }
     requireValue(usableFocal(K.fx) && usableFocal(K.fy), s, "fx/fy", "must be in [1, 1e5] px");
