@@ -36,6 +36,7 @@
 #include <optional>
 
 #include <sys/wait.h>
+#include <unistd.h>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -346,6 +347,14 @@ std::optional<Args> parseArgs(int argc, char** argv) {
         } else
             throw std::invalid_argument("unknown option '" + k + "'\n" + kUsage);
     }
+    // The programs it runs: a --bin without them was reported as devslam-run refusing the
+    // SLAM INI (exit 127, "not found").
+    for (const char* app : {"devslam-run", "devslam-synth"})
+        if (const auto p = fs::path(a.bin) / app;
+            !fs::is_regular_file(p) || ::access(p.c_str(), X_OK) != 0)
+            throw std::invalid_argument("--bin '" + a.bin + "': no program " + app +
+                                        " there (the folder of devslam-bench's own build by "
+                                        "default)");
     return a;
 }
 

@@ -188,6 +188,13 @@ int run(int argc, char** argv) {
     // The same scene and motion, other noise and panel crops: renders to tell a setting's
     // effect from the SLAM's sensitivity to small changes (docs/render.md).
     if (seed) sc.seed = *seed;
+    // A cap, as devslam-bench passes it to every sequence; more than the scenario has rendered
+    // the scenario's frames without a word on the number asked for.
+    if (frames > sc.n_frames)
+        std::cerr << "devslam-synth: --frames " << frames << ": scenario " << sc.name << " has "
+                  << sc.n_frames << " frames ([scenario] n_frames, or duration x rate_hz), "
+                  << "and renders them all; --set scenario.n_frames=N or scenario.duration=S "
+                  << "(the one it gives) makes it longer\n";
     // What devslam-bench asks of each synthetic sequence before its renders: a name it does
     // not know, a --set key the scenario lacks or a photo that does not decode stopped the
     // bench at that sequence's render, after the others'.

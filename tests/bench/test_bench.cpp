@@ -624,6 +624,18 @@ TEST(DevslamBench, AnOlderBuildWithoutTheChecksIsRunWithoutThem) {
               1u)
         << said;
     EXPECT_NE(said.find("devslam-synth failed for a of "), std::string::npos) << said;
+
+    // A --bin without the programs: said so, where it was "devslam-run refuses its SLAM INI
+    // ... (exit 127): ... not found".
+    fs::remove(tmp / "bin" / "devslam-run");
+    const std::string none = "'" + std::string(DEVSLAM_BIN_DIR) + "/devslam-bench' --config '" +
+                             (tmp / "bench.ini").string() + "' --out '" + (tmp / "out").string() +
+                             "' --results none --bin '" + (tmp / "bin").string() + "' > '" +
+                             (tmp / "log.txt").string() + "' 2>&1";
+    EXPECT_NE(std::system(none.c_str()), 0);
+    EXPECT_EQ(readFile(tmp / "log.txt"), "devslam-bench: --bin '" + (tmp / "bin").string() +
+                                             "': no program devslam-run there (the folder of "
+                                             "devslam-bench's own build by default)\n");
 }
 
 TEST(DevslamBench, BadIniIsRefusedNamingSectionAndKey) {

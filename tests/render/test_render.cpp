@@ -663,6 +663,16 @@ TEST(DevslamSynth, CheckReadsTheScenarioAndRendersNothing) {
                          "xyz, 2 people; checked, nothing rendered"),
               std::string::npos)
         << r.out;
+    EXPECT_EQ(r.out.find("--frames 10:"), std::string::npos) << r.out;
+    // --frames is a cap: more than the scenario has renders its frames, and says so (it
+    // rendered 60 without a word on the 100 asked for).
+    r = devslam::test::runApp("devslam-synth", "short_walking --check --frames 100");
+    ASSERT_EQ(r.rc, 0) << r.out;
+    EXPECT_NE(r.out.find(": 60 frames at 30 Hz"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("devslam-synth: --frames 100: scenario short_walking has 60 frames "
+                         "([scenario] n_frames, or duration x rate_hz), and renders them all"),
+              std::string::npos)
+        << r.out;
     for (const auto& [args, says] : std::vector<std::pair<std::string, std::string>>{
              {"short_walking --check --set person_1.sped=1",
               "short_walking.ini with --set [person_1]: unknown key 'sped'"},
