@@ -88,11 +88,16 @@ int planOnSlamMap(const std::string& map, const std::string& from, const std::st
     if (!plan.path) {
         std::printf("result=no_path png=%s\n", png.c_str());
     } else {
+        // A map without an obstacle has no clearance to give: "none", as a run's line says,
+        // where it printed the planner's placeholder (1000000.000 m).
+        char clearance[32] = "none";
+        if (plan.min_clearance < 1e5)
+            std::snprintf(clearance, sizeof clearance, "%.3f m", plan.min_clearance);
         std::printf(
-            "result=path length=%.2f m waypoints=%zu min_clearance=%.3f m "
+            "result=path length=%.2f m waypoints=%zu min_clearance=%s "
             "unknown=%.0f%% png=%s\n",
-            plan.path->length, plan.waypoints.size(), plan.min_clearance,
-            100.0 * plan.unknown_fraction, png.c_str());
+            plan.path->length, plan.waypoints.size(), clearance, 100.0 * plan.unknown_fraction,
+            png.c_str());
         for (const auto& w : plan.waypoints) std::printf("waypoint %.2f %.2f\n", w.x, w.y);
     }
     std::fflush(stdout);
@@ -139,7 +144,13 @@ static int appMain(int argc, char** argv) {
     }
     for (int i = 1; i < argc; i++) {
         const std::string a = argv[i];
-        auto next = [&] { return devslam::core::optionValue(argc, argv, i); };
+        // An empty value (a script's unset variable) was taken as no option: --png '' wrote
+        // the default picture, --navlog '' no navlog, --map '' beside a world was dropped.
+        auto next = [&] {
+            std::string v = devslam::core::optionValue(argc, argv, i);
+            if (v.empty()) throw std::invalid_argument(a + " is empty");
+            return v;
+        };
         try {
             if (a == "--config")
                 config = next();

@@ -933,6 +933,11 @@ TEST(IntegrationNav, OptionWithoutValueIsNamed) {
               "devslam-nav: --method needs a value"},
              {"devslam-nav", world + " --png", "devslam-nav: --png needs a value"},
              {"devslam-nav", "--map --to 1,0", "devslam-nav: --map needs a value"},
+             // an empty value (a script's unset variable) was no option: --png '' wrote the
+             // default picture into ./out
+             {"devslam-nav", world + " --png ''", "devslam-nav: --png is empty"},
+             {"devslam-nav", world + " --navlog ''", "devslam-nav: --navlog is empty"},
+             {"devslam-nav", world + " --map ''", "devslam-nav: --map is empty"},
              {"devslam-nav-bench", "--quick --png-dir --methods CHolonomicND",
               "--png-dir needs a value"}}) {
         const auto r = devslam::test::runApp(app, args);

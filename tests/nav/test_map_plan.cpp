@@ -134,4 +134,21 @@ TEST(MapPlan, DevslamNavPlansOnAMapFile) {
     EXPECT_NE(out.find("goal (2, 0) is inside an obstacle"), std::string::npos) << out;
     EXPECT_EQ(run("--map " + file, out), 2) << out;
     EXPECT_NE(out.find("--map needs --to X,Y"), std::string::npos) << out;
+    // A map without an obstacle: its clearance is "none", not the planner's placeholder
+    // (min_clearance=1000000.000 m).
+    mrpt::maps::COccupancyGridMap2D open;
+    open.setSize(-1, 5, -1, 1, 0.05f, 1.0f);
+    save(open, d.str("open.gridmap"));
+    EXPECT_EQ(run("--map " + d.str("open.gridmap") + " --to 4,0 --png " + d.str("o.png"), out), 0)
+        << out;
+    EXPECT_NE(out.find(" min_clearance=none "), std::string::npos) << out;
+    // More cells than the planner takes (1e8): refused when read, naming the file (30000 x
+    // 30000 cells took 9.7 GB before std::bad_alloc).
+    mrpt::maps::COccupancyGridMap2D big;
+    big.setSize(0, 10001 * 0.05f, 0, 10000 * 0.05f, 0.05f, 0.5f);
+    ASSERT_GT(double(big.getSizeX()) * big.getSizeY(), 1e8);
+    save(big, d.str("big.gridmap"));
+    EXPECT_EQ(run("--map " + d.str("big.gridmap") + " --to 1,1", out), 2) << out;
+    EXPECT_NE(out.find(d.str("big.gridmap") + ": the grid map has "), std::string::npos) << out;
+    EXPECT_NE(out.find(" cells, more than the planner takes (1e8)"), std::string::npos) << out;
 }

@@ -465,6 +465,28 @@ TEST(NavConfig, MrptSectionsAreReadStrictly) {
               "x.ini [CHolonomicFullEval] PHASE1_FACTORS: factor indices must be integers 0..6");
     EXPECT_EQ(errorOf("CHolonomicFullEval", "PHASE2_THRESHOLD", "1.5"),
               "x.ini [CHolonomicFullEval] PHASE2_THRESHOLD: must be in [0, 1]");
+    // (2026-12-07, a bad-input sweep) weights MRPT asserted on at the first step, with a stack
+    // trace: a phase whose factors weigh 0 in all, and negative weights.
+    EXPECT_EQ(errorOf("CHolonomicFullEval", "factorWeights", "1 1 1 1 1 1 0"),
+              "x.ini [CHolonomicFullEval] PHASE1_FACTORS: the factorWeights of these factors sum "
+              "to 0; a phase needs a weight above 0");
+    EXPECT_EQ(errorOf("CHolonomicFullEval", "factorWeights", "1 1 1 1 -1 1 1"),
+              "x.ini [CHolonomicFullEval] factorWeights: must be >= 0");
+    EXPECT_EQ(errorOf("CHolonomicND", "factorWeights", "1 -0.5 1 1"),
+              "x.ini [CHolonomicND] factorWeights: must be >= 0");
+    // PTG settings MRPT took with a message naming no key and a PTG it then ran without (the
+    // alpha constants at 0), or refused mid-sentence (2 paths, fewer than the 15 its
+    // clearance analysis takes), or failed with at the first step (paths shorter than the
+    // 1 m MRPT 2.5's scoring asks for).
+    EXPECT_EQ(errorOf("CReactiveNavigationSystem", "PTG1_cte_a0v_deg", "0"),
+              "x.ini [CReactiveNavigationSystem] PTG1_cte_a0v_deg: must be > 0");
+    EXPECT_EQ(errorOf("CReactiveNavigationSystem", "PTG0_num_paths", "2"),
+              "x.ini [CReactiveNavigationSystem] PTG0_num_paths: must be at least "
+              "PTG0_clearance_decimated_paths (15)");
+    EXPECT_EQ(errorOf("CReactiveNavigationSystem", "PTG0_num_paths", "15"), "");
+    EXPECT_EQ(errorOf("CReactiveNavigationSystem", "PTG3_refDistance", "0.9"),
+              "x.ini [CReactiveNavigationSystem] PTG3_refDistance: must be at least 1 m (MRPT "
+              "2.5 scores each path at its point 1 m along it)");
     EXPECT_EQ(errorOf("CHolonomicVFF", "TARGET_ATTRACTIVE_FORCE", "-20"),
               "x.ini [CHolonomicVFF] TARGET_ATTRACTIVE_FORCE: must be > 0");
     EXPECT_EQ(errorOf("CHolonomicVFF", "TARGET_SLOW_APPROACHING_DISTANCE", "-0.1"),

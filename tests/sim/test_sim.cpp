@@ -140,6 +140,24 @@ TEST(World, BadEntriesNameTheKey) {
     EXPECT_EQ(errorOf(head + "[laser]\nrays = 100000\nrate_hz = 100\n"),
               "w.ini [laser] rays: 100000 rays at 100 Hz over the 60 s timeout are 6e+08 ray "
               "casts (at most 1e8)");
+    // 100 people (with the 4 walls) over 1e6 steps are 1.04e10 person-obstacle tests, about
+    // three minutes: refused (2000 among 2000 obstacles passed, some 17 hours for a run).
+    {
+        std::string crowd = "[world]\nx_min=0\nx_max=50\ny_min=0\ny_max=50\ntimeout=10000\n"
+                            "[robot]\nstart_x=1\nstart_y=1\n[goal]\nx=4\ny=4\n"
+                            "[laser]\nrate_hz=1\n[pedestrians]\n";
+        for (int i = 0; i < 100; i++)
+            crowd += "p" + std::to_string(i) + " = random 0.5 0.2 0 " +
+                     std::to_string(10 + (i % 10) * 3) + " " + std::to_string(10 + (i / 10) * 3) +
+                     "\n";
+        EXPECT_EQ(errorOf(crowd),
+                  "w.ini [pedestrians] p0: 100 people among 4 obstacles over 1e+06 physics "
+                  "steps are 1.04e+10 person-obstacle tests (at most 1e10): fewer people or "
+                  "obstacles, or a shorter [world] timeout");
+        const std::string shorter = "timeout=10000";
+        crowd.replace(crowd.find(shorter), shorter.size(), "timeout=9000");
+        EXPECT_EQ(errorOf(crowd), "");
+    }
     // The key that is wrong is the one named (they were max_v, x_min, start_x for all).
     EXPECT_EQ(errorOf(head + "[robot]\nmax_ang_acc_deg = 0\n"),
               "w.ini [robot] max_ang_acc_deg: speed and acceleration limits must be > 0");

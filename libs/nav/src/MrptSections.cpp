@@ -200,11 +200,19 @@ void checkMrptSections(const mrpt::config::CConfigFileBase& c, const std::string
                 core::requireValue(w.size() == n, section, "factorWeights",
                                    "expected " + std::to_string(n) + " numbers, got " +
                                        std::to_string(w.size()));
+                for (const double x : w)
+                    core::requireValue(x >= 0, section, "factorWeights", "must be >= 0");
             }
         // FullEval's phases: MRPT indexes factorWeights with PHASE<i>_FACTORS and asserts
         // PHASE_COUNT >= 1 only inside each navigation step.
         const std::string fe = "CHolonomicFullEval";
         const std::size_t n_factors = CHolonomicFullEval::TOptions().factorWeights.size();
+        const CHolonomicFullEval::TOptions fe_defaults;
+        std::vector<double> fe_weights(fe_defaults.factorWeights.begin(),
+                                       fe_defaults.factorWeights.end());
+        if (c.keyExists(fe, "factorWeights"))
+            fe_weights = core::parseNumberList(c.read_string(fe, "factorWeights", ""),
+                                               "[" + fe + "] factorWeights");
         if (c.keyExists(fe, "PHASE_COUNT")) {
             const int phases = core::readInt(c, fe, "PHASE_COUNT", 0);
             core::requireValue(phases >= 1 && phases <= 16, fe, "PHASE_COUNT", "must be 1..16");
@@ -216,10 +224,17 @@ void checkMrptSections(const mrpt::config::CConfigFileBase& c, const std::string
                                    "missing (PHASE_COUNT is " + std::to_string(phases) + ")");
                 const auto f = core::parseNumberList(c.read_string(fe, k, ""), "[" + fe + "] " + k);
                 core::requireValue(!f.empty(), fe, k, "expected factor indices");
-                for (const double x : f)
+                double sum = 0;
+                for (const double x : f) {
                     core::requireValue(
                         x >= 0 && x < static_cast<double>(n_factors) && x == std::floor(x), fe, k,
                         "factor indices must be integers 0.." + std::to_string(n_factors - 1));
+                    sum += fe_weights[static_cast<std::size_t>(x)];
+                }
+                // (MRPT asserts it at every step: the run ended at its first, with a stack trace)
+                core::requireValue(sum > 0, fe, k,
+                                   "the factorWeights of these factors sum to 0; a phase needs a "
+                                   "weight above 0");
                 const double th = core::readDouble(c, fe, t, 0.0);
                 core::requireValue(th >= 0 && th <= 1, fe, t, "must be in [0, 1]");
             }
@@ -282,11 +297,23 @@ void checkMrptSections(const mrpt::config::CConfigFileBase& c, const std::string
     for (int i = 0; i < n; ++i) {
         const std::string prefix = "PTG" + std::to_string(i) + "_";
         core::namingSource(source, [&] {
-            for (const char* k :
-                 {"num_paths", "resolution", "refDistance", "v_max_mps", "w_max_dps"})
+            // (the alpha PTG's constants at 0: MRPT printed "Simulation aborted: unexpected
+            // exception!" and ran without the PTG, naming no key)
+            for (const char* k : {"num_paths", "resolution", "refDistance", "v_max_mps",
+                                  "w_max_dps", "cte_a0v_deg", "cte_a0w_deg"})
                 if (c.keyExists(s, prefix + k))
                     core::requireValue(core::readDouble(c, s, prefix + k, 0.0) > 0, s, prefix + k,
                                        "must be > 0");
+            // MRPT's clearance analysis takes clearance_decimated_paths (15) of the paths:
+            // fewer paths stopped on an assertion that ends mid-sentence.
+            if (c.keyExists(s, prefix + "num_paths")) {
+                const double decimated =
+                    core::readDouble(c, s, prefix + "clearance_decimated_paths", 15.0);
+                core::requireValue(core::readDouble(c, s, prefix + "num_paths", 0.0) >= decimated,
+                                   s, prefix + "num_paths",
+                                   "must be at least " + prefix + "clearance_decimated_paths (" +
+                                       std::to_string(static_cast<int>(decimated)) + ")");
+            }
             // Bounds on what MRPT builds at the start, silently: 10000 paths ran for minutes
             // (1000: 7 s), a collision grid of 0.0001 m cells or a 1000 m reference distance
             // ran out of memory ("std::bad_alloc", no key named).
@@ -297,6 +324,13 @@ void checkMrptSections(const mrpt::config::CConfigFileBase& c, const std::string
             if (c.read_string(s, prefix + "Type", "").rfind("CPTG_DiffDrive", 0) != 0) return;
             const double res = core::readDouble(c, s, prefix + "resolution", 0.05);
             const double ref = core::readDouble(c, s, prefix + "refDistance", 2.5);
+            // MRPT 2.5's scoring asks each path for its point 1 m along it: a shorter
+            // reference distance failed at the first step ("Assert condition failed:
+            // pt_in_range", 0.9 m; 0.05 m: "step < m_trajectory[k].size()").
+            if (c.keyExists(s, prefix + "refDistance"))
+                core::requireValue(ref >= 1.0, s, prefix + "refDistance",
+                                   "must be at least 1 m (MRPT 2.5 scores each path at its "
+                                   "point 1 m along it)");
             const double side = 2 * ref / res;
             std::ostringstream m;
             m << "with " << prefix << "refDistance " << ref << " m and " << prefix

@@ -431,6 +431,20 @@ void validatePedestrians(const WorldSpec& w, const std::vector<Obstacle>& static
         m << "(" << q.x << ", " << q.y << ")";
         return m.str();
     };
+    // Each physics step tests every person against every obstacle and person (about 12 ns a
+    // pair): 2000 people among 2000 obstacles passed every other check and simulated 1.6 s a
+    // second, a blocked goal some 17 hours. 1e10 pair tests are about two minutes.
+    if (const double pairs = double(w.pedestrians.size()) *
+                             double(statics.size() + w.pedestrians.size()) *
+                             (w.timeout / w.time_step);
+        pairs > 1e10) {
+        std::ostringstream m;
+        m << w.pedestrians.size() << " people among " << statics.size() << " obstacles over "
+          << w.timeout / w.time_step << " physics steps are " << pairs
+          << " person-obstacle tests (at most 1e10): fewer people or obstacles, or a shorter "
+             "[world] timeout";
+        fail(src, "pedestrians", w.pedestrians.front().name, m.str());
+    }
     for (const auto& p : w.pedestrians) {
         if (p.path.empty()) fail(src, "pedestrians", p.name, "no position given");
         if (p.speed > 5) fail(src, "pedestrians", p.name, "speed must be at most 5 m/s");
