@@ -143,9 +143,10 @@ TEST(World, BadEntriesNameTheKey) {
     // 100 people (with the 4 walls) over 1e6 steps are 1.04e10 person-obstacle tests, about
     // three minutes: refused (2000 among 2000 obstacles passed, some 17 hours for a run).
     {
-        std::string crowd = "[world]\nx_min=0\nx_max=50\ny_min=0\ny_max=50\ntimeout=10000\n"
-                            "[robot]\nstart_x=1\nstart_y=1\n[goal]\nx=4\ny=4\n"
-                            "[laser]\nrate_hz=1\n[pedestrians]\n";
+        std::string crowd =
+            "[world]\nx_min=0\nx_max=50\ny_min=0\ny_max=50\ntimeout=10000\n"
+            "[robot]\nstart_x=1\nstart_y=1\n[goal]\nx=4\ny=4\n"
+            "[laser]\nrate_hz=1\n[pedestrians]\n";
         for (int i = 0; i < 100; i++)
             crowd += "p" + std::to_string(i) + " = random 0.5 0.2 0 " +
                      std::to_string(10 + (i % 10) * 3) + " " + std::to_string(10 + (i / 10) * 3) +
