@@ -80,8 +80,16 @@ int planOnSlamMap(const std::string& map, const std::string& from, const std::st
                                              devslam::nav::refDistanceOf(*ini));
     });
     const auto grid = devslam::nav::loadGridMap(map);
-    const auto plan = devslam::nav::planOnMap(grid, parsePoint(from, "--from"),
-                                              parsePoint(to, "--to"), opts);
+    const auto start = parsePoint(from, "--from"), goal = parsePoint(to, "--to");
+    // The planner's refusal names its "start" or "goal": said as the options and the map
+    // file ("global planner: goal (100, 0) is outside the map ..." named neither).
+    const auto plan = [&] {
+        try {
+            return devslam::nav::planOnMap(grid, start, goal, opts);
+        } catch (const devslam::nav::PlanningError& e) {
+            throw std::invalid_argument(map + ", --from " + from + " --to " + to + ": " + e.what());
+        }
+    }();
     if (png.empty()) png = kDefaultDir + "/plan.png";
     std::printf("map=%s from=(%.2f, %.2f) to=(%.2f, %.2f) ", map.c_str(), plan.from.x,
                 plan.from.y, plan.to.x, plan.to.y);

@@ -132,6 +132,9 @@ TEST(MapPlan, DevslamNavPlansOnAMapFile) {
     EXPECT_TRUE(fs::exists(d.str("p.png")));
     EXPECT_EQ(run("--map " + file + " --from 0,0 --to 2,0", out), 2) << out;
     EXPECT_NE(out.find("goal (2, 0) is inside an obstacle"), std::string::npos) << out;
+    EXPECT_NE(out.find("devslam-nav: " + file + ", --from 0,0 --to 2,0: global planner: "),
+              std::string::npos)
+        << out;  // the options and the file named, not only the planner's "goal"
     EXPECT_EQ(run("--map " + file, out), 2) << out;
     EXPECT_NE(out.find("--map needs --to X,Y"), std::string::npos) << out;
     // A map without an obstacle: its clearance is "none", not the planner's placeholder

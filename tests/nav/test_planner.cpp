@@ -523,7 +523,39 @@ TEST(NavConfig, MrptSectionsAreReadStrictly) {
               "and PTG1_resolution 0.0001 m, the collision grid has 50000 x 50000 cells (at most "
               "3000 x 3000)");
     EXPECT_EQ(errorOf("CAbstractPTGBasedReactive", "speedfilter_tau", "-1"),
-              "x.ini [CAbstractPTGBasedReactive] speedfilter_tau: must be >= 0 s");
+              "x.ini [CAbstractPTGBasedReactive] speedfilter_tau: must be in [0, 10] s");
+    // Taken unchecked until 2026-12-07 (a bad-input sweep): a filter that never lets the
+    // robot speed up, a slow-down ramp beyond the paths, counters and a timeout of 0 or
+    // below, a C PTG's direction other than +-1, a negative priority.
+    EXPECT_EQ(errorOf("CAbstractPTGBasedReactive", "speedfilter_tau", "1e9"),
+              "x.ini [CAbstractPTGBasedReactive] speedfilter_tau: must be in [0, 10] s");
+    EXPECT_EQ(errorOf("CAbstractPTGBasedReactive", "secure_distance_end", "5"),
+              "x.ini [CAbstractPTGBasedReactive] secure_distance_end: must be at most 1 (a "
+              "fraction of each PTG's refDistance)");
+    EXPECT_EQ(errorOf("CAbstractNavigator", "alarm_seems_not_approaching_target_timeout", "0"),
+              "x.ini [CAbstractNavigator] alarm_seems_not_approaching_target_timeout: must be "
+              "> 0 s");
+    EXPECT_EQ(errorOf("CAbstractNavigator", "hysteresis_check_target_is_blocked", "-3"),
+              "x.ini [CAbstractNavigator] hysteresis_check_target_is_blocked: must be >= 1 "
+              "[steps]");
+    EXPECT_EQ(errorOf("CWaypointsNavigator", "min_timesteps_confirm_skip_waypoints", "-1"),
+              "x.ini [CWaypointsNavigator] min_timesteps_confirm_skip_waypoints: must be >= 1 "
+              "[steps]");
+    EXPECT_EQ(errorOf("CReactiveNavigationSystem", "PTG0_K", "0"),
+              "x.ini [CReactiveNavigationSystem] PTG0_K: must be 1 (forward) or -1 (backward)");
+    EXPECT_EQ(errorOf("CReactiveNavigationSystem", "PTG2_K", "-5"),
+              "x.ini [CReactiveNavigationSystem] PTG2_K: must be 1 (forward) or -1 (backward)");
+    EXPECT_EQ(errorOf("CReactiveNavigationSystem", "PTG0_score_priority", "-1"),
+              "x.ini [CReactiveNavigationSystem] PTG0_score_priority: must be >= 0");
+    EXPECT_EQ(errorOf("CMultiObjectiveMotionOptimizerBase", "scores_to_normalize",
+                      "hysteresis_score, bogus_score"),
+              "x.ini [CMultiObjectiveMotionOptimizerBase] scores_to_normalize: no score is "
+              "named 'bogus_score' (scores: target_distance, collision_free_distance_score, "
+              "euclidean_nearness, hysteresis_score, path_index_near_target, "
+              "ptg_priority_score)");
+    EXPECT_EQ(errorOf("CMultiObjectiveMotionOptimizerBase", "scores_to_normalize",
+                      "hysteresis_score,euclidean_nearness"),
+              "");
     // MRPT's other differential-drive PTGs read the same keys as C (K included): accepted.
     for (const char* type : {"CPTG_DiffDrive_CC", "CPTG_DiffDrive_CCS", "CPTG_DiffDrive_CS"})
         EXPECT_EQ(errorOf("CReactiveNavigationSystem", "PTG2_Type", type), "") << type;

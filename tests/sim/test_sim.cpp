@@ -159,6 +159,16 @@ TEST(World, BadEntriesNameTheKey) {
         crowd.replace(crowd.find(shorter), shorter.size(), "timeout=9000");
         EXPECT_EQ(errorOf(crowd), "");
     }
+    // (2026-12-07, a bad-input sweep) a robot whose PTGs took minutes to build, a 3 m
+    // person overlapping the walls, a name too long for the picture's file name (refused
+    // after the run).
+    EXPECT_EQ(errorOf(head + "[robot]\nradius = 2\n"), "w.ini [robot] radius: must be at most 1 m");
+    EXPECT_EQ(errorOf(head + "[pedestrians]\np = random 0.5 3 0 2 2\n"),
+              "w.ini [pedestrians] p: radius must be at most 1 m (a person)");
+    EXPECT_EQ(errorOf("[world]\nname = " + std::string(101, 'n') +
+                      "\nx_min=0\nx_max=5\ny_min=0\ny_max=5\n[robot]\nstart_x=1\nstart_y=1\n"
+                      "[goal]\nx=4\ny=4\n"),
+              "w.ini [world] name: must be at most 100 characters");
     // The key that is wrong is the one named (they were max_v, x_min, start_x for all).
     EXPECT_EQ(errorOf(head + "[robot]\nmax_ang_acc_deg = 0\n"),
               "w.ini [robot] max_ang_acc_deg: speed and acceleration limits must be > 0");

@@ -166,6 +166,23 @@ void checkMrptSections(const mrpt::config::CConfigFileBase& c, const std::string
             c, "CMultiObjectiveMotionOptimizerBase", base, source,
             {{std::regex("score[0-9]+_(name|formula)|movement_assert[0-9]+", std::regex::icase),
               Kind::Text}});
+        // A name no score has was ignored without a word (MRPT normalises the ones it finds).
+        const std::string mo = "CMultiObjectiveMotionOptimizerBase";
+        std::vector<std::string> names;
+        for (int i = 1; c.keyExists(mo, "score" + std::to_string(i) + "_name"); ++i)
+            names.push_back(c.read_string(mo, "score" + std::to_string(i) + "_name", ""));
+        std::istringstream listed(c.read_string(mo, "scores_to_normalize", ""));
+        for (std::string name; std::getline(listed, name, ',');) {
+            std::istringstream words(name);
+            for (std::string w; words >> w;)
+                if (std::find(names.begin(), names.end(), w) == names.end())
+                    core::namingSource(source, [&] {
+                        std::string known;
+                        for (const auto& n : names) known += (known.empty() ? "" : ", ") + n;
+                        core::requireValue(false, mo, "scores_to_normalize",
+                                           "no score is named '" + w + "' (scores: " + known + ")");
+                    });
+        }
     }
     // Values MRPT asserts on only while navigating (a speed limit of 0 or below printed an
     // MRPT stack trace at every step, and the robot still got there) or with a message that
@@ -175,10 +192,26 @@ void checkMrptSections(const mrpt::config::CConfigFileBase& c, const std::string
         for (const char* k : {"robotMax_V_mps", "robotMax_W_degps"})
             if (c.keyExists(ptg, k))
                 core::requireValue(core::readDouble(c, ptg, k, 0.0) > 0, ptg, k, "must be > 0");
-        // (below 0 MRPT's speed filter divided by a negative sum: NaN commands, path -nan m)
-        if (c.keyExists(ptg, "speedfilter_tau"))
-            core::requireValue(core::readDouble(c, ptg, "speedfilter_tau", 0.0) >= 0, ptg,
-                               "speedfilter_tau", "must be >= 0 s");
+        // (below 0 MRPT's speed filter divided by a negative sum: NaN commands, path -nan m;
+        // 1e9 s let the robot creep until the timeout)
+        if (c.keyExists(ptg, "speedfilter_tau")) {
+            const double tau = core::readDouble(c, ptg, "speedfilter_tau", 0.0);
+            core::requireValue(tau >= 0 && tau <= 10, ptg, "speedfilter_tau",
+                               "must be in [0, 10] s");
+        }
+        // Counters and timeouts taken unchecked until 2026-12-07 (a bad-input sweep): 0 or
+        // below gave up on the target at once, or skipped waypoints unconfirmed.
+        const std::string an = "CAbstractNavigator", wn = "CWaypointsNavigator";
+        if (c.keyExists(an, "alarm_seems_not_approaching_target_timeout"))
+            core::requireValue(
+                core::readDouble(c, an, "alarm_seems_not_approaching_target_timeout", 0.0) > 0, an,
+                "alarm_seems_not_approaching_target_timeout", "must be > 0 s");
+        if (c.keyExists(an, "hysteresis_check_target_is_blocked"))
+            core::requireValue(core::readInt(c, an, "hysteresis_check_target_is_blocked", 0) >= 1,
+                               an, "hysteresis_check_target_is_blocked", "must be >= 1 [steps]");
+        if (c.keyExists(wn, "min_timesteps_confirm_skip_waypoints"))
+            core::requireValue(core::readInt(c, wn, "min_timesteps_confirm_skip_waypoints", 0) >= 1,
+                               wn, "min_timesteps_confirm_skip_waypoints", "must be >= 1 [steps]");
         // MRPT asserts end > start in every step (a run of stack traces, ended as an error).
         {
             const CAbstractPTGBasedReactive::TAbstractPTGNavigatorParams d;
@@ -189,6 +222,10 @@ void checkMrptSections(const mrpt::config::CConfigFileBase& c, const std::string
             std::ostringstream why;
             why << "must be > secure_distance_start (" << start << ")";
             core::requireValue(end > start, ptg, "secure_distance_end", why.str());
+            // (normalised by each PTG's refDistance: 5 slowed the robot for obstacles five
+            // reference distances away, and it timed out)
+            core::requireValue(end <= 1, ptg, "secure_distance_end",
+                               "must be at most 1 (a fraction of each PTG's refDistance)");
         }
         for (const auto& [section, n] :
              {std::pair{std::string("CHolonomicND"), CHolonomicND::TOptions().factorWeights.size()},
@@ -304,6 +341,18 @@ void checkMrptSections(const mrpt::config::CConfigFileBase& c, const std::string
                 if (c.keyExists(s, prefix + k))
                     core::requireValue(core::readDouble(c, s, prefix + k, 0.0) > 0, s, prefix + k,
                                        "must be > 0");
+            // A C PTG's K is its direction: +1 forward, -1 backward (0 made paths that do not
+            // move, 5 paths five times the speed limit). A negative priority turned its scores
+            // negative.
+            if (c.read_string(s, prefix + "Type", "") == "CPTG_DiffDrive_C" &&
+                c.keyExists(s, prefix + "K")) {
+                const double K = core::readDouble(c, s, prefix + "K", 1.0);
+                core::requireValue(K == 1 || K == -1, s, prefix + "K",
+                                   "must be 1 (forward) or -1 (backward)");
+            }
+            if (c.keyExists(s, prefix + "score_priority"))
+                core::requireValue(core::readDouble(c, s, prefix + "score_priority", 1.0) >= 0, s,
+                                   prefix + "score_priority", "must be >= 0");
             // MRPT's clearance analysis takes clearance_decimated_paths (15) of the paths:
             // fewer paths stopped on an assertion that ends mid-sentence.
             if (c.keyExists(s, prefix + "num_paths")) {
