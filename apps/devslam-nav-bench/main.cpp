@@ -323,6 +323,7 @@ void count(Tally& t, const devslam::sim::WorldSpec& world, const devslam::sim::E
             break;
         case devslam::sim::Outcome::NoPath:
         case devslam::sim::Outcome::Error:
+        case devslam::sim::Outcome::Interrupted:  // (the bench stops between episodes)
             t.no_run++;
             break;
     }

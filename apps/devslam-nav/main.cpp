@@ -4,6 +4,7 @@
 // devslam-nav --map GRIDMAP --to X,Y: the global route on a map devslam-run built.
 #include <devslam/core/Config.h>
 #include <devslam/core/GzFile.h>
+#include <devslam/core/Interrupt.h>
 #include <devslam/core/Parse.h>
 #include <devslam/core/Results.h>
 #include <devslam/nav/CHolonomicVFHPlus.h>
@@ -256,6 +257,10 @@ static int appMain(int argc, char** argv) {
                 stderr, "devslam-nav: %.0f of %.0f s simulated (%.0f s wall), %.2f m to the goal\n",
                 t, world.timeout, std::chrono::duration<double>(now - wall_start).count(), to_goal);
         };
+        // Ctrl-C ends the run where it is, with its result line and picture (it left
+        // neither), then the program ends by the signal.
+        devslam::core::installStopHandler("devslam-nav");
+        eo.stop = [] { return devslam::core::stopSignal() != 0; };
         const auto r = devslam::sim::runEpisode(world, *ini, nav_opts, eo);
         if (png.empty()) png = kDefaultDir + "/nav_" + world.name + ".png";
         // The result first: a picture that cannot be written must not lose it.
@@ -286,6 +291,7 @@ static int appMain(int argc, char** argv) {
             std::fprintf(stderr, "devslam-nav: %s\n", r.navlog_error.c_str());
             return 1;
         }
+        if (const int sig = devslam::core::stopSignal()) devslam::core::exitBySignal(sig);
         return r.outcome == devslam::sim::Outcome::Success ? 0 : 1;
     } catch (const std::exception& e) {
         // MRPT's exceptions carry banners and a stack trace around their message.

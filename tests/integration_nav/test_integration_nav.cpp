@@ -923,6 +923,33 @@ TEST(IntegrationNav, NavBenchCtrlCPrintsTheEpisodesDone) {
     EXPECT_FALSE(mrpt::system::directoryExists(out + "/png"));
 }
 
+// devslam-nav stopped by Ctrl-C: it printed nothing and wrote no picture (a run of minutes
+// lost). It ends the run where it is, prints the result line and writes the picture, then
+// ends by the signal. The world: office with a person standing just off the goal, so the run
+// lasts until the signal.
+TEST(IntegrationNav, DevslamNavCtrlCKeepsTheResultAndPicture) {
+    const devslam::test::TempDir dir("devslam_");
+    const std::string out = dir.str();
+    std::string world = readFile(kSrc + "/sim_worlds/office.ini");
+    const std::string timeout = "timeout         = 90";
+    ASSERT_NE(world.find(timeout), std::string::npos);
+    world.replace(world.find(timeout), timeout.size(), "timeout = 10000");
+    // (office's last section is its [pedestrians], empty)
+    ASSERT_EQ(world.rfind("\n["), world.rfind("\n[pedestrians]"));
+    world += "\nblocker = scripted 0 0.6 0 6.0 6.85 6.0 6.9\n";
+    std::ofstream(out + "/blocked.ini") << world;
+    const auto r =
+        devslam::test::signalAppWhen("devslam-nav", out + "/blocked.ini --png " + out + "/run.png",
+                                     "s simulated (", SIGINT, out + "/log.txt");
+    ASSERT_TRUE(r.signalled) << "the run ended before the signal:\n" << r.out;
+    EXPECT_EQ(r.rc, 130) << r.out;
+    EXPECT_NE(r.out.find("world=office method=CHolonomicVFHPlus result=interrupted time="),
+              std::string::npos)
+        << r.out;
+    EXPECT_NE(r.out.find("reason: interrupted at t = "), std::string::npos) << r.out;
+    EXPECT_TRUE(std::filesystem::is_regular_file(out + "/run.png"));
+}
+
 // An option's value that is the next option ("--method --png x.png") was read as the value,
 // or as a second world ("more than one world file given"): the option is named instead.
 TEST(IntegrationNav, OptionWithoutValueIsNamed) {

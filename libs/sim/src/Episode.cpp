@@ -77,6 +77,8 @@ const char* toString(Outcome o) {
             return "no_path";
         case Outcome::Error:
             return "error";
+        case Outcome::Interrupted:
+            return "interrupted";
     }
     return "?";
 }
@@ -233,6 +235,13 @@ EpisodeResult runEpisode(const WorldSpec& world, const mrpt::config::CConfigFile
                 break;
             }
             if (opts.on_step) opts.on_step(t, std::hypot(p.x - world.goal.x, p.y - world.goal.y));
+            if (opts.stop && opts.stop()) {
+                res.outcome = Outcome::Interrupted;
+                std::ostringstream why;
+                why << "interrupted at t = " << t << " s";
+                res.reason = why.str();
+                break;
+            }
         }
         sim.step();
         clock.set(sim.time());

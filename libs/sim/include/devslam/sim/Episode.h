@@ -27,11 +27,14 @@ struct EpisodeOptions {
     /// Called after each navigator step with the simulated time [s] and the robot's distance
     /// to the goal [m] (devslam-nav's progress line); empty: none.
     std::function<void(double t, double to_goal)> on_step;
+    /// Asked after each navigator step: true ends the run there as Outcome::Interrupted, with
+    /// what it did so far (devslam-nav's Ctrl-C); empty: never.
+    std::function<bool()> stop;
 };
 
 /// NoPath: no global route at the start; Error: the navigator stopped on an error (the
-/// robot did not report its pose).
-enum class Outcome { Success, Collision, Timeout, NoPath, Error };
+/// robot did not report its pose); Interrupted: EpisodeOptions::stop ended it.
+enum class Outcome { Success, Collision, Timeout, NoPath, Error, Interrupted };
 [[nodiscard]] const char* toString(Outcome o);
 
 struct EpisodeResult {
