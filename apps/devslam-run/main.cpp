@@ -332,6 +332,13 @@ int runOnce(const Args& a) {
     if (core::stopSignal())  // it came after the last frame was read (finalize, outputs)
         std::cerr << "devslam-run: " << core::signalName(core::stopSignal())
                   << " came after the last frame; the run is whole\n";
+    // An earlier stopped run's outputs, kept beside the run they did not replace, stayed
+    // there unmentioned once a whole run replaced that one: said, and left.
+    if (!rep.out_dir.empty() && rep.out_dir == a.out &&
+        std::filesystem::is_directory(std::filesystem::path(a.out) / "stopped_run"))
+        std::cerr << "devslam-run: note: "
+                  << (std::filesystem::path(a.out) / "stopped_run").string()
+                  << " holds an earlier run that stopped early, not this one\n";
     return rep.output_errors.empty() ? 0 : 1;
 }
 

@@ -923,6 +923,17 @@ TEST(DevslamRun, AnUndecodableFrameMidRunKeepsTheFramesBeforeIt) {
         << stopped.out;
     EXPECT_EQ(lines(dir / "all" / "trajectory.txt"), 7u);
     EXPECT_EQ(lines(dir / "all" / "stopped_run" / "trajectory.txt"), 5u);
+    // A whole run into that folder again: the stopped one stays, said to be an earlier run's
+    // (it stayed unmentioned).
+    const auto again = run("--input " + (dir / "seq").string() +
+                           " --mode dynamic --quiet --allow-damaged --out " + (dir / "all").string());
+    EXPECT_EQ(again.rc, 0) << again.out;
+    EXPECT_NE(again.out.find("devslam-run: note: " + (dir / "all" / "stopped_run").string() +
+                             " holds an earlier run that stopped early, not this one"),
+              std::string::npos)
+        << again.out;
+    EXPECT_EQ(lines(dir / "all" / "stopped_run" / "trajectory.txt"), 5u);
+    EXPECT_EQ(all.out.find("holds an earlier run"), std::string::npos) << all.out;
     // A file where stopped_run would go: nothing of the stopped run is written, the whole run
     // is kept, and the summary is still printed (the folder's error escaped the run before).
     fs::remove_all(dir / "all" / "stopped_run");
