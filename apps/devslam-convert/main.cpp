@@ -108,8 +108,13 @@ std::variant<Args, int> parseArgs(int argc, char** argv) {
             args.wo.external_images = true;
         else if (a == "--compression")
             args.wo.compression = int(devslam::core::parseInteger(value(), "--compression", 0, 9));
-        else if (a == "--label")
+        else if (a == "--label") {
             args.wo.sensor_label = value();
+            // (every observation then had no label, or one that split the rawlog's listings)
+            if (args.wo.sensor_label.empty() ||
+                args.wo.sensor_label.find_first_of("\n\r") != std::string::npos)
+                throw std::invalid_argument("--label must not be empty or hold a line break");
+        }
         else if (a == "--allow-damaged")
             args.ro.allow_damaged = true;
         else if (a == "--max-frames")

@@ -242,6 +242,16 @@ TEST(Config, FilterIniFollowsRunFilterConfigWithOverrides) {
                   std::string::npos)
             << e.what();
     }
+    // One that is there but not a file (a folder, /dev/null) is not "no such file".
+    std::ofstream(missing) << "[run]\nfilter_config = .\n";
+    try {
+        (void)loadFilterIni(*loadIni(missing), missing);
+        FAIL();
+    } catch (const std::runtime_error& e) {
+        EXPECT_NE(std::string(e.what()).find(missing + " [run] filter_config: not a regular file '"),
+                  std::string::npos)
+            << e.what();
+    }
     // A filter INI without the filter's sections (an empty file, a slip of the name) ran the
     // filter on its defaults.
     std::ofstream(dir + "/empty.ini") << "# nothing yet\n";

@@ -988,6 +988,13 @@ TEST(DevslamRun, AnUndecodableFrameMidRunKeepsTheFramesBeforeIt) {
         EXPECT_NE(c.out.find("already holds a TUM sequence (rgb.txt)"), std::string::npos) << c.out;
     }
     EXPECT_EQ(lines(dir / "part" / "rgb.txt"), 5u);
+    // An empty label (or one with a line break) for the observations is refused.
+    c = devslam::test::runApp("devslam-convert", (dir / "rest.rawlog").string() + " " +
+                                                     (dir / "lbl.rawlog").string() + " --label ''");
+    EXPECT_EQ(c.rc, 1) << c.out;
+    EXPECT_NE(c.out.find("--label must not be empty or hold a line break"), std::string::npos)
+        << c.out;
+    EXPECT_FALSE(fs::exists(dir / "lbl.rawlog"));
     // Nor a folder without rgb.txt that holds what the TUM writer writes: its ground truth and
     // images were replaced without a word.
     fs::create_directories(dir / "other" / "rgb");

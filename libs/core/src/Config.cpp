@@ -279,7 +279,10 @@ std::unique_ptr<mrpt::config::CConfigFileMemory> loadFilterIni(
     const std::string fc = cfg.read_string("run", "filter_config", "");
     const std::string file = filterIniPath(cfg, path);
     if (!fc.empty() && !std::filesystem::is_regular_file(file))
-        throw std::runtime_error(path + " [run] filter_config: no such file '" + file + "'");
+        throw std::runtime_error(path + " [run] filter_config: " +
+                                 (std::filesystem::exists(file) ? "not a regular file '"
+                                                                : "no such file '") +
+                                 file + "'");
     auto out = loadIni(file);
     // A file of its own holds only the filter's sections (else the SLAM INI's check covers it),
     // and at least one of them: an empty file, or the wrong one, ran the filter on its
