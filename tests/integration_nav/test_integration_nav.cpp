@@ -144,26 +144,17 @@ TEST(IntegrationNav, AStarPlusVfhOnMrptKinematicSimulator) {
 
 /// Targets 0.30-1.20 m from the robot (every 5 cm; the goal tolerance is 0.30 m), at every
 /// bearing (1 deg): those that no PTG of the navigator built from `ini` reaches
-/// (inverseMap_WS2TP false for all), as "d@bearing" strings.
+/// (Navigator::targetsNoPtgReaches), as "d@bearing" strings.
 std::vector<std::string> targetsNoPtgReaches(const mrpt::config::CConfigFileBase& ini) {
     mrpt::kinematics::CVehicleSimul_DiffDriven sim;
     mrpt::maps::COccupancyGridMap2D grid;
     grid.setSize(0, 4, 0, 4, 0.05f, 1.0f);
     KinematicRobot robot(sim, grid);
     devslam::nav::Navigator nav(robot, ini, navOptions(ini));  // builds the PTGs, robot shape set
-    auto& rns = nav.reactive();
     std::vector<std::string> out;
-    for (int cm = 30; cm <= 120; cm += 5)
-        for (int deg = -179; deg <= 180; deg++) {
-            const double d = cm / 100.0, a = deg * M_PI / 180;
-            bool reached = false;
-            for (std::size_t i = 0; i < rns.getPTG_count() && !reached; i++) {
-                int k = 0;
-                double nd = 0;
-                reached = rns.getPTG(i)->inverseMap_WS2TP(d * std::cos(a), d * std::sin(a), k, nd);
-            }
-            if (!reached) out.push_back(std::to_string(cm) + "cm@" + std::to_string(deg));
-        }
+    for (const auto& [d, deg] : nav.targetsNoPtgReaches())
+        out.push_back(std::to_string(static_cast<int>(std::lround(d * 100))) + "cm@" +
+                      std::to_string(deg));
     return out;
 }
 
@@ -191,6 +182,31 @@ TEST(IntegrationNav, EveryTargetAroundTheRobotIsInSomePtgsDomain) {
     EXPECT_NE(std::find(gap.begin(), gap.end(), "35cm@140"), gap.end());
     EXPECT_NE(std::find(gap.begin(), gap.end(), "35cm@-140"), gap.end());
     EXPECT_EQ(std::find(gap.begin(), gap.end(), "60cm@140"), gap.end());
+    // devslam-nav says so when its INI leaves such targets (at 60 deg/s, 4 of them at 0.30 m),
+    // and says nothing with the shipped INI.
+    std::string slow = readFile(kIni);
+    const std::string w = "@define ROBOT_MAX_W  90.0";
+    ASSERT_NE(slow.find(w), std::string::npos);
+    slow.replace(slow.find(w), w.size(), "@define ROBOT_MAX_W  60.0");
+    std::string world = readFile(kSrc + "/sim_worlds/paper_fig6.ini");
+    const std::string mw = "max_w_deg       = 90";
+    ASSERT_NE(world.find(mw), std::string::npos);
+    world.replace(world.find(mw), mw.size(), "max_w_deg = 60");
+    const devslam::test::TempDir dir("devslam_");
+    std::ofstream(dir.str("slow.ini")) << slow;
+    std::ofstream(dir.str("fig6.ini")) << world;
+    auto r = devslam::test::runApp("devslam-nav", dir.str("fig6.ini") + " --config " +
+                                                      dir.str("slow.ini") + " --png " +
+                                                      dir.str("a.png"));
+    EXPECT_NE(r.out.find("devslam-nav: warning: with " + dir.str("slow.ini") + "'s PTGs, 4 "
+                         "targets 0.30-1.20 m from the robot (every 5 cm and degree) lie in no "
+                         "PTG's domain, the first 0.30 m away at "),
+              std::string::npos)
+        << r.out;
+    r = devslam::test::runApp("devslam-nav", kSrc + "/sim_worlds/paper_fig6.ini --png " +
+                                                 dir.str("b.png"));
+    EXPECT_EQ(r.rc, 0) << r.out;
+    EXPECT_EQ(r.out.find("warning"), std::string::npos) << r.out;
 }
 
 // A first target PTG0 (forward arcs) does not reach: MRPT 2.5 compiles its score formulas on

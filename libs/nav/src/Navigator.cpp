@@ -368,6 +368,24 @@ std::string Navigator::closeLog() {
     return why;
 }
 
+std::vector<std::pair<double, int>> Navigator::targetsNoPtgReaches(double min_d, double max_d) {
+    std::vector<std::pair<double, int>> out;
+    const auto& rns = *nav_;
+    const int n = static_cast<int>(std::floor((max_d - min_d) / 0.05 + 1e-9));
+    for (int i = 0; i <= n; i++)
+        for (int deg = -179; deg <= 180; deg++) {
+            const double d = min_d + 0.05 * i, a = deg * M_PI / 180;
+            bool reached = false;
+            for (std::size_t p = 0; p < rns.getPTG_count() && !reached; p++) {
+                int k = 0;
+                double nd = 0;
+                reached = rns.getPTG(p)->inverseMap_WS2TP(d * std::cos(a), d * std::sin(a), k, nd);
+            }
+            if (!reached) out.emplace_back(d, deg);
+        }
+    return out;
+}
+
 std::string Navigator::holonomicMethod() const {
     return static_cast<const ReactiveNav&>(*nav_).holonomicClass();
 }

@@ -144,6 +144,7 @@ EpisodeResult runEpisode(const WorldSpec& world, const mrpt::config::CConfigFile
             refuse("max_w_deg", mrpt::RAD2DEG(world.robot.max_w), " deg/s", "robotMax_W_degps", w);
     }
     nav::Navigator navigator(robot, nav_ini, nav_opts);
+    if (opts.check_ptg_domains) res.ptg_domain_gaps = navigator.targetsNoPtgReaches();
     res.holonomic_method = navigator.holonomicMethod();
     // [m] the free path MRPT's navigator needs to move at all (its default where unset).
     const double secure =

@@ -92,6 +92,12 @@ class Navigator {
     /// The class of the holonomic method MRPT's navigator made (e.g. "CHolonomicVFHPlus").
     [[nodiscard]] std::string holonomicMethod() const;
     [[nodiscard]] mrpt::nav::CReactiveNavigationSystem& reactive();
+    /// Targets `min_d`..`max_d` m from the robot (every 5 cm, every degree of bearing) that no
+    /// PTG reaches (inverseMap_WS2TP false for all), as (distance [m], bearing [deg]). MRPT's
+    /// navigator cannot aim at such a target: it stops ("no way found") until it moves. The
+    /// shipped INI has none from 0.30 m (the goal tolerance) to 1.20 m; other speed limits can.
+    [[nodiscard]] std::vector<std::pair<double, int>> targetsNoPtgReaches(double min_d = 0.30,
+                                                                          double max_d = 1.20);
     /// The navlog being written (NavigatorOptions::log_file), "" when none is.
     [[nodiscard]] const std::string& logPath() const { return log_path_; }
     /// Closes the navlog and returns what went wrong writing it ("cannot write navlog

@@ -30,6 +30,9 @@ struct EpisodeOptions {
     /// Asked after each navigator step: true ends the run there as Outcome::Interrupted, with
     /// what it did so far (devslam-nav's Ctrl-C); empty: never.
     std::function<bool()> stop;
+    /// Also find the targets near the robot that no PTG reaches
+    /// (EpisodeResult::ptg_domain_gaps; about 0.1 s, so off for the bench's episodes).
+    bool check_ptg_domains = false;
 };
 
 /// NoPath: no global route at the start; Error: the navigator stopped on an error (the
@@ -58,6 +61,9 @@ struct EpisodeResult {
     std::vector<mrpt::math::TPoint2D> waypoints;
     std::string navlog;        ///< the navlog written (NavigatorOptions::log_file), else ""
     std::string navlog_error;  ///< why the navlog is cut short (nav::Navigator::closeLog)
+    /// With EpisodeOptions::check_ptg_domains: nav::Navigator::targetsNoPtgReaches()
+    /// (distance [m], bearing [deg]), the targets 0.30-1.20 m away MRPT cannot aim at.
+    std::vector<std::pair<double, int>> ptg_domain_gaps;
 };
 
 /// Runs one episode. Throws nav::PlanningError if start/goal are invalid for the planner.
