@@ -347,15 +347,16 @@ std::optional<Args> parseArgs(int argc, char** argv) {
         } else
             throw std::invalid_argument("unknown option '" + k + "'\n" + kUsage);
     }
-    // The programs it runs: a --bin without them was reported as devslam-run refusing the
-    // SLAM INI (exit 127, "not found").
-    for (const char* app : {"devslam-run", "devslam-synth"})
-        if (const auto p = fs::path(a.bin) / app;
-            !fs::is_regular_file(p) || ::access(p.c_str(), X_OK) != 0)
-            throw std::invalid_argument("--bin '" + a.bin + "': no program " + app +
-                                        " there (the folder of devslam-bench's own build by "
-                                        "default)");
     return a;
+}
+
+/// The programs the bench runs: a --bin without them was reported as devslam-run refusing
+/// the SLAM INI (exit 127, "not found").
+void requireProgram(const Args& a, const char* app) {
+    if (const auto p = fs::path(a.bin) / app;
+        !fs::is_regular_file(p) || ::access(p.c_str(), X_OK) != 0)
+        throw std::invalid_argument("--bin '" + a.bin + "': no program " + app +
+                                    " there (the folder of devslam-bench's own build by default)");
 }
 
 /// The bench INI with the command line's overrides; its output folder made.
@@ -416,6 +417,12 @@ void checkInputs(const Bench& b, const Args& a) {
     const std::string log = (fs::path(b.out_dir) / "check_inputs.log").string();
     std::set<std::pair<std::string, std::string>> checked;  // (INI, mode)
     bool run_checks = true;
+    requireProgram(a, "devslam-run");
+    for (const auto& q : b.sequences)
+        if (!q.scenario.empty()) {
+            requireProgram(a, "devslam-synth");
+            break;
+        }
     for (const auto& q : b.sequences)
         for (const auto& m : b.modes) {
             if (!run_checks || !checked.insert({q.slam_config, m}).second) continue;

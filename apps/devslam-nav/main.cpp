@@ -300,15 +300,16 @@ static int appMain(int argc, char** argv) {
             devslam::sim::writeEpisodePng(world, r, png, world.name + " / " + r.holonomic_method);
         });
         // A navlog asked for and cut short: the run is whole, its log is not.
-        if (!r.navlog_error.empty()) {
+        if (!r.navlog_error.empty())
             std::fprintf(stderr, "devslam-nav: %s\n", r.navlog_error.c_str());
-            return 1;
-        }
         if (const int sig = devslam::core::stopSignal()) devslam::core::exitBySignal(sig);
+        if (!r.navlog_error.empty()) return 1;
         return r.outcome == devslam::sim::Outcome::Success ? 0 : 1;
     } catch (const std::exception& e) {
         // MRPT's exceptions carry banners and a stack trace around their message.
         std::cerr << "devslam-nav: " << devslam::core::innermostMessage(e.what()) << "\n";
+        // (a picture that could not be written after a Ctrl-C'd run: it still ends by it)
+        if (const int sig = devslam::core::stopSignal()) devslam::core::exitBySignal(sig);
         return 2;
     }
 }

@@ -211,7 +211,7 @@ TEST(IntegrationNav, EveryTargetAroundTheRobotIsInSomePtgsDomain) {
 
 // A first target PTG0 (forward arcs) does not reach: MRPT 2.5 compiles its score formulas on
 // PTG0's motion at the first step, and PTG0's motion has no variables when the target is out of
-// its domain (at 0.6 m: bearings of 60-120 deg either side): the run ended at its first step
+// its domain (at 0.6 m: bearings of 52-128 deg either side): the run ended at its first step
 // ("Undefined symbol: 'target_d_norm'"). The navigator now compiles them when it is made, and
 // the robot gets to a goal beside its start.
 TEST(IntegrationNav, AFirstTargetPtg0DoesNotReachIsReached) {
@@ -417,6 +417,16 @@ TEST(IntegrationNav, MrptErrorsEndTheRunNamingTheIni) {
                   std::string::npos)
             << what;
         EXPECT_NE(what.find("1/(1+dist_eucl_min^2"), std::string::npos) << what;
+    }
+    // Every variable a step gives is there when they are compiled, original_col_free_dist
+    // too (which MRPT adds after its scorer): a movement_assert on it was refused.
+    {
+        mrpt::config::CConfigFileMemory with(text);
+        with.write("CMultiObjectiveMotionOptimizerBase", "movement_assert1",
+                   "original_col_free_dist >= 0");
+        const auto o = devslam::nav::NavigatorOptions::fromConfig(with, "with.ini");
+        const auto ok = devslam::sim::runEpisode(world, with, o, {});
+        EXPECT_EQ(ok.outcome, devslam::sim::Outcome::Success) << ok.reason;
     }
 
     // The INI without its [CHolonomicND] section, and ND chosen: our checks pass (a missing

@@ -466,24 +466,28 @@ TEST(NavConfig, MrptSectionsAreReadStrictly) {
     EXPECT_EQ(errorOf("CHolonomicFullEval", "PHASE2_THRESHOLD", "1.5"),
               "x.ini [CHolonomicFullEval] PHASE2_THRESHOLD: must be in [0, 1]");
     // (2026-12-07, a bad-input sweep) weights MRPT asserted on at the first step, with a stack
-    // trace: a phase whose factors weigh 0 in all, and negative weights.
+    // trace: a phase whose factors weigh 0 in all. Negative weights MRPT takes (a review ran
+    // FullEval and ND with them): accepted.
     EXPECT_EQ(errorOf("CHolonomicFullEval", "factorWeights", "1 1 1 1 1 1 0"),
               "x.ini [CHolonomicFullEval] PHASE1_FACTORS: the factorWeights of these factors sum "
               "to 0; a phase needs a weight above 0");
-    EXPECT_EQ(errorOf("CHolonomicFullEval", "factorWeights", "1 1 1 1 -1 1 1"),
-              "x.ini [CHolonomicFullEval] factorWeights: must be >= 0");
-    EXPECT_EQ(errorOf("CHolonomicND", "factorWeights", "1 -0.5 1 1"),
-              "x.ini [CHolonomicND] factorWeights: must be >= 0");
+    EXPECT_EQ(errorOf("CHolonomicND", "factorWeights", "1 -0.5 1 1"), "");
     // PTG settings MRPT took with a message naming no key and a PTG it then ran without (the
-    // alpha constants at 0), or refused mid-sentence (2 paths, fewer than the 15 its
-    // clearance analysis takes), or failed with at the first step (paths shorter than the
-    // 1 m MRPT 2.5's scoring asks for).
+    // alpha constants at 0), or refused mid-sentence (2 paths with evaluate_clearance, fewer
+    // than the 15 its clearance analysis takes; without it they run), or failed with at the
+    // first step (paths shorter than the 1 m MRPT 2.5's scoring asks for).
     EXPECT_EQ(errorOf("CReactiveNavigationSystem", "PTG1_cte_a0v_deg", "0"),
               "x.ini [CReactiveNavigationSystem] PTG1_cte_a0v_deg: must be > 0");
-    EXPECT_EQ(errorOf("CReactiveNavigationSystem", "PTG0_num_paths", "2"),
-              "x.ini [CReactiveNavigationSystem] PTG0_num_paths: must be at least "
-              "PTG0_clearance_decimated_paths (15)");
-    EXPECT_EQ(errorOf("CReactiveNavigationSystem", "PTG0_num_paths", "15"), "");
+    EXPECT_EQ(errorOf("CReactiveNavigationSystem", "PTG0_num_paths", "2"), "");
+    {
+        auto c = shippedNavIni();
+        c.write("CAbstractPTGBasedReactive", "evaluate_clearance", "true");
+        c.write("CReactiveNavigationSystem", "PTG0_num_paths", "2");
+        EXPECT_EQ(navError(c), "x.ini [CReactiveNavigationSystem] PTG0_num_paths: must be at "
+                               "least PTG0_clearance_decimated_paths (15)");
+        c.write("CReactiveNavigationSystem", "PTG0_num_paths", "15");
+        EXPECT_EQ(navError(c), "");
+    }
     EXPECT_EQ(errorOf("CReactiveNavigationSystem", "PTG3_refDistance", "0.9"),
               "x.ini [CReactiveNavigationSystem] PTG3_refDistance: must be at least 1 m (MRPT "
               "2.5 scores each path at its point 1 m along it)");
@@ -523,28 +527,26 @@ TEST(NavConfig, MrptSectionsAreReadStrictly) {
               "and PTG1_resolution 0.0001 m, the collision grid has 50000 x 50000 cells (at most "
               "3000 x 3000)");
     EXPECT_EQ(errorOf("CAbstractPTGBasedReactive", "speedfilter_tau", "-1"),
-              "x.ini [CAbstractPTGBasedReactive] speedfilter_tau: must be in [0, 10] s");
+              "x.ini [CAbstractPTGBasedReactive] speedfilter_tau: must be in [0, 1e4] s");
     // Taken unchecked until 2026-12-07 (a bad-input sweep): a filter that never lets the
-    // robot speed up, a slow-down ramp beyond the paths, counters and a timeout of 0 or
-    // below, a C PTG's direction other than +-1, a negative priority.
+    // robot speed up (1e9 s; 1e5 s still ran), a slow-down ramp beyond the paths, a timeout of
+    // 0, a negative count of steps, a C PTG's direction 0, a negative priority.
     EXPECT_EQ(errorOf("CAbstractPTGBasedReactive", "speedfilter_tau", "1e9"),
-              "x.ini [CAbstractPTGBasedReactive] speedfilter_tau: must be in [0, 10] s");
+              "x.ini [CAbstractPTGBasedReactive] speedfilter_tau: must be in [0, 1e4] s");
     EXPECT_EQ(errorOf("CAbstractPTGBasedReactive", "secure_distance_end", "5"),
               "x.ini [CAbstractPTGBasedReactive] secure_distance_end: must be at most 1 (a "
               "fraction of each PTG's refDistance)");
     EXPECT_EQ(errorOf("CAbstractNavigator", "alarm_seems_not_approaching_target_timeout", "0"),
               "x.ini [CAbstractNavigator] alarm_seems_not_approaching_target_timeout: must be "
               "> 0 s");
-    EXPECT_EQ(errorOf("CAbstractNavigator", "hysteresis_check_target_is_blocked", "-3"),
-              "x.ini [CAbstractNavigator] hysteresis_check_target_is_blocked: must be >= 1 "
-              "[steps]");
     EXPECT_EQ(errorOf("CWaypointsNavigator", "min_timesteps_confirm_skip_waypoints", "-1"),
-              "x.ini [CWaypointsNavigator] min_timesteps_confirm_skip_waypoints: must be >= 1 "
+              "x.ini [CWaypointsNavigator] min_timesteps_confirm_skip_waypoints: must be >= 0 "
               "[steps]");
+    EXPECT_EQ(errorOf("CWaypointsNavigator", "min_timesteps_confirm_skip_waypoints", "0"), "");
     EXPECT_EQ(errorOf("CReactiveNavigationSystem", "PTG0_K", "0"),
-              "x.ini [CReactiveNavigationSystem] PTG0_K: must be 1 (forward) or -1 (backward)");
-    EXPECT_EQ(errorOf("CReactiveNavigationSystem", "PTG2_K", "-5"),
-              "x.ini [CReactiveNavigationSystem] PTG2_K: must be 1 (forward) or -1 (backward)");
+              "x.ini [CReactiveNavigationSystem] PTG0_K: must not be 0 (its sign is the "
+              "direction: 1 forward, -1 backward)");
+    EXPECT_EQ(errorOf("CReactiveNavigationSystem", "PTG2_K", "-5"), "");  // MRPT takes its sign
     EXPECT_EQ(errorOf("CReactiveNavigationSystem", "PTG0_score_priority", "-1"),
               "x.ini [CReactiveNavigationSystem] PTG0_score_priority: must be >= 0");
     EXPECT_EQ(errorOf("CMultiObjectiveMotionOptimizerBase", "scores_to_normalize",

@@ -133,7 +133,8 @@ class ReactiveNav : public mrpt::nav::CReactiveNavigationSystem {
         ptg->initTPObstacles(free_space);
         for (auto& d : free_space) d /= ptg->getRefDistance();  // normalised, as in a step
         mrpt::nav::ClearanceDiagram clearance;
-        ptg->initClearanceDiagram(clearance);
+        // (as a step does: only with evaluate_clearance, which asserts more of the PTG)
+        if (params_abstract_ptg_navigator.evaluate_clearance) ptg->initClearanceDiagram(clearance);
         std::vector<mrpt::nav::TCandidateMovementPTG> motion(1);
         motion[0].PTG = ptg;
         motion[0].direction = tp.target_alpha;
@@ -147,6 +148,9 @@ class ReactiveNav : public mrpt::nav::CReactiveNavigationSystem {
         // variables' names, and a formula evaluated with this made-up motion's values (the
         // robot's pose is not known yet) could come out NaN, which MRPT throws on.
         motion[0].speed = -1.0;
+        // A step adds this one after the scorer (build_movement_candidate), and formulas may
+        // use it (CAbstractPTGBasedReactive.h lists it).
+        motion[0].props["original_col_free_dist"] = motion[0].props["collision_free_distance"];
         mrpt::nav::CMultiObjectiveMotionOptimizerBase::TResultInfo decided;
         (void)m_multiobjopt->decide(motion, decided);
     }

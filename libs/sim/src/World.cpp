@@ -439,9 +439,10 @@ void validatePedestrians(const WorldSpec& w, const std::vector<Obstacle>& static
         m << "(" << q.x << ", " << q.y << ")";
         return m.str();
     };
-    // Each physics step tests every person against every obstacle and person (about 12 ns a
-    // pair): 2000 people among 2000 obstacles passed every other check and simulated 1.6 s a
-    // second, a blocked goal some 17 hours. 1e10 pair tests are about two minutes.
+    // Each physics step tests every person against every obstacle and person (about 6 ns a
+    // pair): 2000 people among 2000 obstacles passed every other check and simulated 5 s in
+    // 25 s of wall time (0.01 s steps), a 1e6-step run some 14 hours. 1e10 pair tests are
+    // about a minute.
     if (const double pairs = double(w.pedestrians.size()) *
                              double(statics.size() + w.pedestrians.size()) *
                              (w.timeout / w.time_step);
