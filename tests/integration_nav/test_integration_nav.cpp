@@ -207,6 +207,14 @@ TEST(IntegrationNav, EveryTargetAroundTheRobotIsInSomePtgsDomain) {
                                                  dir.str("b.png"));
     EXPECT_EQ(r.rc, 0) << r.out;
     EXPECT_EQ(r.out.find("warning"), std::string::npos) << r.out;
+    // The bench says it once (one of its episodes looks).
+    r = devslam::test::runApp("devslam-nav-bench",
+                              "--per-category 1 --methods CHolonomicVFHPlus --config " +
+                                  dir.str("slow.ini") + " --results none --png-dir " +
+                                  dir.str("png"));
+    const std::string said = "devslam-nav-bench: warning: with the INI's PTGs, 4 targets";
+    EXPECT_NE(r.out.find(said), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find(said), r.out.rfind(said)) << r.out;
 }
 
 // A first target PTG0 (forward arcs) does not reach: MRPT 2.5 compiles its score formulas on
