@@ -374,15 +374,9 @@ Episodes runEpisodes(const Args& a, const mrpt::config::CConfigFileBase& ini,
                                     shortName(g.method) + ": " + error);
             if (!r.navlog_error.empty() && ep.navlogs_cut++ == 0)
                 ep.first_navlog_error = r.navlog_error;
-            if (!r.ptg_domain_gaps.empty()) {
-                const auto& [d, deg] = r.ptg_domain_gaps.front();
-                std::fprintf(stderr,
-                             "\ndevslam-nav-bench: warning: with the INI's PTGs, %zu targets "
-                             "0.30-1.20 m from the robot (every 5 cm and degree) lie in no PTG's "
-                             "domain, the first %.2f m away at %d deg; MRPT stops when its target "
-                             "is there (docs/nav.md, \"A target close behind\")\n",
-                             r.ptg_domain_gaps.size(), d, deg);
-            }
+            if (!r.ptg_domain_gaps.empty())
+                std::cerr << "\ndevslam-nav-bench: warning: with the INI's PTGs, "
+                          << devslam::nav::describePtgDomainGaps(r.ptg_domain_gaps) << "\n";
             bar.update(++ep.done, std::string(devslam::sim::toString(cats[g.category])) + " " +
                                       shortName(g.method));
         },

@@ -265,16 +265,9 @@ static int appMain(int argc, char** argv) {
         const auto r = devslam::sim::runEpisode(world, *ini, nav_opts, eo);
         // Speed limits other than the shipped ones can leave targets near the robot that no
         // PTG reaches, where MRPT stops for good ("no way found"): said, before the result.
-        if (!r.ptg_domain_gaps.empty()) {
-            const auto& [d, deg] = r.ptg_domain_gaps.front();
-            std::fprintf(stderr,
-                         "devslam-nav: warning: with %s's PTGs, %zu targets 0.30-1.20 m from the "
-                         "robot (every 5 cm and degree) lie in no PTG's domain, the first %.2f m "
-                         "away at %d deg; MRPT stops when its target is there, until a PTG of "
-                         "a smaller turning radius reaches it (docs/nav.md, \"A target close "
-                         "behind\")\n",
-                         config.c_str(), r.ptg_domain_gaps.size(), d, deg);
-        }
+        if (!r.ptg_domain_gaps.empty())
+            std::cerr << "devslam-nav: warning: with " << config << "'s PTGs, "
+                      << devslam::nav::describePtgDomainGaps(r.ptg_domain_gaps) << "\n";
         if (png.empty()) png = kDefaultDir + "/nav_" + world.name + ".png";
         // The result first: a picture that cannot be written must not lose it.
         // A clearance never measured (nothing of that kind in the world; no path, so no step

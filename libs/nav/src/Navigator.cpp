@@ -15,6 +15,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <ctime>
 #include <filesystem>
 #include <functional>
@@ -388,6 +389,18 @@ std::vector<std::pair<double, int>> Navigator::targetsNoPtgReaches(double min_d,
             if (!reached) out.emplace_back(d, deg);
         }
     return out;
+}
+
+std::string describePtgDomainGaps(const std::vector<std::pair<double, int>>& gaps) {
+    if (gaps.empty()) return {};
+    char text[320];
+    std::snprintf(text, sizeof text,
+                  "%zu targets 0.30-1.20 m from the robot (every 5 cm and degree) lie in no PTG's "
+                  "domain, the first %.2f m away at %d deg; MRPT stops when its target is there, "
+                  "until a PTG of a smaller turning radius reaches it (docs/nav.md, \"A target "
+                  "close behind\")",
+                  gaps.size(), gaps.front().first, gaps.front().second);
+    return text;
 }
 
 std::string Navigator::holonomicMethod() const {

@@ -60,6 +60,11 @@ struct NavigatorOptions {
 /// 0.9 x `ref_distance` (a waypoint beyond the PTGs' reach cannot be aimed at).
 [[nodiscard]] double waypointSpacing(double waypoint_spacing, double ref_distance);
 
+/// "N targets 0.30-1.20 m from the robot (every 5 cm and degree) lie in no PTG's domain, the
+/// first D m away at B deg; MRPT stops when its target is there (...)": the warning the apps
+/// give for Navigator::targetsNoPtgReaches()'s result (not empty).
+[[nodiscard]] std::string describePtgDomainGaps(const std::vector<std::pair<double, int>>& gaps);
+
 /// Outcome of one step.
 enum class NavState { Idle, Navigating, GoalReached, Error };
 [[nodiscard]] const char* toString(NavState s);
