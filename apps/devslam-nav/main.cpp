@@ -69,6 +69,16 @@ void writePicture(const std::string& png, Write&& write) {
     }
 }
 
+/// A clearance for the result line: "none" where none was measured (nothing of that kind in
+/// the world, no step driven, a map without an obstacle), not the placeholder it holds then
+/// (EpisodeResult's 1e9 m, the planner's 1e6 m); worlds lie within +-1e4 m.
+std::string clearanceText(double v) {
+    if (v >= 1e5) return "none";
+    char text[32];
+    std::snprintf(text, sizeof text, "%.3f m", v);
+    return text;
+}
+
 /// devslam-nav --map: A* and waypoints on a SLAM grid, one result line and a picture.
 int planOnSlamMap(const std::string& map, const std::string& from, const std::string& to,
                   const std::string& config, std::string png) {
@@ -97,16 +107,11 @@ int planOnSlamMap(const std::string& map, const std::string& from, const std::st
     if (!plan.path) {
         std::printf("result=no_path png=%s\n", png.c_str());
     } else {
-        // A map without an obstacle has no clearance to give: "none", as a run's line says,
-        // where it printed the planner's placeholder (1000000.000 m).
-        char clearance[32] = "none";
-        if (plan.min_clearance < 1e5)
-            std::snprintf(clearance, sizeof clearance, "%.3f m", plan.min_clearance);
         std::printf(
             "result=path length=%.2f m waypoints=%zu min_clearance=%s "
             "unknown=%.0f%% png=%s\n",
-            plan.path->length, plan.waypoints.size(), clearance, 100.0 * plan.unknown_fraction,
-            png.c_str());
+            plan.path->length, plan.waypoints.size(), clearanceText(plan.min_clearance).c_str(),
+            100.0 * plan.unknown_fraction, png.c_str());
         for (const auto& w : plan.waypoints) std::printf("waypoint %.2f %.2f\n", w.x, w.y);
     }
     std::fflush(stdout);
@@ -270,21 +275,14 @@ static int appMain(int argc, char** argv) {
                       << devslam::nav::describePtgDomainGaps(r.ptg_domain_gaps) << "\n";
         if (png.empty()) png = kDefaultDir + "/nav_" + world.name + ".png";
         // The result first: a picture that cannot be written must not lose it.
-        // A clearance never measured (nothing of that kind in the world; no path, so no step
-        // driven) is "none", not the result's 1e9 placeholder.
-        const auto clearance = [](double v) {
-            if (v >= 1e8) return std::string("none");
-            char text[32];
-            std::snprintf(text, sizeof text, "%.3f m", v);
-            return std::string(text);
-        };
         std::printf(
             "world=%s method=%s result=%s time=%.2f s path=%.2f m astar=%.2f m "
             "min_clearance_static=%s min_clearance_people=%s collisions_static=%d "
             "collisions_people=%d replans=%d png=%s%s%s\n",
             world.name.c_str(), r.holonomic_method.c_str(), devslam::sim::toString(r.outcome),
             r.time, r.path_length, r.astar_length,
-            clearance(r.min_clearance_static).c_str(), clearance(r.min_clearance_people).c_str(),
+            clearanceText(r.min_clearance_static).c_str(),
+            clearanceText(r.min_clearance_people).c_str(),
             r.static_collisions, r.person_collisions, r.replans, png.c_str(),
             r.navlog.empty() ? "" : " navlog=", r.navlog.c_str());
         if (!r.reason.empty()) std::printf("reason: %s\n", r.reason.c_str());

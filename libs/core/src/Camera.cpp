@@ -63,6 +63,10 @@ namespace {
 /// A focal length in [1, 1e5] px: 0, inf or 1e-300 from a damaged file made the SLAM's grid map
 /// loop forever.
 bool usableFocal(double f) { return f >= 1.0 && f <= 1e5; }
+/// A distortion coefficient in [-100, 100]: k1 = 1e6 folded every depth pixel out of the
+/// colour image (a frame without depth, without a word); real lenses, fisheyes included, stay
+/// well inside.
+bool usableDistortion(double d) { return std::abs(d) <= 100; }
 }  // namespace
 
 std::string CameraIntrinsics::problem() const {
@@ -76,10 +80,8 @@ std::string CameraIntrinsics::problem() const {
     if (!(cx >= 0 && cx < width && cy >= 0 && cy < height))
         return "principal point (" + str(cx) + ", " + str(cy) + ") lies outside the " +
                std::to_string(width) + "x" + std::to_string(height) + " image";
-    // (k1 = 1e6 folded every depth pixel out of the colour image: a frame without depth,
-    // without a word; real lenses, fisheyes included, stay well inside 100)
     for (const double d : dist)
-        if (!(std::abs(d) <= 100))
+        if (!usableDistortion(d))
             return "a distortion coefficient is " + str(d) + ": must be in [-100, 100]";
     return {};
 }
@@ -107,10 +109,10 @@ CameraIntrinsics CameraIntrinsics::fromConfig(const mrpt::config::CConfigFileBas
     if (const auto dist_text = readTextIfPresent(c, s, "dist")) {
         const auto d = parseNumberList(*dist_text, "[" + s + "] dist");
         requireValue(d.size() == 5, s, "dist", "must have 5 values k1 k2 p1 p2 k3");
-        // problem()'s bound: a TUM folder's camera.ini with k1 = 1e9 was taken, and the run
-        // lost every frame after the first without a word on the file
+        // (a TUM folder's camera.ini with k1 = 1e9 was taken, and the run lost every frame
+        // after the first without a word on the file)
         for (const double v : d)
-            requireValue(std::abs(v) <= 100, s, "dist",
+            requireValue(usableDistortion(v), s, "dist",
                          "each coefficient must be in [-100, 100] (a real lens, a fisheye "
                          "too, stays well inside)");
         std::copy(d.begin(), d.end(), K.dist.begin());

@@ -39,9 +39,9 @@ mrpt::maps::COccupancyGridMap2D loadGridMap(const std::string& path) {
         throw std::runtime_error(path + ": truncated or corrupt gzip stream (" + gz + ")");
     if (grid.getSizeX() == 0 || grid.getSizeY() == 0)
         throw std::runtime_error(path + ": the grid map is empty");
-    // The planner keeps several numbers per cell: 30000 x 30000 cells (a 4 MB file) took
-    // 9.7 GB before std::bad_alloc, naming no file. A world's grid has the same bound.
-    if (const double cells = double(grid.getSizeX()) * double(grid.getSizeY()); cells > 1e8)
+    // 30000 x 30000 cells (a 4 MB file) took 9.7 GB before std::bad_alloc, naming no file.
+    if (const double cells = double(grid.getSizeX()) * double(grid.getSizeY());
+        cells > kMaxGridCells)
         throw std::runtime_error(path + ": the grid map has " + std::to_string(grid.getSizeX()) +
                                  " x " + std::to_string(grid.getSizeY()) +
                                  " cells, more than the planner takes (1e8)");

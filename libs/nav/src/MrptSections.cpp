@@ -17,6 +17,7 @@
 #include <mrpt/nav/reactive/CWaypointsNavigator.h>
 #include <mrpt/nav/tpspace/CParameterizedTrajectoryGenerator.h>
 #include <mrpt/rtti/CObject.h>
+#include <mrpt/system/string_utils.h>
 
 #include <algorithm>
 #include <cctype>
@@ -171,18 +172,17 @@ void checkMrptSections(const mrpt::config::CConfigFileBase& c, const std::string
         std::vector<std::string> names;
         for (int i = 1; c.keyExists(mo, "score" + std::to_string(i) + "_name"); ++i)
             names.push_back(c.read_string(mo, "score" + std::to_string(i) + "_name", ""));
-        std::istringstream listed(c.read_string(mo, "scores_to_normalize", ""));
-        for (std::string name; std::getline(listed, name, ',');) {
-            std::istringstream words(name);
-            for (std::string w; words >> w;)
-                if (std::find(names.begin(), names.end(), w) == names.end())
-                    core::namingSource(source, [&] {
-                        std::string known;
-                        for (const auto& n : names) known += (known.empty() ? "" : ", ") + n;
-                        core::requireValue(false, mo, "scores_to_normalize",
-                                           "no score is named '" + w + "' (scores: " + known + ")");
-                    });
-        }
+        // (split as MRPT splits it)
+        std::vector<std::string> listed;
+        mrpt::system::tokenize(c.read_string(mo, "scores_to_normalize", ""), ", \t", listed);
+        for (const auto& w : listed)
+            if (std::find(names.begin(), names.end(), w) == names.end())
+                core::namingSource(source, [&] {
+                    std::string known;
+                    for (const auto& n : names) known += (known.empty() ? "" : ", ") + n;
+                    core::requireValue(false, mo, "scores_to_normalize",
+                                       "no score is named '" + w + "' (scores: " + known + ")");
+                });
     }
     // Values MRPT asserts on only while navigating (a speed limit of 0 or below printed an
     // MRPT stack trace at every step, and the robot still got there) or with a message that
@@ -238,8 +238,8 @@ void checkMrptSections(const mrpt::config::CConfigFileBase& c, const std::string
         // FullEval's phases: MRPT indexes factorWeights with PHASE<i>_FACTORS and asserts
         // PHASE_COUNT >= 1 only inside each navigation step.
         const std::string fe = "CHolonomicFullEval";
-        const std::size_t n_factors = CHolonomicFullEval::TOptions().factorWeights.size();
         const CHolonomicFullEval::TOptions fe_defaults;
+        const std::size_t n_factors = fe_defaults.factorWeights.size();
         std::vector<double> fe_weights(fe_defaults.factorWeights.begin(),
                                        fe_defaults.factorWeights.end());
         if (c.keyExists(fe, "factorWeights"))

@@ -373,13 +373,14 @@ std::string Navigator::closeLog() {
     return why;
 }
 
-std::vector<std::pair<double, int>> Navigator::targetsNoPtgReaches(double min_d, double max_d) {
+std::vector<std::pair<double, int>> Navigator::targetsNoPtgReaches() {
     std::vector<std::pair<double, int>> out;
     const auto& rns = *nav_;
-    const int n = static_cast<int>(std::floor((max_d - min_d) / 0.05 + 1e-9));
+    const int n = static_cast<int>(
+        std::lround((kPtgGapMaxDistance - kPtgGapMinDistance) / 0.05));
     for (int i = 0; i <= n; i++)
         for (int deg = -179; deg <= 180; deg++) {
-            const double d = min_d + 0.05 * i, a = deg * M_PI / 180;
+            const double d = kPtgGapMinDistance + 0.05 * i, a = deg * M_PI / 180;
             bool reached = false;
             for (std::size_t p = 0; p < rns.getPTG_count() && !reached; p++) {
                 int k = 0;
@@ -395,11 +396,12 @@ std::string describePtgDomainGaps(const std::vector<std::pair<double, int>>& gap
     if (gaps.empty()) return {};
     char text[320];
     std::snprintf(text, sizeof text,
-                  "%zu targets 0.30-1.20 m from the robot (every 5 cm and degree) lie in no PTG's "
+                  "%zu targets %.2f-%.2f m from the robot (every 5 cm and degree) lie in no PTG's "
                   "domain, the first %.2f m away at %d deg; MRPT stops when its target is there, "
                   "until a PTG of a smaller turning radius reaches it (docs/nav.md, \"A target "
                   "close behind\")",
-                  gaps.size(), gaps.front().first, gaps.front().second);
+                  gaps.size(), kPtgGapMinDistance, kPtgGapMaxDistance, gaps.front().first,
+                  gaps.front().second);
     return text;
 }
 

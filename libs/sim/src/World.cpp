@@ -238,11 +238,10 @@ void validateBoundsAndTiming(const WorldSpec& w) {
             fail(src, "world", key, "must be within +-10000 m (Bullet's single precision)");
     if (w.grid_resolution <= 0 || w.grid_resolution > 0.5)
         fail(src, "world", "grid_resolution", "must be in (0, 0.5] m");
-    // The occupancy grid holds every cell of the bounds; MRPT counts them in 32 bits.
-    constexpr double kMaxCells = 1e8;
+    // The occupancy grid holds every cell of the bounds.
     const double cells =
         (w.x_max - w.x_min) / w.grid_resolution * ((w.y_max - w.y_min) / w.grid_resolution);
-    if (cells > kMaxCells) {
+    if (cells > nav::kMaxGridCells) {
         std::ostringstream m;
         m << "bounds " << w.x_max - w.x_min << " x " << w.y_max - w.y_min << " m at "
           << w.grid_resolution << " m make " << cells << " grid cells (at most 1e8)";

@@ -25,6 +25,10 @@
 
 namespace devslam::nav {
 
+/// The most cells a grid the planner takes may have: it keeps several numbers per cell, and
+/// MRPT counts a grid's cells in 32 bits (a world's bounds and a --map file alike).
+inline constexpr double kMaxGridCells = 1e8;
+
 /// Parameters of the grid A* (INI section [global_planner]).
 struct GridPlannerOptions {
     double robot_radius = 0.25;        ///< [m] cells closer than this to an obstacle are lethal

@@ -60,6 +60,10 @@ struct NavigatorOptions {
 /// 0.9 x `ref_distance` (a waypoint beyond the PTGs' reach cannot be aimed at).
 [[nodiscard]] double waypointSpacing(double waypoint_spacing, double ref_distance);
 
+/// The distances Navigator::targetsNoPtgReaches() looks at [m]: from the goal tolerance of the
+/// shipped worlds out to where PTG0 and PTG2 reach every bearing.
+inline constexpr double kPtgGapMinDistance = 0.30, kPtgGapMaxDistance = 1.20;
+
 /// "N targets 0.30-1.20 m from the robot (every 5 cm and degree) lie in no PTG's domain, the
 /// first D m away at B deg; MRPT stops when its target is there (...)": the warning the apps
 /// give for Navigator::targetsNoPtgReaches()'s result (not empty).
@@ -97,12 +101,11 @@ class Navigator {
     /// The class of the holonomic method MRPT's navigator made (e.g. "CHolonomicVFHPlus").
     [[nodiscard]] std::string holonomicMethod() const;
     [[nodiscard]] mrpt::nav::CReactiveNavigationSystem& reactive();
-    /// Targets `min_d`..`max_d` m from the robot (every 5 cm, every degree of bearing) that no
-    /// PTG reaches (inverseMap_WS2TP false for all), as (distance [m], bearing [deg]). MRPT's
-    /// navigator cannot aim at such a target: it stops ("no way found") until it moves. The
-    /// shipped INI has none from 0.30 m (the goal tolerance) to 1.20 m; other speed limits can.
-    [[nodiscard]] std::vector<std::pair<double, int>> targetsNoPtgReaches(double min_d = 0.30,
-                                                                          double max_d = 1.20);
+    /// Targets kPtgGapMinDistance..kPtgGapMaxDistance m from the robot (every 5 cm, every
+    /// degree of bearing) that no PTG reaches (inverseMap_WS2TP false for all), as (distance
+    /// [m], bearing [deg]). MRPT's navigator cannot aim at such a target: it stops ("no way
+    /// found") until it moves. The shipped INI has none; other speed limits can.
+    [[nodiscard]] std::vector<std::pair<double, int>> targetsNoPtgReaches();
     /// The navlog being written (NavigatorOptions::log_file), "" when none is.
     [[nodiscard]] const std::string& logPath() const { return log_path_; }
     /// Closes the navlog and returns what went wrong writing it ("cannot write navlog

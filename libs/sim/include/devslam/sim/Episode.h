@@ -30,8 +30,8 @@ struct EpisodeOptions {
     /// Asked after each navigator step: true ends the run there as Outcome::Interrupted, with
     /// what it did so far (devslam-nav's Ctrl-C); empty: never.
     std::function<bool()> stop;
-    /// Also find the targets near the robot that no PTG reaches
-    /// (EpisodeResult::ptg_domain_gaps; about 0.1 s, so off for the bench's episodes).
+    /// Also find the targets near the robot that no PTG reaches (EpisodeResult::ptg_domain_gaps;
+    /// about 0.1 s: devslam-nav asks it of its run, the bench of one episode).
     bool check_ptg_domains = false;
 };
 
