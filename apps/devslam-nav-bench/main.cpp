@@ -53,6 +53,7 @@ struct Args {
                                      "CHolonomicFullEval"};
     uint32_t seed = 1;
     std::optional<double> person_margin;  ///< [m] overrides [navigator] person_margin
+    std::optional<double> max_speed;      ///< [m/s] every world's robot and the INI's PTGs
 };
 
 /// "a,b": the --methods value that gives `methods`.
@@ -73,7 +74,9 @@ void usage(std::ostream& os = std::cerr) {
           "  --results FILE    RESULTS.md to update (default docs/RESULTS.md; none: no file)\n"
           "  --png-dir DIR     where PNGs go (default docs/images)\n"
           "  --seed S          first world seed (default 1)\n"
-          "  --person-margin M [m] overrides the INI's [navigator] person_margin\n";
+          "  --person-margin M [m] overrides the INI's [navigator] person_margin\n"
+          "  --max-speed V     [m/s] the robot's top speed: every world's [robot] max_v and\n"
+          "                    the INI's robotMax_V_mps and PTG<i>_v_max_mps\n";
 }
 
 struct Tally {
@@ -198,7 +201,12 @@ std::optional<int> parseArgs(int argc, char** argv, Args& a) {
                 png_dir_given = true;
             } else if (s == "--person-margin")
                 a.person_margin = devslam::core::parseNumber(next(), "--person-margin");
-            else if (s == "--seed")
+            else if (s == "--max-speed") {
+                a.max_speed = devslam::core::parseNumber(next(), "--max-speed");
+                // (the world files' own bound)
+                if (!(*a.max_speed > 0 && *a.max_speed <= 5))
+                    throw std::invalid_argument("--max-speed: must be in (0, 5] m/s");
+            } else if (s == "--seed")
                 a.seed = static_cast<uint32_t>(
                     devslam::core::parseInteger(next(), "--seed", 0, UINT32_MAX));
             else if (s == "--methods") {
@@ -257,6 +265,7 @@ std::optional<int> parseArgs(int argc, char** argv, Args& a) {
         if (!same(a.config, d.config)) changed.push_back("--config");
         if (a.seed != d.seed) changed.push_back("--seed");
         if (a.person_margin) changed.push_back("--person-margin");
+        if (a.max_speed) changed.push_back("--max-speed");
         if (!same(a.png_dir, d.png_dir)) changed.push_back("--png-dir");
     }
     if (!results_given && !a.quick && changed.empty())
@@ -283,6 +292,7 @@ struct Episodes {
     };
     std::map<std::pair<int, std::string>, Tally> tally;
     std::map<std::string, std::vector<double>> step_ms;
+    std::map<std::string, devslam::nav::SpeedGuardStats> guard;  ///< summed per method
     std::vector<Picture> pictures;
     std::size_t total = 0, done = 0;
     double sim_seconds = 0, wall = 0;  ///< [s]
@@ -348,21 +358,31 @@ Episodes runEpisodes(const Args& a, const mrpt::config::CConfigFileBase& ini,
     // The PTGs come from the INI alone: one episode looks for targets no PTG reaches (about
     // 0.1 s), as devslam-nav does for each run.
     std::atomic_flag domains_checked = ATOMIC_FLAG_INIT;
+    // The world as run: with --max-speed its robot's top speed (which the score's optimal
+    // time divides by) is that one.
+    const auto asRun = [&](devslam::sim::WorldSpec w) {
+        if (a.max_speed) w.robot.max_v = *a.max_speed;
+        return w;
+    };
     devslam::sim::runEpisodeGrid(
         cats, a.per_category, a.seed, a.methods, nav_opts.planner,
         [&](const devslam::sim::WorldSpec& world, const std::string& m) {
             devslam::sim::EpisodeOptions eo;
             eo.holonomic_method = m;
             eo.check_ptg_domains = !domains_checked.test_and_set();
-            return devslam::sim::runEpisode(world, ini, nav_opts, eo);
+            return devslam::sim::runEpisode(asRun(world), ini, nav_opts, eo);
         },
         [&](const devslam::sim::GridEpisode& g) {
             const auto& r = g.result;
             ep.sim_seconds += r.time;
-            count(ep.tally[{static_cast<int>(g.category), g.method}], *g.world, r);
+            count(ep.tally[{static_cast<int>(g.category), g.method}], asRun(*g.world), r);
             for (double s : r.step_seconds) ep.step_ms[g.method].push_back(1e3 * s);
+            auto& gs = ep.guard[g.method];
+            gs.commands += r.guard.commands;
+            gs.slowed += r.guard.slowed;
+            gs.stopped += r.guard.stopped;
             if (g.index == 0 && g.method == a.methods.front())  // pictured after the results
-                ep.pictures.push_back({*g.world, r, g.method});
+                ep.pictures.push_back({asRun(*g.world), r, g.method});
             // An exception out of the episode, or a run the navigator ended by an error (MRPT
             // refusing a setting mid-run): not results.
             const std::string error = !g.error.empty() ? g.error
@@ -393,6 +413,7 @@ std::string headerMarkdown(const Args& a, const devslam::nav::NavigatorOptions& 
     md << "## Navigation benchmark (`devslam-nav-bench`)\n\n"
        << "Command: `devslam-nav-bench --per-category " << a.per_category << " --seed " << a.seed
        << (a.person_margin ? " --person-margin " + num(*a.person_margin) : std::string())
+       << (a.max_speed ? " --max-speed " + num(*a.max_speed) : std::string())
        << (a.methods.size() < 4 ? " --methods " + methodList(a.methods) : std::string())
        << (a.quick ? " --quick" : "") << "` (config `"
        << devslam::core::shownPath(a.config, DEVSLAM_SOURCE_DIR) << "`; people get "
@@ -480,8 +501,30 @@ std::string timingMarkdown(const Args& a, const Episodes& ep, int ptg_count) {
     const double vfh_ms = timeVfhStep();
     const double astar_ms = timeAStar400(&astar_len);
     std::ostringstream md;
-    md << "![success rates](" << imageLink(a) << "/nav_bench_success.png)\n\n"
-       << "### Timing (thread CPU time, so shared-machine load does not inflate it)\n\n| "
+    md << "![success rates](" << imageLink(a) << "/nav_bench_success.png)\n\n";
+    if (std::any_of(ep.guard.begin(), ep.guard.end(),
+                    [](const auto& g) { return g.second.commands > 0; })) {
+        // A sentence, not a table: a row per method would read as another result row.
+        md << "**Speed guard** (`[navigator] speed_guard`, docs/nav.md): of MRPT's commands "
+              "over all runs, those scaled down to what the robot can follow and stop from:";
+        const char* sep = " ";
+        for (const auto& m : a.methods) {
+            const auto it = ep.guard.find(m);
+            if (it == ep.guard.end()) continue;
+            const auto& g = it->second;
+            const auto share = [&](std::size_t k) {
+                char b[48];
+                std::snprintf(b, sizeof b, "%zu (%.2f %%)", k,
+                              g.commands ? 100.0 * double(k) / double(g.commands) : 0.0);
+                return std::string(b);
+            };
+            md << sep << shortName(m) << " " << share(g.slowed) << " of " << g.commands << ", "
+               << g.stopped << " to a stop";
+            sep = "; ";
+        }
+        md << ".\n\n";
+    }
+    md << "### Timing (thread CPU time, so shared-machine load does not inflate it)\n\n| "
           "measure | median |\n|---|---|\n"
        << "| one VFH+ step (`vfhPlusStep`, 121 sectors, synthetic fields, 2000 calls) | "
        << num(vfh_ms * 1e3, 1) << " us |\n";
@@ -522,6 +565,13 @@ int appMain(int argc, char** argv) {
             if (*a.person_margin < 0 || *a.person_margin > 2.0)
                 throw std::invalid_argument("--person-margin: must be in [0, 2] m");
             nav_opts.person_margin = *a.person_margin;
+        }
+        if (a.max_speed) {  // what MRPT commands and predicts: the robot's new top speed
+            ini->write("CAbstractPTGBasedReactive", "robotMax_V_mps", *a.max_speed);
+            const int n = ini->read_int("CReactiveNavigationSystem", "PTG_COUNT", 0);
+            for (int i = 0; i < n; ++i)
+                ini->write("CReactiveNavigationSystem", "PTG" + std::to_string(i) + "_v_max_mps",
+                           *a.max_speed);
         }
         const auto cats = devslam::sim::allCategories();
         const Episodes ep = runEpisodes(a, *ini, nav_opts, cats);

@@ -278,12 +278,11 @@ static int appMain(int argc, char** argv) {
         std::printf(
             "world=%s method=%s result=%s time=%.2f s path=%.2f m astar=%.2f m "
             "min_clearance_static=%s min_clearance_people=%s collisions_static=%d "
-            "collisions_people=%d replans=%d png=%s%s%s\n",
+            "collisions_people=%d replans=%d guard_slowed=%zu/%zu png=%s%s%s\n",
             world.name.c_str(), r.holonomic_method.c_str(), devslam::sim::toString(r.outcome),
-            r.time, r.path_length, r.astar_length,
-            clearanceText(r.min_clearance_static).c_str(),
-            clearanceText(r.min_clearance_people).c_str(),
-            r.static_collisions, r.person_collisions, r.replans, png.c_str(),
+            r.time, r.path_length, r.astar_length, clearanceText(r.min_clearance_static).c_str(),
+            clearanceText(r.min_clearance_people).c_str(), r.static_collisions, r.person_collisions,
+            r.replans, r.guard.slowed, r.guard.commands, png.c_str(),
             r.navlog.empty() ? "" : " navlog=", r.navlog.c_str());
         if (!r.reason.empty()) std::printf("reason: %s\n", r.reason.c_str());
         std::fflush(stdout);

@@ -359,6 +359,10 @@ TEST(NavConfig, TheShippedNavIniLoads) {
     EXPECT_DOUBLE_EQ(o.nav_period, 0.1);
     EXPECT_DOUBLE_EQ(o.planner.waypoint_spacing, 1.5);
     EXPECT_DOUBLE_EQ(o.person_margin, 0.1);
+    EXPECT_TRUE(o.guard.enabled);
+    EXPECT_DOUBLE_EQ(o.guard.max_acc, 1.0);
+    EXPECT_NEAR(o.guard.max_ang_acc, M_PI, 1e-12);  // 180 deg/s^2
+    EXPECT_DOUBLE_EQ(o.guard.margin, 0.02);
     VfhPlusOptions v;
     v.loadFromConfigFile(*cfg, "CHolonomicVFHPlus", path);
     EXPECT_GT(v.mu1, v.mu2 + v.mu3);
@@ -582,6 +586,17 @@ TEST(NavConfig, UnknownKeyIsReported) {
               "x.ini [navigator] person_margin: must be in [0, 2] m");
     EXPECT_EQ(errorOf({{"navigator", "nav_period", 5.0}}),
               "x.ini [navigator] nav_period: must be in (0, 1] s");
+    // The speed guard's limits: a robot that cannot accelerate never moves, one above the
+    // world files' bounds is no robot they describe.
+    for (const double a : {0.0, -1.0, 21.0})
+        EXPECT_EQ(errorOf({{"navigator", "max_acc", a}}),
+                  "x.ini [navigator] max_acc: must be in (0, 20] m/s^2")
+            << a;
+    EXPECT_EQ(errorOf({{"navigator", "max_ang_acc_deg", 0.0}}),
+              "x.ini [navigator] max_ang_acc_deg: must be in (0, 3600] deg/s^2");
+    EXPECT_EQ(errorOf({{"navigator", "guard_margin", -0.01}}),
+              "x.ini [navigator] guard_margin: must be in [0, 1] m");
+    EXPECT_EQ(errorOf({{"navigator", "guard_margin", 0.0}}), "");
     for (const double d : {-1.0, 0.0, 1e9})
         EXPECT_EQ(errorOf({{"navigator", "waypoint_allowed_distance", d}}),
                   "x.ini [navigator] waypoint_allowed_distance: must be in (0, 10] m")

@@ -6,6 +6,7 @@
 
 #include "MrptSections.h"
 
+#include <mrpt/core/bits_math.h>
 #include <mrpt/maps/CSimplePointsMap.h>
 #include <mrpt/nav/reactive/CReactiveNavigationSystem.h>
 #include <mrpt/poses/CPose2D.h>
@@ -240,7 +241,8 @@ NavigatorOptions readNavigatorOptions(const mrpt::config::CConfigFileBase& c,
     const std::string s = "navigator";
     core::requireKnownKeys(c, s,
                            {"nav_period", "waypoint_allowed_distance", "holonomic_method",
-                            "robot_radius", "person_margin", "log_file", "log_directory"},
+                            "robot_radius", "person_margin", "log_file", "log_directory",
+                            "speed_guard", "max_acc", "max_ang_acc_deg", "guard_margin"},
                            source);
     o.nav_period = core::readDouble(c, s, "nav_period", o.nav_period);
     o.waypoint_allowed_distance =
@@ -251,6 +253,11 @@ NavigatorOptions readNavigatorOptions(const mrpt::config::CConfigFileBase& c,
     o.person_margin = core::readDouble(c, s, "person_margin", o.person_margin);
     o.log_file = core::readBool(c, s, "log_file", o.log_file);
     o.log_directory = c.read_string(s, "log_directory", o.log_directory);
+    o.guard.enabled = core::readBool(c, s, "speed_guard", o.guard.enabled);
+    o.guard.max_acc = core::readDouble(c, s, "max_acc", o.guard.max_acc);
+    o.guard.max_ang_acc = mrpt::DEG2RAD(
+        core::readDouble(c, s, "max_ang_acc_deg", mrpt::RAD2DEG(o.guard.max_ang_acc)));
+    o.guard.margin = core::readDouble(c, s, "guard_margin", o.guard.margin);
     // At a period of seconds the robot drove blind into what it had not yet seen; a reached
     // radius of kilometres skipped every waypoint of the route.
     core::requireValue(o.nav_period > 0 && o.nav_period <= 1.0, s, "nav_period",
@@ -260,6 +267,14 @@ NavigatorOptions readNavigatorOptions(const mrpt::config::CConfigFileBase& c,
     core::requireValue(o.robot_radius > 0, s, "robot_radius", "must be > 0 m");
     core::requireValue(o.person_margin >= 0 && o.person_margin <= 2.0, s, "person_margin",
                        "must be in [0, 2] m");
+    // (the world files' own bounds: 20 m/s^2, 3600 deg/s^2)
+    core::requireValue(o.guard.max_acc > 0 && o.guard.max_acc <= 20, s, "max_acc",
+                       "must be in (0, 20] m/s^2");
+    core::requireValue(
+        o.guard.max_ang_acc > 0 && o.guard.max_ang_acc <= mrpt::DEG2RAD(3600.0) + 1e-9, s,
+        "max_ang_acc_deg", "must be in (0, 3600] deg/s^2");
+    core::requireValue(o.guard.margin >= 0 && o.guard.margin <= 1.0, s, "guard_margin",
+                       "must be in [0, 1] m");
     checkMrptSections(c, source);
     o.planner.loadFromConfigFile(c, "global_planner", source);
     o.replan.loadFromConfigFile(c, "replan", source);
@@ -318,7 +333,9 @@ Navigator::Navigator(mrpt::nav::CRobot2NavInterface& robot,
     cfg.write(sec_rns, "RobotModel_shape2D_xs", xs);
     cfg.write(sec_rns, "RobotModel_shape2D_ys", ys);
 
-    nav_ = std::make_unique<ReactiveNav>(robot_, opts_.log_directory);
+    guarded_ =
+        std::make_unique<GuardedRobot>(robot_, opts_.robot_radius, opts_.nav_period, opts_.guard);
+    nav_ = std::make_unique<ReactiveNav>(*guarded_, opts_.log_directory);
     nav_->setMinLoggingLevel(opts_.verbose ? mrpt::system::LVL_DEBUG : mrpt::system::LVL_ERROR);
     if (opts_.log_file) {
         // Its parents too (a missing one was a std::filesystem error naming no option).

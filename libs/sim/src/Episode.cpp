@@ -89,6 +89,8 @@ EpisodeResult runEpisode(const WorldSpec& world, const mrpt::config::CConfigFile
     EpisodeResult res;
     nav_opts.robot_radius = world.robot.radius;
     nav_opts.planner.robot_radius = world.robot.radius;
+    nav_opts.guard.max_acc = world.robot.max_acc;
+    nav_opts.guard.max_ang_acc = world.robot.max_ang_acc;
     if (!opts.holonomic_method.empty()) nav_opts.holonomic_method = opts.holonomic_method;
 
     Simulator sim(world);
@@ -251,6 +253,7 @@ EpisodeResult runEpisode(const WorldSpec& world, const mrpt::config::CConfigFile
     res.static_collisions = sim.collisions().static_events;
     res.person_collisions = sim.collisions().person_events;
     res.replans = navigator.replanCount();
+    res.guard = navigator.guardStats();
     res.trajectory.push_back(sim.robotPose());
     closeLog();
     return res;

@@ -15,6 +15,7 @@
 /// Not thread-safe. Time comes from mrpt::Clock (set it to Simulated in a simulator).
 #include <devslam/nav/GridPlanner.h>
 #include <devslam/nav/Replan.h>
+#include <devslam/nav/SpeedGuard.h>
 
 #include <mrpt/config/CConfigFileMemory.h>
 #include <mrpt/math/TPose2D.h>
@@ -45,6 +46,10 @@ struct NavigatorOptions {
     bool verbose = false;  ///< MRPT navigator log level INFO instead of ERROR (not in INI)
     /// The INI these options and MRPT's sections came from, for messages (fromConfig sets it).
     std::string source = "the navigation INI";
+    /// [navigator] speed_guard, max_acc, max_ang_acc_deg, guard_margin: the robot's
+    /// acceleration limits, which MRPT's PTGs ignore (SpeedGuard.h; the simulator sets them
+    /// from the world's [robot]).
+    SpeedGuardOptions guard;
     GridPlannerOptions planner;
     ReplanOptions replan;
 
@@ -101,6 +106,8 @@ class Navigator {
     /// The class of the holonomic method MRPT's navigator made (e.g. "CHolonomicVFHPlus").
     [[nodiscard]] std::string holonomicMethod() const;
     [[nodiscard]] mrpt::nav::CReactiveNavigationSystem& reactive();
+    /// What the speed guard did so far (commands all 0 with the guard off).
+    [[nodiscard]] const SpeedGuardStats& guardStats() const { return guarded_->stats(); }
     /// Targets kPtgGapMinDistance..kPtgGapMaxDistance m from the robot (every 5 cm, every
     /// degree of bearing) that no PTG reaches (inverseMap_WS2TP false for all), as (distance
     /// [m], bearing [deg]). MRPT's navigator cannot aim at such a target: it stops ("no way
@@ -122,6 +129,7 @@ class Navigator {
     void sendWaypoints(std::size_t first);
     mrpt::nav::CRobot2NavInterface& robot_;
     NavigatorOptions opts_;
+    std::unique_ptr<GuardedRobot> guarded_;  ///< what nav_ drives: robot_ through the guard
     std::unique_ptr<mrpt::nav::CReactiveNavigationSystem> nav_;
     class NavlogStream;
     NavlogStream* navlog_ = nullptr;  ///< owned by nav_ (its log stream); null when none

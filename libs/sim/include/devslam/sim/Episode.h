@@ -53,6 +53,7 @@ struct EpisodeResult {
     int static_collisions = 0;          ///< contact events with walls/boxes
     int person_collisions = 0;          ///< contact events with people
     int replans = 0;
+    nav::SpeedGuardStats guard;        ///< what the speed guard did (nav::Navigator::guardStats)
     std::string holonomic_method;      ///< the class MRPT's navigator made
     std::vector<double> step_seconds;  ///< wall time of each navigationStep()
     std::vector<mrpt::math::TPose2D> trajectory;

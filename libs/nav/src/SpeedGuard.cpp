@@ -1,0 +1,202 @@
+#include <devslam/nav/SpeedGuard.h>
+
+#include <mrpt/kinematics/CVehicleVelCmd_DiffDriven.h>
+#include <mrpt/maps/CSimplePointsMap.h>
+
+#include <algorithm>
+#include <cmath>
+
+namespace devslam::nav {
+
+namespace {
+constexpr double kStep = 0.02;         ///< [s] integration step of the predicted motion
+constexpr double kSensorSlack = 0.01;  ///< [m] the clearance now may seem this much larger
+constexpr double kContactGap = 0.005;  ///< [m] never planned nearer to a point than this
+constexpr double kStopped = 1e-3;      ///< [m/s], [rad/s] a speed taken as stopped
+constexpr double kMaxHorizon = 30.0;   ///< [s] bound on the stopping time looked at
+
+/// One step of each axis toward its command, by at most its acceleration limit (as
+/// sim::Simulator drives the robot).
+double ramp(double now, double cmd, double acc, double dt) {
+    return now + std::clamp(cmd - now, -acc * dt, acc * dt);
+}
+
+/// True when holding (vc, wc) for `hold` s, then stopping, keeps every point at least
+/// `need[i]` from the robot's centre.
+bool admissible(double v, double w, double vc, double wc, double hold,
+                const std::vector<mrpt::math::TPoint2D>& pts, const std::vector<double>& need,
+                const SpeedGuardOptions& o) {
+    double x = 0, y = 0, th = 0, t = 0;
+    const auto clear = [&] {
+        for (std::size_t i = 0; i < pts.size(); ++i)
+            if (std::hypot(pts[i].x - x, pts[i].y - y) < need[i]) return false;
+        return true;
+    };
+    while (t < kMaxHorizon) {
+        const bool holding = t < hold;
+        const double tv = holding ? vc : 0.0, tw = holding ? wc : 0.0;
+        if (!holding && std::abs(v) < kStopped && std::abs(w) < kStopped) break;
+        // midpoint speeds over the step
+        const double v1 = ramp(v, tv, o.max_acc, kStep), w1 = ramp(w, tw, o.max_ang_acc, kStep);
+        const double vm = 0.5 * (v + v1), wm = 0.5 * (w + w1);
+        const double thm = th + 0.5 * wm * kStep;
+        x += vm * std::cos(thm) * kStep;
+        y += vm * std::sin(thm) * kStep;
+        th += wm * kStep;
+        v = v1;
+        w = w1;
+        t += kStep;
+        if (!clear()) return false;
+    }
+    return true;
+}
+}  // namespace
+
+double guardScale(const GuardMotion& m, const std::vector<mrpt::math::TPoint2D>& obstacles,
+                  double radius, const SpeedGuardOptions& o, int* checked) {
+    if (checked) *checked = 0;
+    // Only points the robot could reach: the farthest it can go is at its top speed over
+    // the hold and the stop after it.
+    const double vmax = std::max(std::abs(m.v0), std::abs(m.vc));
+    const double reach =
+        vmax * m.hold + 0.5 * o.max_acc * m.hold * m.hold +
+        (vmax + o.max_acc * m.hold) * (vmax + o.max_acc * m.hold) / (2 * o.max_acc) + radius +
+        o.margin + kStep * (vmax + o.max_acc * m.hold);
+    std::vector<mrpt::math::TPoint2D> pts;
+    std::vector<double> dist;
+    double nearest = 1e300;
+    for (const auto& p : obstacles) {
+        const double d = std::hypot(p.x, p.y);
+        if (!(d <= reach)) continue;  // (NaN points too)
+        pts.push_back(p);
+        dist.push_back(d);
+        nearest = std::min(nearest, d);
+    }
+    if (pts.empty()) return 1.0;
+    // Radius and margin; where the robot is nearer than that to something already, its
+    // clearance now (so it may drive along a wall it brushes: per point, every point of the
+    // wall ahead would be nearer than now), less the laser's noise, but never under a few
+    // millimetres; and no point nearer than it is now (so a robot that close can still
+    // turn in place or back away, where the few millimetres would forbid every motion).
+    const double base =
+        std::max(radius + kContactGap, std::min(radius + o.margin, nearest - kSensorSlack));
+    std::vector<double> need(pts.size());
+    for (std::size_t i = 0; i < pts.size(); ++i) need[i] = std::min(base, dist[i] - 1e-6);
+    for (int k = 10; k >= 0; --k) {
+        const double s = 0.1 * k;
+        if (checked) ++*checked;
+        if (admissible(m.v0, m.w0, s * m.vc, s * m.wc, m.hold, pts, need, o)) return s;
+    }
+    return 0.0;
+}
+
+GuardedRobot::GuardedRobot(mrpt::nav::CRobot2NavInterface& robot, double radius, double period,
+                           SpeedGuardOptions o)
+    : robot_(robot), radius_(radius), period_(period), opts_(o) {
+    setMinLoggingLevel(mrpt::system::LVL_WARN);
+}
+
+bool GuardedRobot::getCurrentPoseAndSpeeds(mrpt::math::TPose2D& pose,
+                                           mrpt::math::TTwist2D& vel_global,
+                                           mrpt::system::TTimeStamp& timestamp,
+                                           mrpt::math::TPose2D& odometry, std::string& frame_id) {
+    const bool ok = robot_.getCurrentPoseAndSpeeds(pose, vel_global, timestamp, odometry, frame_id);
+    if (ok) {
+        // the global twist in the robot's frame: forward speed and turn rate
+        v_ = vel_global.vx * std::cos(pose.phi) + vel_global.vy * std::sin(pose.phi);
+        w_ = vel_global.omega;
+    }
+    return ok;
+}
+
+bool GuardedRobot::changeSpeeds(const mrpt::kinematics::CVehicleVelCmd& cmd) {
+    const auto* dd = dynamic_cast<const mrpt::kinematics::CVehicleVelCmd_DiffDriven*>(&cmd);
+    has_last_ = dd != nullptr;
+    if (dd) last_ = *dd;
+    if (!opts_.enabled || !dd) return robot_.changeSpeeds(cmd);
+    stats_.commands++;
+    GuardMotion m;
+    m.v0 = v_;
+    m.w0 = w_;
+    m.vc = dd->lin_vel;
+    m.wc = dd->ang_vel;
+    m.hold = period_;
+    const double s = guardScale(m, points_, radius_, opts_);
+    if (s >= 1.0) return robot_.changeSpeeds(cmd);
+    stats_.slowed++;
+    if (s <= 0 && (dd->lin_vel != 0 || dd->ang_vel != 0)) stats_.stopped++;
+    mrpt::kinematics::CVehicleVelCmd_DiffDriven scaled;
+    scaled.lin_vel = s * dd->lin_vel;
+    scaled.ang_vel = s * dd->ang_vel;
+    return robot_.changeSpeeds(scaled);
+}
+
+bool GuardedRobot::changeSpeedsNOP() {
+    if (!opts_.enabled || !has_last_) return robot_.changeSpeedsNOP();
+    const auto cmd = last_;  // (changeSpeeds sets last_)
+    return changeSpeeds(cmd);
+}
+
+bool GuardedRobot::stop(bool is_emergency_stop) {
+    return robot_.stop(is_emergency_stop);
+}
+mrpt::kinematics::CVehicleVelCmd::Ptr GuardedRobot::getEmergencyStopCmd() {
+    return robot_.getEmergencyStopCmd();
+}
+mrpt::kinematics::CVehicleVelCmd::Ptr GuardedRobot::getStopCmd() {
+    return robot_.getStopCmd();
+}
+mrpt::kinematics::CVehicleVelCmd::Ptr GuardedRobot::getAlignCmd(double relative_heading_radians) {
+    return robot_.getAlignCmd(relative_heading_radians);
+}
+bool GuardedRobot::startWatchdog(float T_ms) {
+    return robot_.startWatchdog(T_ms);
+}
+bool GuardedRobot::stopWatchdog() {
+    return robot_.stopWatchdog();
+}
+
+bool GuardedRobot::senseObstacles(mrpt::maps::CSimplePointsMap& obstacles,
+                                  mrpt::system::TTimeStamp& timestamp) {
+    const bool ok = robot_.senseObstacles(obstacles, timestamp);
+    points_.clear();
+    if (ok) {
+        const auto& xs = obstacles.getPointsBufferRef_x();
+        const auto& ys = obstacles.getPointsBufferRef_y();
+        for (std::size_t i = 0; i < xs.size(); ++i) points_.emplace_back(xs[i], ys[i]);
+    }
+    return ok;
+}
+
+void GuardedRobot::sendNavigationStartEvent() {
+    robot_.sendNavigationStartEvent();
+}
+void GuardedRobot::sendNavigationEndEvent() {
+    robot_.sendNavigationEndEvent();
+}
+void GuardedRobot::sendWaypointReachedEvent(int waypoint_index, bool reached_nSkipped) {
+    robot_.sendWaypointReachedEvent(waypoint_index, reached_nSkipped);
+}
+void GuardedRobot::sendNewWaypointTargetEvent(int waypoint_index) {
+    robot_.sendNewWaypointTargetEvent(waypoint_index);
+}
+void GuardedRobot::sendNavigationEndDueToErrorEvent() {
+    robot_.sendNavigationEndDueToErrorEvent();
+}
+void GuardedRobot::sendWaySeemsBlockedEvent() {
+    robot_.sendWaySeemsBlockedEvent();
+}
+void GuardedRobot::sendApparentCollisionEvent() {
+    robot_.sendApparentCollisionEvent();
+}
+void GuardedRobot::sendCannotGetCloserToBlockedTargetEvent() {
+    robot_.sendCannotGetCloserToBlockedTargetEvent();
+}
+double GuardedRobot::getNavigationTime() {
+    return robot_.getNavigationTime();
+}
+void GuardedRobot::resetNavigationTimer() {
+    robot_.resetNavigationTimer();
+}
+
+}  // namespace devslam::nav
