@@ -518,8 +518,11 @@ std::string timingMarkdown(const Args& a, const Episodes& ep, int ptg_count) {
                               g.commands ? 100.0 * double(k) / double(g.commands) : 0.0);
                 return std::string(b);
             };
-            md << sep << shortName(m) << " " << share(g.slowed) << " of " << g.commands << ", "
-               << g.stopped << " to a stop";
+            if (g.commands == 0)  // (VFF: MRPT finds no way, and only stops the robot)
+                md << sep << shortName(m) << " none sent";
+            else
+                md << sep << shortName(m) << " " << share(g.slowed) << " of " << g.commands << ", "
+                   << g.stopped << " to a stop";
             sep = "; ";
         }
         md << ".\n\n";

@@ -1022,6 +1022,32 @@ TEST(IntegrationNav, DevslamNavCtrlCKeepsTheResultAndPicture) {
 
 // An option's value that is the next option ("--method --png x.png") was read as the value,
 // or as a second world ("more than one world file given"): the option is named instead.
+// A score that evaluates to NaN ends the run in its first step, as an error naming the INI.
+// MRPT logs the exception it caught with its location and call stack (15 lines naming no
+// file, before every such run of a bench): said in one line.
+TEST(IntegrationNav, MrptsErrorLogIsOneLine) {
+    const devslam::test::TempDir dir("devslam_");
+    std::string text = readFile(kIni);
+    const std::string from = "score3_formula  = 1/(1+dist_eucl_min^2)";
+    ASSERT_NE(text.find(from), std::string::npos);
+    text.replace(text.find(from), from.size(), "score3_formula  = sqrt(-1-dist_eucl_min)");
+    std::ofstream(dir.str("nan.ini")) << text;
+    const auto r = devslam::test::runApp(
+        "devslam-nav", kSrc + "/sim_worlds/obstacle_near_goal.ini --config " + dir.str("nan.ini") +
+                           " --png " + dir.str("nan.png"));
+    EXPECT_EQ(r.rc, 1) << r.out;
+    EXPECT_NE(r.out.find("result=error"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("MRPT: [CAbstractPTGBasedReactive::performNavigationStep] Stopping "
+                         "robot and finishing navigation due to exception: Undefined value "
+                         "evaluating score `euclidean_nearness`"),
+              std::string::npos)
+        << r.out;
+    EXPECT_NE(r.out.find("nan.ini?): Undefined value evaluating score"), std::string::npos)
+        << r.out;
+    EXPECT_EQ(r.out.find("Call stack backtrace"), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("==== MRPT exception"), std::string::npos) << r.out;
+}
+
 TEST(IntegrationNav, OptionWithoutValueIsNamed) {
     const std::string world = kSrc + "/sim_worlds/paper_fig6.ini";
     for (const auto& [app, args, says] :

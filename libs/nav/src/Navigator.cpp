@@ -24,6 +24,7 @@
 #include <map>
 #include <mutex>
 #include <sstream>
+#include <string_view>
 #include <utility>
 
 namespace devslam::nav {
@@ -60,6 +61,19 @@ void removeDamagedCacheFiles(const std::string& dir, bool verbose) {
             std::cerr << "navigator: removed the damaged PTG cache file " << f
                       << " (MRPT builds it again)\n";
     }
+}
+
+/// An MRPT log message on one line: its first line, then the innermost "Message:" of the
+/// exception it carries (MRPT prints that with its location and call stack, 15 lines that
+/// name no file, before the navigator's own one-line reason).
+std::string oneLine(std::string_view msg) {
+    const std::string m(msg);
+    const auto nl = m.find('\n');
+    std::string head = m.substr(0, nl);
+    while (!head.empty() && (head.back() == ':' || head.back() == ' ')) head.pop_back();
+    if (nl == std::string::npos) return head;
+    const std::string inner = core::innermostMessage(m.substr(nl + 1));
+    return inner.empty() ? head : head + ": " + inner;
 }
 
 /// CPU time of the calling thread [s]: step timings that do not depend on machine load.
@@ -337,6 +351,14 @@ Navigator::Navigator(mrpt::nav::CRobot2NavInterface& robot,
         std::make_unique<GuardedRobot>(robot_, opts_.robot_radius, opts_.nav_period, opts_.guard);
     nav_ = std::make_unique<ReactiveNav>(*guarded_, opts_.log_directory);
     nav_->setMinLoggingLevel(opts_.verbose ? mrpt::system::LVL_DEBUG : mrpt::system::LVL_ERROR);
+    if (!opts_.verbose) {  // (--verbose keeps MRPT's own printing, call stacks and all)
+        nav_->logging_enable_console_output = false;
+        nav_->setVerbosityLevelForCallbacks(mrpt::system::LVL_ERROR);
+        nav_->logRegisterCallback([](std::string_view msg, mrpt::system::VerbosityLevel level,
+                                     std::string_view, const mrpt::Clock::time_point&) {
+            if (level >= mrpt::system::LVL_ERROR) std::cerr << "MRPT: " << oneLine(msg) << "\n";
+        });
+    }
     if (opts_.log_file) {
         // Its parents too (a missing one was a std::filesystem error naming no option).
         std::error_code ec;
