@@ -115,6 +115,8 @@ bool GuardedRobot::changeSpeeds(const mrpt::kinematics::CVehicleVelCmd& cmd) {
     if (dd) last_ = *dd;
     if (!opts_.enabled || !dd) return robot_.changeSpeeds(cmd);
     stats_.commands++;
+    // A stop is sent as it is: nothing slower exists.
+    if (dd->lin_vel == 0 && dd->ang_vel == 0) return robot_.changeSpeeds(cmd);
     GuardMotion m;
     m.v0 = v_;
     m.w0 = w_;
@@ -124,7 +126,7 @@ bool GuardedRobot::changeSpeeds(const mrpt::kinematics::CVehicleVelCmd& cmd) {
     const double s = guardScale(m, points_, radius_, opts_);
     if (s >= 1.0) return robot_.changeSpeeds(cmd);
     stats_.slowed++;
-    if (s <= 0 && (dd->lin_vel != 0 || dd->ang_vel != 0)) stats_.stopped++;
+    if (s <= 0) stats_.stopped++;
     mrpt::kinematics::CVehicleVelCmd_DiffDriven scaled;
     scaled.lin_vel = s * dd->lin_vel;
     scaled.ang_vel = s * dd->ang_vel;
