@@ -24,6 +24,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
@@ -75,8 +76,8 @@ void usage(std::ostream& os = std::cerr) {
           "  --png-dir DIR     where PNGs go (default docs/images)\n"
           "  --seed S          first world seed (default 1)\n"
           "  --person-margin M [m] overrides the INI's [navigator] person_margin\n"
-          "  --max-speed V     [m/s] the robot's top speed: every world's [robot] max_v and\n"
-          "                    the INI's robotMax_V_mps and PTG<i>_v_max_mps\n";
+          "  --max-speed V     [m/s] the robot's top speed: every world's [robot] max_v, the\n"
+          "                    INI's robotMax_V_mps and each PTG<i>_v_max_mps equal to it\n";
 }
 
 struct Tally {
@@ -570,11 +571,19 @@ int appMain(int argc, char** argv) {
             nav_opts.person_margin = *a.person_margin;
         }
         if (a.max_speed) {  // what MRPT commands and predicts: the robot's new top speed
+            // The PTGs that run at the robot's top speed take the new one; a PTG slower on
+            // purpose (the shipped PTG3, 0.3 m/s for its tight turns behind the robot) keeps
+            // its speed: raised, its turns widened and left targets near the robot in no
+            // PTG's domain.
+            const double top = ini->read_double("CAbstractPTGBasedReactive", "robotMax_V_mps", 0);
             ini->write("CAbstractPTGBasedReactive", "robotMax_V_mps", *a.max_speed);
             const int n = ini->read_int("CReactiveNavigationSystem", "PTG_COUNT", 0);
-            for (int i = 0; i < n; ++i)
-                ini->write("CReactiveNavigationSystem", "PTG" + std::to_string(i) + "_v_max_mps",
-                           *a.max_speed);
+            for (int i = 0; i < n; ++i) {
+                const std::string key = "PTG" + std::to_string(i) + "_v_max_mps";
+                const double v = ini->read_double("CReactiveNavigationSystem", key, top);
+                if (std::abs(v - top) <= 1e-9 * std::max(1.0, top))
+                    ini->write("CReactiveNavigationSystem", key, *a.max_speed);
+            }
         }
         const auto cats = devslam::sim::allCategories();
         const Episodes ep = runEpisodes(a, *ini, nav_opts, cats);

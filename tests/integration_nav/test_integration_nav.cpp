@@ -1020,8 +1020,6 @@ TEST(IntegrationNav, DevslamNavCtrlCKeepsTheResultAndPicture) {
     EXPECT_TRUE(std::filesystem::is_regular_file(out + "/run.png"));
 }
 
-// An option's value that is the next option ("--method --png x.png") was read as the value,
-// or as a second world ("more than one world file given"): the option is named instead.
 // A score that evaluates to NaN ends the run in its first step, as an error naming the INI.
 // MRPT logs the exception it caught with its location and call stack (15 lines naming no
 // file, before every such run of a bench): said in one line.
@@ -1048,6 +1046,8 @@ TEST(IntegrationNav, MrptsErrorLogIsOneLine) {
     EXPECT_EQ(r.out.find("==== MRPT exception"), std::string::npos) << r.out;
 }
 
+// An option's value that is the next option ("--method --png x.png") was read as the value,
+// or as a second world ("more than one world file given"): the option is named instead.
 TEST(IntegrationNav, OptionWithoutValueIsNamed) {
     const std::string world = kSrc + "/sim_worlds/paper_fig6.ini";
     for (const auto& [app, args, says] :

@@ -592,8 +592,11 @@ TEST(NavConfig, UnknownKeyIsReported) {
         EXPECT_EQ(errorOf({{"navigator", "max_acc", a}}),
                   "x.ini [navigator] max_acc: must be in (0, 20] m/s^2")
             << a;
-    EXPECT_EQ(errorOf({{"navigator", "max_ang_acc_deg", 0.0}}),
-              "x.ini [navigator] max_ang_acc_deg: must be in (0, 3600] deg/s^2");
+    for (const double a : {0.0, 3601.0})
+        EXPECT_EQ(errorOf({{"navigator", "max_ang_acc_deg", a}}),
+                  "x.ini [navigator] max_ang_acc_deg: must be in (0, 3600] deg/s^2")
+            << a;
+    EXPECT_EQ(errorOf({{"navigator", "max_ang_acc_deg", 3600.0}}), "");
     EXPECT_EQ(errorOf({{"navigator", "guard_margin", -0.01}}),
               "x.ini [navigator] guard_margin: must be in [0, 1] m");
     EXPECT_EQ(errorOf({{"navigator", "guard_margin", 0.0}}), "");

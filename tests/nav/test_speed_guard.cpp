@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -100,26 +101,62 @@ TEST(SpeedGuard, ATurnTheRobotCannotTakeInTimeIsSlowed) {
     quick.max_acc = 20;
     quick.max_ang_acc = 60;
     EXPECT_EQ(guardScale(m, wallAhead(1.3), kRadius, quick), 1.0);
+    // The turn rate's own lag: at 1 m/s a box corner 0.5 m ahead and 0.25 m to the right is
+    // cleared by a left turn of 90 deg/s taken at once (in 0.1 s it turns 9 deg, then brakes
+    // along it), not by the same turn built up at 180 deg/s^2 (under 2 deg), nor straight on.
+    const std::vector<TPoint2D> corner{{0.5, -0.25}};
+    auto instant_turn = limits();
+    instant_turn.max_ang_acc = 1e6;
+    const auto turn = motion(1.0, 0, 1.0, M_PI / 2);
+    EXPECT_EQ(guardScale(turn, corner, kRadius, instant_turn), 1.0);
+    EXPECT_EQ(guardScale(turn, corner, kRadius, limits()), 0.0);
+    EXPECT_EQ(guardScale(motion(1.0, 0, 1.0, 0), corner, kRadius, instant_turn), 0.0);
+}
+
+// Driven at a wall by a command that never changes (as a navigator that wants to go there),
+// step after step, the robot stops short of it: inside the margin the bound is fixed, so it
+// does not creep in by the laser's noise at every step (the bound taken from the clearance
+// now let it end 6-10 mm from the wall).
+TEST(SpeedGuard, RepeatedStepsDoNotCreepIntoTheMargin) {
+    const auto o = limits();
+    for (const double speed : {0.1, 0.3, 0.6, 1.0}) {
+        const double wall = 1.0;  // [m] its x; the robot starts at 0 facing it
+        double x = 0, v = 0;
+        for (int step = 0; step < 300; ++step) {  // 30 s of 0.1 s navigation periods
+            const double s = guardScale(motion(v, 0, speed, 0), wallAhead(wall - x), kRadius, o);
+            const double vc = s * speed;
+            for (int k = 0; k < 10; ++k) {  // the robot at 100 Hz, as sim::Simulator drives it
+                const double v1 = v + std::clamp(vc - v, -o.max_acc * 0.01, o.max_acc * 0.01);
+                x += 0.5 * (v + v1) * 0.01;
+                v = v1;
+            }
+        }
+        const double clearance = wall - x - kRadius;
+        EXPECT_GE(clearance, o.margin - 0.01 - 1e-3) << speed;  // the margin less the noise
+        EXPECT_LE(clearance, o.margin + 0.01) << speed;         // and it did come close
+        EXPECT_NEAR(v, 0, 1e-9) << speed;
+    }
 }
 
 // A point already inside radius + margin (a wall brushed, a person come close) does not
-// freeze the robot: it may turn in place, or move away, and toward it only while it keeps
-// 5 mm of the gap.
+// freeze the robot: it may turn in place, or move away, and toward it only down to the
+// margin less the laser's noise.
 TEST(SpeedGuard, APointAlreadyNearOnlyForbidsComingCloser) {
     const std::vector<TPoint2D> near{{0.253, 0.0}};  // 3 mm from the robot's edge, ahead
     EXPECT_EQ(guardScale(motion(0, 0, 0, 1.0), near, kRadius, limits()), 1.0);
     EXPECT_EQ(guardScale(motion(0, 0, -0.3, 0), near, kRadius, limits()), 1.0);
     EXPECT_EQ(guardScale(motion(0, 0, 0.3, 0), near, kRadius, limits()), 0.0);
-    // 1 cm from the edge: 0.3 m/s for 0.1 s and the stop after it would take 1 cm; 0.03 m/s
-    // takes 2 mm
-    const std::vector<TPoint2D> cm{{0.26, 0.0}};
+    // 1.5 cm from the edge (inside the 2 cm margin): the robot may come 5 mm nearer, to the
+    // margin less 1 cm of laser noise. 0.3 m/s for 0.1 s and the stop after it would take
+    // 1 cm; 0.03 m/s takes 2 mm.
+    const std::vector<TPoint2D> cm{{0.265, 0.0}};
     const double s = guardScale(motion(0, 0, 0.3, 0), cm, kRadius, limits());
     EXPECT_LT(s, 1.0);
     EXPECT_GT(s, 0.0);
-    // Driving along a wall 1 cm off: every point of the wall ahead is nearer than now, but
+    // Driving along a wall 1.5 cm off: every point of the wall ahead is nearer than now, but
     // the clearance stays.
     std::vector<TPoint2D> wall;
-    for (double x = -2; x <= 2; x += 0.02) wall.emplace_back(x, 0.26);
+    for (double x = -2; x <= 2; x += 0.02) wall.emplace_back(x, 0.265);
     EXPECT_EQ(guardScale(motion(0.5, 0, 0.5, 0), wall, kRadius, limits()), 1.0);
     // NaN points (a sensor's gaps) are left out, not taken as everywhere
     const std::vector<TPoint2D> gap{{std::nan(""), std::nan("")}};

@@ -13,6 +13,7 @@
 #include <mrpt/system/filesystem.h>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -63,17 +64,27 @@ void removeDamagedCacheFiles(const std::string& dir, bool verbose) {
     }
 }
 
-/// An MRPT log message on one line: its first line, then the innermost "Message:" of the
-/// exception it carries (MRPT prints that with its location and call stack, 15 lines that
-/// name no file, before the navigator's own one-line reason).
+/// An MRPT log message on one line: its first non-blank line, then the innermost "Message:"
+/// of the exception it carries (MRPT prints that with its location and call stack, 15 lines
+/// that name no file, before the navigator's own one-line reason), or else its other lines
+/// joined.
 std::string oneLine(std::string_view msg) {
-    const std::string m(msg);
-    const auto nl = m.find('\n');
-    std::string head = m.substr(0, nl);
+    std::vector<std::string> lines;
+    std::istringstream in{std::string(msg)};
+    for (std::string l; std::getline(in, l);) {
+        while (!l.empty() && std::isspace(static_cast<unsigned char>(l.back()))) l.pop_back();
+        if (l.find_first_not_of(" \t") != std::string::npos) lines.push_back(l);
+    }
+    if (lines.empty()) return {};
+    std::string head = lines.front();
+    if (lines.size() == 1) return head;
     while (!head.empty() && (head.back() == ':' || head.back() == ' ')) head.pop_back();
-    if (nl == std::string::npos) return head;
-    const std::string inner = core::innermostMessage(m.substr(nl + 1));
-    return inner.empty() ? head : head + ": " + inner;
+    const std::string rest(msg.substr(msg.find(lines.front()) + lines.front().size()));
+    if (rest.find("Message:") != std::string::npos)
+        return head + ": " + core::innermostMessage(rest);
+    for (std::size_t i = 1; i < lines.size(); ++i)
+        head += (i == 1 ? ": " : " ") + lines[i].substr(lines[i].find_first_not_of(" \t"));
+    return head;
 }
 
 /// CPU time of the calling thread [s]: step timings that do not depend on machine load.

@@ -10,7 +10,7 @@ namespace devslam::nav {
 
 namespace {
 constexpr double kStep = 0.02;         ///< [s] integration step of the predicted motion
-constexpr double kSensorSlack = 0.01;  ///< [m] the clearance now may seem this much larger
+constexpr double kSensorSlack = 0.01;  ///< [m] the laser's noise, given up inside the margin
 constexpr double kContactGap = 0.005;  ///< [m] never planned nearer to a point than this
 constexpr double kStopped = 1e-3;      ///< [m/s], [rad/s] a speed taken as stopped
 constexpr double kMaxHorizon = 30.0;   ///< [s] bound on the stopping time looked at
@@ -61,7 +61,7 @@ double guardScale(const GuardMotion& m, const std::vector<mrpt::math::TPoint2D>&
     const double reach =
         vmax * m.hold + 0.5 * o.max_acc * m.hold * m.hold +
         (vmax + o.max_acc * m.hold) * (vmax + o.max_acc * m.hold) / (2 * o.max_acc) + radius +
-        o.margin + kStep * (vmax + o.max_acc * m.hold);
+        std::max(o.margin, kContactGap) + kStep * (vmax + o.max_acc * m.hold);
     std::vector<mrpt::math::TPoint2D> pts;
     std::vector<double> dist;
     double nearest = 1e300;
@@ -73,13 +73,15 @@ double guardScale(const GuardMotion& m, const std::vector<mrpt::math::TPoint2D>&
         nearest = std::min(nearest, d);
     }
     if (pts.empty()) return 1.0;
-    // Radius and margin; where the robot is nearer than that to something already, its
-    // clearance now (so it may drive along a wall it brushes: per point, every point of the
-    // wall ahead would be nearer than now), less the laser's noise, but never under a few
-    // millimetres; and no point nearer than it is now (so a robot that close can still
-    // turn in place or back away, where the few millimetres would forbid every motion).
-    const double base =
-        std::max(radius + kContactGap, std::min(radius + o.margin, nearest - kSensorSlack));
+    // Radius and margin. Where the robot is inside that already (a wall brushed, a person
+    // come close), the margin less the laser's noise, so that it can drive along a wall it
+    // brushes (every point of the wall ahead is nearer than now) - a fixed bound, not one
+    // taken from the clearance now: that one sank by the noise at every step, and a robot
+    // driving at a wall crept to 6-10 mm of it. And no point nearer than it is now, so that
+    // a robot pushed closer still can turn in place or back away.
+    const double base = nearest >= radius + o.margin
+                            ? radius + o.margin
+                            : radius + std::max(o.margin - kSensorSlack, kContactGap);
     std::vector<double> need(pts.size());
     for (std::size_t i = 0; i < pts.size(); ++i) need[i] = std::min(base, dist[i] - 1e-6);
     for (int k = 10; k >= 0; --k) {
@@ -133,6 +135,8 @@ bool GuardedRobot::changeSpeeds(const mrpt::kinematics::CVehicleVelCmd& cmd) {
     return robot_.changeSpeeds(scaled);
 }
 
+// MRPT sends a NOP only through PTGs that support it (its holonomic blend PTG); its
+// diff-drive ones never do. Sent again, the command counts again.
 bool GuardedRobot::changeSpeedsNOP() {
     if (!opts_.enabled || !has_last_) return robot_.changeSpeedsNOP();
     const auto cmd = last_;  // (changeSpeeds sets last_)
@@ -140,6 +144,7 @@ bool GuardedRobot::changeSpeedsNOP() {
 }
 
 bool GuardedRobot::stop(bool is_emergency_stop) {
+    has_last_ = false;  // (a NOP after a stop keeps the robot stopped)
     return robot_.stop(is_emergency_stop);
 }
 mrpt::kinematics::CVehicleVelCmd::Ptr GuardedRobot::getEmergencyStopCmd() {

@@ -17,11 +17,10 @@
 ///   MRPT navigationStep() ── changeSpeeds(v, w) ──► GuardedRobot ── s·(v, w) ──► robot
 ///                                                    ▲ latest speeds and sensed points
 ///
-/// The requirement is relaxed where the robot is already nearer than radius + margin to a
-/// point: the path may not take it below its clearance now (less 1 cm of laser noise, but
-/// never within 5 mm of a point), nor nearer to any point than it is now, so a robot
-/// brushing past a wall or a person can drive along it or away, and can always turn in
-/// place. Sensed points are taken as still (people too).
+/// Inside radius + margin already (a wall brushed, a person come close), the bound is the
+/// margin less 1 cm of laser noise (at least 5 mm), so a robot can drive along a wall it
+/// brushes, and no point may come nearer than it is now, so a robot pushed closer still can
+/// back away or turn in place. Sensed points are taken as still (people too).
 #include <mrpt/kinematics/CVehicleVelCmd_DiffDriven.h>
 #include <mrpt/math/TPoint2D.h>
 #include <mrpt/nav/reactive/CRobot2NavInterface.h>
