@@ -14,6 +14,7 @@
 #include <devslam/nav/BenchFixtures.h>
 #include <devslam/nav/CHolonomicVFHPlus.h>
 #include <devslam/nav/GridPlanner.h>
+#include <devslam/nav/SpeedGuard.h>
 #include <devslam/nav/VfhPlus.h>
 #include <devslam/sim/Episode.h>
 #include <devslam/sim/RandomWorlds.h>
@@ -205,7 +206,7 @@ std::optional<int> parseArgs(int argc, char** argv, Args& a) {
             else if (s == "--max-speed") {
                 a.max_speed = devslam::core::parseNumber(next(), "--max-speed");
                 // (the world files' own bound)
-                if (!(*a.max_speed > 0 && *a.max_speed <= 5))
+                if (!(*a.max_speed > 0 && *a.max_speed <= devslam::nav::kMaxRobotSpeed))
                     throw std::invalid_argument("--max-speed: must be in (0, 5] m/s");
             } else if (s == "--seed")
                 a.seed = static_cast<uint32_t>(

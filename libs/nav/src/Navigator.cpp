@@ -292,12 +292,12 @@ NavigatorOptions readNavigatorOptions(const mrpt::config::CConfigFileBase& c,
     core::requireValue(o.robot_radius > 0, s, "robot_radius", "must be > 0 m");
     core::requireValue(o.person_margin >= 0 && o.person_margin <= 2.0, s, "person_margin",
                        "must be in [0, 2] m");
-    // (the world files' own bounds: 20 m/s^2, 3600 deg/s^2)
-    core::requireValue(o.guard.max_acc > 0 && o.guard.max_acc <= 20, s, "max_acc",
+    // (the world files' own bounds)
+    core::requireValue(o.guard.max_acc > 0 && o.guard.max_acc <= kMaxRobotAcc, s, "max_acc",
                        "must be in (0, 20] m/s^2");
     core::requireValue(
-        o.guard.max_ang_acc > 0 && o.guard.max_ang_acc <= mrpt::DEG2RAD(3600.0) + 1e-9, s,
-        "max_ang_acc_deg", "must be in (0, 3600] deg/s^2");
+        o.guard.max_ang_acc > 0 && o.guard.max_ang_acc <= mrpt::DEG2RAD(kMaxRobotAngAccDeg) + 1e-9,
+        s, "max_ang_acc_deg", "must be in (0, 3600] deg/s^2");
     core::requireValue(o.guard.margin >= 0 && o.guard.margin <= 1.0, s, "guard_margin",
                        "must be in [0, 1] m");
     checkMrptSections(c, source);

@@ -63,13 +63,13 @@ double guardScale(const GuardMotion& m, const std::vector<mrpt::math::TPoint2D>&
         (vmax + o.max_acc * m.hold) * (vmax + o.max_acc * m.hold) / (2 * o.max_acc) + radius +
         std::max(o.margin, kContactGap) + kStep * (vmax + o.max_acc * m.hold);
     std::vector<mrpt::math::TPoint2D> pts;
-    std::vector<double> dist;
+    std::vector<double> need;  // each point's distance now, then the least it may have
     double nearest = 1e300;
     for (const auto& p : obstacles) {
         const double d = std::hypot(p.x, p.y);
         if (!(d <= reach)) continue;  // (NaN points too)
         pts.push_back(p);
-        dist.push_back(d);
+        need.push_back(d);
         nearest = std::min(nearest, d);
     }
     if (pts.empty()) return 1.0;
@@ -82,8 +82,7 @@ double guardScale(const GuardMotion& m, const std::vector<mrpt::math::TPoint2D>&
     const double base = nearest >= radius + o.margin
                             ? radius + o.margin
                             : radius + std::max(o.margin - kSensorSlack, kContactGap);
-    std::vector<double> need(pts.size());
-    for (std::size_t i = 0; i < pts.size(); ++i) need[i] = std::min(base, dist[i] - 1e-6);
+    for (double& n : need) n = std::min(base, n - 1e-6);
     for (int k = 10; k >= 0; --k) {
         const double s = 0.1 * k;
         if (checked) ++*checked;

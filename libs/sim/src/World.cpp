@@ -1,6 +1,7 @@
 #include <devslam/core/Config.h>
 #include <devslam/core/Parse.h>
 #include <devslam/nav/GridPlanner.h>
+#include <devslam/nav/SpeedGuard.h>
 #include <devslam/sim/World.h>
 
 #include <mrpt/config/CConfigFileBase.h>
@@ -276,9 +277,10 @@ void validateRobotAndLaser(const WorldSpec& w) {
     // max_w_deg = 1e12 a robot that jumps across the world in one step.
     if (!(std::abs(w.robot.start.phi) <= 2 * M_PI + 1e-9))
         fail(src, "robot", "start_yaw_deg", "must be in [-360, 360] deg");
-    if (w.robot.max_v > 5) fail(src, "robot", "max_v", "must be at most 5 m/s");
-    if (w.robot.max_acc > 20) fail(src, "robot", "max_acc", "must be at most 20 m/s^2");
-    if (w.robot.max_ang_acc > mrpt::DEG2RAD(3600.0) + 1e-9)
+    if (w.robot.max_v > nav::kMaxRobotSpeed) fail(src, "robot", "max_v", "must be at most 5 m/s");
+    if (w.robot.max_acc > nav::kMaxRobotAcc)
+        fail(src, "robot", "max_acc", "must be at most 20 m/s^2");
+    if (w.robot.max_ang_acc > mrpt::DEG2RAD(nav::kMaxRobotAngAccDeg) + 1e-9)
         fail(src, "robot", "max_ang_acc_deg", "must be at most 3600 deg/s^2");
     if (w.robot.max_w > mrpt::DEG2RAD(720.0) + 1e-9)
         fail(src, "robot", "max_w_deg", "must be at most 720 deg/s");

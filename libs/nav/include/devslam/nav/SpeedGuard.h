@@ -30,6 +30,10 @@
 
 namespace devslam::nav {
 
+/// The most a robot is taken to do, by the world files' [robot] and the navigator's INI alike:
+/// top speed [m/s], acceleration [m/s^2], angular acceleration [deg/s^2].
+inline constexpr double kMaxRobotSpeed = 5.0, kMaxRobotAcc = 20.0, kMaxRobotAngAccDeg = 3600.0;
+
 /// [navigator] speed_guard, max_acc, max_ang_acc_deg, guard_margin.
 struct SpeedGuardOptions {
     bool enabled = true;
