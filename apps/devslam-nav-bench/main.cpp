@@ -55,6 +55,8 @@ struct Args {
                                      "CHolonomicFullEval"};
     uint32_t seed = 1;
     std::optional<double> person_margin;  ///< [m] overrides [navigator] person_margin
+    std::optional<double> person_predict;  ///< [s] overrides [navigator] person_predict_horizon
+    std::vector<devslam::sim::Category> categories = devslam::sim::allCategories();
     std::optional<double> max_speed;      ///< [m/s] every world's robot and the INI's PTGs
 };
 
@@ -62,6 +64,13 @@ struct Args {
 std::string methodList(const std::vector<std::string>& methods) {
     std::string s;
     for (const auto& m : methods) s += (s.empty() ? "" : ",") + m;
+    return s;
+}
+
+/// "a,b": the --categories value that gives `cats`.
+std::string categoryList(const std::vector<devslam::sim::Category>& cats) {
+    std::string s;
+    for (const auto c : cats) s += (s.empty() ? "" : ",") + std::string(devslam::sim::toString(c));
     return s;
 }
 
@@ -77,6 +86,10 @@ void usage(std::ostream& os = std::cerr) {
           "  --png-dir DIR     where PNGs go (default docs/images)\n"
           "  --seed S          first world seed (default 1)\n"
           "  --person-margin M [m] overrides the INI's [navigator] person_margin\n"
+          "  --person-predict H\n"
+          "                    [s] overrides the INI's [navigator] person_predict_horizon\n"
+          "  --categories a,b  only these categories (open_clutter, corridor_people, office,\n"
+          "                    obstacle_near_goal; default all)\n"
           "  --max-speed V     [m/s] the robot's top speed: every world's [robot] max_v, the\n"
           "                    INI's robotMax_V_mps and each PTG<i>_v_max_mps equal to it\n";
 }
@@ -203,7 +216,38 @@ std::optional<int> parseArgs(int argc, char** argv, Args& a) {
                 png_dir_given = true;
             } else if (s == "--person-margin")
                 a.person_margin = devslam::core::parseNumber(next(), "--person-margin");
-            else if (s == "--max-speed") {
+            else if (s == "--person-predict") {
+                a.person_predict = devslam::core::parseNumber(next(), "--person-predict");
+                if (!(*a.person_predict >= 0 && *a.person_predict <= 5.0))
+                    throw std::invalid_argument("--person-predict: must be in [0, 5] s");
+            } else if (s == "--categories") {
+                a.categories.clear();
+                std::stringstream ss(next());
+                std::string name;
+                while (std::getline(ss, name, ',')) {
+                    if (name.empty()) continue;
+                    std::string known;
+                    bool found = false;
+                    for (const auto c : devslam::sim::allCategories()) {
+                        known +=
+                            (known.empty() ? "" : ", ") + std::string(devslam::sim::toString(c));
+                        if (name != devslam::sim::toString(c)) continue;
+                        if (std::find(a.categories.begin(), a.categories.end(), c) !=
+                            a.categories.end())
+                            throw std::invalid_argument("--categories: '" + name +
+                                                        "' is listed twice");
+                        a.categories.push_back(c);
+                        found = true;
+                    }
+                    if (!found)
+                        throw std::invalid_argument("--categories: unknown category '" + name +
+                                                    "' (known: " + known + ")");
+                }
+                if (a.categories.empty()) throw std::invalid_argument("--categories is empty");
+                // In the bench's own order: the tables, and whether this is RESULTS.md's bench,
+                // do not depend on how the list was written.
+                std::sort(a.categories.begin(), a.categories.end());
+            } else if (s == "--max-speed") {
                 a.max_speed = devslam::core::parseNumber(next(), "--max-speed");
                 // (the world files' own bound)
                 if (!(*a.max_speed > 0 && *a.max_speed <= devslam::nav::kMaxRobotSpeed))
@@ -267,6 +311,8 @@ std::optional<int> parseArgs(int argc, char** argv, Args& a) {
         if (!same(a.config, d.config)) changed.push_back("--config");
         if (a.seed != d.seed) changed.push_back("--seed");
         if (a.person_margin) changed.push_back("--person-margin");
+        if (a.person_predict) changed.push_back("--person-predict");
+        if (a.categories != d.categories) changed.push_back("--categories");
         if (a.max_speed) changed.push_back("--max-speed");
         if (!same(a.png_dir, d.png_dir)) changed.push_back("--png-dir");
     }
@@ -415,12 +461,20 @@ std::string headerMarkdown(const Args& a, const devslam::nav::NavigatorOptions& 
     md << "## Navigation benchmark (`devslam-nav-bench`)\n\n"
        << "Command: `devslam-nav-bench --per-category " << a.per_category << " --seed " << a.seed
        << (a.person_margin ? " --person-margin " + num(*a.person_margin) : std::string())
+       << (a.person_predict ? " --person-predict " + num(*a.person_predict) : std::string())
        << (a.max_speed ? " --max-speed " + num(*a.max_speed) : std::string())
        << (a.methods.size() < 4 ? " --methods " + methodList(a.methods) : std::string())
+       << (a.categories != devslam::sim::allCategories()
+               ? " --categories " + categoryList(a.categories)
+               : std::string())
        << (a.quick ? " --quick" : "") << "` (config `"
        << devslam::core::shownPath(a.config, DEVSLAM_SOURCE_DIR) << "`; people get "
-       << num(nav_opts.person_margin) << " m more room than walls, `person_margin`). "
-       << a.per_category << " seeded random worlds "
+       << num(nav_opts.person_margin) << " m more room than walls, `person_margin`"
+       << (nav_opts.person_predict_horizon > 0
+               ? ", and walkers' paths " + num(nav_opts.person_predict_horizon) +
+                     " s ahead are obstacles too, `person_predict_horizon`"
+               : std::string())
+       << "). " << a.per_category << " seeded random worlds "
        << "per category, " << a.per_category * n_categories
        << " worlds in all, the same worlds for every method; Bullet simulation at 100 Hz, "
           "navigator at 10 Hz, simulated clock. Success: within the goal tolerance before the "
@@ -571,6 +625,7 @@ int appMain(int argc, char** argv) {
                 throw std::invalid_argument("--person-margin: must be in [0, 2] m");
             nav_opts.person_margin = *a.person_margin;
         }
+        if (a.person_predict) nav_opts.person_predict_horizon = *a.person_predict;
         if (a.max_speed) {  // what MRPT commands and predicts: the robot's new top speed
             // The PTGs that run at the robot's top speed take the new one; a PTG slower on
             // purpose (the shipped PTG3, 0.3 m/s for its tight turns behind the robot) keeps
@@ -586,7 +641,7 @@ int appMain(int argc, char** argv) {
                     ini->write("CReactiveNavigationSystem", key, *a.max_speed);
             }
         }
-        const auto cats = devslam::sim::allCategories();
+        const auto& cats = a.categories;
         const Episodes ep = runEpisodes(a, *ini, nav_opts, cats);
         std::ostringstream md;
         md << headerMarkdown(a, nav_opts, cats.size());

@@ -916,6 +916,28 @@ TEST(IntegrationNav, AppsSmokeTest) {
     r = navBench("--quick --per-category 50");
     EXPECT_EQ(r.rc, 2);
     EXPECT_NE(r.out.find("--quick runs 2 worlds per category"), std::string::npos) << r.out;
+    r = navBench("--quick --categories corridor_people,corridor");
+    EXPECT_EQ(r.rc, 2);
+    EXPECT_NE(r.out.find("--categories: unknown category 'corridor' (known: open_clutter, "
+                         "corridor_people, office, obstacle_near_goal)"),
+              std::string::npos)
+        << r.out;
+    r = navBench("--quick --categories office,office");
+    EXPECT_EQ(r.rc, 2);
+    EXPECT_NE(r.out.find("--categories: 'office' is listed twice"), std::string::npos) << r.out;
+    r = navBench("--quick --person-predict 6");
+    EXPECT_EQ(r.rc, 2);
+    EXPECT_NE(r.out.find("--person-predict: must be in [0, 5] s"), std::string::npos) << r.out;
+    // One category alone: its table, and the command line says so.
+    r = devslam::test::runApp("devslam-nav-bench",
+                              "--quick --categories obstacle_near_goal "
+                              "--methods CHolonomicVFHPlus --png-dir " +
+                                  out + "/one_category");
+    EXPECT_EQ(r.rc, 0) << r.out;
+    EXPECT_NE(r.out.find("### obstacle_near_goal"), std::string::npos) << r.out;
+    EXPECT_EQ(r.out.find("### office"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("--categories obstacle_near_goal --quick`"), std::string::npos) << r.out;
+    EXPECT_NE(r.out.find("2 worlds in all"), std::string::npos) << r.out;
     std::ofstream(out + "/broken.md") << "# R\n<!-- BEGIN nav -->\nold\n";
     r = navBench("--per-category 1 --methods CHolonomicVFHPlus --results " + out + "/broken.md");
     EXPECT_EQ(r.rc, 2);

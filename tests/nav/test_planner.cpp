@@ -600,6 +600,11 @@ TEST(NavConfig, UnknownKeyIsReported) {
     EXPECT_EQ(errorOf({{"navigator", "guard_margin", -0.01}}),
               "x.ini [navigator] guard_margin: must be in [0, 1] m");
     EXPECT_EQ(errorOf({{"navigator", "guard_margin", 0.0}}), "");
+    for (const double h : {-0.1, 5.5})
+        EXPECT_EQ(errorOf({{"navigator", "person_predict_horizon", h}}),
+                  "x.ini [navigator] person_predict_horizon: must be in [0, 5] s")
+            << h;
+    EXPECT_EQ(errorOf({{"navigator", "person_predict_horizon", 0.0}}), "");
     for (const double d : {-1.0, 0.0, 1e9})
         EXPECT_EQ(errorOf({{"navigator", "waypoint_allowed_distance", d}}),
                   "x.ini [navigator] waypoint_allowed_distance: must be in (0, 10] m")

@@ -49,6 +49,17 @@ WorldSpec roomWithBox() {
     return w;
 }
 
+/// [m] the nearest sensed point straight ahead of the robot (within 5 cm of its x axis).
+double nearestAhead(const mrpt::maps::CSimplePointsMap& m) {
+    double best = 1e9;
+    for (size_t i = 0; i < m.size(); i++) {
+        float x, y;
+        m.getPoint(i, x, y);
+        if (std::abs(y) < 0.05 && x > 0) best = std::min(best, double(x));
+    }
+    return best;
+}
+
 /// [m] the exact distance from (x, y) to the nearest of `statics`.
 double nearestObstacle(const std::vector<Obstacle>& statics, double x, double y) {
     double d = 1e9;
@@ -569,17 +580,8 @@ TEST(SimRobot, PeopleGetARingOfPointsTheMarginOut) {
     EXPECT_EQ(plain.size(), 360u);
     EXPECT_EQ(ringed.size(), 360u + 12u * on_person);  // 12 ring points per person point
     // The nearest sensed point ahead moves 0.3 m closer; the walls' points stay.
-    const auto nearest_ahead = [](const mrpt::maps::CSimplePointsMap& m) {
-        double best = 1e9;
-        for (size_t i = 0; i < m.size(); i++) {
-            float x, y;
-            m.getPoint(i, x, y);
-            if (std::abs(y) < 0.05 && x > 0) best = std::min(best, double(x));
-        }
-        return best;
-    };
-    EXPECT_NEAR(nearest_ahead(plain), 1.28, 0.02);
-    EXPECT_NEAR(nearest_ahead(ringed), 0.98, 0.02);
+    EXPECT_NEAR(nearestAhead(plain), 1.28, 0.02);
+    EXPECT_NEAR(nearestAhead(ringed), 0.98, 0.02);
     // A person already inside the margin: no ring point inside the robot's own disc.
     WorldSpec near = w;
     near.pedestrians[0].path = {{2.6, 3}};  // edge 0.13 m from the robot's edge
@@ -593,6 +595,96 @@ TEST(SimRobot, PeopleGetARingOfPointsTheMarginOut) {
         pts.getPoint(i, x, y);
         EXPECT_GE(std::hypot(x, y), w.robot.radius) << "point " << i;
     }
+}
+
+// With a prediction horizon, a walker coming at the robot is also sensed along its path
+// (PeopleTracker): points between it and the robot, as far as it walks in that time; one who
+// stands adds none.
+TEST(SimRobot, AWalkersPathIsSensedAhead) {
+    auto w = room();
+    w.pedestrians_yield = false;
+    w.laser.range = 15.0;
+    Pedestrian p;
+    p.name = "p";
+    p.radius = 0.22;
+    p.speed = 1.0;
+    p.path = {{8, 3}, {4, 3}};  // at the robot, along y = 3, from 5.78 m to 1.78 m off its edge
+    w.pedestrians.push_back(p);
+    const auto run = [&](const WorldSpec& world, double horizon) {
+        Simulator sim(world);
+        SimRobot robot(sim, 0.0, horizon);
+        mrpt::maps::CSimplePointsMap pts;
+        mrpt::system::TTimeStamp ts;
+        for (int i = 0; i < 150; i++) {  // 1.5 s, a navigator at 10 Hz
+            sim.step();
+            if (i % 10 == 9) {
+                EXPECT_TRUE(robot.senseObstacles(pts, ts));
+            }
+        }
+        const double walker = sim.pedestrianPositions().at(0).x - 2 - p.radius;
+        return std::make_pair(walker, nearestAhead(pts));
+    };
+    const auto [walker, plain] = run(w, 0.0);
+    EXPECT_NEAR(walker, 8 - 1.5 - 2 - 0.22, 0.02) << "[m] its near side from the robot centre";
+    EXPECT_NEAR(plain, walker, 0.02);
+    const auto [walker1, ahead] = run(w, 1.0);
+    EXPECT_DOUBLE_EQ(walker1, walker);
+    // 1 m/s for 1 s: the nearest point a metre in front of the walker
+    EXPECT_NEAR(ahead, walker - 1.0, 0.08);
+    // A person who stands: nothing ahead of them.
+    auto still = w;
+    still.pedestrians[0].speed = 0;
+    const auto [stands, still_ahead] = run(still, 1.0);
+    EXPECT_NEAR(still_ahead, stands, 0.02);
+}
+
+// The walker's path from a turning robot with a laser slower than the navigator: the scan's
+// person points go to the world from the pose the scan was taken at, and the predicted ones
+// come back from the robot's pose now (0.1 rad apart here: 0.5 m at 5 m, had either been
+// the other pose).
+TEST(SimRobot, AWalkersPathIsGivenFromTheRobotsPoseNow) {
+    auto w = room();
+    w.pedestrians_yield = false;
+    w.laser.range = 15.0;
+    w.laser.rate = 5.0;
+    Pedestrian p;
+    p.name = "p";
+    p.radius = 0.22;
+    p.speed = 1.0;
+    p.path = {{8, 3}, {4, 3}};  // along y = 3, at the robot
+    w.pedestrians.push_back(p);
+    Simulator sim(w);
+    SimRobot robot(sim, 0.0, 1.0);
+    sim.setCommand(0, 1.0);  // turning in place
+    mrpt::maps::CSimplePointsMap pts;
+    mrpt::system::TTimeStamp ts;
+    for (int i = 0; i < 150; i++) {
+        sim.step();
+        if (i % 10 == 9) {
+            ASSERT_TRUE(robot.senseObstacles(pts, ts));
+        }
+    }
+    ASSERT_LT(sim.scan().t, sim.time() - 0.05) << "the last scan is older than the robot's pose";
+    ASSERT_GT(std::abs(sim.robotPose().phi - sim.scan().pose.phi), 0.05);
+    const mrpt::poses::CPose2D now(sim.robotPose());
+    const double near_side = sim.pedestrianPositions().at(0).x - p.radius;
+    double band_start = 1e9;
+    std::size_t off = 0, in_band = 0;
+    for (std::size_t k = 0; k < pts.size(); k++) {
+        float x, y;
+        pts.getPoint(k, x, y);
+        double gx, gy;
+        now.composePoint(x, y, gx, gy);
+        if (gx < 0.3 || gx > 9.7 || gy < 0.3 || gy > 5.7) continue;  // the walls
+        if (std::abs(gy - 3) > 0.3) off++;
+        if (gx < near_side - 0.05) {
+            in_band++;
+            band_start = std::min(band_start, gx);
+        }
+    }
+    EXPECT_EQ(off, 0u) << "points off the walker's line y = 3";
+    EXPECT_GT(in_band, 10u);
+    EXPECT_NEAR(band_start, near_side - 1.0, 0.1) << "[m] the band's end, 1 s at 1 m/s ahead";
 }
 
 // A laser slower than the navigator: between scans the robot moves on, and the last scan's

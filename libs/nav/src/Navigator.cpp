@@ -264,11 +264,12 @@ NavigatorOptions readNavigatorOptions(const mrpt::config::CConfigFileBase& c,
     NavigatorOptions o;
     o.source = source;
     const std::string s = "navigator";
-    core::requireKnownKeys(c, s,
-                           {"nav_period", "waypoint_allowed_distance", "holonomic_method",
-                            "robot_radius", "person_margin", "log_file", "log_directory",
-                            "speed_guard", "max_acc", "max_ang_acc_deg", "guard_margin"},
-                           source);
+    core::requireKnownKeys(
+        c, s,
+        {"nav_period", "waypoint_allowed_distance", "holonomic_method", "robot_radius",
+         "person_margin", "person_predict_horizon", "log_file", "log_directory", "speed_guard",
+         "max_acc", "max_ang_acc_deg", "guard_margin"},
+        source);
     o.nav_period = core::readDouble(c, s, "nav_period", o.nav_period);
     o.waypoint_allowed_distance =
         core::readDouble(c, s, "waypoint_allowed_distance", o.waypoint_allowed_distance);
@@ -276,6 +277,8 @@ NavigatorOptions readNavigatorOptions(const mrpt::config::CConfigFileBase& c,
     requireHolonomicMethod(o.holonomic_method, "[" + s + "] holonomic_method");
     o.robot_radius = core::readDouble(c, s, "robot_radius", o.robot_radius);
     o.person_margin = core::readDouble(c, s, "person_margin", o.person_margin);
+    o.person_predict_horizon =
+        core::readDouble(c, s, "person_predict_horizon", o.person_predict_horizon);
     o.log_file = core::readBool(c, s, "log_file", o.log_file);
     o.log_directory = c.read_string(s, "log_directory", o.log_directory);
     o.guard.enabled = core::readBool(c, s, "speed_guard", o.guard.enabled);
@@ -292,6 +295,9 @@ NavigatorOptions readNavigatorOptions(const mrpt::config::CConfigFileBase& c,
     core::requireValue(o.robot_radius > 0, s, "robot_radius", "must be > 0 m");
     core::requireValue(o.person_margin >= 0 && o.person_margin <= 2.0, s, "person_margin",
                        "must be in [0, 2] m");
+    // Beyond a few seconds a walker's straight path is a guess that walls the corridor off.
+    core::requireValue(o.person_predict_horizon >= 0 && o.person_predict_horizon <= 5.0, s,
+                       "person_predict_horizon", "must be in [0, 5] s");
     // (the world files' own bounds)
     core::requireValue(o.guard.max_acc > 0 && o.guard.max_acc <= kMaxRobotAcc, s, "max_acc",
                        "must be in (0, 20] m/s^2");

@@ -94,7 +94,7 @@ EpisodeResult runEpisode(const WorldSpec& world, const mrpt::config::CConfigFile
     if (!opts.holonomic_method.empty()) nav_opts.holonomic_method = opts.holonomic_method;
 
     Simulator sim(world);
-    SimRobot robot(sim, nav_opts.person_margin);
+    SimRobot robot(sim, nav_opts.person_margin, nav_opts.person_predict_horizon);
     const auto grid = rasterize(world);
     const auto statics = staticObstacles(world);
     {  // A band above the laser's plane (min_obstacles_height 0.5) left the robot blind: it

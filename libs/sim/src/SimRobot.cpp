@@ -69,15 +69,36 @@ bool SimRobot::senseObstacles(mrpt::maps::CSimplePointsMap& obstacles,
         if (ring && std::hypot(x, y) < keep_out) return;
         obstacles.insertPoint(static_cast<float>(x), static_cast<float>(y), z);
     };
+    std::vector<mrpt::math::TPoint2D> person_world;  // this scan's person points, for the tracker
+    const mrpt::poses::CPose2D scan_pose(s.pose);
     for (size_t i = 0; i < s.ranges.size(); i++) {
         if (!s.hit[i]) continue;
         const double x = s.ranges[i] * std::cos(s.angles[i]);
         const double y = s.ranges[i] * std::sin(s.angles[i]);
         insert(x, y, false);
+        if (predict_horizon_ > 0 && s.person[i]) {
+            mrpt::math::TPoint2D w;
+            scan_pose.composePoint(x, y, w.x, w.y);
+            person_world.push_back(w);
+        }
         if (person_margin_ <= 0 || !s.person[i]) continue;
         for (int k = 0; k < kRing; k++) {
             const double a = 2 * M_PI * k / kRing;
             insert(x + person_margin_ * std::cos(a), y + person_margin_ * std::sin(a), true);
+        }
+    }
+    if (predict_horizon_ > 0) {
+        // Once per scan (the tracker ignores a scan it has had); the predicted points, in the
+        // world frame, are put in the robot's frame now. Those inside the robot's own shape are
+        // left out as ring points are: a walker's path through where the robot stands would
+        // block every motion, and the walker's own points still keep the robot off them.
+        tracker_.update(s.t, {s.pose.x, s.pose.y}, person_world);
+        const mrpt::poses::CPose2D now(sim_.robotPose());
+        for (const auto& w : tracker_.predictedPoints(predict_horizon_)) {
+            double x = 0, y = 0;
+            now.inverseComposePoint(w.x, w.y, x, y);
+            if (std::hypot(x, y) < keep_out) continue;
+            obstacles.insertPoint(static_cast<float>(x), static_cast<float>(y), z);
         }
     }
     timestamp = mrpt::Clock::now();

@@ -40,6 +40,10 @@ struct NavigatorOptions {
     /// [m] extra room kept from people: the robot interface surrounds each sensed point it
     /// knows to be on a person with a ring of points this far out (SimRobot; 0 = off).
     double person_margin = 0.10;
+    /// [s] how far ahead walkers' paths are sensed as obstacles: the robot interface tracks
+    /// the people it sees and reports each moving one's points along its velocity that far
+    /// (PeopleTracker.h; SimRobot; 0 = off).
+    double person_predict_horizon = 1.0;
     bool log_file = false;  ///< write an MRPT .reactivenavlog
     std::string log_directory = "reactivenav.logs";
     std::string ptg_cache_directory = "";  ///< "" = a folder in the system temp dir

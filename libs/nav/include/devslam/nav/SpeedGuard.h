@@ -20,7 +20,8 @@
 /// Inside radius + margin already (a wall brushed, a person come close), the bound is the
 /// margin less 1 cm of laser noise (at least 5 mm), so a robot can drive along a wall it
 /// brushes, and no point may come nearer than it is now, so a robot pushed closer still can
-/// back away or turn in place. Sensed points are taken as still (people too).
+/// back away or turn in place. Sensed points are taken as still (people too;
+/// walkers' predicted paths come as points, PeopleTracker.h).
 #include <mrpt/kinematics/CVehicleVelCmd_DiffDriven.h>
 #include <mrpt/math/TPoint2D.h>
 #include <mrpt/nav/reactive/CRobot2NavInterface.h>

@@ -9,10 +9,16 @@
 /// keep that much more distance from people than from walls. (The simulator knows which
 /// body a ray hit; on the robot that knowledge would come from the person detector.)
 ///
+/// Walkers' paths too: with `person_predict_horizon` > 0 the person points of each new scan
+/// feed a nav::PeopleTracker, and every moving person's points are also reported where its
+/// velocity takes them over that many seconds (nav/PeopleTracker.h), so the navigator gives
+/// way to where people are going, not only to where they are.
+///
 /// Usage:
 ///   devslam::sim::SimRobot robot(sim);
 ///   mrpt::nav::CReactiveNavigationSystem nav(robot);
 /// Not thread-safe.
+#include <devslam/nav/PeopleTracker.h>
 #include <devslam/sim/Simulator.h>
 
 #include <mrpt/nav/reactive/CRobot2NavInterface.h>
@@ -21,9 +27,11 @@ namespace devslam::sim {
 
 class SimRobot : public mrpt::nav::CRobot2NavInterface {
   public:
-    /// `person_margin` [m]: see above; 0 reports the scan as it is.
-    explicit SimRobot(Simulator& sim, double person_margin = 0.0)
-        : sim_(sim), person_margin_(person_margin) {
+    /// `person_margin` [m], `person_predict_horizon` [s]: see above; 0 and 0 report the scan
+    /// as it is.
+    explicit SimRobot(Simulator& sim, double person_margin = 0.0,
+                      double person_predict_horizon = 0.0)
+        : sim_(sim), person_margin_(person_margin), predict_horizon_(person_predict_horizon) {
         setMinLoggingLevel(mrpt::system::LVL_WARN);
     }
 
@@ -52,10 +60,14 @@ class SimRobot : public mrpt::nav::CRobot2NavInterface {
     [[nodiscard]] int endEvents() const { return end_events_; }
     [[nodiscard]] int errorEvents() const { return error_events_; }
     [[nodiscard]] int blockedEvents() const { return blocked_events_; }
+    /// The people tracked from the scans (only with a prediction horizon > 0).
+    [[nodiscard]] const nav::PeopleTracker& peopleTracker() const { return tracker_; }
 
   private:
     Simulator& sim_;
-    double person_margin_ = 0;  ///< [m]
+    double person_margin_ = 0;    ///< [m]
+    double predict_horizon_ = 0;  ///< [s]
+    nav::PeopleTracker tracker_;
     double nav_t0_ = 0;
     int end_events_ = 0, error_events_ = 0, blocked_events_ = 0;
 };
