@@ -14,6 +14,7 @@
 #include <devslam/nav/BenchFixtures.h>
 #include <devslam/nav/CHolonomicVFHPlus.h>
 #include <devslam/nav/GridPlanner.h>
+#include <devslam/nav/Navigator.h>
 #include <devslam/nav/SpeedGuard.h>
 #include <devslam/nav/VfhPlus.h>
 #include <devslam/sim/Episode.h>
@@ -218,7 +219,8 @@ std::optional<int> parseArgs(int argc, char** argv, Args& a) {
                 a.person_margin = devslam::core::parseNumber(next(), "--person-margin");
             else if (s == "--person-predict") {
                 a.person_predict = devslam::core::parseNumber(next(), "--person-predict");
-                if (!(*a.person_predict >= 0 && *a.person_predict <= 5.0))
+                if (!(*a.person_predict >= 0 &&
+                      *a.person_predict <= devslam::nav::kMaxPersonPredictHorizon))
                     throw std::invalid_argument("--person-predict: must be in [0, 5] s");
             } else if (s == "--categories") {
                 a.categories.clear();
@@ -226,22 +228,15 @@ std::optional<int> parseArgs(int argc, char** argv, Args& a) {
                 std::string name;
                 while (std::getline(ss, name, ',')) {
                     if (name.empty()) continue;
-                    std::string known;
-                    bool found = false;
-                    for (const auto c : devslam::sim::allCategories()) {
-                        known +=
-                            (known.empty() ? "" : ", ") + std::string(devslam::sim::toString(c));
-                        if (name != devslam::sim::toString(c)) continue;
-                        if (std::find(a.categories.begin(), a.categories.end(), c) !=
-                            a.categories.end())
-                            throw std::invalid_argument("--categories: '" + name +
-                                                        "' is listed twice");
-                        a.categories.push_back(c);
-                        found = true;
-                    }
-                    if (!found)
+                    const auto c = devslam::sim::categoryNamed(name);
+                    if (!c)
                         throw std::invalid_argument("--categories: unknown category '" + name +
-                                                    "' (known: " + known + ")");
+                                                    "' (known: " + devslam::sim::categoryNames() +
+                                                    ")");
+                    if (std::find(a.categories.begin(), a.categories.end(), *c) !=
+                        a.categories.end())
+                        throw std::invalid_argument("--categories: '" + name + "' is listed twice");
+                    a.categories.push_back(*c);
                 }
                 if (a.categories.empty()) throw std::invalid_argument("--categories is empty");
                 // In the bench's own order: the tables, and whether this is RESULTS.md's bench,
@@ -621,7 +616,7 @@ int appMain(int argc, char** argv) {
         const auto ini = devslam::core::loadIni(a.config);
         auto nav_opts = devslam::nav::NavigatorOptions::fromConfig(*ini, a.config);
         if (a.person_margin) {
-            if (*a.person_margin < 0 || *a.person_margin > 2.0)
+            if (*a.person_margin < 0 || *a.person_margin > devslam::nav::kMaxPersonMargin)
                 throw std::invalid_argument("--person-margin: must be in [0, 2] m");
             nav_opts.person_margin = *a.person_margin;
         }

@@ -28,15 +28,13 @@ devslam::sim::WorldSpec loadOrGenerate(const std::string& spec) {
     if (spec.rfind(prefix, 0) != 0) return devslam::sim::loadWorld(spec);
     const auto colon = spec.rfind(':');
     const std::string cat = spec.substr(prefix.size(), colon - prefix.size());
-    for (auto c : devslam::sim::allCategories())
-        if (cat == devslam::sim::toString(c))
-            return devslam::sim::randomWorld(
-                c,
-                static_cast<uint32_t>(devslam::core::parseInteger(
-                    spec.substr(colon + 1), "random world seed in '" + spec + "'", 0, UINT32_MAX)));
-    throw std::invalid_argument(
-        "unknown random world category '" + cat +
-        "' (known: open_clutter, corridor_people, office, obstacle_near_goal)");
+    const auto c = devslam::sim::categoryNamed(cat);
+    if (!c)
+        throw std::invalid_argument("unknown random world category '" + cat +
+                                    "' (known: " + devslam::sim::categoryNames() + ")");
+    return devslam::sim::randomWorld(
+        *c, static_cast<uint32_t>(devslam::core::parseInteger(
+                spec.substr(colon + 1), "random world seed in '" + spec + "'", 0, UINT32_MAX)));
 }
 
 /// "X,Y" [m].

@@ -293,11 +293,12 @@ NavigatorOptions readNavigatorOptions(const mrpt::config::CConfigFileBase& c,
     core::requireValue(o.waypoint_allowed_distance > 0 && o.waypoint_allowed_distance <= 10.0, s,
                        "waypoint_allowed_distance", "must be in (0, 10] m");
     core::requireValue(o.robot_radius > 0, s, "robot_radius", "must be > 0 m");
-    core::requireValue(o.person_margin >= 0 && o.person_margin <= 2.0, s, "person_margin",
-                       "must be in [0, 2] m");
+    core::requireValue(o.person_margin >= 0 && o.person_margin <= kMaxPersonMargin, s,
+                       "person_margin", "must be in [0, 2] m");
     // Beyond a few seconds a walker's straight path is a guess that walls the corridor off.
-    core::requireValue(o.person_predict_horizon >= 0 && o.person_predict_horizon <= 5.0, s,
-                       "person_predict_horizon", "must be in [0, 5] s");
+    core::requireValue(
+        o.person_predict_horizon >= 0 && o.person_predict_horizon <= kMaxPersonPredictHorizon, s,
+        "person_predict_horizon", "must be in [0, 5] s");
     // (the world files' own bounds)
     core::requireValue(o.guard.max_acc > 0 && o.guard.max_acc <= kMaxRobotAcc, s, "max_acc",
                        "must be in (0, 20] m/s^2");

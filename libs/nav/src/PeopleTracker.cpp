@@ -100,7 +100,6 @@ void PeopleTracker::update(double t, const mrpt::math::TPoint2D& sensor,
         TrackedPerson p;
         p.id = next_id_++;
         p.centre = clusters[c].centre;
-        p.velocity = {0, 0};
         p.points = std::move(clusters[c].points);
         p.t = p.centre_t = t;
         p.scans = 1;

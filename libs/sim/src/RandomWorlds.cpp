@@ -26,6 +26,18 @@ std::vector<Category> allCategories() {
             Category::ObstacleNearGoal};
 }
 
+std::optional<Category> categoryNamed(const std::string& name) {
+    for (const auto c : allCategories())
+        if (name == toString(c)) return c;
+    return std::nullopt;
+}
+
+std::string categoryNames() {
+    std::string s;
+    for (const auto c : allCategories()) s += (s.empty() ? "" : ", ") + std::string(toString(c));
+    return s;
+}
+
 bool hasPeople(Category c) {
     return c == Category::CorridorPeople;
 }

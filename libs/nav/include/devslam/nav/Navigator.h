@@ -31,6 +31,10 @@ class CReactiveNavigationSystem;
 
 namespace devslam::nav {
 
+/// The largest [navigator] person_margin [m] and person_predict_horizon [s] taken, by the INI
+/// and devslam-nav-bench's overrides alike.
+inline constexpr double kMaxPersonMargin = 2.0, kMaxPersonPredictHorizon = 5.0;
+
 /// INI section [navigator] plus the planner ([global_planner]) and replanning ([replan]).
 struct NavigatorOptions {
     double nav_period = 0.1;                 ///< [s] period of navigationStep()

@@ -12,6 +12,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -20,6 +21,10 @@ namespace devslam::sim {
 enum class Category { OpenClutter, CorridorPeople, Office, ObstacleNearGoal };
 [[nodiscard]] const char* toString(Category c);
 [[nodiscard]] std::vector<Category> allCategories();
+/// The category whose toString() is `name`; none for another name.
+[[nodiscard]] std::optional<Category> categoryNamed(const std::string& name);
+/// "open_clutter, corridor_people, ...": every category's name, for messages.
+[[nodiscard]] std::string categoryNames();
 /// True for categories whose worlds have moving people.
 [[nodiscard]] bool hasPeople(Category c);
 

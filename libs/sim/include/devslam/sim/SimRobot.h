@@ -60,8 +60,6 @@ class SimRobot : public mrpt::nav::CRobot2NavInterface {
     [[nodiscard]] int endEvents() const { return end_events_; }
     [[nodiscard]] int errorEvents() const { return error_events_; }
     [[nodiscard]] int blockedEvents() const { return blocked_events_; }
-    /// The people tracked from the scans (only with a prediction horizon > 0).
-    [[nodiscard]] const nav::PeopleTracker& peopleTracker() const { return tracker_; }
 
   private:
     Simulator& sim_;
