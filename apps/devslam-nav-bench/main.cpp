@@ -424,6 +424,7 @@ Episodes runEpisodes(const Args& a, const mrpt::config::CConfigFileBase& ini,
             gs.commands += r.guard.commands;
             gs.slowed += r.guard.slowed;
             gs.stopped += r.guard.stopped;
+            gs.by_walkers += r.guard.by_walkers;
             if (g.index == 0 && g.method == a.methods.front())  // pictured after the results
                 ep.pictures.push_back({asRun(*g.world), r, g.method});
             // An exception out of the episode, or a run the navigator ended by an error (MRPT
@@ -573,7 +574,8 @@ std::string timingMarkdown(const Args& a, const Episodes& ep, int ptg_count) {
                 md << sep << shortName(m) << " none sent";
             else
                 md << sep << shortName(m) << " " << share(g.slowed) << " of " << g.commands << ", "
-                   << g.stopped << " to a stop";
+                   << g.stopped << " to a stop, " << g.by_walkers
+                   << " lower than the still points ask, for a walker's coming positions";
             sep = "; ";
         }
         md << ".\n\n";

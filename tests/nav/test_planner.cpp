@@ -605,6 +605,14 @@ TEST(NavConfig, UnknownKeyIsReported) {
                   "x.ini [navigator] person_predict_horizon: must be in [0, 5] s")
             << h;
     EXPECT_EQ(errorOf({{"navigator", "person_predict_horizon", 0.0}}), "");
+    {
+        auto c = shippedNavIni();
+        c.write("navigator", "guard_walkers", std::string("sometimes"));
+        const auto e = navError(c);
+        EXPECT_NE(e.find("x.ini [navigator] guard_walkers"), std::string::npos) << e;
+        c.write("navigator", "guard_walkers", std::string("false"));
+        EXPECT_EQ(navError(c), "");
+    }
     for (const double d : {-1.0, 0.0, 1e9})
         EXPECT_EQ(errorOf({{"navigator", "waypoint_allowed_distance", d}}),
                   "x.ini [navigator] waypoint_allowed_distance: must be in (0, 10] m")

@@ -162,3 +162,59 @@ TEST(SpeedGuard, APointAlreadyNearOnlyForbidsComingCloser) {
     const std::vector<TPoint2D> gap{{std::nan(""), std::nan("")}};
     EXPECT_EQ(guardScale(motion(0.5, 0, 0.5, 0), gap, kRadius, limits()), 1.0);
 }
+
+namespace {
+/// A walker's near side as the laser sees it: an arc of points of a 0.22 m disc centred at
+/// (cx, cy), facing the robot at the origin, moving at (vx, vy) [m/s].
+devslam::nav::MovingPoints walker(double cx, double cy, double vx, double vy) {
+    devslam::nav::MovingPoints w;
+    const double r = 0.22, facing = std::atan2(-cy, -cx);
+    for (int k = -3; k <= 3; ++k) {
+        const double a = facing + 0.35 * k;
+        w.points.emplace_back(cx + r * std::cos(a), cy + r * std::sin(a));
+    }
+    w.velocity = {vx, vy};
+    return w;
+}
+}  // namespace
+
+// A walker coming head-on: from 1 m/s the robot stops in 0.5 m (0.6 m with the hold), so the
+// walker's near side 1.2 m ahead is clear as a still point (0.27 m to spare)... but walking at
+// the robot at 1 m/s it covers 0.7 m in the 0.7 s of that stop, and meets it. One walking
+// away, or across well ahead, is no reason to slow; nor any walker with `walkers` off.
+TEST(SpeedGuard, AWalkerIsCheckedWhereItWillBe) {
+    const auto m = motion(1.0, 0, 1.0, 0);
+    const auto coming = walker(1.42, 0, -1.0, 0);
+    EXPECT_EQ(guardScale(m, coming.points, kRadius, limits()), 1.0) << "as still points";
+    EXPECT_LT(guardScale(m, coming.points, {coming}, kRadius, limits()), 1.0);
+    const auto going = walker(1.42, 0, 1.0, 0);
+    EXPECT_EQ(guardScale(m, going.points, {going}, kRadius, limits()), 1.0);
+    const auto crossing = walker(2.5, -1.0, 0, 1.0);  // crosses y = 0 at 1 s, 2.5 m ahead
+    EXPECT_EQ(guardScale(m, crossing.points, {crossing}, kRadius, limits()), 1.0);
+    auto off = limits();
+    off.walkers = false;
+    EXPECT_EQ(guardScale(m, coming.points, {coming}, kRadius, off), 1.0);
+    // A walker far enough: in the 1.1 s of motion the robot goes 0.6 m, the walker 1.1 m, and
+    // 0.27 m are kept; its near side 2.08 m ahead leaves 0.11 m.
+    const auto far = walker(2.3, 0, -1.0, 0);
+    EXPECT_EQ(guardScale(m, far.points, {far}, kRadius, limits()), 1.0);
+}
+
+// A walker catching up from behind meets the robot whatever it does, and the sooner the
+// harder it brakes: of the scales clear of the still points, the guard sends the one whose
+// contact comes latest (here going on at full speed), not a stop. All 11 scales were tried.
+TEST(SpeedGuard, AWalkerCatchingUpIsNotMetByStopping) {
+    const auto m = motion(0.6, 0, 0.6, 0);
+    const auto behind = walker(-1.02, 0, 1.2, 0);  // near side 0.8 m behind the centre
+    int tried = 0;
+    EXPECT_EQ(guardScale(m, behind.points, {behind}, kRadius, limits(), &tried), 1.0);
+    EXPECT_EQ(tried, 11) << "no scale keeps clear of the walker";
+    // ... but never one a still point forbids: with a wall 0.5 m ahead the robot goes on no
+    // faster than the wall alone allows.
+    auto pts = behind.points;
+    const auto wall = wallAhead(0.5);
+    pts.insert(pts.end(), wall.begin(), wall.end());
+    const double by_wall = guardScale(m, pts, kRadius, limits());
+    EXPECT_LT(by_wall, 1.0);
+    EXPECT_EQ(guardScale(m, pts, {behind}, kRadius, limits()), by_wall);
+}

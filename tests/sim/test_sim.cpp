@@ -687,6 +687,58 @@ TEST(SimRobot, AWalkersPathIsGivenFromTheRobotsPoseNow) {
     EXPECT_NEAR(band_start, near_side - 1.0, 0.1) << "[m] the band's end, 1 s at 1 m/s ahead";
 }
 
+// The walkers the speed guard gets (nav::WalkerSensor): from a turning robot with a 5 Hz laser,
+// the walker's velocity turned into the robot's frame now, and its last scan's points moved
+// along it to now (the scan is up to 0.2 s old: 0.2 m at 1 m/s). None without tracking.
+TEST(SimRobot, WalkersAreGivenToTheGuardWhereTheyAreNow) {
+    auto w = room();
+    w.pedestrians_yield = false;
+    w.laser.range = 15.0;
+    w.laser.rate = 5.0;
+    Pedestrian p;
+    p.name = "p";
+    p.radius = 0.22;
+    p.speed = 1.0;
+    p.path = {{8, 3}, {4, 3}};  // along y = 3, at the robot
+    w.pedestrians.push_back(p);
+    for (const double horizon : {0.0, 1.0}) {
+        Simulator sim(w);
+        SimRobot robot(sim, 0.0, horizon);
+        sim.setCommand(0, 1.0);  // turning in place
+        mrpt::maps::CSimplePointsMap pts;
+        mrpt::system::TTimeStamp ts;
+        for (int i = 0; i < 150; i++) {
+            sim.step();
+            if (i % 10 == 9) {
+                ASSERT_TRUE(robot.senseObstacles(pts, ts));
+            }
+        }
+        const auto walkers = robot.sensedWalkers();
+        if (horizon == 0) {
+            EXPECT_TRUE(walkers.empty()) << "no tracking, no walkers";
+            continue;
+        }
+        ASSERT_GT(sim.time() - sim.scan().t, 0.05) << "the last scan is older than now";
+        ASSERT_EQ(walkers.size(), 1u);
+        const mrpt::poses::CPose2D now(sim.robotPose());
+        // robot frame -> world; the robot has turned by about 1.3 rad, so a velocity left in the
+        // world frame would be 1 m/s off (the tracker's own error, 5 Hz scans from a turning
+        // robot, is about 0.1 m/s)
+        ASSERT_GT(std::abs(now.phi()), 1.0);
+        const auto& v = walkers[0].velocity;
+        EXPECT_NEAR(std::cos(now.phi()) * v.x - std::sin(now.phi()) * v.y, -1.0, 0.15);
+        EXPECT_NEAR(std::sin(now.phi()) * v.x + std::cos(now.phi()) * v.y, 0.0, 0.15);
+        const auto centre = sim.pedestrianPositions().at(0);
+        ASSERT_GE(walkers[0].points.size(), 3u);
+        for (const auto& q : walkers[0].points) {
+            double gx, gy;
+            now.composePoint(q.x, q.y, gx, gy);
+            EXPECT_NEAR(std::hypot(gx - centre.x, gy - centre.y), p.radius, 0.05)
+                << "a point on the walker where it is now";
+        }
+    }
+}
+
 // A laser slower than the navigator: between scans the robot moves on, and the last scan's
 // points are given from where it is now (they were placed as if taken there: 0.5 m off
 // turning at 1.2 rad/s with a 5 Hz laser).

@@ -268,7 +268,7 @@ NavigatorOptions readNavigatorOptions(const mrpt::config::CConfigFileBase& c,
         c, s,
         {"nav_period", "waypoint_allowed_distance", "holonomic_method", "robot_radius",
          "person_margin", "person_predict_horizon", "log_file", "log_directory", "speed_guard",
-         "max_acc", "max_ang_acc_deg", "guard_margin"},
+         "max_acc", "max_ang_acc_deg", "guard_margin", "guard_walkers"},
         source);
     o.nav_period = core::readDouble(c, s, "nav_period", o.nav_period);
     o.waypoint_allowed_distance =
@@ -286,6 +286,7 @@ NavigatorOptions readNavigatorOptions(const mrpt::config::CConfigFileBase& c,
     o.guard.max_ang_acc = mrpt::DEG2RAD(
         core::readDouble(c, s, "max_ang_acc_deg", mrpt::RAD2DEG(o.guard.max_ang_acc)));
     o.guard.margin = core::readDouble(c, s, "guard_margin", o.guard.margin);
+    o.guard.walkers = core::readBool(c, s, "guard_walkers", o.guard.walkers);
     // At a period of seconds the robot drove blind into what it had not yet seen; a reached
     // radius of kilometres skipped every waypoint of the route.
     core::requireValue(o.nav_period > 0 && o.nav_period <= 1.0, s, "nav_period",

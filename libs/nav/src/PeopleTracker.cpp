@@ -109,13 +109,20 @@ void PeopleTracker::update(double t, const mrpt::math::TPoint2D& sensor,
     }
 }
 
+std::vector<TrackedPerson> PeopleTracker::walkers(double min_speed) const {
+    std::vector<TrackedPerson> out;
+    for (const auto& p : people_)
+        if (p.centre_scans >= o_.min_scans && p.velocity.norm() >= min_speed && p.t == last_t_)
+            out.push_back(p);
+    return out;
+}
+
 std::vector<mrpt::math::TPoint2D> PeopleTracker::predictedPoints(double horizon, double spacing,
                                                                  double min_speed) const {
     std::vector<mrpt::math::TPoint2D> out;
     if (horizon <= 0 || spacing <= 0) return out;
-    for (const auto& p : people_) {
+    for (const auto& p : walkers(min_speed)) {
         const double speed = p.velocity.norm();
-        if (p.centre_scans < o_.min_scans || speed < min_speed || p.t != last_t_) continue;
         const int n = std::max(1, static_cast<int>(std::ceil(speed * horizon / spacing)));
         for (int k = 1; k <= n; k++) {
             const mrpt::math::TPoint2D shift = p.velocity * (horizon * k / n);

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace devslam::nav {
 
@@ -21,17 +22,27 @@ double ramp(double now, double cmd, double acc, double dt) {
     return now + std::clamp(cmd - now, -acc * dt, acc * dt);
 }
 
-/// True when holding (vc, wc) for `hold` s, then stopping, keeps every point at least
-/// `need[i]` from the robot's centre.
-bool admissible(double v, double w, double vc, double wc, double hold,
-                const std::vector<mrpt::math::TPoint2D>& pts, const std::vector<double>& need,
-                const SpeedGuardOptions& o) {
+constexpr double kNever = std::numeric_limits<double>::infinity();
+
+/// A walker's points, each with the least distance it may have from the robot's centre.
+struct Walker {
+    std::vector<mrpt::math::TPoint2D> pts;
+    std::vector<double> need;
+    mrpt::math::TPoint2D vel{0, 0};
+};
+
+/// When holding (vc, wc) for `hold` s, then stopping, first brings the robot's centre nearer to
+/// a still point than its need[i] (`still`) and to a walker's point, the walker going on at its
+/// velocity, than its need (`walker`); kNever where it does not. The walkers are looked at only
+/// where the still points leave the motion clear.
+struct Contact {
+    double still = kNever, walker = kNever;
+};
+Contact firstContact(double v, double w, double vc, double wc, double hold,
+                     const std::vector<mrpt::math::TPoint2D>& pts, const std::vector<double>& need,
+                     const std::vector<Walker>& walkers, const SpeedGuardOptions& o) {
     double x = 0, y = 0, th = 0, t = 0;
-    const auto clear = [&] {
-        for (std::size_t i = 0; i < pts.size(); ++i)
-            if (std::hypot(pts[i].x - x, pts[i].y - y) < need[i]) return false;
-        return true;
-    };
+    Contact c;
     while (t < kMaxHorizon) {
         const bool holding = t < hold;
         const double tv = holding ? vc : 0.0, tw = holding ? wc : 0.0;
@@ -46,14 +57,31 @@ bool admissible(double v, double w, double vc, double wc, double hold,
         v = v1;
         w = w1;
         t += kStep;
-        if (!clear()) return false;
+        for (std::size_t i = 0; i < pts.size(); ++i)
+            if (std::hypot(pts[i].x - x, pts[i].y - y) < need[i]) {
+                c.still = t;
+                return c;
+            }
+        if (c.walker < kNever) continue;  // (still points may yet be met)
+        for (const auto& wk : walkers) {
+            const double ox = wk.vel.x * t, oy = wk.vel.y * t;
+            for (std::size_t i = 0; i < wk.pts.size() && c.walker == kNever; ++i)
+                if (std::hypot(wk.pts[i].x + ox - x, wk.pts[i].y + oy - y) < wk.need[i])
+                    c.walker = t;
+        }
     }
-    return true;
+    return c;
 }
 }  // namespace
 
 double guardScale(const GuardMotion& m, const std::vector<mrpt::math::TPoint2D>& obstacles,
                   double radius, const SpeedGuardOptions& o, int* checked) {
+    return guardScale(m, obstacles, {}, radius, o, checked);
+}
+
+double guardScale(const GuardMotion& m, const std::vector<mrpt::math::TPoint2D>& obstacles,
+                  const std::vector<MovingPoints>& walkers, double radius,
+                  const SpeedGuardOptions& o, int* checked) {
     if (checked) *checked = 0;
     // Only points the robot could reach: the farthest it can go is at its top speed over
     // the hold and the stop after it.
@@ -62,6 +90,13 @@ double guardScale(const GuardMotion& m, const std::vector<mrpt::math::TPoint2D>&
         vmax * m.hold + 0.5 * o.max_acc * m.hold * m.hold +
         (vmax + o.max_acc * m.hold) * (vmax + o.max_acc * m.hold) / (2 * o.max_acc) + radius +
         std::max(o.margin, kContactGap) + kStep * (vmax + o.max_acc * m.hold);
+    // ... and walkers' points that can meet it before it stands: its longest motion, the hold
+    // and the slower axis's stop after it (and a step).
+    const double wmax = std::max(std::abs(m.w0), std::abs(m.wc));
+    const double longest = m.hold +
+                           std::max((vmax + o.max_acc * m.hold) / o.max_acc,
+                                    (wmax + o.max_ang_acc * m.hold) / o.max_ang_acc) +
+                           kStep;
     std::vector<mrpt::math::TPoint2D> pts;
     std::vector<double> need;  // each point's distance now, then the least it may have
     double nearest = 1e300;
@@ -72,7 +107,22 @@ double guardScale(const GuardMotion& m, const std::vector<mrpt::math::TPoint2D>&
         need.push_back(d);
         nearest = std::min(nearest, d);
     }
-    if (pts.empty()) return 1.0;
+    std::vector<Walker> near_walkers;
+    if (o.walkers)
+        for (const auto& wk : walkers) {
+            Walker n;
+            n.vel = wk.velocity;
+            const double travel = wk.velocity.norm() * longest;
+            for (const auto& p : wk.points) {
+                const double d = std::hypot(p.x, p.y);
+                if (!(d <= reach + travel)) continue;
+                n.pts.push_back(p);
+                n.need.push_back(d);
+                nearest = std::min(nearest, d);
+            }
+            if (!n.pts.empty() && std::isfinite(travel)) near_walkers.push_back(std::move(n));
+        }
+    if (pts.empty() && near_walkers.empty()) return 1.0;
     // Radius and margin. Where the robot is inside that already (a wall brushed, a person
     // come close), the margin less the laser's noise, so that it can drive along a wall it
     // brushes (every point of the wall ahead is nearer than now) - a fixed bound, not one
@@ -83,17 +133,31 @@ double guardScale(const GuardMotion& m, const std::vector<mrpt::math::TPoint2D>&
                             ? radius + o.margin
                             : radius + std::max(o.margin - kSensorSlack, kContactGap);
     for (double& n : need) n = std::min(base, n - 1e-6);
+    for (auto& wk : near_walkers)
+        for (double& n : wk.need) n = std::min(base, n - 1e-6);
+    double best = 0.0, latest = -1.0;  // of the scales clear of the still points
     for (int k = 10; k >= 0; --k) {
         const double s = 0.1 * k;
         if (checked) ++*checked;
-        if (admissible(m.v0, m.w0, s * m.vc, s * m.wc, m.hold, pts, need, o)) return s;
+        const Contact c =
+            firstContact(m.v0, m.w0, s * m.vc, s * m.wc, m.hold, pts, need, near_walkers, o);
+        if (c.still < kNever) continue;
+        if (c.walker == kNever) return s;
+        if (c.walker > latest) {
+            latest = c.walker;
+            best = s;
+        }
     }
-    return 0.0;
+    return best;
 }
 
 GuardedRobot::GuardedRobot(mrpt::nav::CRobot2NavInterface& robot, double radius, double period,
                            SpeedGuardOptions o)
-    : robot_(robot), radius_(radius), period_(period), opts_(o) {
+    : robot_(robot),
+      radius_(radius),
+      period_(period),
+      opts_(o),
+      walker_sensor_(dynamic_cast<WalkerSensor*>(&robot)) {
     setMinLoggingLevel(mrpt::system::LVL_WARN);
 }
 
@@ -124,10 +188,12 @@ bool GuardedRobot::changeSpeeds(const mrpt::kinematics::CVehicleVelCmd& cmd) {
     m.vc = dd->lin_vel;
     m.wc = dd->ang_vel;
     m.hold = period_;
-    const double s = guardScale(m, points_, radius_, opts_);
+    const double s = guardScale(m, points_, walkers_, radius_, opts_);
     if (s >= 1.0) return robot_.changeSpeeds(cmd);
     stats_.slowed++;
     if (s <= 0) stats_.stopped++;
+    if (opts_.walkers && !walkers_.empty() && guardScale(m, points_, radius_, opts_) != s)
+        stats_.by_walkers++;
     mrpt::kinematics::CVehicleVelCmd_DiffDriven scaled;
     scaled.lin_vel = s * dd->lin_vel;
     scaled.ang_vel = s * dd->ang_vel;
@@ -171,6 +237,9 @@ bool GuardedRobot::senseObstacles(mrpt::maps::CSimplePointsMap& obstacles,
         const auto& ys = obstacles.getPointsBufferRef_y();
         for (std::size_t i = 0; i < xs.size(); ++i) points_.emplace_back(xs[i], ys[i]);
     }
+    walkers_.clear();
+    if (ok && walker_sensor_ && opts_.enabled && opts_.walkers)
+        walkers_ = walker_sensor_->sensedWalkers();
     return ok;
 }
 

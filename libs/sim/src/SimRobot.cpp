@@ -105,4 +105,23 @@ bool SimRobot::senseObstacles(mrpt::maps::CSimplePointsMap& obstacles,
     return true;
 }
 
+std::vector<nav::MovingPoints> SimRobot::sensedWalkers() {
+    std::vector<nav::MovingPoints> out;
+    if (predict_horizon_ <= 0) return out;  // (the tracker is fed only then)
+    const mrpt::poses::CPose2D now(sim_.robotPose());
+    const double c = std::cos(now.phi()), s = std::sin(now.phi());
+    const double age = sim_.time() - sim_.scan().t;  // (a laser slower than the navigator)
+    for (const auto& p : tracker_.walkers()) {
+        nav::MovingPoints m;
+        m.velocity = {c * p.velocity.x + s * p.velocity.y, -s * p.velocity.x + c * p.velocity.y};
+        for (const auto& q : p.points) {
+            mrpt::math::TPoint2D r;
+            now.inverseComposePoint(q.x + p.velocity.x * age, q.y + p.velocity.y * age, r.x, r.y);
+            m.points.push_back(r);
+        }
+        out.push_back(std::move(m));
+    }
+    return out;
+}
+
 }  // namespace devslam::sim

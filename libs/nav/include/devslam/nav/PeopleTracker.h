@@ -69,6 +69,10 @@ class PeopleTracker {
     /// `spacing` [m] of its path up to `horizon` [s] after the last scan (the points
     /// themselves not included); people slower than `min_speed` [m/s], with fewer than
     /// `min_scans` centres measured, or not in the last scan, add none.
+    /// The tracks predictedPoints() moves: seen in the last scan, with `min_scans` centres
+    /// measured and at least `min_speed` [m/s].
+    [[nodiscard]] std::vector<TrackedPerson> walkers(double min_speed = 0.15) const;
+
     [[nodiscard]] std::vector<mrpt::math::TPoint2D> predictedPoints(double horizon,
                                                                     double spacing = 0.10,
                                                                     double min_speed = 0.15) const;

@@ -12,20 +12,22 @@
 /// Walkers' paths too: with `person_predict_horizon` > 0 the person points of each new scan
 /// feed a nav::PeopleTracker, and every moving person's points are also reported where its
 /// velocity takes them over that many seconds (nav/PeopleTracker.h), so the navigator gives
-/// way to where people are going, not only to where they are.
+/// way to where people are going, not only to where they are. The same tracks go to the speed
+/// guard as walkers (nav::WalkerSensor), which it checks at each instant of a stop.
 ///
 /// Usage:
 ///   devslam::sim::SimRobot robot(sim);
 ///   mrpt::nav::CReactiveNavigationSystem nav(robot);
 /// Not thread-safe.
 #include <devslam/nav/PeopleTracker.h>
+#include <devslam/nav/SpeedGuard.h>
 #include <devslam/sim/Simulator.h>
 
 #include <mrpt/nav/reactive/CRobot2NavInterface.h>
 
 namespace devslam::sim {
 
-class SimRobot : public mrpt::nav::CRobot2NavInterface {
+class SimRobot : public mrpt::nav::CRobot2NavInterface, public nav::WalkerSensor {
   public:
     /// `person_margin` [m], `person_predict_horizon` [s]: see above; 0 and 0 report the scan
     /// as it is.
@@ -45,6 +47,9 @@ class SimRobot : public mrpt::nav::CRobot2NavInterface {
     mrpt::kinematics::CVehicleVelCmd::Ptr getStopCmd() override;
     bool senseObstacles(mrpt::maps::CSimplePointsMap& obstacles,
                         mrpt::system::TTimeStamp& timestamp) override;
+    /// The tracker's walkers (with `person_predict_horizon` > 0, else none): their last
+    /// scan's points moved along their velocity to now, in the robot's frame now.
+    [[nodiscard]] std::vector<nav::MovingPoints> sensedWalkers() override;
     double getNavigationTime() override { return sim_.time() - nav_t0_; }
     void resetNavigationTimer() override { nav_t0_ = sim_.time(); }
 
