@@ -558,7 +558,9 @@ std::string timingMarkdown(const Args& a, const Episodes& ep, int ptg_count) {
                     [](const auto& g) { return g.second.commands > 0; })) {
         // A sentence, not a table: a row per method would read as another result row.
         md << "**Speed guard** (`[navigator] speed_guard`, docs/nav.md): of MRPT's commands "
-              "over all runs, those scaled down to what the robot can follow and stop from:";
+              "over all runs, those scaled down to what the robot can follow and stop from "
+              "(\"for walkers\": lower than the still points alone ask, for where walkers "
+              "will be, `guard_walkers`):";
         const char* sep = " ";
         for (const auto& m : a.methods) {
             const auto it = ep.guard.find(m);
@@ -574,8 +576,7 @@ std::string timingMarkdown(const Args& a, const Episodes& ep, int ptg_count) {
                 md << sep << shortName(m) << " none sent";
             else
                 md << sep << shortName(m) << " " << share(g.slowed) << " of " << g.commands << ", "
-                   << g.stopped << " to a stop, " << g.by_walkers
-                   << " lower than the still points ask, for a walker's coming positions";
+                   << g.stopped << " to a stop, " << g.by_walkers << " for walkers";
             sep = "; ";
         }
         md << ".\n\n";

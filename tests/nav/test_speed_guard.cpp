@@ -179,9 +179,10 @@ devslam::nav::MovingPoints walker(double cx, double cy, double vx, double vy) {
 }  // namespace
 
 // A walker coming head-on: from 1 m/s the robot stops in 0.5 m (0.6 m with the hold), so the
-// walker's near side 1.2 m ahead is clear as a still point (0.27 m to spare)... but walking at
-// the robot at 1 m/s it covers 0.7 m in the 0.7 s of that stop, and meets it. One walking
-// away, or across well ahead, is no reason to slow; nor any walker with `walkers` off.
+// walker's near side 1.2 m ahead is clear as a still point (0.33 m beyond the 0.27 m kept)...
+// but walking at the robot at 1 m/s it covers 1.1 m in the 1.1 s of the hold and that stop,
+// and meets it. One walking away, or passing 0.75 m to the side, is no reason to slow; nor any
+// walker with `walkers` off.
 TEST(SpeedGuard, AWalkerIsCheckedWhereItWillBe) {
     const auto m = motion(1.0, 0, 1.0, 0);
     const auto coming = walker(1.42, 0, -1.0, 0);
@@ -189,8 +190,9 @@ TEST(SpeedGuard, AWalkerIsCheckedWhereItWillBe) {
     EXPECT_LT(guardScale(m, coming.points, {coming}, kRadius, limits()), 1.0);
     const auto going = walker(1.42, 0, 1.0, 0);
     EXPECT_EQ(guardScale(m, going.points, {going}, kRadius, limits()), 1.0);
-    const auto crossing = walker(2.5, -1.0, 0, 1.0);  // crosses y = 0 at 1 s, 2.5 m ahead
-    EXPECT_EQ(guardScale(m, crossing.points, {crossing}, kRadius, limits()), 1.0);
+    // (near enough to be looked at: within the robot's reach, 1 m, and the walker's 1.22 m)
+    const auto passing = walker(1.6, 0.75, -1.0, 0);
+    EXPECT_EQ(guardScale(m, passing.points, {passing}, kRadius, limits()), 1.0);
     auto off = limits();
     off.walkers = false;
     EXPECT_EQ(guardScale(m, coming.points, {coming}, kRadius, off), 1.0);
@@ -198,6 +200,30 @@ TEST(SpeedGuard, AWalkerIsCheckedWhereItWillBe) {
     // 0.27 m are kept; its near side 2.08 m ahead leaves 0.11 m.
     const auto far = walker(2.3, 0, -1.0, 0);
     EXPECT_EQ(guardScale(m, far.points, {far}, kRadius, limits()), 1.0);
+}
+
+// A walker inside the margin (1 cm off the robot's edge, walking away) does not loosen the bound
+// of the still points: a wall that 0.5 m/s held and the stop bring 5 mm inside the margin
+// slows the robot with the walker there as without it (the first version took the walker's
+// nearness for a brushed wall and let the robot 1 cm nearer to it).
+TEST(SpeedGuard, AWalkerNeverLoosensTheWallsBound) {
+    const auto m = motion(0.5, 0, 0.5, 0);  // 0.05 m held, 0.125 m to stop
+    const auto wall = wallAhead(0.175 + 0.265);
+    const double alone = guardScale(m, wall, kRadius, limits());
+    EXPECT_LT(alone, 1.0);
+    devslam::nav::MovingPoints away;
+    away.points = {{-0.26, 0.0}};
+    away.velocity = {-1.0, 0.0};
+    double still_only = -1;
+    EXPECT_EQ(guardScale(m, wall, {away}, kRadius, limits(), nullptr, &still_only), alone);
+    EXPECT_EQ(still_only, alone);
+}
+
+// A robot at rest that only turns moves its disc nowhere: a walker coming at it is no reason
+// to turn slower (a slower turn ends sooner, before the walker arrives, and seemed to miss it).
+TEST(SpeedGuard, AWalkerDoesNotSlowATurnInPlace) {
+    const auto coming = walker(0.64, 0, -1.0, 0);  // near side 0.42 m off: 0.27 m in 0.15 s
+    EXPECT_EQ(guardScale(motion(0, 0, 0, 2.0), coming.points, {coming}, kRadius, limits()), 1.0);
 }
 
 // A walker catching up from behind meets the robot whatever it does, and the sooner the

@@ -689,7 +689,7 @@ TEST(SimRobot, AWalkersPathIsGivenFromTheRobotsPoseNow) {
 
 // The walkers the speed guard gets (nav::WalkerSensor): from a turning robot with a 5 Hz laser,
 // the walker's velocity turned into the robot's frame now, and its last scan's points moved
-// along it to now (the scan is up to 0.2 s old: 0.2 m at 1 m/s). None without tracking.
+// along it to now (the scan is 0.1 s old here: 0.1 m at 1 m/s). None without tracking.
 TEST(SimRobot, WalkersAreGivenToTheGuardWhereTheyAreNow) {
     auto w = room();
     w.pedestrians_yield = false;

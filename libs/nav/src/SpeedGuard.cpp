@@ -32,9 +32,9 @@ struct Walker {
 };
 
 /// When holding (vc, wc) for `hold` s, then stopping, first brings the robot's centre nearer to
-/// a still point than its need[i] (`still`) and to a walker's point, the walker going on at its
-/// velocity, than its need (`walker`); kNever where it does not. The walkers are looked at only
-/// where the still points leave the motion clear.
+/// a still point than its need[i] (`still`) and, while it drives, to a walker's point, the
+/// walker going on at its velocity, than its need (`walker`); kNever where it does not. The
+/// walkers are looked at only where the still points leave the motion clear.
 struct Contact {
     double still = kNever, walker = kNever;
 };
@@ -62,7 +62,9 @@ Contact firstContact(double v, double w, double vc, double wc, double hold,
                 c.still = t;
                 return c;
             }
-        if (c.walker < kNever) continue;  // (still points may yet be met)
+        // (still points may yet be met; a robot that only turns does not move its disc, and
+        // walkers that meet it then would meet it whatever it did)
+        if (c.walker < kNever || std::abs(vm) < kStopped) continue;
         for (const auto& wk : walkers) {
             const double ox = wk.vel.x * t, oy = wk.vel.y * t;
             for (std::size_t i = 0; i < wk.pts.size() && c.walker == kNever; ++i)
@@ -81,8 +83,9 @@ double guardScale(const GuardMotion& m, const std::vector<mrpt::math::TPoint2D>&
 
 double guardScale(const GuardMotion& m, const std::vector<mrpt::math::TPoint2D>& obstacles,
                   const std::vector<MovingPoints>& walkers, double radius,
-                  const SpeedGuardOptions& o, int* checked) {
+                  const SpeedGuardOptions& o, int* checked, double* still_only) {
     if (checked) *checked = 0;
+    if (still_only) *still_only = 1.0;
     // Only points the robot could reach: the farthest it can go is at its top speed over
     // the hold and the stop after it.
     const double vmax = std::max(std::abs(m.v0), std::abs(m.vc));
@@ -99,7 +102,7 @@ double guardScale(const GuardMotion& m, const std::vector<mrpt::math::TPoint2D>&
                            kStep;
     std::vector<mrpt::math::TPoint2D> pts;
     std::vector<double> need;  // each point's distance now, then the least it may have
-    double nearest = 1e300;
+    double nearest = 1e300, nearest_walker = 1e300;
     for (const auto& p : obstacles) {
         const double d = std::hypot(p.x, p.y);
         if (!(d <= reach)) continue;  // (NaN points too)
@@ -110,17 +113,18 @@ double guardScale(const GuardMotion& m, const std::vector<mrpt::math::TPoint2D>&
     std::vector<Walker> near_walkers;
     if (o.walkers)
         for (const auto& wk : walkers) {
+            const double travel = wk.velocity.norm() * longest;
+            if (!std::isfinite(travel)) continue;
             Walker n;
             n.vel = wk.velocity;
-            const double travel = wk.velocity.norm() * longest;
             for (const auto& p : wk.points) {
                 const double d = std::hypot(p.x, p.y);
                 if (!(d <= reach + travel)) continue;
                 n.pts.push_back(p);
                 n.need.push_back(d);
-                nearest = std::min(nearest, d);
+                nearest_walker = std::min(nearest_walker, d);
             }
-            if (!n.pts.empty() && std::isfinite(travel)) near_walkers.push_back(std::move(n));
+            if (!n.pts.empty()) near_walkers.push_back(std::move(n));
         }
     if (pts.empty() && near_walkers.empty()) return 1.0;
     // Radius and margin. Where the robot is inside that already (a wall brushed, a person
@@ -129,19 +133,26 @@ double guardScale(const GuardMotion& m, const std::vector<mrpt::math::TPoint2D>&
     // taken from the clearance now: that one sank by the noise at every step, and a robot
     // driving at a wall crept to 6-10 mm of it. And no point nearer than it is now, so that
     // a robot pushed closer still can turn in place or back away.
-    const double base = nearest >= radius + o.margin
-                            ? radius + o.margin
-                            : radius + std::max(o.margin - kSensorSlack, kContactGap);
-    for (double& n : need) n = std::min(base, n - 1e-6);
+    // (the walkers' points on their own: they never loosen the bound of the still ones)
+    const auto base = [&](double closest) {
+        return closest >= radius + o.margin
+                   ? radius + o.margin
+                   : radius + std::max(o.margin - kSensorSlack, kContactGap);
+    };
+    for (double& n : need) n = std::min(base(nearest), n - 1e-6);
     for (auto& wk : near_walkers)
-        for (double& n : wk.need) n = std::min(base, n - 1e-6);
+        for (double& n : wk.need) n = std::min(base(nearest_walker), n - 1e-6);
     double best = 0.0, latest = -1.0;  // of the scales clear of the still points
+    bool clear_seen = false;
+    if (still_only) *still_only = 0.0;
     for (int k = 10; k >= 0; --k) {
         const double s = 0.1 * k;
         if (checked) ++*checked;
         const Contact c =
             firstContact(m.v0, m.w0, s * m.vc, s * m.wc, m.hold, pts, need, near_walkers, o);
         if (c.still < kNever) continue;
+        if (!clear_seen && still_only) *still_only = s;  // (the largest: the first)
+        clear_seen = true;
         if (c.walker == kNever) return s;
         if (c.walker > latest) {
             latest = c.walker;
@@ -188,12 +199,12 @@ bool GuardedRobot::changeSpeeds(const mrpt::kinematics::CVehicleVelCmd& cmd) {
     m.vc = dd->lin_vel;
     m.wc = dd->ang_vel;
     m.hold = period_;
-    const double s = guardScale(m, points_, walkers_, radius_, opts_);
+    double still_only = 1.0;
+    const double s = guardScale(m, points_, walkers_, radius_, opts_, nullptr, &still_only);
     if (s >= 1.0) return robot_.changeSpeeds(cmd);
     stats_.slowed++;
     if (s <= 0) stats_.stopped++;
-    if (opts_.walkers && !walkers_.empty() && guardScale(m, points_, radius_, opts_) != s)
-        stats_.by_walkers++;
+    if (s < still_only) stats_.by_walkers++;
     mrpt::kinematics::CVehicleVelCmd_DiffDriven scaled;
     scaled.lin_vel = s * dd->lin_vel;
     scaled.ang_vel = s * dd->ang_vel;

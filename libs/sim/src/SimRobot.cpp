@@ -110,8 +110,8 @@ std::vector<nav::MovingPoints> SimRobot::sensedWalkers() {
     if (predict_horizon_ <= 0) return out;  // (the tracker is fed only then)
     const mrpt::poses::CPose2D now(sim_.robotPose());
     const double c = std::cos(now.phi()), s = std::sin(now.phi());
-    const double age = sim_.time() - sim_.scan().t;  // (a laser slower than the navigator)
     for (const auto& p : tracker_.walkers()) {
+        const double age = sim_.time() - p.t;  // (a laser slower than the navigator)
         nav::MovingPoints m;
         m.velocity = {c * p.velocity.x + s * p.velocity.y, -s * p.velocity.x + c * p.velocity.y};
         for (const auto& q : p.points) {

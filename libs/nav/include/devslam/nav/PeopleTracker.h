@@ -65,14 +65,14 @@ class PeopleTracker {
     /// The tracks, seen within `forget_after` of the last scan.
     [[nodiscard]] const std::vector<TrackedPerson>& people() const { return people_; }
 
-    /// Copies of each tracked person's latest points moved along its velocity, every
-    /// `spacing` [m] of its path up to `horizon` [s] after the last scan (the points
-    /// themselves not included); people slower than `min_speed` [m/s], with fewer than
-    /// `min_scans` centres measured, or not in the last scan, add none.
     /// The tracks predictedPoints() moves: seen in the last scan, with `min_scans` centres
     /// measured and at least `min_speed` [m/s].
     [[nodiscard]] std::vector<TrackedPerson> walkers(double min_speed = 0.15) const;
 
+    /// Copies of each tracked person's latest points moved along its velocity, every
+    /// `spacing` [m] of its path up to `horizon` [s] after the last scan (the points
+    /// themselves not included); people slower than `min_speed` [m/s], with fewer than
+    /// `min_scans` centres measured, or not in the last scan, add none.
     [[nodiscard]] std::vector<mrpt::math::TPoint2D> predictedPoints(double horizon,
                                                                     double spacing = 0.10,
                                                                     double min_speed = 0.15) const;

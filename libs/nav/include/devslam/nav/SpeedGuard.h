@@ -89,11 +89,14 @@ struct GuardMotion {
 /// the still points and of every walker's points as they move (each walker point kept the
 /// distance a still point would be); of the scales clear of the still points only, the one
 /// whose first contact with a walker comes latest (ties: the larger); 0 when none is clear of
-/// the still points. `o.walkers` false ignores `walkers`.
+/// the still points. Walkers are met only while the robot drives: one that reaches it after it
+/// stands, or while it only turns, would reach it whatever it did. `o.walkers` false ignores
+/// `walkers`. `still_only` (optional) gets the scale the still points alone allow.
 [[nodiscard]] double guardScale(const GuardMotion& m,
                                 const std::vector<mrpt::math::TPoint2D>& obstacles,
                                 const std::vector<MovingPoints>& walkers, double radius,
-                                const SpeedGuardOptions& o, int* checked = nullptr);
+                                const SpeedGuardOptions& o, int* checked = nullptr,
+                                double* still_only = nullptr);
 
 /// What the guard did over a run.
 struct SpeedGuardStats {
