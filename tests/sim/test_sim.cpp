@@ -597,31 +597,49 @@ TEST(SimRobot, PeopleGetARingOfPointsTheMarginOut) {
     }
 }
 
-// With a prediction horizon, a walker coming at the robot is also sensed along its path
-// (PeopleTracker): points between it and the robot, as far as it walks in that time; one who
-// stands adds none.
-TEST(SimRobot, AWalkersPathIsSensedAhead) {
+namespace {
+constexpr double kWalkerRadius = 0.22;
+
+/// room() with a walker "p" (0.22 m, 1 m/s) coming at the robot along y = 3, from 5.78 m to
+/// 1.78 m off its edge, who does not pause for it; a 15 m laser.
+WorldSpec roomWithWalker() {
     auto w = room();
     w.pedestrians_yield = false;
     w.laser.range = 15.0;
     Pedestrian p;
     p.name = "p";
-    p.radius = 0.22;
+    p.radius = kWalkerRadius;
     p.speed = 1.0;
-    p.path = {{8, 3}, {4, 3}};  // at the robot, along y = 3, from 5.78 m to 1.78 m off its edge
+    p.path = {{8, 3}, {4, 3}};
     w.pedestrians.push_back(p);
+    return w;
+}
+
+/// 1.5 s of simulation, `robot` asked for its obstacles at 10 Hz as a navigator would; the
+/// last points it gave.
+mrpt::maps::CSimplePointsMap senseFor1500ms(Simulator& sim, SimRobot& robot) {
+    mrpt::maps::CSimplePointsMap pts;
+    mrpt::system::TTimeStamp ts;
+    for (int i = 0; i < 150; i++) {
+        sim.step();
+        if (i % 10 == 9) {
+            EXPECT_TRUE(robot.senseObstacles(pts, ts));
+        }
+    }
+    return pts;
+}
+}  // namespace
+
+// With a prediction horizon, a walker coming at the robot is also sensed along its path
+// (PeopleTracker): points between it and the robot, as far as it walks in that time; one who
+// stands adds none.
+TEST(SimRobot, AWalkersPathIsSensedAhead) {
+    const auto w = roomWithWalker();
     const auto run = [&](const WorldSpec& world, double horizon) {
         Simulator sim(world);
         SimRobot robot(sim, 0.0, horizon);
-        mrpt::maps::CSimplePointsMap pts;
-        mrpt::system::TTimeStamp ts;
-        for (int i = 0; i < 150; i++) {  // 1.5 s, a navigator at 10 Hz
-            sim.step();
-            if (i % 10 == 9) {
-                EXPECT_TRUE(robot.senseObstacles(pts, ts));
-            }
-        }
-        const double walker = sim.pedestrianPositions().at(0).x - 2 - p.radius;
+        const auto pts = senseFor1500ms(sim, robot);
+        const double walker = sim.pedestrianPositions().at(0).x - 2 - kWalkerRadius;
         return std::make_pair(walker, nearestAhead(pts));
     };
     const auto [walker, plain] = run(w, 0.0);
@@ -643,31 +661,16 @@ TEST(SimRobot, AWalkersPathIsSensedAhead) {
 // come back from the robot's pose now (0.1 rad apart here: 0.5 m at 5 m, had either been
 // the other pose).
 TEST(SimRobot, AWalkersPathIsGivenFromTheRobotsPoseNow) {
-    auto w = room();
-    w.pedestrians_yield = false;
-    w.laser.range = 15.0;
+    auto w = roomWithWalker();
     w.laser.rate = 5.0;
-    Pedestrian p;
-    p.name = "p";
-    p.radius = 0.22;
-    p.speed = 1.0;
-    p.path = {{8, 3}, {4, 3}};  // along y = 3, at the robot
-    w.pedestrians.push_back(p);
     Simulator sim(w);
     SimRobot robot(sim, 0.0, 1.0);
     sim.setCommand(0, 1.0);  // turning in place
-    mrpt::maps::CSimplePointsMap pts;
-    mrpt::system::TTimeStamp ts;
-    for (int i = 0; i < 150; i++) {
-        sim.step();
-        if (i % 10 == 9) {
-            ASSERT_TRUE(robot.senseObstacles(pts, ts));
-        }
-    }
+    const auto pts = senseFor1500ms(sim, robot);
     ASSERT_LT(sim.scan().t, sim.time() - 0.05) << "the last scan is older than the robot's pose";
     ASSERT_GT(std::abs(sim.robotPose().phi - sim.scan().pose.phi), 0.05);
     const mrpt::poses::CPose2D now(sim.robotPose());
-    const double near_side = sim.pedestrianPositions().at(0).x - p.radius;
+    const double near_side = sim.pedestrianPositions().at(0).x - kWalkerRadius;
     double band_start = 1e9;
     std::size_t off = 0, in_band = 0;
     for (std::size_t k = 0; k < pts.size(); k++) {
@@ -691,28 +694,13 @@ TEST(SimRobot, AWalkersPathIsGivenFromTheRobotsPoseNow) {
 // the walker's velocity turned into the robot's frame now, and its last scan's points moved
 // along it to now (the scan is 0.1 s old here: 0.1 m at 1 m/s). None without tracking.
 TEST(SimRobot, WalkersAreGivenToTheGuardWhereTheyAreNow) {
-    auto w = room();
-    w.pedestrians_yield = false;
-    w.laser.range = 15.0;
+    auto w = roomWithWalker();
     w.laser.rate = 5.0;
-    Pedestrian p;
-    p.name = "p";
-    p.radius = 0.22;
-    p.speed = 1.0;
-    p.path = {{8, 3}, {4, 3}};  // along y = 3, at the robot
-    w.pedestrians.push_back(p);
     for (const double horizon : {0.0, 1.0}) {
         Simulator sim(w);
         SimRobot robot(sim, 0.0, horizon);
         sim.setCommand(0, 1.0);  // turning in place
-        mrpt::maps::CSimplePointsMap pts;
-        mrpt::system::TTimeStamp ts;
-        for (int i = 0; i < 150; i++) {
-            sim.step();
-            if (i % 10 == 9) {
-                ASSERT_TRUE(robot.senseObstacles(pts, ts));
-            }
-        }
+        (void)senseFor1500ms(sim, robot);
         const auto walkers = robot.sensedWalkers();
         if (horizon == 0) {
             EXPECT_TRUE(walkers.empty()) << "no tracking, no walkers";
@@ -733,7 +721,7 @@ TEST(SimRobot, WalkersAreGivenToTheGuardWhereTheyAreNow) {
         for (const auto& q : walkers[0].points) {
             double gx, gy;
             now.composePoint(q.x, q.y, gx, gy);
-            EXPECT_NEAR(std::hypot(gx - centre.x, gy - centre.y), p.radius, 0.05)
+            EXPECT_NEAR(std::hypot(gx - centre.x, gy - centre.y), kWalkerRadius, 0.05)
                 << "a point on the walker where it is now";
         }
     }
