@@ -624,21 +624,8 @@ int appMain(int argc, char** argv) {
             nav_opts.person_margin = *a.person_margin;
         }
         if (a.person_predict) nav_opts.person_predict_horizon = *a.person_predict;
-        if (a.max_speed) {  // what MRPT commands and predicts: the robot's new top speed
-            // The PTGs that run at the robot's top speed take the new one; a PTG slower on
-            // purpose (the shipped PTG3, 0.3 m/s for its tight turns behind the robot) keeps
-            // its speed: raised, its turns widened and left targets near the robot in no
-            // PTG's domain.
-            const double top = ini->read_double("CAbstractPTGBasedReactive", "robotMax_V_mps", 0);
-            ini->write("CAbstractPTGBasedReactive", "robotMax_V_mps", *a.max_speed);
-            const int n = ini->read_int("CReactiveNavigationSystem", "PTG_COUNT", 0);
-            for (int i = 0; i < n; ++i) {
-                const std::string key = "PTG" + std::to_string(i) + "_v_max_mps";
-                const double v = ini->read_double("CReactiveNavigationSystem", key, top);
-                if (std::abs(v - top) <= 1e-9 * std::max(1.0, top))
-                    ini->write("CReactiveNavigationSystem", key, *a.max_speed);
-            }
-        }
+        // what MRPT commands and predicts: the robot's new top speed
+        if (a.max_speed) devslam::nav::setTopSpeed(*ini, *a.max_speed);
         const auto& cats = a.categories;
         const Episodes ep = runEpisodes(a, *ini, nav_opts, cats);
         std::ostringstream md;

@@ -19,6 +19,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <optional>
 #include <string>
 
 namespace {
@@ -130,6 +131,8 @@ void usage(std::ostream& os = std::cerr) {
           "  --png FILE      picture of the run (default out/devslam-nav/nav_<world>.png)\n"
           "  --navlog DIR    also write MRPT's navlog into DIR\n"
           "  --verbose       MRPT navigator messages (DEBUG level)\n"
+          "  --max-speed V   [m/s] the robot's top speed: the world's [robot] max_v, the\n"
+          "                  INI's robotMax_V_mps and each PTG that ran at the old one\n"
           "       devslam-nav --map GRIDMAP --to X,Y [--from X,Y] [--config FILE] [--png FILE]\n"
           "  the global route (A* and waypoints, [global_planner] of --config) on a map\n"
           "  devslam-run built (its map_grid.gridmap: x forward, y left, metres, the\n"
@@ -144,6 +147,7 @@ static int appMain(int argc, char** argv) {
     std::string method;  // empty: the INI's [navigator] holonomic_method
     bool verbose = false;
     bool from_given = false;
+    std::optional<double> max_speed;  // [m/s] over the world's and the INI's
     const auto refuse = [](const std::exception& e) {
         std::cerr << "devslam-nav: " << e.what() << "\n";
         usage();
@@ -174,7 +178,12 @@ static int appMain(int argc, char** argv) {
                 navlog = next();
             else if (a == "--verbose")
                 verbose = true;
-            else if (a == "--map")
+            else if (a == "--max-speed") {
+                max_speed = devslam::core::parseNumber(next(), "--max-speed");
+                // (the world files' own bound)
+                if (!(*max_speed > 0 && *max_speed <= devslam::nav::kMaxRobotSpeed))
+                    throw std::invalid_argument("--max-speed: must be in (0, 5] m/s");
+            } else if (a == "--map")
                 map = next();
             else if (a == "--from") {
                 from = next();
@@ -202,7 +211,8 @@ static int appMain(int argc, char** argv) {
     if (!map.empty())
         for (const auto& [given, option] : {std::pair{!method.empty(), "--method"},
                                             {!navlog.empty(), "--navlog"},
-                                            {verbose, "--verbose"}})
+                                            {verbose, "--verbose"},
+                                            {max_speed.has_value(), "--max-speed"}})
             if (given) {
                 std::cerr << "devslam-nav: " << option
                           << " does not go with --map, which plans a path and drives no robot\n";
@@ -232,9 +242,13 @@ static int appMain(int argc, char** argv) {
         }
         if (!map.empty()) return planOnSlamMap(map, from, to, config, png);
         if (!method.empty()) devslam::nav::requireHolonomicMethod(method, "--method");
-        const auto world = loadOrGenerate(world_path);
+        auto world = loadOrGenerate(world_path);
         const auto ini = devslam::core::loadIni(config);
         auto nav_opts = devslam::nav::NavigatorOptions::fromConfig(*ini, config);
+        if (max_speed) {  // the robot's, and what MRPT commands and predicts
+            world.robot.max_v = *max_speed;
+            devslam::nav::setTopSpeed(*ini, *max_speed);
+        }
         nav_opts.verbose = verbose;
         devslam::sim::EpisodeOptions eo;
         eo.holonomic_method = method;
@@ -268,9 +282,11 @@ static int appMain(int argc, char** argv) {
         const auto r = devslam::sim::runEpisode(world, *ini, nav_opts, eo);
         // Speed limits other than the shipped ones can leave targets near the robot that no
         // PTG reaches, where MRPT stops for good ("no way found"): said, before the result.
-        if (!r.ptg_domain_gaps.empty())
-            std::cerr << "devslam-nav: warning: with " << config << "'s PTGs, "
-                      << devslam::nav::describePtgDomainGaps(r.ptg_domain_gaps) << "\n";
+        if (!r.ptg_domain_gaps.empty()) {
+            std::cerr << "devslam-nav: warning: with " << config << "'s PTGs";
+            if (max_speed) std::cerr << " at --max-speed " << *max_speed << " m/s";
+            std::cerr << ", " << devslam::nav::describePtgDomainGaps(r.ptg_domain_gaps) << "\n";
+        }
         if (png.empty()) png = kDefaultDir + "/nav_" + world.name + ".png";
         // The result first: a picture that cannot be written must not lose it.
         std::printf(

@@ -794,6 +794,20 @@ TEST(IntegrationNav, AppsSmokeTest) {
     r = devslam::test::runApp("devslam-nav", "--map " + out + "/none.gridmap --method CHolonomicND");
     EXPECT_EQ(r.rc, 2);
     EXPECT_NE(r.out.find("--method does not go with --map"), std::string::npos) << r.out;
+    r = devslam::test::runApp("devslam-nav", "--map " + out + "/none.gridmap --max-speed 1");
+    EXPECT_EQ(r.rc, 2);
+    EXPECT_NE(r.out.find("--max-speed does not go with --map"), std::string::npos) << r.out;
+    // --max-speed: paper_fig6 at 1.6 m/s, as TheSpeedGuardKeepsAFastRobotOffTheWall runs it
+    // (the world's max_v and the INI's ROBOT_MAX_V): the goal, sooner than at 0.6 m/s.
+    r = nav("--max-speed 1.6 --png " + out + "/fast.png");
+    EXPECT_EQ(r.rc, 0) << r.out;
+    EXPECT_NE(r.out.find("result=success time=12."), std::string::npos) << r.out;
+    for (const char* bad : {"0", "5.5", "fast"}) {
+        r = nav(std::string("--max-speed ") + bad + " --png " + out + "/bad.png");
+        EXPECT_EQ(r.rc, 2) << bad;
+        EXPECT_NE(r.out.find("--max-speed"), std::string::npos) << bad << ": " << r.out;
+        EXPECT_EQ(r.out.find("result="), std::string::npos) << r.out;
+    }
     // A --navlog that cannot be a folder is named as the option (it was blamed on the INI's
     // [navigator] log_directory).
     std::ofstream(out + "/not_a_folder") << "x";

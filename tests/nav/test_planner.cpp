@@ -574,6 +574,27 @@ TEST(NavConfig, MrptSectionsAreReadStrictly) {
     EXPECT_NE(errorOf("CMultiObjectiveMotionOptimizerBase", "scor7_name", "extra"), "");
 }
 
+// --max-speed's INI: MRPT's top speed and the PTGs at it take the new one; PTG3, slower on
+// purpose (0.3 m/s, its tight turns behind the robot), keeps its own.
+TEST(NavConfig, SetTopSpeedRaisesThePtgsAtTheTopSpeedOnly) {
+    auto c = shippedNavIni();
+    ASSERT_EQ(c.read_double("CAbstractPTGBasedReactive", "robotMax_V_mps", 0), 0.6);
+    devslam::nav::setTopSpeed(c, 1.4);
+    EXPECT_EQ(c.read_double("CAbstractPTGBasedReactive", "robotMax_V_mps", 0), 1.4);
+    for (const char* key : {"PTG0_v_max_mps", "PTG1_v_max_mps", "PTG2_v_max_mps"})
+        EXPECT_EQ(c.read_double("CReactiveNavigationSystem", key, 0), 1.4) << key;
+    EXPECT_EQ(c.read_double("CReactiveNavigationSystem", "PTG3_v_max_mps", 0), 0.3);
+    EXPECT_EQ(navError(c), "");
+    for (const double v : {0.0, -1.0, 5.5, std::nan("")}) {
+        try {
+            devslam::nav::setTopSpeed(c, v);
+            ADD_FAILURE() << v;
+        } catch (const std::invalid_argument& e) {
+            EXPECT_STREQ(e.what(), "--max-speed: must be in (0, 5] m/s");
+        }
+    }
+}
+
 TEST(NavConfig, UnknownKeyIsReported) {
     // The message of reading one INI holding `section.key = value`, "" when it is accepted.
     const auto errorOf = [](const std::vector<std::tuple<std::string, std::string, double>>& kv) {

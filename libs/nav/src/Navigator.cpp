@@ -495,6 +495,20 @@ double refDistanceOf(const mrpt::config::CConfigFileBase& nav_ini) {
     return core::readDouble(nav_ini, "CAbstractPTGBasedReactive", "ref_distance", 0.0, true);
 }
 
+void setTopSpeed(mrpt::config::CConfigFileBase& nav_ini, double v, const std::string& option) {
+    if (!(v > 0 && v <= kMaxRobotSpeed))
+        throw std::invalid_argument(option + ": must be in (0, 5] m/s");
+    const double top = nav_ini.read_double("CAbstractPTGBasedReactive", "robotMax_V_mps", 0);
+    nav_ini.write("CAbstractPTGBasedReactive", "robotMax_V_mps", v);
+    const int n = nav_ini.read_int("CReactiveNavigationSystem", "PTG_COUNT", 0);
+    for (int i = 0; i < n; ++i) {
+        const std::string key = "PTG" + std::to_string(i) + "_v_max_mps";
+        const double ptg = nav_ini.read_double("CReactiveNavigationSystem", key, top);
+        if (std::abs(ptg - top) <= 1e-9 * std::max(1.0, top))
+            nav_ini.write("CReactiveNavigationSystem", key, v);
+    }
+}
+
 double waypointSpacing(double waypoint_spacing, double ref_distance) {
     return std::min(waypoint_spacing, 0.9 * ref_distance);
 }

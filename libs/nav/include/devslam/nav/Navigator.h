@@ -69,6 +69,14 @@ struct NavigatorOptions {
 /// [m] MRPT's TP-Space distance, [CAbstractPTGBasedReactive] ref_distance of a navigation
 /// INI (required): its PTGs see no farther.
 [[nodiscard]] double refDistanceOf(const mrpt::config::CConfigFileBase& nav_ini);
+/// Sets a navigation INI's top speed to `v` [m/s] (in (0, kMaxRobotSpeed]): MRPT's
+/// robotMax_V_mps, and each PTG's v_max_mps that was the old top speed. A PTG slower on purpose
+/// (the shipped PTG3, 0.3 m/s for its tight turns behind the robot) keeps its speed: raised, its
+/// turns widened and left targets near the robot in no PTG's domain. `--max-speed` of
+/// devslam-nav and devslam-nav-bench; throws std::invalid_argument naming `option` for a bad v.
+void setTopSpeed(mrpt::config::CConfigFileBase& nav_ini, double v,
+                 const std::string& option = "--max-speed");
+
 /// [m] the spacing of the waypoints the navigator gets: `waypoint_spacing`, at most
 /// 0.9 x `ref_distance` (a waypoint beyond the PTGs' reach cannot be aimed at).
 [[nodiscard]] double waypointSpacing(double waypoint_spacing, double ref_distance);
