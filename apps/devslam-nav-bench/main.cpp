@@ -244,9 +244,7 @@ std::optional<int> parseArgs(int argc, char** argv, Args& a) {
                 std::sort(a.categories.begin(), a.categories.end());
             } else if (s == "--max-speed") {
                 a.max_speed = devslam::core::parseNumber(next(), "--max-speed");
-                // (the world files' own bound)
-                if (!(*a.max_speed > 0 && *a.max_speed <= devslam::nav::kMaxRobotSpeed))
-                    throw std::invalid_argument("--max-speed: must be in (0, 5] m/s");
+                devslam::nav::requireTopSpeed(*a.max_speed);
             } else if (s == "--seed")
                 a.seed = static_cast<uint32_t>(
                     devslam::core::parseInteger(next(), "--seed", 0, UINT32_MAX));

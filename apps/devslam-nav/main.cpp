@@ -180,9 +180,7 @@ static int appMain(int argc, char** argv) {
                 verbose = true;
             else if (a == "--max-speed") {
                 max_speed = devslam::core::parseNumber(next(), "--max-speed");
-                // (the world files' own bound)
-                if (!(*max_speed > 0 && *max_speed <= devslam::nav::kMaxRobotSpeed))
-                    throw std::invalid_argument("--max-speed: must be in (0, 5] m/s");
+                devslam::nav::requireTopSpeed(*max_speed);
             } else if (a == "--map")
                 map = next();
             else if (a == "--from") {

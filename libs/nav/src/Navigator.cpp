@@ -495,9 +495,13 @@ double refDistanceOf(const mrpt::config::CConfigFileBase& nav_ini) {
     return core::readDouble(nav_ini, "CAbstractPTGBasedReactive", "ref_distance", 0.0, true);
 }
 
-void setTopSpeed(mrpt::config::CConfigFileBase& nav_ini, double v, const std::string& option) {
+void requireTopSpeed(double v, const std::string& option) {
     if (!(v > 0 && v <= kMaxRobotSpeed))
         throw std::invalid_argument(option + ": must be in (0, 5] m/s");
+}
+
+void setTopSpeed(mrpt::config::CConfigFileBase& nav_ini, double v, const std::string& option) {
+    requireTopSpeed(v, option);
     const double top = nav_ini.read_double("CAbstractPTGBasedReactive", "robotMax_V_mps", 0);
     nav_ini.write("CAbstractPTGBasedReactive", "robotMax_V_mps", v);
     const int n = nav_ini.read_int("CReactiveNavigationSystem", "PTG_COUNT", 0);

@@ -69,6 +69,10 @@ struct NavigatorOptions {
 /// [m] MRPT's TP-Space distance, [CAbstractPTGBasedReactive] ref_distance of a navigation
 /// INI (required): its PTGs see no farther.
 [[nodiscard]] double refDistanceOf(const mrpt::config::CConfigFileBase& nav_ini);
+/// Throws std::invalid_argument("OPTION: must be in (0, 5] m/s") unless 0 < v <=
+/// kMaxRobotSpeed (the world files' own bound): the check of `--max-speed` in both apps.
+void requireTopSpeed(double v, const std::string& option = "--max-speed");
+
 /// Sets a navigation INI's top speed to `v` [m/s] (in (0, kMaxRobotSpeed]): MRPT's
 /// robotMax_V_mps, and each PTG's v_max_mps that was the old top speed. A PTG slower on purpose
 /// (the shipped PTG3, 0.3 m/s for its tight turns behind the robot) keeps its speed: raised, its
