@@ -623,7 +623,10 @@ int appMain(int argc, char** argv) {
         }
         if (a.person_predict) nav_opts.person_predict_horizon = *a.person_predict;
         // what MRPT commands and predicts: the robot's new top speed
-        if (a.max_speed) devslam::nav::setTopSpeed(*ini, *a.max_speed);
+        if (a.max_speed) {
+            devslam::nav::setTopSpeed(*ini, *a.max_speed);
+            nav_opts.source += " with --max-speed " + devslam::core::shortestReal(*a.max_speed);
+        }
         const auto& cats = a.categories;
         const Episodes ep = runEpisodes(a, *ini, nav_opts, cats);
         std::ostringstream md;

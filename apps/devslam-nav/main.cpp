@@ -246,6 +246,7 @@ static int appMain(int argc, char** argv) {
         if (max_speed) {  // the robot's, and what MRPT commands and predicts
             world.robot.max_v = *max_speed;
             devslam::nav::setTopSpeed(*ini, *max_speed);
+            nav_opts.source += " with --max-speed " + devslam::core::shortestReal(*max_speed);
         }
         nav_opts.verbose = verbose;
         devslam::sim::EpisodeOptions eo;

@@ -358,6 +358,17 @@ TEST(Parse, NumberListsNameTheBadToken) {
             << t;
 }
 
+TEST(Parse, ClippedQuotesALongTextInPart) {
+    using devslam::core::clipped;
+    EXPECT_EQ(clipped("  short  "), "short");
+    EXPECT_EQ(clipped(std::string(80, 'a')), std::string(80, 'a'));
+    EXPECT_EQ(clipped(std::string(81, 'a')), std::string(80, 'a') + "... (81 characters)");
+    // Never half a character: "\u00e9" is two bytes, and the 80th byte is the first of one.
+    std::string accents = std::string(79, 'a');
+    for (int i = 0; i < 10; i++) accents += "\u00e9";
+    EXPECT_EQ(clipped(accents), std::string(79, 'a') + "... (99 characters)");
+}
+
 TEST(Parse, ExtensionsInAnyCase) {
     EXPECT_TRUE(endsWithNoCase("a/b.PNG", ".png"));
     EXPECT_TRUE(endsWithNoCase("b.png", ".png"));
@@ -501,6 +512,15 @@ TEST(Config, RepeatedKeysAndSectionsAreRefused) {
     EXPECT_EQ(error("[navigator\nk = 1\n"), path + " line 1: '[navigator' has no ']'");
     EXPECT_EQ(error("[a]\nk = 1\nspeed 3\n"),
               path + " line 3: 'speed 3' is neither a [section] nor a key = value");
+    // A junk line is quoted in part: a 500 kB one was quoted whole.
+    EXPECT_EQ(error("[a]\nk = 1\n" + std::string(100000, 'x') + "\n"),
+              path + " line 3: '" + std::string(80, 'x') +
+                  "... (100000 characters)' is neither a [section] nor a key = value");
+    // MRPT 2.5 knows @define alone and skips any other directive: "@include" read nothing.
+    EXPECT_EQ(error("@include other.ini\n[a]\nk = 1\n"),
+              path +
+                  " line 1: '@include' is no directive MRPT knows (only @define): the line "
+                  "would be ignored");
     EXPECT_EQ(error("[orb] junk\nk = 1\n"),
               path + " line 1: '[orb] junk': text after the section's ']'");
     EXPECT_EQ(error("[orb] # the features\n[b] // more\n[c] ; and\nk = 1\n"), "");

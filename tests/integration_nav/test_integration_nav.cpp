@@ -287,7 +287,10 @@ TEST(IntegrationNav, TheSpeedGuardKeepsAFastRobotOffTheWall) {
 // The other failure of MRPT 2.5's scoring: paths too tight to reach 1 m (a turning radius
 // under about 0.13 m; the shipped PTGs at 360 deg/s have 0.095 m). The reason says what to
 // change, where it said to lower both speed limits (a lower v makes the radius smaller still).
-TEST(IntegrationNav, PathsTooTightForMrptsScoringAreAnErrorThatSaysWhy) {
+// MRPT 2.5 scores a motion at a point up to 1 m along its path: a PTG with a path shorter than
+// that (a tight turn) stopped the run with "pt_in_range" when such a motion was first scored,
+// mid-run (at 0.2 m/s after 63 s of corridor_people_7). Refused when the navigator is made.
+TEST(IntegrationNav, PathsTooTightForMrptsScoringAreRefusedBeforeTheRun) {
     devslam::nav::registerNavClasses();
     std::string text = readFile(kIni);  // as written: @define lines included
     const std::string from = "@define ROBOT_MAX_W  90.0";
@@ -296,12 +299,41 @@ TEST(IntegrationNav, PathsTooTightForMrptsScoringAreAnErrorThatSaysWhy) {
     const mrpt::config::CConfigFileMemory ini(text);
     auto world = devslam::sim::loadWorld(kSrc + "/sim_worlds/paper_fig6.ini");
     world.robot.max_w = 2 * M_PI;  // the robot can turn as fast as the INI asks
-    const auto r = devslam::sim::runEpisode(world, ini, navOptions(ini), {});
-    ASSERT_EQ(r.outcome, devslam::sim::Outcome::Error) << r.reason;
-    EXPECT_NE(r.reason.find("pt_in_range"), std::string::npos) << r.reason;
-    EXPECT_NE(r.reason.find("turning radius v_max / w_max is under about 0.13 m"),
+    world.timeout = 1;
+    const auto refused = [&](const mrpt::config::CConfigFileBase& c) -> std::string {
+        auto o = navOptions(c);
+        o.source = "n.ini";
+        try {
+            (void)devslam::sim::runEpisode(world, c, o, {});
+        } catch (const std::invalid_argument& e) {
+            return e.what();
+        }
+        return "";
+    };
+    std::string why = refused(ini);
+    EXPECT_NE(why.find("n.ini: PTG0 (CPTG_DiffDrive_C, v_max 0.6 m/s, w_max 360 deg/s, "
+                       "[CReactiveNavigationSystem] PTG0_*): its tightest turn's path ends "),
               std::string::npos)
-        << r.reason;
+        << why;
+    EXPECT_NE(why.find(" m along, short of the 1 m along every path at which MRPT 2.5 scores a "
+                       "motion (it would stop the run with 'pt_in_range'): raise its v_max or "
+                       "lower its w_max"),
+              std::string::npos)
+        << why;
+    // The shipped INI at 0.2 m/s: its tightest arcs end 0.997 m along.
+    mrpt::config::CConfigFileMemory slow(readFile(kIni));
+    devslam::nav::setTopSpeed(slow, 0.2);
+    world.robot.max_w = M_PI / 2;
+    world.robot.max_v = 0.2;
+    why = refused(slow);
+    EXPECT_NE(
+        why.find("PTG0 (CPTG_DiffDrive_C, v_max 0.2 m/s, w_max 90 deg/s, "
+                 "[CReactiveNavigationSystem] PTG0_*): its tightest turn's path ends 0.997 m"),
+        std::string::npos)
+        << why;
+    devslam::nav::setTopSpeed(slow, 0.25);  // 1.25 m: runs
+    world.robot.max_v = 0.25;
+    EXPECT_EQ(refused(slow), "");
 }
 
 // A person stands on the route, 1.5 m ahead, where the map shows nothing: the replanned
@@ -418,6 +450,23 @@ TEST(IntegrationNav, ATimeoutStandingAtTheStartSaysWhy) {
                                 "ref_distance = 12.50 cm of free path to move)"),
               std::string::npos)
         << stood.reason;
+    // A score formula that gives every motion no usable score (here NaN): MRPT sends no
+    // command, and the reason says so (the run said only that the robot never left its start).
+    world.robot.start.x = 1;
+    mrpt::config::CConfigFileMemory inf(readFile(kIni));
+    const std::string sc = "CMultiObjMotionOpt_Scalarization", key = "scalar_score_formula";
+    std::string formula = inf.read_string(sc, key, "");
+    const std::string term = "0.1*hysteresis_score";
+    ASSERT_NE(formula.find(term), std::string::npos) << formula;
+    inf.write(sc, key, formula.replace(formula.find(term), term.size(), "(0/0)*hysteresis_score"));
+    const auto none = devslam::sim::runEpisode(world, inf, opts, {});
+    ASSERT_EQ(none.outcome, devslam::sim::Outcome::Timeout) << none.reason;
+    EXPECT_EQ(none.guard.commands, 0u);
+    EXPECT_NE(none.reason.find("; MRPT's navigator sent no motion command: none of its candidate "
+                               "motions scored as usable (its INI's score formulas?), and "
+                               "--verbose prints its reason at each step"),
+              std::string::npos)
+        << none.reason;
 }
 
 // The INI's [navigator] holonomic_method is the method used unless the episode names another

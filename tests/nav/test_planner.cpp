@@ -441,6 +441,17 @@ TEST(NavConfig, MrptSectionsAreReadStrictly) {
                   .find("x.ini [CAbstractPTGBasedReactive]: unknown key 'secure_distanse_start' "
                         "(MRPT's navigator knows: "),
               std::string::npos);
+    // exprtk's inf in a formula: every motion scored inf or NaN, and the robot never moved.
+    EXPECT_EQ(errorOf("CMultiObjMotionOpt_Scalarization", "scalar_score_formula",
+                      "ptg_priority_score*(0.3*target_distance + INF*hysteresis_score)"),
+              "x.ini [CMultiObjMotionOpt_Scalarization] scalar_score_formula: uses exprtk's "
+              "constant inf: a score of inf or NaN leaves MRPT no motion to choose");
+    EXPECT_EQ(errorOf("CMultiObjectiveMotionOptimizerBase", "score1_formula", "-inf"),
+              "x.ini [CMultiObjectiveMotionOptimizerBase] score1_formula: uses exprtk's constant "
+              "inf: a score of inf or NaN leaves MRPT no motion to choose");
+    EXPECT_EQ(errorOf("CMultiObjMotionOpt_Scalarization", "scalar_score_formula",
+                      "ptg_priority_score*(0.3*target_distance + 8.0*info_gain)"),
+              "");  // a name holding "inf" is no constant
     EXPECT_EQ(errorOf("CHolonomicND", "factorWeights", "1 0.5 x 0.4"),
               "x.ini [CHolonomicND] factorWeights: 'x' is not a number");
     // Values MRPT asserts on only while navigating: a speed limit of 0 or below gave an MRPT

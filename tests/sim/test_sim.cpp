@@ -335,6 +335,63 @@ TEST(World, ValuesBulletAndTheGridCannotHoldAreErrors) {
     EXPECT_EQ(errorOf(pillar + "[pedestrians]\np = scripted 1 0.2 0 4 5.6 6 5.6\n"), "");
 }
 
+TEST(World, ObstaclesTooCostlyToRasterizeOrSimulateAreErrors) {
+    const std::string head =
+        "[world]\nx_min=0\nx_max=5000\ny_min=0\ny_max=5000\n"
+        "grid_resolution=0.5\ntimeout=2\n[robot]\nstart_x=1\nstart_y=1\n"
+        "[goal]\nx=3\ny=1\n[obstacles]\n";
+    // Each of these 1000 m boxes covers 4e6 cells: 74 of them took the rasterizer 3e8 tests.
+    std::string big = head;
+    for (int i = 0; i < 80; i++) big += "b" + std::to_string(i) + " = box 2500 2500 1000 1000\n";
+    EXPECT_EQ(errorOf(big),
+              "w.ini [obstacles]: the 84 obstacles cover 3.21e+08 grid cells of 0.5 m (counted "
+              "per obstacle, at most 3e8): fewer or smaller obstacles, or a coarser [world] "
+              "grid_resolution");
+    // A clearance test per obstacle and physics step: 1e4 obstacles over a 1000 s run.
+    std::string many =
+        "[world]\nx_min=0\nx_max=100\ny_min=0\ny_max=100\ntimeout=1000\n"
+        "[robot]\nstart_x=1\nstart_y=1\n[goal]\nx=3\ny=1\n[obstacles]\n";
+    for (int i = 0; i < 10000; i++)
+        many += "o" + std::to_string(i) + " = cylinder " + std::to_string(10 + (i % 80)) + " " +
+                std::to_string(10 + (i / 80) % 80) + " 0.05\n";
+    EXPECT_EQ(errorOf(many),
+              "w.ini [obstacles]: 10004 obstacles over 1e+05 physics steps are 1e+09 clearance "
+              "tests (at most 3e8): fewer obstacles, or a shorter [world] timeout");
+    // (a 10 s run of them is accepted)
+    EXPECT_EQ(errorOf(std::regex_replace(many, std::regex("timeout=1000"), "timeout=10")), "");
+}
+
+TEST(World, RasterizeMarksTheCellsWithinHalfACellOfEachObstacle) {
+    auto w = room();
+    w.boundary_walls = false;
+    w.grid_resolution = 0.1;
+    Obstacle wall;
+    wall.name = "wall";
+    wall.cx = 5;
+    wall.cy = 1.5;
+    wall.sx = 6;  // long and thin: its bounding square would be 6 m across
+    wall.sy = 0.12;
+    wall.yaw = 0.3;
+    Obstacle pillar = wall;
+    pillar.name = "pillar";
+    pillar.shape = Obstacle::Shape::Cylinder;
+    pillar.cx = 8;
+    pillar.cy = 4.5;
+    pillar.radius = 0.33;
+    w.obstacles = {wall, pillar};
+    const auto g = rasterize(w);
+    int occupied = 0;
+    for (unsigned y = 0; y < g.getSizeY(); y++)
+        for (unsigned x = 0; x < g.getSizeX(); x++) {
+            const mrpt::math::TPoint2D c{g.idx2x(x), g.idx2y(y)};
+            const double d = std::min(distanceToObstacle(wall, c), distanceToObstacle(pillar, c));
+            const bool near = d <= 0.05 * 0.999;
+            EXPECT_EQ(g.getCell(x, y) < 0.5f, near) << x << " " << y << " d=" << d;
+            occupied += near;
+        }
+    EXPECT_GT(occupied, 80);  // the wall's 60 cells along it, and the pillar's
+}
+
 TEST(World, DistanceToRotatedBox) {
     Obstacle o;
     o.cx = 1;

@@ -67,10 +67,10 @@ void refuseMisreadLines(const std::string& text, const std::string& path) {
             // A key or section joined to a comment is lost without a word ("# see C:\docs\"
             // above a key); a comment joined to one (a shell command's '\') is harmless.
             if (in_comment && !isComment(line))
-                throw std::invalid_argument(
-                    path + " line " + std::to_string(n - 1) +
-                    ": a comment ends in '\\', so MRPT reads line " + std::to_string(n) + " ('" +
-                    trimmed(line) + "') as part of it");
+                throw std::invalid_argument(path + " line " + std::to_string(n - 1) +
+                                            ": a comment ends in '\\', so MRPT reads line " +
+                                            std::to_string(n) + " ('" + clipped(line) +
+                                            "') as part of it");
             continue;
         }
         in_comment = false;
@@ -80,31 +80,37 @@ void refuseMisreadLines(const std::string& text, const std::string& path) {
             in_comment = continued;
             continue;
         }
-        if (line[a] == '@') {  // a directive: only @define matters for names
+        if (line[a] == '@') {  // a directive: MRPT 2.5 knows @define alone
             std::istringstream d(line.substr(a));
             std::string word, name, value;
             d >> word >> name;
             std::getline(d, value);
-            if (word == "@define" && !name.empty()) defines[name] = trimmed(value);
+            // Any other it skips without a word: "@include other.ini" read nothing.
+            if (word != "@define")
+                throw std::invalid_argument(path + " line " + std::to_string(n) + ": '" +
+                                            clipped(word) +
+                                            "' is no directive MRPT knows (only @define): the "
+                                            "line would be ignored");
+            if (!name.empty()) defines[name] = trimmed(value);
             continue;
         }
         if (line[a] == '[') {
             const auto b = line.find(']', a);
             if (b == std::string::npos)  // MRPT would make a section of it and the next line
                 throw std::invalid_argument(path + " line " + std::to_string(n) + ": '" +
-                                            trimmed(line) + "' has no ']'");
+                                            clipped(line) + "' has no ']'");
             // After ']' only a comment: MRPT ignores the rest ("[orb] junk" is [orb]).
             const auto rest = line.find_first_not_of(" \t", b + 1);
             if (rest != std::string::npos && line[rest] != '#' && line[rest] != ';' &&
                 line.compare(rest, 2, "//") != 0)
                 throw std::invalid_argument(path + " line " + std::to_string(n) + ": '" +
-                                            trimmed(line) + "': text after the section's ']'");
+                                            clipped(line) + "': text after the section's ']'");
             section = trimmed(expand(line.substr(a + 1, b - a - 1)));  // MRPT trims the name
             // MRPT files the keys after "[]" with those before any section, and the checks
             // then named the key but not the line.
             if (section.empty())
                 throw std::invalid_argument(path + " line " + std::to_string(n) + ": '" +
-                                            trimmed(line) + "' names no section");
+                                            clipped(line) + "' names no section");
             const auto [at, fresh] = sections.emplace(lowercase(section), n);
             if (!fresh)
                 throw std::invalid_argument(
@@ -115,7 +121,7 @@ void refuseMisreadLines(const std::string& text, const std::string& path) {
         const auto eq = line.find('=', a);
         if (eq == std::string::npos || eq == a)  // MRPT ignores such a line without a word
             throw std::invalid_argument(path + " line " + std::to_string(n) + ": '" +
-                                        trimmed(line) +
+                                        clipped(line) +
                                         "' is neither a [section] nor a key = value");
         const std::string key = trimmed(expand(line.substr(a, eq - a)));
         if (key.empty() || key.find("${") != std::string::npos) continue;  // not resolvable here
@@ -339,14 +345,6 @@ std::vector<std::string> unknownKeys(const mrpt::config::CConfigFileBase& cfg,
         if (std::find(known.begin(), known.end(), k) == known.end()) unknown.push_back(k);
     return unknown;
 }
-
-namespace {
-std::string shortestReal(double v) {
-    char buf[32];
-    const auto r = std::to_chars(buf, buf + sizeof buf, v);  // shortest form that reads back
-    return std::string(buf, r.ptr);
-}
-}  // namespace
 
 void writeKey(mrpt::config::CConfigFileBase& cfg, const std::string& section,
               const std::string& key, double value) {

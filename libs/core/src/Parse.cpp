@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
+#include <charconv>
 #include <cmath>
 #include <cstdlib>
 #include <set>
@@ -17,6 +18,20 @@ std::string trimmed(const std::string& text) {
     return b < e ? std::string(b, e) : std::string();
 }
 
+std::string clipped(const std::string& text, std::size_t max) {
+    const std::string t = trimmed(text);
+    if (t.size() <= max) return t;
+    std::size_t cut = max;
+    while (cut > 0 && (static_cast<unsigned char>(t[cut]) & 0xC0) == 0x80) --cut;
+    return t.substr(0, cut) + "... (" + std::to_string(t.size()) + " characters)";
+}
+
+std::string shortestReal(double v) {
+    char buf[32];
+    const auto r = std::to_chars(buf, buf + sizeof buf, v);
+    return std::string(buf, r.ptr);
+}
+
 std::string lowercase(std::string text) {
     for (char& c : text) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
     return text;
@@ -26,7 +41,7 @@ namespace {
 
 [[noreturn]] void fail(const std::string& what, const std::string& expected,
                        const std::string& text) {
-    throw std::invalid_argument(what + ": expected " + expected + ", got '" + text + "'");
+    throw std::invalid_argument(what + ": expected " + expected + ", got '" + clipped(text) + "'");
 }
 
 /// strtod also reads C's hexadecimal numbers ("0x10" is 16, "0x1p-5"), which no reader of
@@ -98,7 +113,7 @@ std::vector<double> parseNumberList(const std::string& text, const std::string& 
         (open == 1 &&
          (text.find('[') > text.find(']') || text.find_first_not_of(" \t") != text.find('[') ||
           text.find_last_not_of(" \t") != text.find(']'))))
-        throw std::invalid_argument(what + ": '" + text +
+        throw std::invalid_argument(what + ": '" + clipped(text) +
                                     "' has unmatched brackets (write [a b c] or a b c)");
     std::string t = text;
     for (char& c : t)
@@ -113,7 +128,7 @@ std::vector<double> parseNumberList(const std::string& text, const std::string& 
             char* end = nullptr;
             std::strtod(tok.c_str(), &end);
             const bool whole = !hexadecimal(tok) && end == tok.c_str() + tok.size();
-            throw std::invalid_argument(what + ": '" + tok + "' is not a " +
+            throw std::invalid_argument(what + ": '" + clipped(tok) + "' is not a " +
                                         (whole ? "finite number" : "number"));
         }
         out.push_back(v);

@@ -184,6 +184,26 @@ void checkMrptSections(const mrpt::config::CConfigFileBase& c, const std::string
                                        "no score is named '" + w + "' (scores: " + known + ")");
                 });
     }
+    // exprtk's constant inf in a formula scored every motion inf or NaN: MRPT found "no way"
+    // at each step, and the run said only that the robot never left its start (nan and 1e400
+    // are refused where a value is a number; a formula is text).
+    core::namingSource(source, [&] {
+        static const std::regex inf("(^|[^a-z0-9_])inf(inity)?($|[^a-z0-9_])", std::regex::icase);
+        static const std::regex formula("score[0-9]+_formula|movement_assert[0-9]+",
+                                        std::regex::icase);
+        const auto check = [&](const std::string& sec, const std::string& key) {
+            core::requireValue(!std::regex_search(c.read_string(sec, key, ""), inf), sec, key,
+                               "uses exprtk's constant inf: a score of inf or NaN leaves MRPT "
+                               "no motion to choose");
+        };
+        const std::string sc = "CMultiObjMotionOpt_Scalarization";
+        if (c.keyExists(sc, "scalar_score_formula")) check(sc, "scalar_score_formula");
+        const std::string mo = "CMultiObjectiveMotionOptimizerBase";
+        std::vector<std::string> keys;
+        c.getAllKeys(mo, keys);
+        for (const auto& k : keys)
+            if (std::regex_match(k, formula)) check(mo, k);
+    });
     // Values MRPT asserts on only while navigating (a speed limit of 0 or below printed an
     // MRPT stack trace at every step, and the robot still got there) or with a message that
     // names no file and stops mid-sentence (factorWeights of the wrong length).

@@ -419,6 +419,33 @@ Navigator::Navigator(mrpt::nav::CRobot2NavInterface& robot,
         throw std::invalid_argument(opts_.source + ": MRPT's navigator refuses these settings: " +
                                     core::innermostMessage(e.what()));
     }
+    requirePathsOfOneMetre(cfg);
+}
+
+void Navigator::requirePathsOfOneMetre(const mrpt::config::CConfigFileBase& cfg) const {
+    // MRPT 2.5 scores a candidate motion at the point of its path a normalised distance (up to
+    // 1) along, which it takes for metres: on a path that ends sooner, as a tight turn's does
+    // (v_max / w_max small), that step failed ("Assert condition failed: pt_in_range"), in the
+    // middle of a run, the first time such a motion was scored (the shipped PTGs at --max-speed
+    // 0.2, whose tightest arcs end 0.997 m along). Every path's length is known once the PTGs
+    // are built. (The 0.1 % spares a path MRPT cut at exactly 1 m, as PTG3's, by round-off.)
+    for (std::size_t p = 0; p < nav_->getPTG_count(); p++) {
+        const auto* ptg = nav_->getPTG(p);
+        double shortest = std::numeric_limits<double>::infinity();
+        for (uint16_t k = 0; k < ptg->getPathCount(); k++)
+            shortest = std::min(shortest, ptg->getPathDist(k, ptg->getPathStepCount(k) - 1));
+        if (shortest >= 0.999) continue;
+        const std::string s = "CReactiveNavigationSystem", i = "PTG" + std::to_string(p);
+        std::ostringstream m;
+        m.precision(3);
+        m << opts_.source << ": " << i << " (" << cfg.read_string(s, i + "_Type", "?") << ", v_max "
+          << cfg.read_double(s, i + "_v_max_mps", 0) << " m/s, w_max "
+          << cfg.read_double(s, i + "_w_max_dps", 0) << " deg/s, [" << s << "] " << i
+          << "_*): its tightest turn's path ends " << shortest
+          << " m along, short of the 1 m along every path at which MRPT 2.5 scores a motion "
+             "(it would stop the run with 'pt_in_range'): raise its v_max or lower its w_max";
+        throw std::invalid_argument(m.str());
+    }
 }
 
 Navigator::~Navigator() = default;
@@ -630,10 +657,9 @@ NavState Navigator::step(double t) {
         // the shipped PTGs at robotMax_W_degps 360.
         if (msg.find("pt_in_range") != std::string::npos)
             last_error_ +=
-                " (a PTG's paths end before the 1 m along them MRPT 2.5 asks for "
-                "when their turning radius v_max / w_max is under about 0.13 m, as "
-                "the shipped PTGs' at robotMax_W_degps 360 deg/s: lower that PTG's "
-                "w_max or raise its v_max)";
+                " (a PTG's path ends before the 1 m along it at which MRPT 2.5 scores a "
+                "motion, as a tight turn's does: lower that PTG's w_max or raise its "
+                "v_max)";
         active_ = false;
         return NavState::Error;
     }

@@ -47,9 +47,11 @@ class SimulatedClock {
 /// (`secure_distance_start` x `ref_distance` of free path: 12.5 cm with the shipped INI,
 /// which stopped a robot whose edge started 1-6 cm from a wall, docs/sim.md). The world
 /// check cannot refuse such a start, as it does not see the navigation INI; before this the
-/// run only said "not at the goal".
+/// run only said "not at the goal". `sent_none`: MRPT sent no motion command in the whole
+/// run (known with the speed guard on, which counts them), as when a score formula gave every
+/// motion inf or NaN.
 std::string standingReason(double farthest, const mrpt::math::TPoint2D& start, double radius,
-                           const std::vector<Obstacle>& statics, double secure) {
+                           const std::vector<Obstacle>& statics, double secure, bool sent_none) {
     if (farthest > 0.02) return "";
     std::ostringstream why;
     why.precision(2);
@@ -61,6 +63,10 @@ std::string standingReason(double farthest, const mrpt::math::TPoint2D& start, d
             << "', less than the navigator's secure distance (secure_distance_start x "
                "ref_distance = "
             << secure * 100 << " cm of free path to move): start it farther away";
+    else if (sent_none)
+        why << "; MRPT's navigator sent no motion command: none of its candidate motions "
+               "scored as usable (its INI's score formulas?), and --verbose prints its reason "
+               "at each step";
     return why.str();
 }
 }  // namespace
@@ -223,7 +229,8 @@ EpisodeResult runEpisode(const WorldSpec& world, const mrpt::config::CConfigFile
             res.outcome = Outcome::Timeout;
             std::ostringstream why;  // "60 s", not to_string's "60.000000 s"
             why << "not at the goal after " << world.timeout << " s"
-                << standingReason(farthest, {start.x, start.y}, r, statics, secure);
+                << standingReason(farthest, {start.x, start.y}, r, statics, secure,
+                                  nav_opts.guard.enabled && navigator.guardStats().commands == 0);
             res.reason = why.str();
             break;
         }

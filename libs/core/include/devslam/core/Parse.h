@@ -49,6 +49,14 @@ namespace devslam::core {
 /// `text` without the blanks (std::isspace) at its ends.
 [[nodiscard]] std::string trimmed(const std::string& text);
 
+/// `text` trimmed, and when longer than `max` characters its first ones, cut at a whole UTF-8
+/// character, with "... (N characters)": for quoting a line or a value in a message (a 500 kB
+/// junk line of a world file was quoted whole).
+[[nodiscard]] std::string clipped(const std::string& text, std::size_t max = 80);
+
+/// The shortest text that reads back as `v` ("0.2", not "0.200000"), for writing a number.
+[[nodiscard]] std::string shortestReal(double v);
+
 /// `text` in lower case (ASCII letters), for names read in any letter case.
 [[nodiscard]] std::string lowercase(std::string text);
 

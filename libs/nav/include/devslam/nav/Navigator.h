@@ -147,6 +147,8 @@ class Navigator {
     void setPath(const GridPath& p);
     /// Sends waypoints_ from index `first` on (the last one at least) to MRPT.
     void sendWaypoints(std::size_t first);
+    /// Throws std::invalid_argument naming the PTG when one of its paths ends under 1 m along.
+    void requirePathsOfOneMetre(const mrpt::config::CConfigFileBase& cfg) const;
     mrpt::nav::CRobot2NavInterface& robot_;
     NavigatorOptions opts_;
     std::unique_ptr<GuardedRobot> guarded_;  ///< what nav_ drives: robot_ through the guard
