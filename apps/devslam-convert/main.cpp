@@ -130,6 +130,10 @@ std::variant<Args, int> parseArgs(int argc, char** argv) {
                   << kUsage;
         return 2;
     }
+    // (an empty OUTPUT wrote its TUM folder into /, a script's unset variable)
+    for (const auto& [name, p] : {std::pair{"INPUT", pos[0]}, {"OUTPUT", pos[1]}})
+        if (p.empty())
+            throw std::invalid_argument(std::string(name) + " is empty: name a file or folder");
     args.input = pos[0];
     args.output = pos[1];
     return args;

@@ -74,11 +74,12 @@ static int appMain(int argc, char** argv) {
                 if (u != "s" && u != "f")
                     throw std::invalid_argument("--delta-unit: 's' or 'f', got '" + u + "'");
                 ro.delta_in_frames = (u == "f");
-            } else if (a == "--json")
-                json = value();
-            else if (a == "--plot")
-                plot = value();
-            else if (a == "--title")
+            } else if (a == "--json" || a == "--plot") {
+                // (an empty one, a script's unset variable, wrote nothing and said nothing)
+                (a == "--json" ? json : plot) = value();
+                if ((a == "--json" ? json : plot).empty())
+                    throw std::invalid_argument(a + ": the file name is empty");
+            } else if (a == "--title")
                 title = value();
             else if (a == "--no-rpe")
                 rpe = false;

@@ -93,8 +93,9 @@ int cutTexture(const std::vector<std::string>& a) {
     if (core::sameFile(a[1], a[3]))
         throw std::invalid_argument("--cut-texture OUT '" + a[3] + "' is the IMAGE '" + a[1] +
                                     "': writing it would destroy the photo; name another");
-    const cv::Mat img = cv::imread(a[1], cv::IMREAD_COLOR);
-    if (img.empty()) throw std::runtime_error("cannot read '" + a[1] + "'");
+    std::string why;
+    const cv::Mat img = core::readImage(a[1], cv::IMREAD_COLOR, why);
+    if (img.empty()) throw std::runtime_error("cannot read '" + a[1] + "'" + why);
     const auto v = core::parseNumberList(a[2], "--cut-texture box", 4);
     // Pixels: 180.5 was cut at 180 without a word, and 1e10 overflowed the int.
     for (double x : v)

@@ -1089,6 +1089,11 @@ TEST(GzFile, InnermostMessageSkipsEmptyMessages) {
     EXPECT_EQ(innermostMessage(nested + "Message:"), "inner text");
     EXPECT_EQ(innermostMessage(nested + "Message:   \nmore"), "inner text");
     EXPECT_EQ(innermostMessage("Message:"), "Message:");
+    // An OpenCV error MRPT wraps with its banner alone (a zero-byte external image).
+    EXPECT_EQ(innermostMessage("==== MRPT exception ====\nOpenCV(4.6.0) ./modules/imgcodecs/"
+                               "src/loadsave.cpp:816: error: (-215:Assertion failed) "
+                               "!buf.empty() in function 'imdecode_'\nCall stack backtrace:\n"),
+              "OpenCV: (-215:Assertion failed) !buf.empty() in function 'imdecode_'");
 }
 
 // A gzip file written through MRPT's stream interface: read back whole, and a full disk is

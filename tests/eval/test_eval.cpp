@@ -461,6 +461,9 @@ TEST(Report, RefusesOverflowNonFiniteJsonAndOutputsThatAreInputs) {
              {g + " " + e + " --json " + e, "--json '" + e + "' is the input '" + e + "'"},
              {g + " " + e + " --json " + g, "--json '" + g + "' is the input '" + g + "'"},
              {g + " " + e + " --json --plot " + d.str("p.png"), "--json needs a value"},
+             // (an empty name, a script's unset variable, wrote nothing and said nothing)
+             {g + " " + e + " --plot '' --json " + d.str("j.json"),
+              "--plot: the file name is empty"},
              {g + " " + e + " --json " + d.str("p.png") + " --plot " + d.str("x/../p.png"),
               "--json and --plot are the same file '" + d.str("x/../p.png") +
                   "': the plot would replace the figures; name two"}}) {

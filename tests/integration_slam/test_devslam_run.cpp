@@ -594,6 +594,20 @@ TEST(DevslamConvert, MaxFramesMustBeAtLeastOne) {
     EXPECT_FALSE(fs::exists(dir / "x.rawlog"));
 }
 
+// An empty OUTPUT (a script's unset variable) wrote its TUM folder into / ("" + "/rgb").
+TEST(DevslamConvert, AnEmptyNameIsRefused) {
+    const std::string data = std::string(DEVSLAM_SOURCE_DIR) + "/data/tum/fr1_xyz_first37";
+    const auto out = devslam::test::runApp("devslam-convert", data + " ''");
+    EXPECT_EQ(out.rc, 1) << out.out;
+    EXPECT_NE(out.out.find("devslam-convert: OUTPUT is empty: name a file or folder"),
+              std::string::npos)
+        << out.out;
+    const auto in = devslam::test::runApp("devslam-convert", "'' x.rawlog");
+    EXPECT_EQ(in.rc, 1) << in.out;
+    EXPECT_NE(in.out.find("INPUT is empty"), std::string::npos) << in.out;
+    EXPECT_THROW(devslam::io::TumWriter("", "x"), std::invalid_argument);
+}
+
 // --allow-damaged with no frame that decodes: an empty output is a failure, not rc 0.
 TEST(DevslamConvert, NoFrameConvertedIsAFailure) {
     const devslam::test::TempDir d("devslam_");

@@ -59,7 +59,12 @@ void copyTumSubset(const std::string& dst, std::size_t n) {
 }
 
 void writeText(const std::string& path, const std::string& text) {
-    std::ofstream(path) << text;
+    std::ofstream(path, std::ios::binary) << text;
+}
+
+std::string readBytes(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(in), {});
 }
 
 // Runs f, expects an E (std::runtime_error unless given) whose message matches `pattern`
@@ -368,7 +373,18 @@ TEST(TrajectoryIO, RoundTripAndErrors) {
                 "bad\\.txt line 3: expected .*got 7");
     writeText(d.str("bad.txt"), "1 0 0 0 0 0 0 1\n1 0 0 0 0 0 0 1\n");
     expectError([&] { (void)io::readTumTrajectory(d.str("bad.txt")); },
-                "line 2: duplicate timestamp");
+                "line 2: duplicate timestamp 1 \\(previous pose at line 1\\)");
+    // A stamp out of range is named on its own line (1e300 was read, and the next line was
+    // blamed for coming before it).
+    writeText(d.str("bad.txt"), "1 0 0 0 0 0 0 1\n# x\n1e300 0 0 0 0 0 0 1\n3 0 0 0 0 0 0 1\n");
+    expectError([&] { (void)io::readTumTrajectory(d.str("bad.txt")); },
+                "line 3: timestamp 1e300 is not in \\[0, 1e11\\] s");
+    writeText(d.str("bad.txt"), "-5 0 0 0 0 0 0 1\n");
+    expectError([&] { (void)io::readTumTrajectory(d.str("bad.txt")); },
+                "line 1: timestamp -5 is not in \\[0, 1e11\\] s");
+    writeText(d.str("bad.txt"), "5 0 0 0 0 0 0 1\n\n4 0 0 0 0 0 0 1\n");
+    expectError([&] { (void)io::readTumTrajectory(d.str("bad.txt")); },
+                "line 3: unsorted timestamp 4 \\(previous pose at line 1\\)");
     writeText(d.str("bad.txt"), "1 0 0 0 0 0 0 3\n");
     expectError([&] { (void)io::readTumTrajectory(d.str("bad.txt")); }, "line 1: quaternion norm");
     // The TUM tools' float() reads no hexadecimal (std::stod did: 0x1p-3 was 0.125).
@@ -511,6 +527,35 @@ TEST(Rawlog, TruncatedFileReportsWhatWasRead) {
                 << e.what();
         }
     }
+    // Something after the whole gzip stream: zlib ends there without a word, so a second
+    // rawlog appended with a damaged first byte (its frames), or junk, was lost silently. The
+    // frames before it are whole (their member's checksum held).
+    const auto whole = readBytes(path);
+    for (const std::string& tail :
+         {std::string(1000, '\0'), std::string("junk"), "\x1e" + whole.substr(1)}) {
+        const std::string joined = d.str("joined.rawlog");
+        writeText(joined, whole + tail);
+        try {
+            (void)io::openRgbd(joined);
+            ADD_FAILURE() << "a rawlog with " << tail.size() << " bytes after it opened";
+        } catch (const io::DamagedInput& e) {
+            EXPECT_EQ(e.intact(), 6u) << e.what();
+            EXPECT_EQ(std::string(e.what()),
+                      joined + ": " + std::to_string(tail.size()) +
+                          " bytes after the end of its gzip data at byte " +
+                          std::to_string(whole.size()) +
+                          " are no gzip stream (another file appended, or damage) after 6 RGB-D "
+                          "observations");
+        }
+        io::ReaderOptions o;
+        o.allow_damaged = true;
+        EXPECT_EQ(io::openRgbd(joined, o)->size(), 6u);
+    }
+    {  // a second whole member is read on (two rawlogs joined with cat): its frames come after
+        const std::string joined = d.str("joined.rawlog");
+        writeText(joined, whole + whole);
+        expectError([&] { (void)io::openRgbd(joined); }, "observation 6: unsorted timestamp");
+    }
     // Cut the file in the middle of the 4th observation (observations are similar in size).
     const auto size = fs::file_size(path);
     fs::resize_file(path, size * 7 / 12);
@@ -595,13 +640,24 @@ TEST(Rawlog, LaterObservationsNameTheFileAndObservation) {
         for (std::size_t i = 0; i < 3; ++i) w.write(tum.read(i));
         w.close();
     }
-    // A file that is there but does not decode is found when its frame is read.
+    // A file that is there but does not decode is found when its frame is read, and named: a
+    // zero-byte one gave MRPT's banner alone ("==== MRPT exception ====").
+    writeText(d.str("ext_Images/frame_1_rgb.png"), "");
+    {
+        io::RawlogReader r(path);
+        EXPECT_TRUE(r.next());
+        expectError([&] { (void)r.next(); },
+                    R"(ext\.rawlog observation 1: external colour image '.*frame_1_rgb\.png' )"
+                    R"(does not decode \(OpenCV: .*!buf\.empty\(\).*\)$)");
+    }
     writeText(d.str("ext_Images/frame_1_rgb.png"), "not a png");
     {
         io::RawlogReader r(path);
         ASSERT_EQ(r.size(), 3u);
         EXPECT_TRUE(r.next());
-        expectError([&] { (void)r.next(); }, R"(ext\.rawlog observation 1: )");
+        expectError([&] { (void)r.next(); },
+                    R"(ext\.rawlog observation 1: external colour image '.*frame_1_rgb\.png' )"
+                    R"(does not decode)");
         // The reader goes on after the bad observation, and counts it.
         const auto third = r.next();
         ASSERT_TRUE(third);

@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <stdexcept>
@@ -92,6 +94,53 @@ void writeGzFileWhole(const std::string& path, const std::string& kind,
     throw std::runtime_error("cannot write " + kind + " '" + path + "': " + why);
 }
 
+// (Written out with zlib's inflate: no zlib call tells where gzread's last member ended.)
+std::string gzipTrailingData(const std::string& path) {
+    std::FILE* f = std::fopen(path.c_str(), "rb");
+    if (f == nullptr) return "";
+    z_stream s{};
+    if (inflateInit2(&s, 15 + 16) != Z_OK) {  // gzip only
+        std::fclose(f);
+        return "";
+    }
+    std::vector<unsigned char> in(1 << 16), out(1 << 16);
+    std::uint64_t read = 0;  // bytes of the file read into `in` so far
+    std::string found;
+    const auto topUp = [&] {  // keeps what is left of `in` and reads more after it
+        std::memmove(in.data(), s.next_in, s.avail_in);
+        const std::size_t n = std::fread(in.data() + s.avail_in, 1, in.size() - s.avail_in, f);
+        read += n;
+        s.next_in = in.data();
+        s.avail_in += static_cast<uInt>(n);
+        return n > 0;
+    };
+    s.next_in = in.data();
+    for (;;) {
+        if (s.avail_in == 0 && !topUp()) break;  // cut short: gzread says so
+        s.next_out = out.data();
+        s.avail_out = static_cast<uInt>(out.size());
+        const int rc = inflate(&s, Z_NO_FLUSH);
+        if (rc == Z_STREAM_END) {
+            const std::uint64_t end = read - s.avail_in;  // where this member ends
+            if (s.avail_in < 2) topUp();
+            if (s.avail_in == 0) break;  // the file's end
+            if (s.avail_in >= 2 && s.next_in[0] == 0x1f && s.next_in[1] == 0x8b) {
+                inflateReset(&s);
+                continue;
+            }
+            std::fseek(f, 0, SEEK_END);
+            const auto size = static_cast<std::uint64_t>(std::ftell(f));
+            found = std::to_string(size - end) + " bytes after the end of its gzip data at byte " +
+                    std::to_string(end) + " are no gzip stream (another file appended, or damage)";
+            break;
+        }
+        if (rc != Z_OK && rc != Z_BUF_ERROR) break;  // damage: gzread says what
+    }
+    inflateEnd(&s);
+    std::fclose(f);
+    return found;
+}
+
 std::string gzipDamage(const std::string& path) {
     gzFile f = gzopen(path.c_str(), "rb");
     if (f == nullptr) return "cannot open";
@@ -111,6 +160,17 @@ std::string gzipDamage(const std::string& path) {
 
 std::string innermostMessage(const std::string& what) {
     std::string best = what.substr(0, what.find('\n'));
+    // An exception MRPT wraps without a "Message:" (OpenCV's, from inside CImage) has the
+    // banner as its first line and the text on the next: the banner alone said nothing.
+    if (best == "==== MRPT exception ====") {
+        const std::size_t b = what.find('\n');
+        if (b != std::string::npos) best = what.substr(b + 1, what.find('\n', b + 1) - b - 1);
+    }
+    // OpenCV's "OpenCV(4.6.0) ./modules/x.cpp:816: error: (-215:Assertion failed) ...": its
+    // source line is of no use to the reader.
+    if (best.rfind("OpenCV(", 0) == 0)
+        if (const std::size_t e = best.find(": error: "); e != std::string::npos)
+            best = "OpenCV: " + best.substr(e + 9);
     for (std::size_t p = what.find("Message:"); p != std::string::npos;
          p = what.find("Message:", p + 1)) {
         const std::size_t b = what.find_first_not_of(' ', p + 8);

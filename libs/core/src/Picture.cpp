@@ -20,4 +20,17 @@ void writePngWhole(const std::string& path, const cv::Mat& image) {
     writeFileWhole(path, std::string(png.begin(), png.end()));
 }
 
+cv::Mat readImage(const std::string& path, int flags, std::string& why) {
+    why.clear();
+    try {
+        return cv::imread(path, flags);
+    } catch (const cv::Exception& e) {
+        std::string reason = e.err;  // the failed check, without OpenCV's file and line
+        while (!reason.empty() && (reason.back() == '\n' || reason.back() == ' '))
+            reason.pop_back();
+        why = " (OpenCV: " + reason + ")";
+        return {};
+    }
+}
+
 }  // namespace devslam::core

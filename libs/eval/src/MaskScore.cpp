@@ -1,5 +1,7 @@
 #include <devslam/eval/MaskScore.h>
 
+#include <devslam/core/Picture.h>
+
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -126,10 +128,11 @@ PersonTruth::FrameTruth PersonTruth::frame(double timestamp, cv::Size expected) 
         throw MissingTruth(folder_ + "/persons.txt: no entry for frame " + stamp);
     const std::string label_path = folder_ + "/labels/" + stamp + ".png";
     FrameTruth f;
-    f.labels = cv::imread(label_path, cv::IMREAD_UNCHANGED);
+    std::string why;
+    f.labels = core::readImage(label_path, cv::IMREAD_UNCHANGED, why);
     if (f.labels.empty() || f.labels.type() != CV_8UC1)
         throw MissingTruth("cannot read person labels '" + label_path +
-                                 "' (expected an 8-bit one-channel PNG)");
+                           "' (expected an 8-bit one-channel PNG)" + why);
     if (!expected.empty() && f.labels.size() != expected)
         throw std::runtime_error(
             "person labels '" + label_path + "' are " + std::to_string(f.labels.cols) + "x" +

@@ -222,13 +222,24 @@ std::string printable(std::string m) {
 }  // namespace
 
 core::Frame frameFromObservation(const CObservation3DRangeScan& o, const std::string& what) {
-    if (!o.hasIntensityImage || o.intensityImage.isEmpty())
-        throw std::runtime_error(what + ": observation has no colour image");
+    cv::Mat img;  // an external one is decoded here, when first used
+    try {
+        if (o.hasIntensityImage && !o.intensityImage.isEmpty()) img = o.intensityImage.asCvMatRef();
+    } catch (const std::exception& e) {
+        // (MRPT's text was its banner alone for a zero-byte file, naming none)
+        const auto& c = o.intensityImage;
+        throw std::runtime_error(
+            what + ": " +
+            (c.isExternallyStored()
+                 ? "external colour image '" + c.getExternalStorageFileAbsolutePath() + "'"
+                 : std::string("colour image")) +
+            " does not decode (" + core::innermostMessage(e.what()) + ")");
+    }
+    if (img.empty()) throw std::runtime_error(what + ": observation has no colour image");
     if (!o.hasRangeImage || o.rangeImage.rows() == 0)
         throw std::runtime_error(what + ": observation has no depth image");
     core::Frame f;
     f.timestamp = mrpt::Clock::toDouble(o.timestamp);
-    const cv::Mat& img = o.intensityImage.asCvMatRef();
     if (img.channels() == 3)
         f.bgr = img.clone();  // CImage colour is BGR
     else if (img.channels() == 1)
@@ -460,6 +471,9 @@ RawlogReader::RawlogReader(std::string path, ReaderOptions opts)
         }
         if (const std::string gz = core::gzipDamage(path_); !gz.empty())
             throw std::runtime_error("truncated or corrupt gzip stream (" + gz + ")");
+        // (the frames before are whole: their gzip member's checksum held)
+        if (const std::string after = core::gzipTrailingData(path_); !after.empty())
+            throw std::runtime_error(after);
     } catch (const MixedSensors&) {
         throw;
     } catch (const std::exception& e) {

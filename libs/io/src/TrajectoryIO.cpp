@@ -16,6 +16,7 @@ namespace devslam::io {
 
 core::Trajectory readTumTrajectory(const std::string& path) {
     core::Trajectory traj;
+    int previous = 0;  // the line of traj.back()
     detail::forEachDataLine(path, [&](int line, const std::vector<std::string>& tok) {
         if (tok.size() != 8)
             throw std::runtime_error(
@@ -31,11 +32,17 @@ core::Trajectory readTumTrajectory(const std::string& path) {
                 throw std::runtime_error(detail::lineError(
                     path, line,
                     std::string(kNames[k]) + " " + tok[k] + " is beyond +-1e6 m (not metres?)"));
+        // As rgb.txt's: a last pose at 1e300 s was read, and the RPE paired the poses before
+        // it across the gap (30 pairs instead of 5 on the shipped frames).
+        if (v[0] < 0 || v[0] > 1e11)
+            throw std::runtime_error(
+                detail::lineError(path, line, "timestamp " + tok[0] + " is not in [0, 1e11] s"));
         if (!traj.empty() && v[0] <= traj.back().t)
-            throw std::runtime_error(detail::lineError(
-                path, line,
-                v[0] == traj.back().t ? "duplicate timestamp " + tok[0]
-                                      : "timestamp " + tok[0] + " is earlier than the previous"));
+            throw std::runtime_error(
+                detail::lineError(path, line,
+                                  detail::stampNotAfter(v[0], traj.back().t, tok[0]) +
+                                      " (previous pose at line " + std::to_string(previous) + ")"));
+        previous = line;
         try {
             traj.push_back({v[0], core::fromTum(v[1], v[2], v[3], v[4], v[5], v[6], v[7])});
         } catch (const std::invalid_argument& e) {

@@ -5,6 +5,7 @@
 
 #include <devslam/core/Association.h>
 #include <devslam/core/Config.h>
+#include <devslam/core/Picture.h>
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -85,16 +86,17 @@ void loadTumImages(const std::string& rgb_path, const std::string& depth_path, d
                    core::Frame& f) {
     requireFileInFolder(rgb_path, "colour image");
     requireFileInFolder(depth_path, "depth image");
-    cv::Mat rgb = cv::imread(rgb_path, cv::IMREAD_UNCHANGED);
-    if (rgb.empty()) throw std::runtime_error(rgb_path + ": cannot decode colour image");
+    std::string why;
+    cv::Mat rgb = core::readImage(rgb_path, cv::IMREAD_UNCHANGED, why);
+    if (rgb.empty()) throw std::runtime_error(rgb_path + ": cannot decode colour image" + why);
     if (rgb.depth() != CV_8U)
         throw std::runtime_error(rgb_path + ": colour image must be 8 bits per channel");
     if (rgb.channels() == 1)
         cv::cvtColor(rgb, rgb, cv::COLOR_GRAY2BGR);
     else if (rgb.channels() == 4)
         cv::cvtColor(rgb, rgb, cv::COLOR_BGRA2BGR);
-    cv::Mat raw = cv::imread(depth_path, cv::IMREAD_UNCHANGED);
-    if (raw.empty()) throw std::runtime_error(depth_path + ": cannot decode depth image");
+    cv::Mat raw = core::readImage(depth_path, cv::IMREAD_UNCHANGED, why);
+    if (raw.empty()) throw std::runtime_error(depth_path + ": cannot decode depth image" + why);
     if (raw.type() != CV_16UC1)
         throw std::runtime_error(depth_path +
                                  ": depth must be a 16-bit single-channel PNG (TUM format)");

@@ -34,6 +34,8 @@ TumWriter::TumWriter(std::string folder, const std::string& description, bool fr
     : folder_(std::move(folder)),
       rgb_list_(nullptr, &std::fclose),
       depth_list_(nullptr, &std::fclose) {
+    // (folder_ + "/rgb" of an empty name is "/rgb": a sequence was written into /)
+    if (folder_.empty()) throw std::invalid_argument("TumWriter: the folder's name is empty");
     std::error_code ec;
     fs::create_directories(folder_ + "/rgb", ec);
     fs::create_directories(folder_ + "/depth", ec);

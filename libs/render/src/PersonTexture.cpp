@@ -1,5 +1,7 @@
 #include <devslam/render/PersonTexture.h>
 
+#include <devslam/core/Picture.h>
+
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
@@ -49,8 +51,9 @@ std::string textureTooLarge(const cv::Mat& img, const std::string& path) {
 }
 
 PersonTexture loadPersonTexture(const std::string& path, int cell_px) {
-    const cv::Mat img = cv::imread(path, cv::IMREAD_UNCHANGED);
-    if (img.empty()) throw std::runtime_error("person texture '" + path + "': cannot read");
+    std::string why;
+    const cv::Mat img = core::readImage(path, cv::IMREAD_UNCHANGED, why);
+    if (img.empty()) throw std::runtime_error("person texture '" + path + "': cannot read" + why);
     if (const auto big = textureTooLarge(img, path); !big.empty())
         throw std::runtime_error("person " + big);
     if (img.type() != CV_8UC4)

@@ -1,6 +1,8 @@
 #include <devslam/render/PersonTexture.h>
 #include <devslam/render/SequenceRenderer.h>
 
+#include <devslam/core/Picture.h>
+
 #include <mrpt/img/CImage.h>
 #include <mrpt/img/TCamera.h>
 #include <mrpt/math/CMatrixDynamic.h>
@@ -169,8 +171,10 @@ struct SequenceRenderer::Impl {
         const auto key = std::make_pair(path, blur);
         auto it = photos.find(key);
         if (it != photos.end()) return it->second;
-        cv::Mat img = cv::imread(path, cv::IMREAD_COLOR);
-        if (img.empty()) throw std::runtime_error("render: cannot read texture '" + path + "'");
+        std::string why;
+        cv::Mat img = core::readImage(path, cv::IMREAD_COLOR, why);
+        if (img.empty())
+            throw std::runtime_error("render: cannot read texture '" + path + "'" + why);
         // (panelCrop cuts at least 8 x 8 px: a smaller photo failed in an OpenCV assertion)
         if (img.cols < 8 || img.rows < 8)
             throw std::runtime_error("render: texture '" + path + "' is " +

@@ -67,8 +67,17 @@ void writeGzFileWhole(const std::string& path, const std::string& kind,
 /// "cannot open", ...).
 [[nodiscard]] std::string gzipDamage(const std::string& path);
 
+/// What follows the last gzip member of the gzip file at `path`, if anything does: zlib (and
+/// so MRPT's stream) reads members one after another and ends quietly at anything else, so a
+/// second rawlog appended with a damaged header, or junk after a whole one, lost its frames
+/// without a word. "" when the file is gzip members alone, or no gzip at all, or damaged
+/// inside (gzipDamage says how); else "N bytes after the end of its gzip data at byte B are
+/// no gzip stream (...)".
+[[nodiscard]] std::string gzipTrailingData(const std::string& path);
+
 /// The innermost non-empty "Message:" line of an MRPT exception text (its first line when
-/// it has none).
+/// it has none, the line after MRPT's banner when that is the first; an OpenCV error without
+/// OpenCV's source location).
 [[nodiscard]] std::string innermostMessage(const std::string& what);
 
 }  // namespace devslam::core

@@ -17,4 +17,10 @@ namespace devslam::core {
 /// 8 or 16 bits is converted to 8, as cv::imwrite does).
 void writePngWhole(const std::string& path, const cv::Mat& image);
 
+/// cv::imread(path, flags), except that an image OpenCV refuses with an exception (a PNG whose
+/// header claims 100000 x 100000 px: "OpenCV(4.6.0) .../loadsave.cpp:77: error: (-215:Assertion
+/// failed) pixels <= CV_IO_MAX_IMAGE_PIXELS ...", naming no file, ended a run) comes back empty
+/// as one that does not decode, with `why` set to " (OpenCV: <its reason>)"; else `why` is "".
+[[nodiscard]] cv::Mat readImage(const std::string& path, int flags, std::string& why);
+
 }  // namespace devslam::core
