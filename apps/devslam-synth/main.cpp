@@ -119,6 +119,9 @@ int run(int argc, char** argv) {
         return a.empty() ? 2 : 0;
     }
     if (a[0] == "--list") {
+        // (anything after it, "--list --check" included, was ignored without a word)
+        if (a.size() > 1)
+            throw std::invalid_argument("--list takes nothing more, got '" + a[1] + "'");
         std::vector<std::string> names;
         for (const auto& e : fs::directory_iterator(kSynthDir))
             if (e.path().extension() == ".ini" &&

@@ -1094,6 +1094,11 @@ TEST(GzFile, InnermostMessageSkipsEmptyMessages) {
                                "src/loadsave.cpp:816: error: (-215:Assertion failed) "
                                "!buf.empty() in function 'imdecode_'\nCall stack backtrace:\n"),
               "OpenCV: (-215:Assertion failed) !buf.empty() in function 'imdecode_'");
+    // MRPT's ASSERT_GT_ puts the values on the lines after its message: kept.
+    EXPECT_EQ(innermostMessage("==== MRPT exception ====\nFile: a.cpp:12\nMessage: "
+                               "ASSERT_GT_(ymax,ymin) failed with\nymax=0\nymin=2.5\n"
+                               "Call stack backtrace:\n"),
+              "ASSERT_GT_(ymax,ymin) failed with ymax=0, ymin=2.5");
 }
 
 // A gzip file written through MRPT's stream interface: read back whole, and a full disk is

@@ -682,7 +682,9 @@ TEST(DevslamSynth, CheckReadsTheScenarioAndRendersNothing) {
              {"short_walking --check -o " + tmp.str("o"),
               "-o does not go with --check (it renders nothing)"},
              {"short_walking --check --if-changed",
-              "--if-changed does not go with --check (it renders nothing)"}}) {
+              "--if-changed does not go with --check (it renders nothing)"},
+             // (the --check was ignored without a word)
+             {"--list --check", "--list takes nothing more, got '--check'"}}) {
         r = devslam::test::runApp("devslam-synth", args);
         EXPECT_EQ(r.rc, 1) << args << "\n" << r.out;
         EXPECT_NE(r.out.find(says), std::string::npos) << args << "\n" << r.out;
@@ -1019,7 +1021,7 @@ TEST(Scenario, ShippedFilesLoadAndTyposAreReported) {
     // Paths are relative to the file that names them: a copy elsewhere names what is missing.
     fs::copy_file(kSynth + "/office_room.ini", tmp.str("office_room.ini"));
     expectMessage([&] { (void)loadScenario(withEdit(shipped, "seed ", "seed ")); },
-                  "wall_textures: no such file or folder");
+                  "' is no such file or folder");
     std::string abs = shipped;  // the same scenario with absolute paths
     for (std::size_t p = abs.find("../../data"); p != std::string::npos; p = abs.find("../../data"))
         abs.replace(p, 5, kRoot);
@@ -1292,8 +1294,14 @@ TEST(Scenario, ShippedFilesLoadAndTyposAreReported) {
     EXPECT_NO_THROW((void)loadScenario(base, {"scenario.near_clip=0.01", "scenario.far_clip=1e4"}));
     expectMessage([&] { (void)loadScenario(base, {"person_9.speed=1"}); },  // a new person
                   tmp.str("s.ini") + " with --set [person_9] kind: missing");
-    expectMessage([&] { (void)loadScenario(base, {"scenario.room=nowhere.ini"}); },
-                  tmp.str("s.ini") + " [scenario] room: no such file '");
+    expectMessage(
+        [&] { (void)loadScenario(base, {"scenario.room=nowhere.ini"}); },
+        tmp.str("s.ini") + " [scenario] room: '" + tmp.str("nowhere.ini") + "' is no such file");
+    // One that is there but no file was "no such file" too.
+    expectMessage([&] { (void)loadScenario(base, {"scenario.room=/dev/zero"}); },
+                  tmp.str("s.ini") + " [scenario] room: '/dev/zero' is no regular file");
+    expectMessage([&] { (void)loadScenario(base, {"scenario.room=" + tmp.str("")}); },
+                  "' is a folder, not a room file");
     // room_set: written over the room file's [room] and [box_*] settings, checked like them.
     const auto withRoomSet = [&](const std::string& items) {
         return withEdit(text, "n_frames        = 60", "n_frames = 60\nroom_set = " + items);

@@ -159,24 +159,35 @@ std::string gzipDamage(const std::string& path) {
 }
 
 std::string innermostMessage(const std::string& what) {
-    std::string best = what.substr(0, what.find('\n'));
+    const auto lineAt = [&](std::size_t b) { return what.substr(b, what.find('\n', b) - b); };
+    std::size_t at = 0;  // where the chosen line starts
     // An exception MRPT wraps without a "Message:" (OpenCV's, from inside CImage) has the
     // banner as its first line and the text on the next: the banner alone said nothing.
-    if (best == "==== MRPT exception ====") {
-        const std::size_t b = what.find('\n');
-        if (b != std::string::npos) best = what.substr(b + 1, what.find('\n', b + 1) - b - 1);
+    if (lineAt(0) == "==== MRPT exception ====" && what.find('\n') != std::string::npos)
+        at = what.find('\n') + 1;
+    for (std::size_t p = what.find("Message:"); p != std::string::npos;
+         p = what.find("Message:", p + 1)) {
+        const std::size_t b = what.find_first_not_of(' ', p + 8);
+        if (b == std::string::npos || what[b] == '\n') continue;  // an empty "Message:"
+        at = b;
     }
+    std::string best = lineAt(at);
+    // MRPT's ASSERT_GT_(a,b) and kin write the values on the next two lines: the message
+    // ended "failed with", and the values were lost.
+    if (const std::string tail = "failed with";
+        best.size() >= tail.size() &&
+        best.compare(best.size() - tail.size(), tail.size(), tail) == 0)
+        for (std::size_t b = what.find('\n', at), k = 0; b != std::string::npos && k < 2; ++k) {
+            const std::string value = lineAt(b + 1);
+            if (value.empty() || value.find('=') == std::string::npos) break;
+            best += (k == 0 ? " " : ", ") + value;
+            b = what.find('\n', b + 1);
+        }
     // OpenCV's "OpenCV(4.6.0) ./modules/x.cpp:816: error: (-215:Assertion failed) ...": its
     // source line is of no use to the reader.
     if (best.rfind("OpenCV(", 0) == 0)
         if (const std::size_t e = best.find(": error: "); e != std::string::npos)
             best = "OpenCV: " + best.substr(e + 9);
-    for (std::size_t p = what.find("Message:"); p != std::string::npos;
-         p = what.find("Message:", p + 1)) {
-        const std::size_t b = what.find_first_not_of(' ', p + 8);
-        if (b == std::string::npos || what[b] == '\n') continue;  // an empty "Message:"
-        best = what.substr(b, what.find('\n', b) - b);
-    }
     return best;
 }
 

@@ -63,7 +63,10 @@ std::vector<std::string> resolveImages(const std::string& list, const std::strin
         } else if (fs::is_regular_file(p)) {
             out.push_back(p.string());
         } else {
-            throw std::runtime_error(what + ": no such file or folder '" + p.string() + "'");
+            // (a device or a pipe was "no such file", which is there)
+            throw std::runtime_error(
+                what + ": '" + p.string() + "' " +
+                (fs::exists(p) ? "is no regular file or folder" : "is no such file or folder"));
         }
     }
     // Checked here, where the key is known (the renderer, which reads them at the first
@@ -367,7 +370,10 @@ Scenario readScenario(const std::string& path, const std::vector<std::string>& o
     sc.room.overrides =
         core::overrideItems(cfg->read_string(s, "room_set", ""), path + " [" + s + "] room_set");
     if (!fs::is_regular_file(room))
-        throw std::invalid_argument(path + " [scenario] room: no such file '" + room + "'");
+        throw std::invalid_argument(path + " [scenario] room: '" + room + "' " +
+                                    (fs::is_directory(room) ? "is a folder, not a room file"
+                                     : fs::exists(room)     ? "is no regular file"
+                                                            : "is no such file"));
     try {
         loadRoom(room, sc.room);
     } catch (const std::invalid_argument& e) {
