@@ -214,7 +214,7 @@ Loaded loadConfig(const Args& a, const std::vector<std::string>& extra_sets = {}
     const std::string ini_mode = l.cfg->read_string("run", "mode", "dynamic");
     for (const auto& [mode, where] : {std::pair{ini_mode, l.config_source + " [run] mode"},
                                       std::pair{a.mode, std::string("--mode")}}) {
-        if (mode.empty()) continue;  // no --mode
+        if (mode.empty() && where == "--mode") continue;  // no --mode (an empty INI mode is bad)
         try {
             run::requireMode(mode);
         } catch (const std::invalid_argument& e) {

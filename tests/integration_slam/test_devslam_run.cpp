@@ -258,6 +258,10 @@ TEST(DevslamRun, BadInputIsReported) {
     EXPECT_EQ(r.rc, 1);
     EXPECT_NE(r.out.find(ini.string() + " [run] mode: unknown mode 'dynamc'"), std::string::npos)
         << r.out;
+    // An empty one was taken for no --mode, and named neither the INI nor --set.
+    r = run("--set run.mode= --quiet --out ''");
+    EXPECT_EQ(r.rc, 1);
+    EXPECT_NE(r.out.find(" with --set [run] mode: unknown mode ''"), std::string::npos) << r.out;
     r = run("--set dataset.camera=freiburg9 --mode none --quiet --out ''");
     EXPECT_EQ(r.rc, 1);
     EXPECT_NE(r.out.find("[dataset] camera: unknown camera preset 'freiburg9'"), std::string::npos)
