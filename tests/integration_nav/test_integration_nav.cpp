@@ -494,7 +494,7 @@ TEST(IntegrationNav, TheIniChoosesTheHolonomicMethod) {
 // at its first step). The navigator compiles the formulas when it is made now: refused before
 // the run, naming the INI and the formula, as what else MRPT refuses then (a section the
 // chosen method needs is missing). What MRPT finds only while navigating ends the run as an
-// error naming the INI (IntegrationNav.PathsTooTightForMrptsScoringAreAnErrorThatSaysWhy).
+// error naming the INI (IntegrationNav.MrptsErrorLogIsOneLine).
 TEST(IntegrationNav, MrptErrorsEndTheRunNamingTheIni) {
     auto world = devslam::sim::loadWorld(kSrc + "/sim_worlds/obstacle_near_goal.ini");
     const std::string text = readFile(kIni);
