@@ -223,6 +223,10 @@ TEST(TumReader, MalformedListsNameFileAndLine) {
     expectError([&] { (void)io::openRgbd(long_name); }, "^" + long_name + ": File name too long$");
     writeText(d.str("plain"), "x");  // a path through a file: not there, as ENOENT
     expectError([&] { (void)io::openRgbd(d.str("plain/x")); }, "no such TUM folder or rawlog");
+    // There, but neither (it was "no such"); and an empty name.
+    expectError([&] { (void)io::openRgbd("/dev/null"); },
+                "^/dev/null: neither a TUM folder nor a rawlog file$");
+    expectError([&] { (void)io::openRgbd(""); }, "^the input's name is empty");
 }
 
 // Lists as other tools write them: a byte-order mark and CRLF (Windows editors), an image

@@ -1,6 +1,7 @@
 #include <devslam/eval/Metrics.h>
 
 #include <devslam/core/Association.h>
+#include <devslam/core/Parse.h>
 #include <devslam/core/Pose.h>
 
 #include <Eigen/Geometry>
@@ -50,7 +51,8 @@ AteResult computeAte(const core::Trajectory& gt, const core::Trajectory& est,
         throw std::invalid_argument(
             "ATE: only " + std::to_string(pairs.size()) + " of " + std::to_string(est.size()) +
             " estimated poses associate with the ground truth within " +
-            std::to_string(opts.max_dt) + " s (wrong files, or timestamps in other units?)");
+            core::shortestReal(opts.max_dt) +  // (to_string wrote 1e-300 as 0.000000)
+            " s (wrong files, or timestamps in other units?)");
     AteResult r;
     r.n_gt = gt.size();
     r.n_est = est.size();

@@ -60,7 +60,12 @@ std::unique_ptr<RgbdReader> openRgbd(const std::string& path, const ReaderOption
                                      "devslam-overlay --input video:FILE)");
         return std::make_unique<RawlogReader>(path, opts);
     }
-    throw std::runtime_error(path + ": no such TUM folder or rawlog file");
+    // (a device, a pipe or a socket given as the input was "no such" input, which is there;
+    // an empty name was quoted as nothing at all)
+    if (path.empty())
+        throw std::runtime_error("the input's name is empty: give a TUM folder or rawlog");
+    throw std::runtime_error(path + (fs::exists(st) ? ": neither a TUM folder nor a rawlog file"
+                                                    : ": no such TUM folder or rawlog file"));
 }
 
 }  // namespace devslam::io
