@@ -360,13 +360,13 @@ TEST(Parse, NumberListsNameTheBadToken) {
 
 TEST(Parse, ClippedQuotesALongTextInPart) {
     using devslam::core::clipped;
-    EXPECT_EQ(clipped("  short  "), "short");
+    EXPECT_EQ(clipped("  short  "), "  short  ");  // blanks may be what is wrong: kept
     EXPECT_EQ(clipped(std::string(80, 'a')), std::string(80, 'a'));
-    EXPECT_EQ(clipped(std::string(81, 'a')), std::string(80, 'a') + "... (81 characters)");
+    EXPECT_EQ(clipped(std::string(81, 'a')), std::string(80, 'a') + "... (81 bytes)");
     // Never half a character: "\u00e9" is two bytes, and the 80th byte is the first of one.
     std::string accents = std::string(79, 'a');
     for (int i = 0; i < 10; i++) accents += "\u00e9";
-    EXPECT_EQ(clipped(accents), std::string(79, 'a') + "... (99 characters)");
+    EXPECT_EQ(clipped(accents), std::string(79, 'a') + "... (99 bytes)");
 }
 
 TEST(Parse, ExtensionsInAnyCase) {
@@ -515,7 +515,7 @@ TEST(Config, RepeatedKeysAndSectionsAreRefused) {
     // A junk line is quoted in part: a 500 kB one was quoted whole.
     EXPECT_EQ(error("[a]\nk = 1\n" + std::string(100000, 'x') + "\n"),
               path + " line 3: '" + std::string(80, 'x') +
-                  "... (100000 characters)' is neither a [section] nor a key = value");
+                  "... (100000 bytes)' is neither a [section] nor a key = value");
     // MRPT 2.5 knows @define alone and skips any other directive: "@include" read nothing.
     EXPECT_EQ(error("@include other.ini\n[a]\nk = 1\n"),
               path +
@@ -1103,6 +1103,27 @@ TEST(GzFile, InnermostMessageSkipsEmptyMessages) {
 
 // A gzip file written through MRPT's stream interface: read back whole, and a full disk is
 // an error naming the file and why, at the write that hit it or at the close.
+// A writer that fails with an empty text is a failure: the part file was renamed over the
+// file as if it had been written whole (the failure was known by its text alone).
+TEST(GzFile, AFailureWithoutATextLeavesTheFileAsItWas) {
+    const devslam::test::TempDir d("devslam_gzwhole");
+    const std::string path = d.str("m.gridmap");
+    std::ofstream(path) << "the old map";
+    try {
+        devslam::core::writeGzFileWhole(path, "grid map", [](mrpt::io::CStream& s) {
+            s.Write("x", 1);
+            throw std::runtime_error("");
+        });
+        ADD_FAILURE() << "a failed write passed";
+    } catch (const std::runtime_error& e) {
+        EXPECT_EQ(std::string(e.what()),
+                  "cannot write grid map '" + path + "': the writer failed without saying why");
+    }
+    std::ifstream in(path);
+    EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), "the old map");
+    EXPECT_FALSE(std::filesystem::exists(path + ".part"));
+}
+
 TEST(GzFile, OutputStreamWritesAGzipFileAndSaysWhyAWriteFailed) {
     const devslam::test::TempDir d("devslam_gz_");
     const std::string path = d.str("a.gz");

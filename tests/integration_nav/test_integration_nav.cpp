@@ -312,12 +312,12 @@ TEST(IntegrationNav, PathsTooTightForMrptsScoringAreRefusedBeforeTheRun) {
     };
     std::string why = refused(ini);
     EXPECT_NE(why.find("n.ini: PTG0 (CPTG_DiffDrive_C, v_max 0.6 m/s, w_max 360 deg/s, "
-                       "[CReactiveNavigationSystem] PTG0_*): its tightest turn's path ends "),
+                       "[CReactiveNavigationSystem] PTG0_*): its shortest path ends "),
               std::string::npos)
         << why;
     EXPECT_NE(why.find(" m along, short of the 1 m along every path at which MRPT 2.5 scores a "
-                       "motion (it would stop the run with 'pt_in_range'): raise its v_max or "
-                       "lower its w_max"),
+                       "motion (it would stop the run with 'pt_in_range'): its tightest turn "
+                       "(v_max / w_max) is too tight; raise its v_max or lower its w_max"),
               std::string::npos)
         << why;
     // The shipped INI at 0.2 m/s: its tightest arcs end 0.997 m along.
@@ -326,10 +326,9 @@ TEST(IntegrationNav, PathsTooTightForMrptsScoringAreRefusedBeforeTheRun) {
     world.robot.max_w = M_PI / 2;
     world.robot.max_v = 0.2;
     why = refused(slow);
-    EXPECT_NE(
-        why.find("PTG0 (CPTG_DiffDrive_C, v_max 0.2 m/s, w_max 90 deg/s, "
-                 "[CReactiveNavigationSystem] PTG0_*): its tightest turn's path ends 0.997 m"),
-        std::string::npos)
+    EXPECT_NE(why.find("PTG0 (CPTG_DiffDrive_C, v_max 0.2 m/s, w_max 90 deg/s, "
+                       "[CReactiveNavigationSystem] PTG0_*): its shortest path ends 0.9971 m"),
+              std::string::npos)
         << why;
     devslam::nav::setTopSpeed(slow, 0.25);  // 1.25 m: runs
     world.robot.max_v = 0.25;

@@ -449,6 +449,11 @@ TEST(NavConfig, MrptSectionsAreReadStrictly) {
     EXPECT_EQ(errorOf("CMultiObjectiveMotionOptimizerBase", "score1_formula", "-inf"),
               "x.ini [CMultiObjectiveMotionOptimizerBase] score1_formula: uses exprtk's constant "
               "inf: a score of inf or NaN leaves MRPT no motion to choose");
+    EXPECT_NE(errorOf("CMultiObjectiveMotionOptimizerBase", "score1_formula", "0.5*2inf"), "");
+    // A movement assertion may compare with inf: a truth value, no score.
+    EXPECT_EQ(errorOf("CMultiObjectiveMotionOptimizerBase", "movement_assert1",
+                      "collision_free_distance < inf"),
+              "");
     EXPECT_EQ(errorOf("CMultiObjMotionOpt_Scalarization", "scalar_score_formula",
                       "ptg_priority_score*(0.3*target_distance + 8.0*info_gain)"),
               "");  // a name holding "inf" is no constant

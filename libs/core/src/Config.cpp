@@ -69,7 +69,7 @@ void refuseMisreadLines(const std::string& text, const std::string& path) {
             if (in_comment && !isComment(line))
                 throw std::invalid_argument(path + " line " + std::to_string(n - 1) +
                                             ": a comment ends in '\\', so MRPT reads line " +
-                                            std::to_string(n) + " ('" + clipped(line) +
+                                            std::to_string(n) + " ('" + clipped(trimmed(line)) +
                                             "') as part of it");
             continue;
         }
@@ -98,19 +98,20 @@ void refuseMisreadLines(const std::string& text, const std::string& path) {
             const auto b = line.find(']', a);
             if (b == std::string::npos)  // MRPT would make a section of it and the next line
                 throw std::invalid_argument(path + " line " + std::to_string(n) + ": '" +
-                                            clipped(line) + "' has no ']'");
+                                            clipped(trimmed(line)) + "' has no ']'");
             // After ']' only a comment: MRPT ignores the rest ("[orb] junk" is [orb]).
             const auto rest = line.find_first_not_of(" \t", b + 1);
             if (rest != std::string::npos && line[rest] != '#' && line[rest] != ';' &&
                 line.compare(rest, 2, "//") != 0)
                 throw std::invalid_argument(path + " line " + std::to_string(n) + ": '" +
-                                            clipped(line) + "': text after the section's ']'");
+                                            clipped(trimmed(line)) +
+                                            "': text after the section's ']'");
             section = trimmed(expand(line.substr(a + 1, b - a - 1)));  // MRPT trims the name
             // MRPT files the keys after "[]" with those before any section, and the checks
             // then named the key but not the line.
             if (section.empty())
                 throw std::invalid_argument(path + " line " + std::to_string(n) + ": '" +
-                                            clipped(line) + "' names no section");
+                                            clipped(trimmed(line)) + "' names no section");
             const auto [at, fresh] = sections.emplace(lowercase(section), n);
             if (!fresh)
                 throw std::invalid_argument(
@@ -121,7 +122,7 @@ void refuseMisreadLines(const std::string& text, const std::string& path) {
         const auto eq = line.find('=', a);
         if (eq == std::string::npos || eq == a)  // MRPT ignores such a line without a word
             throw std::invalid_argument(path + " line " + std::to_string(n) + ": '" +
-                                        clipped(line) +
+                                        clipped(trimmed(line)) +
                                         "' is neither a [section] nor a key = value");
         const std::string key = trimmed(expand(line.substr(a, eq - a)));
         if (key.empty() || key.find("${") != std::string::npos) continue;  // not resolvable here

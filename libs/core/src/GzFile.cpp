@@ -73,19 +73,22 @@ void writeGzFileWhole(const std::string& path, const std::string& kind,
                       const std::function<void(mrpt::io::CStream&)>& write) {
     const std::string part = path + ".part";
     std::string why;
+    bool failed = true;  // (not `why.empty()`: an exception with an empty text is a failure too)
     try {
         GzOutputStream s(part, 1, kind);
         try {
             write(s);
             s.close();
+            failed = false;
         } catch (const std::exception& e) {
             why = !s.lastError().empty() ? s.lastError() : innermostMessage(e.what());
         }
     } catch (const std::exception& e) {  // not made (its folder is not there, ...)
         why = std::strerror(errno != 0 ? errno : EIO);
     }
+    if (failed && why.empty()) why = "the writer failed without saying why";
     std::error_code ec;
-    if (why.empty()) {
+    if (!failed) {
         std::filesystem::rename(part, path, ec);
         if (!ec) return;
         why = ec.message();
@@ -128,10 +131,14 @@ std::string gzipTrailingData(const std::string& path) {
                 inflateReset(&s);
                 continue;
             }
-            std::fseek(f, 0, SEEK_END);
-            const auto size = static_cast<std::uint64_t>(std::ftell(f));
-            found = std::to_string(size - end) + " bytes after the end of its gzip data at byte " +
-                    std::to_string(end) + " are no gzip stream (another file appended, or damage)";
+            const long size = std::fseek(f, 0, SEEK_END) == 0 ? std::ftell(f) : -1L;
+            const std::uint64_t extra = size > 0 && std::uint64_t(size) > end
+                                            ? std::uint64_t(size) - end
+                                            : std::uint64_t(s.avail_in);  // (at least)
+            found = std::to_string(extra) + (extra == 1 ? " byte" : " bytes") +
+                    " after the end of its gzip data at byte " + std::to_string(end) +
+                    (extra == 1 ? " is" : " are") +
+                    " no gzip stream (another file appended, or damage)";
             break;
         }
         if (rc != Z_OK && rc != Z_BUF_ERROR) break;  // damage: gzread says what
@@ -172,6 +179,10 @@ std::string innermostMessage(const std::string& what) {
         at = b;
     }
     std::string best = lineAt(at);
+    if (best.empty()) {  // nothing after the banner: the first line of text there is
+        const std::size_t b = what.find_first_not_of("\n");
+        best = b == std::string::npos ? std::string() : lineAt(b);
+    }
     // MRPT's ASSERT_GT_(a,b) and kin write the values on the next two lines: the message
     // ended "failed with", and the values were lost.
     if (const std::string tail = "failed with";

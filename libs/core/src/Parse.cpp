@@ -19,11 +19,10 @@ std::string trimmed(const std::string& text) {
 }
 
 std::string clipped(const std::string& text, std::size_t max) {
-    const std::string t = trimmed(text);
-    if (t.size() <= max) return t;
+    if (text.size() <= max) return text;
     std::size_t cut = max;
-    while (cut > 0 && (static_cast<unsigned char>(t[cut]) & 0xC0) == 0x80) --cut;
-    return t.substr(0, cut) + "... (" + std::to_string(t.size()) + " characters)";
+    while (cut > 0 && (static_cast<unsigned char>(text[cut]) & 0xC0) == 0x80) --cut;
+    return text.substr(0, cut) + "... (" + std::to_string(text.size()) + " bytes)";
 }
 
 std::string shortestReal(double v) {

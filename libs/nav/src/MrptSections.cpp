@@ -188,9 +188,10 @@ void checkMrptSections(const mrpt::config::CConfigFileBase& c, const std::string
     // at each step, and the run said only that the robot never left its start (nan and 1e400
     // are refused where a value is a number; a formula is text).
     core::namingSource(source, [&] {
-        static const std::regex inf("(^|[^a-z0-9_])inf(inity)?($|[^a-z0-9_])", std::regex::icase);
-        static const std::regex formula("score[0-9]+_formula|movement_assert[0-9]+",
-                                        std::regex::icase);
+        // (a digit before it is exprtk's implicit product, "2inf"; a movement_assert may
+        // compare with inf, a truth value and no score)
+        static const std::regex inf("(^|[^a-z_])inf(inity)?($|[^a-z0-9_])", std::regex::icase);
+        static const std::regex formula("score[0-9]+_formula", std::regex::icase);
         const auto check = [&](const std::string& sec, const std::string& key) {
             core::requireValue(!std::regex_search(c.read_string(sec, key, ""), inf), sec, key,
                                "uses exprtk's constant inf: a score of inf or NaN leaves MRPT "

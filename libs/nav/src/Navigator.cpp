@@ -428,22 +428,29 @@ void Navigator::requirePathsOfOneMetre(const mrpt::config::CConfigFileBase& cfg)
     // (v_max / w_max small), that step failed ("Assert condition failed: pt_in_range"), in the
     // middle of a run, the first time such a motion was scored (the shipped PTGs at --max-speed
     // 0.2, whose tightest arcs end 0.997 m along). Every path's length is known once the PTGs
-    // are built. (The 0.1 % spares a path MRPT cut at exactly 1 m, as PTG3's, by round-off.)
+    // are built (the shipped PTG3's, of refDistance 1 m, end 1.0000007 m along).
     for (std::size_t p = 0; p < nav_->getPTG_count(); p++) {
         const auto* ptg = nav_->getPTG(p);
         double shortest = std::numeric_limits<double>::infinity();
         for (uint16_t k = 0; k < ptg->getPathCount(); k++)
             shortest = std::min(shortest, ptg->getPathDist(k, ptg->getPathStepCount(k) - 1));
-        if (shortest >= 0.999) continue;
+        if (shortest >= 1.0) continue;
         const std::string s = "CReactiveNavigationSystem", i = "PTG" + std::to_string(p);
         std::ostringstream m;
-        m.precision(3);
+        m.precision(4);
         m << opts_.source << ": " << i << " (" << cfg.read_string(s, i + "_Type", "?") << ", v_max "
           << cfg.read_double(s, i + "_v_max_mps", 0) << " m/s, w_max "
           << cfg.read_double(s, i + "_w_max_dps", 0) << " deg/s, [" << s << "] " << i
-          << "_*): its tightest turn's path ends " << shortest
+          << "_*): its shortest path ends " << shortest
           << " m along, short of the 1 m along every path at which MRPT 2.5 scores a motion "
-             "(it would stop the run with 'pt_in_range'): raise its v_max or lower its w_max";
+             "(it would stop the run with 'pt_in_range'): ";
+        // (no path is longer than refDistance: then neither speed helps; a differential-drive
+        // PTG's under 1 m is refused when the INI is read, this is for any other kind)
+        if (ptg->getRefDistance() < 1.0)
+            m << "its refDistance " << ptg->getRefDistance() << " m must be at least 1 m";
+        else
+            m << "its tightest turn (v_max / w_max) is too tight; raise its v_max or lower its "
+                 "w_max";
         throw std::invalid_argument(m.str());
     }
 }

@@ -335,7 +335,7 @@ void validateObstacles(const WorldSpec& w) {
 }
 
 /// What the obstacles cost: rasterize() tests each grid cell of each obstacle's bounding
-/// square, and a run measures the robot's clearance to every obstacle at every physics step.
+/// box, and a run measures the robot's clearance to every obstacle at every physics step.
 /// Neither was bounded: 1000 boxes of 1000 m ran for minutes before printing anything, and
 /// 100 000 boxes simulated a second in 1.7 s of wall time (a 10 000 s timeout, some 5 hours).
 void validateObstacleCost(const WorldSpec& w, const std::vector<Obstacle>& statics) {

@@ -49,9 +49,9 @@ namespace devslam::core {
 /// `text` without the blanks (std::isspace) at its ends.
 [[nodiscard]] std::string trimmed(const std::string& text);
 
-/// `text` trimmed, and when longer than `max` characters its first ones, cut at a whole UTF-8
-/// character, with "... (N characters)": for quoting a line or a value in a message (a 500 kB
-/// junk line of a world file was quoted whole).
+/// `text` as it is, or when longer than `max` bytes its first ones, cut at a whole UTF-8
+/// character, with "... (N bytes)": for quoting a line or a value in a message (a 500 kB junk
+/// line of a world file was quoted whole).
 [[nodiscard]] std::string clipped(const std::string& text, std::size_t max = 80);
 
 /// The shortest text that reads back as `v` ("0.2", not "0.200000"), for writing a number.
