@@ -75,10 +75,10 @@ static int appMain(int argc, char** argv) {
                     throw std::invalid_argument("--delta-unit: 's' or 'f', got '" + u + "'");
                 ro.delta_in_frames = (u == "f");
             } else if (a == "--json" || a == "--plot") {
+                std::string& out = a == "--json" ? json : plot;
+                out = value();
                 // (an empty one, a script's unset variable, wrote nothing and said nothing)
-                (a == "--json" ? json : plot) = value();
-                if ((a == "--json" ? json : plot).empty())
-                    throw std::invalid_argument(a + ": the file name is empty");
+                if (out.empty()) throw std::invalid_argument(a + ": the file name is empty");
             } else if (a == "--title")
                 title = value();
             else if (a == "--no-rpe")

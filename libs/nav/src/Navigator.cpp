@@ -658,15 +658,8 @@ NavState Navigator::step(double t) {
         why.error_code == mrpt::nav::CAbstractNavigator::ERR_OTHER) {
         const std::string msg = core::innermostMessage(why.error_msg);
         last_error_ = "MRPT's navigation step failed (settings in " + opts_.source + "?): " + msg;
-        // pt_in_range comes from MRPT's scoring of candidate motions (docs/nav.md): MRPT 2.5
-        // asks every path for its point 1 (pseudo)metre along it, which a path of turning
-        // radius v / w under about 0.13 m never reaches (it ends after about 0.975 of a turn):
-        // the shipped PTGs at robotMax_W_degps 360.
-        if (msg.find("pt_in_range") != std::string::npos)
-            last_error_ +=
-                " (a PTG's path ends before the 1 m along it at which MRPT 2.5 scores a "
-                "motion, as a tight turn's does: lower that PTG's w_max or raise its "
-                "v_max)";
+        // (MRPT's pt_in_range, a path shorter than the 1 m it scores at, is refused when the
+        // navigator is made: requirePathsOfOneMetre)
         active_ = false;
         return NavState::Error;
     }
