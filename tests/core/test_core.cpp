@@ -12,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include <zlib.h>
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgcodecs.hpp>
 
@@ -1160,6 +1161,106 @@ TEST(GzFile, OutputStreamWritesAGzipFileAndSaysWhyAWriteFailed) {
                   "error writing thing '/dev/full': its end was not written (disk full?), the "
                   "file is cut short");
     }
+}
+
+namespace {
+// zlib's own verdict on a file, as gzipDamage gave it until gzipCheck read the file once for
+// both of its answers: gzread to the end, then gzerror without the file's name.
+std::string gzreadDamage(const std::string& path) {
+    gzFile f = gzopen(path.c_str(), "rb");
+    if (f == nullptr) return "cannot open";
+    std::vector<char> buf(1 << 16);
+    int n = 0;
+    while ((n = gzread(f, buf.data(), static_cast<unsigned>(buf.size()))) > 0) {
+    }
+    int err = Z_OK;
+    const char* msg = gzerror(f, &err);
+    std::string out = (n < 0 || (err != Z_OK && err != Z_STREAM_END)) ? msg : "";
+    gzclose(f);
+    if (out.rfind(path + ": ", 0) == 0) out.erase(0, path.size() + 2);
+    return out;
+}
+}  // namespace
+
+// gzipCheck inflates the file itself (to find where the gzip data ends) and must tell its
+// damage as zlib's gzread does: every cut, every flipped byte of the header and trailer and
+// some in the data, and what may follow a whole stream. Its messages are those of the text
+// rawlog and map errors quote.
+TEST(GzFile, OneReadThroughGivesZlibsOwnVerdictAndWhatFollowsTheStream) {
+    const devslam::test::TempDir d("devslam_gzcheck");
+    std::string data(200000, '\0');
+    std::mt19937 g(7);
+    for (std::size_t i = 0; i < data.size(); ++i)  // half compressible, half not
+        data[i] = static_cast<char>(i < data.size() / 2 ? (i / 97) & 0xff : g() & 0xff);
+    const std::string whole_path = d.str("whole.gz");
+    {
+        GzOutputStream s(whole_path, 1, "thing");
+        s.Write(data.data(), data.size());
+        s.close();
+    }
+    std::ifstream in(whole_path, std::ios::binary);
+    const std::string whole((std::istreambuf_iterator<char>(in)), {});
+    ASSERT_GT(whole.size(), 100000u);
+    const std::string path = d.str("f");
+    const auto write = [&](const std::string& bytes) {
+        std::ofstream(path, std::ios::binary) << bytes;
+    };
+    std::size_t compared = 0, damaged = 0;
+    const auto same = [&](const std::string& bytes, const std::string& what) {
+        write(bytes);
+        const GzipCheck c = gzipCheck(path);
+        EXPECT_EQ(c.damage, gzreadDamage(path)) << what;
+        if (!c.damage.empty()) {
+            ++damaged;
+            EXPECT_EQ(c.trailing, "") << what;
+        }
+        ++compared;
+        return c;
+    };
+    EXPECT_EQ(same(whole, "whole").damage, "");
+    std::vector<std::size_t> cuts = {0, 1, 2, 3, 9, 10, 11, 5000, whole.size() / 2};
+    for (std::size_t k = 1; k <= 9; ++k) cuts.push_back(whole.size() - k);  // in the trailer
+    for (std::size_t n : cuts) same(whole.substr(0, n), "cut at " + std::to_string(n));
+    EXPECT_EQ(gzipCheck(path).damage, "unexpected end of file");  // the last: 1 byte short
+    std::vector<std::size_t> flips = {0, 1, 2, 3, 4, 8, 9, 10, 100, whole.size() / 2};
+    for (std::size_t k = 1; k <= 8; ++k) flips.push_back(whole.size() - k);
+    for (std::size_t at : flips)
+        for (unsigned char mask : {0x01, 0x80, 0xff}) {
+            std::string b = whole;
+            b[at] = static_cast<char>(b[at] ^ mask);
+            same(b, "byte " + std::to_string(at) + " ^ " + std::to_string(mask));
+        }
+    EXPECT_EQ(gzipCheck(path).damage, "incorrect data check");  // the last: a CRC byte flipped
+    // No gzip at all: zlib passes it through, as MRPT reads a plain rawlog.
+    EXPECT_EQ(same("", "empty").damage, "");
+    EXPECT_EQ(same("\x1f", "one magic byte").damage, "");
+    EXPECT_EQ(same("plain text, no gzip", "text").damage, "");
+    // After a whole stream: a second member is read on; anything else is what follows it.
+    EXPECT_EQ(same(whole + whole, "two members").trailing, "");
+    same(whole + whole.substr(0, 500), "a second member cut short");
+    const std::string after =
+        " after the end of its gzip data at byte " + std::to_string(whole.size());
+    EXPECT_EQ(same(whole + "\x1f", "a lone magic byte after it").trailing,
+              "1 byte" + after + " is no gzip stream (another file appended, or damage)");
+    EXPECT_EQ(same(whole + "x" + whole.substr(1), "a member with its first byte changed").trailing,
+              std::to_string(whole.size()) + " bytes" + after +
+                  " are no gzip stream (another file appended, or damage)");
+    EXPECT_EQ(same(whole + std::string(70000, '\0'), "zeros after it").trailing,
+              "70000 bytes" + after + " are no gzip stream (another file appended, or damage)");
+    // Not a file to read: zlib's reason.
+    EXPECT_EQ(gzipCheck(d.str("no_such.gz")).damage, "cannot open");
+    EXPECT_EQ(gzipCheck(d.str("")).damage, gzreadDamage(d.str("")));  // the folder
+    EXPECT_EQ(gzipCheck(d.str("")).damage, "Is a directory");
+    EXPECT_GT(damaged, 40u) << "of " << compared;  // the comparisons are not all of whole files
+    // Stopped from outside: it returns before reading on, and says so.
+    std::atomic<bool> stop{true};
+    write(whole.substr(0, whole.size() / 2));
+    const GzipCheck stopped = gzipCheck(path, &stop);
+    EXPECT_TRUE(stopped.stopped);
+    EXPECT_EQ(stopped.damage, "");
+    stop = false;
+    EXPECT_FALSE(gzipCheck(path, &stop).stopped);
+    EXPECT_EQ(gzipCheck(path, &stop).damage, "unexpected end of file");
 }
 
 // An output folder held for a run: a second claim (a second run into it at once) is refused;

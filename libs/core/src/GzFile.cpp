@@ -3,6 +3,7 @@
 #include <zlib.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cerrno>
 #include <cstdint>
 #include <cstdio>
@@ -97,72 +98,103 @@ void writeGzFileWhole(const std::string& path, const std::string& kind,
     throw std::runtime_error("cannot write " + kind + " '" + path + "': " + why);
 }
 
-// (Written out with zlib's inflate: no zlib call tells where gzread's last member ended.)
-std::string gzipTrailingData(const std::string& path) {
+// Written out with zlib's inflate: no zlib call tells where gzread's last member ended. It
+// follows gzread's rules (gz_look, gz_decomp in zlib's gzread.c), so that `damage` is the text
+// gzread's gzerror gives, without reading the file a second time: a file not starting with
+// the gzip magic is no gzip (gzread copies it as it is); after a member, the magic starts the
+// next one, and anything else ends the stream (gzread drops it: `trailing` says what it was).
+GzipCheck gzipCheck(const std::string& path, const std::atomic<bool>* stop) {
+    GzipCheck out;
     std::FILE* f = std::fopen(path.c_str(), "rb");
-    if (f == nullptr) return "";
-    z_stream s{};
-    if (inflateInit2(&s, 15 + 16) != Z_OK) {  // gzip only
-        std::fclose(f);
-        return "";
+    if (f == nullptr) {
+        out.damage = "cannot open";
+        return out;
     }
-    std::vector<unsigned char> in(1 << 16), out(1 << 16);
+    z_stream s{};
+    if (inflateInit2(&s, 15 + 16) != Z_OK) {  // gzip only, as gzread
+        std::fclose(f);
+        out.damage = "out of memory";
+        return out;
+    }
+    std::vector<unsigned char> in(1 << 16), out_buf(1 << 16);
     std::uint64_t read = 0;  // bytes of the file read into `in` so far
-    std::string found;
+    bool read_failed = false;
+    int read_errno = 0;       // errno of the read that failed
     const auto topUp = [&] {  // keeps what is left of `in` and reads more after it
         std::memmove(in.data(), s.next_in, s.avail_in);
+        errno = 0;
         const std::size_t n = std::fread(in.data() + s.avail_in, 1, in.size() - s.avail_in, f);
+        if (n == 0 && std::ferror(f) != 0 && !read_failed) {
+            read_failed = true;
+            read_errno = errno != 0 ? errno : EIO;
+        }
         read += n;
         s.next_in = in.data();
         s.avail_in += static_cast<uInt>(n);
         return n > 0;
     };
+    const auto readError = [&] { return std::string(std::strerror(read_errno)); };
     s.next_in = in.data();
-    for (;;) {
-        if (s.avail_in == 0 && !topUp()) break;  // cut short: gzread says so
-        s.next_out = out.data();
-        s.avail_out = static_cast<uInt>(out.size());
-        const int rc = inflate(&s, Z_NO_FLUSH);
-        if (rc == Z_STREAM_END) {
-            const std::uint64_t end = read - s.avail_in;  // where this member ends
-            if (s.avail_in < 2) topUp();
-            if (s.avail_in == 0) break;  // the file's end
-            if (s.avail_in >= 2 && s.next_in[0] == 0x1f && s.next_in[1] == 0x8b) {
-                inflateReset(&s);
-                continue;
+    const auto gzipMagicNext = [&] {
+        if (s.avail_in < 2) topUp();
+        return s.avail_in >= 2 && s.next_in[0] == 0x1f && s.next_in[1] == 0x8b;
+    };
+    if (!gzipMagicNext()) {  // no gzip (an empty file, a plain rawlog): gzread copies it
+        if (read_failed) out.damage = readError();
+    } else {
+        for (;;) {
+            if (stop != nullptr && stop->load(std::memory_order_relaxed)) {
+                out.stopped = true;
+                break;
             }
-            const long size = std::fseek(f, 0, SEEK_END) == 0 ? std::ftell(f) : -1L;
-            const std::uint64_t extra = size > 0 && std::uint64_t(size) > end
-                                            ? std::uint64_t(size) - end
-                                            : std::uint64_t(s.avail_in);  // (at least)
-            found = std::to_string(extra) + (extra == 1 ? " byte" : " bytes") +
-                    " after the end of its gzip data at byte " + std::to_string(end) +
-                    (extra == 1 ? " is" : " are") +
-                    " no gzip stream (another file appended, or damage)";
-            break;
+            if (s.avail_in == 0 && !topUp()) {
+                out.damage = read_failed ? readError() : "unexpected end of file";
+                break;
+            }
+            s.next_out = out_buf.data();
+            s.avail_out = static_cast<uInt>(out_buf.size());
+            const int rc = inflate(&s, Z_NO_FLUSH);
+            if (rc == Z_STREAM_END) {
+                const std::uint64_t end = read - s.avail_in;  // where this member ends
+                if (gzipMagicNext()) {
+                    inflateReset(&s);
+                    continue;
+                }
+                if (read_failed) {
+                    out.damage = readError();
+                } else if (s.avail_in > 0) {
+                    const long size = std::fseek(f, 0, SEEK_END) == 0 ? std::ftell(f) : -1L;
+                    const std::uint64_t extra = size > 0 && std::uint64_t(size) > end
+                                                    ? std::uint64_t(size) - end
+                                                    : std::uint64_t(s.avail_in);  // (at least)
+                    out.trailing = std::to_string(extra) + (extra == 1 ? " byte" : " bytes") +
+                                   " after the end of its gzip data at byte " +
+                                   std::to_string(end) + (extra == 1 ? " is" : " are") +
+                                   " no gzip stream (another file appended, or damage)";
+                }
+                break;
+            }
+            if (rc == Z_DATA_ERROR) {
+                out.damage = s.msg != nullptr ? s.msg : "compressed data error";
+                break;
+            }
+            if (rc == Z_MEM_ERROR) {
+                out.damage = "out of memory";
+                break;
+            }
+            if (rc == Z_STREAM_ERROR || rc == Z_NEED_DICT) {
+                out.damage = "internal error: inflate stream corrupt";
+                break;
+            }
         }
-        if (rc != Z_OK && rc != Z_BUF_ERROR) break;  // damage: gzread says what
     }
     inflateEnd(&s);
     std::fclose(f);
-    return found;
+    return out;
 }
 
 std::string gzipDamage(const std::string& path) {
-    gzFile f = gzopen(path.c_str(), "rb");
-    if (f == nullptr) return "cannot open";
-    std::vector<char> buf(1 << 20);
-    int n = 0;
-    while ((n = gzread(f, buf.data(), static_cast<unsigned>(buf.size()))) > 0) {
-    }
-    int err = Z_OK;
-    const char* msg = gzerror(f, &err);
-    std::string out = (n < 0 || (err != Z_OK && err != Z_STREAM_END)) ? msg : "";
-    gzclose(f);
-    // zlib puts the file's name in front ("<path>: unexpected end of file"): the callers name
-    // it themselves, and it came out twice.
-    if (out.rfind(path + ": ", 0) == 0) out.erase(0, path.size() + 2);
-    return out;
+    return gzipCheck(path).damage;
 }
 
 std::string innermostMessage(const std::string& what) {
