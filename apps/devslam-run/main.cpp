@@ -282,7 +282,14 @@ int runOnce(const Args& a) {
         throw std::invalid_argument(
             "--replay with mode truth: the renderer's person truth is found by the frames' "
             "stamps, which the replay makes anew; replay another mode");
-    auto reader = openInput(a.input, l.reader, a.replay);
+    std::unique_ptr<io::RgbdReader> reader;
+    {
+        io::OpenProgressBar opening(a.input, a.quiet ? nullptr : stderr);
+        io::ReaderOptions ro = l.reader;
+        ro.on_open = opening.callback();
+        reader = openInput(a.input, ro, a.replay);
+        opening.finish();
+    }
     if (const std::string lost = reader->damage(); !lost.empty())
         std::cerr << "devslam-run: WARNING: running on the intact part of the input only: " << lost
                   << "\n";

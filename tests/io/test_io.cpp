@@ -7,6 +7,7 @@
 #include <devslam/io/VideoReader.h>
 
 #include <gtest/gtest.h>
+#include <zlib.h>
 
 #include <sys/stat.h>
 #include <mrpt/img/CImage.h>
@@ -629,6 +630,77 @@ TEST(Rawlog, FileCutAfterOpeningIsAnError) {
     // The broken stream cannot go on: the next call ends the input, and does not throw the
     // same error forever (devslam-convert --allow-damaged looped on it, growing).
     EXPECT_FALSE(r.next().has_value());
+}
+
+// Opening reads the whole rawlog (frames counted, zlib's check beside): a progress bar is
+// told each frame found and how far into the file's bytes the check is, ending with all of
+// them; an input that opens at once draws no bar, and a TUM folder never calls it.
+TEST(Rawlog, OpeningTellsItsProgress) {
+    TempDir d;
+    io::TumReader tum(kTum);
+    const std::string path = d.str("six.rawlog");
+    {
+        io::RawlogWriter w(path, {});
+        for (std::size_t i = 0; i < 6; ++i) w.write(tum.read(i));
+        w.close();
+    }
+    std::vector<std::size_t> frames;
+    std::uint64_t last_read = 0, total = 0;
+    bool bytes_in_order = true;
+    io::ReaderOptions ro;
+    ro.on_open = [&](std::size_t n, std::uint64_t read, std::uint64_t of) {
+        frames.push_back(n);
+        bytes_in_order = bytes_in_order && read >= last_read && read <= of;
+        last_read = read;
+        total = of;
+    };
+    std::FILE* out = std::tmpfile();
+    ASSERT_NE(out, nullptr);
+    {
+        io::OpenProgressBar bar(path, out);
+        ro.on_open = [&, inner = ro.on_open, cb = bar.callback()](std::size_t n, std::uint64_t r,
+                                                                  std::uint64_t of) {
+            inner(n, r, of);
+            cb(n, r, of);
+        };
+        const auto reader = io::openRgbd(path, ro);
+        bar.finish();
+        EXPECT_EQ(reader->size(), 6u);
+    }
+    EXPECT_EQ(frames, (std::vector<std::size_t>{1, 2, 3, 4, 5, 6, 6}));
+    EXPECT_TRUE(bytes_in_order);
+    EXPECT_EQ(total, fs::file_size(path));
+    EXPECT_EQ(last_read, total);
+    EXPECT_EQ(std::ftell(out), 0L) << "a bar for an input that opened at once";
+    std::fclose(out);
+    // A plain (not gzip) rawlog, which zlib's check does not read: the scan's own place.
+    const std::string plain = d.str("plain.rawlog");
+    {
+        gzFile in = gzopen(path.c_str(), "rb");
+        ASSERT_NE(in, nullptr);
+        std::ofstream o(plain, std::ios::binary);
+        std::vector<char> buf(1 << 16);
+        for (int n; (n = gzread(in, buf.data(), static_cast<unsigned>(buf.size()))) > 0;)
+            o.write(buf.data(), n);
+        gzclose(in);
+    }
+    frames.clear();
+    last_read = 0;
+    std::uint64_t first_read = 0;
+    ro.on_open = [&, inner = ro.on_open](std::size_t n, std::uint64_t r, std::uint64_t of) {
+        if (frames.empty()) first_read = r;
+        inner(n, r, of);
+    };
+    EXPECT_EQ(io::openRgbd(plain, ro)->size(), 6u);
+    EXPECT_EQ(frames, (std::vector<std::size_t>{1, 2, 3, 4, 5, 6, 6}));
+    EXPECT_TRUE(bytes_in_order);
+    EXPECT_EQ(total, fs::file_size(plain));
+    EXPECT_GT(total, fs::file_size(path));
+    EXPECT_NEAR(double(first_read), total / 6.0, total / 60.0) << "one frame of six read";
+    EXPECT_EQ(last_read, total);
+    frames.clear();
+    (void)io::openRgbd(kTum, ro);
+    EXPECT_TRUE(frames.empty());
 }
 
 TEST(Rawlog, LaterObservationsNameTheFileAndObservation) {

@@ -103,7 +103,7 @@ void writeGzFileWhole(const std::string& path, const std::string& kind,
 // gzread's gzerror gives, without reading the file a second time: a file not starting with
 // the gzip magic is no gzip (gzread copies it as it is); after a member, the magic starts the
 // next one, and anything else ends the stream (gzread drops it: `trailing` says what it was).
-GzipCheck gzipCheck(const std::string& path, const std::atomic<bool>* stop) {
+GzipCheck gzipCheck(const std::string& path, GzipCheckControl* control) {
     GzipCheck out;
     std::FILE* f = std::fopen(path.c_str(), "rb");
     if (f == nullptr) {
@@ -129,6 +129,7 @@ GzipCheck gzipCheck(const std::string& path, const std::atomic<bool>* stop) {
             read_errno = errno != 0 ? errno : EIO;
         }
         read += n;
+        if (control != nullptr) control->bytes_read.store(read, std::memory_order_relaxed);
         s.next_in = in.data();
         s.avail_in += static_cast<uInt>(n);
         return n > 0;
@@ -143,7 +144,7 @@ GzipCheck gzipCheck(const std::string& path, const std::atomic<bool>* stop) {
         if (read_failed) out.damage = readError();
     } else {
         for (;;) {
-            if (stop != nullptr && stop->load(std::memory_order_relaxed)) {
+            if (control != nullptr && control->stop.load(std::memory_order_relaxed)) {
                 out.stopped = true;
                 break;
             }

@@ -35,6 +35,7 @@ void ProgressBar::finish(const std::string& extra) {
 
 void ProgressBar::draw(std::size_t done, const std::string& extra, bool final_line) {
     if (out_ == nullptr) return;
+    shown_ = true;
     const double elapsed =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
     const double rate = elapsed > 0 ? static_cast<double>(done) / elapsed : 0.0;

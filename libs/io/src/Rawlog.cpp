@@ -20,6 +20,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstdio>
@@ -437,14 +438,32 @@ RawlogReader::RawlogReader(std::string path, ReaderOptions opts)
     // zlib's verdict on the whole file (damage inside it, data after its end), found on a
     // second thread beside the scan: reading a 700 MB rawlog through took 5 s on its own, as
     // long as the scan, and was done twice after it. Stopped when the scan fails otherwise.
-    std::atomic<bool> stop_check{false};
+    core::GzipCheckControl control;
     std::future<core::GzipCheck> check_future =
         std::async(std::launch::async | std::launch::deferred,
-                   [this, &stop_check] { return core::gzipCheck(path_, &stop_check); });
+                   [this, &control] { return core::gzipCheck(path_, &control); });
     struct StopOnExit {  // (destroyed before the future, whose destructor waits for it)
         std::atomic<bool>& stop;
         ~StopOnExit() { stop = true; }
-    } stop_on_exit{stop_check};
+    } stop_on_exit{control.stop};
+    // Progress: in a gzip file the check's place stands for the scan's (MRPT's stream tells no
+    // place in the compressed file; both read it through at about the same pace); a plain
+    // rawlog, which the check does not read, is as far as the scan.
+    const std::uint64_t file_bytes = fs::file_size(path_);
+    const bool gzip = [&] {
+        unsigned char magic[2] = {};
+        std::FILE* f = std::fopen(path_.c_str(), "rb");
+        const bool is =
+            f != nullptr && std::fread(magic, 1, 2, f) == 2 && magic[0] == 0x1f && magic[1] == 0x8b;
+        if (f != nullptr) std::fclose(f);
+        return is;
+    }();
+    const auto progress = [&](std::uint64_t plain_at) {
+        if (opts_.on_open)
+            opts_.on_open(n_frames_,
+                          std::min(file_bytes, gzip ? control.bytes_read.load() : plain_at),
+                          file_bytes);
+    };
     std::optional<core::GzipCheck> check;
     const auto checked = [&]() -> const core::GzipCheck& {
         if (!check) check = check_future.get();
@@ -487,12 +506,14 @@ RawlogReader::RawlogReader(std::string path, ReaderOptions opts)
                                          cameraChange(o->cameraParamsIntensity, first_cam));
             }
             ++n_frames_;
+            progress(s.file.getPosition());
         }
         if (const std::string& gz = checked().damage; !gz.empty())
             throw std::runtime_error("truncated or corrupt gzip stream (" + gz + ")");
         // (the frames before are whole: their gzip member's checksum held)
         if (const std::string& after = checked().trailing; !after.empty())
             throw std::runtime_error(after);
+        if (opts_.on_open) opts_.on_open(n_frames_, file_bytes, file_bytes);  // read through
     } catch (const MixedSensors&) {
         throw;
     } catch (const std::exception& e) {

@@ -37,6 +37,27 @@ void ReaderOptions::requireCameraName(const std::string& camera, const std::stri
     }
 }
 
+OpenProgressBar::OpenProgressBar(const std::string& path, std::FILE* out)
+    : label_("opening " + fs::path(path).filename().string()), out_(out) {}
+
+OpenProgressBar::~OpenProgressBar() {
+    if (bar_ && bar_->shown()) bar_->finish("(stopped)");
+}
+
+std::function<void(std::size_t, std::uint64_t, std::uint64_t)> OpenProgressBar::callback() {
+    return [this](std::size_t frames, std::uint64_t read, std::uint64_t total) {
+        constexpr double kMB = 1e6;
+        if (!bar_) bar_.emplace(label_, static_cast<std::size_t>(total / kMB + 0.5), out_);
+        frames_ = frames;
+        bar_->update(static_cast<std::size_t>(read / kMB + (read == total ? 0.5 : 0.0)),
+                     "MB read, " + std::to_string(frames) + " frames");
+    };
+}
+
+void OpenProgressBar::finish() {
+    if (bar_ && bar_->shown()) bar_->finish("MB read, " + std::to_string(frames_) + " frames");
+}
+
 std::unique_ptr<RgbdReader> openRgbd(const std::string& path, const ReaderOptions& opts) {
     // (error codes: a name too long or a folder that cannot be entered threw a bare
     // "filesystem error: status: ..." that named no option)

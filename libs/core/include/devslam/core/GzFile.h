@@ -80,9 +80,17 @@ struct GzipCheck {
     bool stopped = false;
 };
 
-/// Reads the file at `path` through once. `stop` (may be null), when it becomes true, ends the
-/// reading early (for a check run beside another reader that failed first).
-[[nodiscard]] GzipCheck gzipCheck(const std::string& path, const std::atomic<bool>* stop = nullptr);
+/// What a caller on another thread sees of a gzipCheck and may do to it.
+struct GzipCheckControl {
+    /// Set true to end the reading early (a check run beside another reader that failed
+    /// first); the check then returns with `stopped`.
+    std::atomic<bool> stop{false};
+    /// Bytes of the file read so far (for a progress bar).
+    std::atomic<std::uint64_t> bytes_read{0};
+};
+
+/// Reads the file at `path` through once; `control` may be null.
+[[nodiscard]] GzipCheck gzipCheck(const std::string& path, GzipCheckControl* control = nullptr);
 
 /// `gzipCheck(path).damage`.
 [[nodiscard]] std::string gzipDamage(const std::string& path);

@@ -22,6 +22,8 @@ class ProgressBar {
                 double min_interval_s = 0.25);
     void update(std::size_t done, const std::string& extra = {});
     void finish(const std::string& extra = {});
+    /// Whether a line has been drawn (update() draws only after the interval).
+    [[nodiscard]] bool shown() const { return shown_; }
 
   private:
     void draw(std::size_t done, const std::string& extra, bool final_line);
@@ -33,6 +35,7 @@ class ProgressBar {
     std::chrono::steady_clock::time_point start_, last_draw_;
     std::size_t last_done_ = 0;
     bool finished_ = false;
+    bool shown_ = false;
 };
 
 }  // namespace devslam::core

@@ -11,6 +11,11 @@
 #include <devslam/core/Frame.h>
 #include <devslam/core/Trajectory.h>
 
+#include <devslam/core/Progress.h>
+
+#include <cstdint>
+#include <cstdio>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <stdexcept>
@@ -38,6 +43,12 @@ struct ReaderOptions {
     /// disk) the frames before the damage, of a TUM folder the rgb-depth pairs whose listed
     /// images exist. Not an INI key: the command-line flag `--allow-damaged` sets it.
     bool allow_damaged = false;
+    /// Called while a rawlog is read through as it opens (after each RGB-D observation found,
+    /// and once more with bytes_read = bytes_total when it is read through and whole; a TUM
+    /// folder opens at once and never calls it): the frames found so far, and how far into the
+    /// file's bytes the reading is. For a progress bar (`OpenProgressBar`); not an INI key.
+    std::function<void(std::size_t frames, std::uint64_t bytes_read, std::uint64_t bytes_total)>
+        on_open;
 
     void loadFromConfig(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
     /// Throws std::invalid_argument "<what>: unknown camera preset '...' (known: ...) or auto"
@@ -85,6 +96,32 @@ class RgbdReader {
     /// What of the input could not be read and is left out ("" = nothing), with
     /// `ReaderOptions::allow_damaged`.
     [[nodiscard]] virtual std::string damage() const { return {}; }
+};
+
+/// A progress bar for an input that takes a while to open (a rawlog is read through to count
+/// its frames and check it: 6 s for 700 MB): "opening seq.rawlog [#####....] 350/705 MB ...
+/// 312 frames". Drawn only once opening has taken ProgressBar's interval, so an input that
+/// opens at once prints nothing.
+///   io::OpenProgressBar bar(path);
+///   opts.on_open = bar.callback();
+///   auto reader = io::openRgbd(path, opts);
+///   bar.finish();
+class OpenProgressBar {
+  public:
+    explicit OpenProgressBar(const std::string& path, std::FILE* out = stderr);
+    ~OpenProgressBar();  ///< ends a drawn line (an error printed after it starts its own)
+    OpenProgressBar(const OpenProgressBar&) = delete;
+    OpenProgressBar& operator=(const OpenProgressBar&) = delete;
+    /// For ReaderOptions::on_open; refers to this bar, which must outlive the opening.
+    [[nodiscard]] std::function<void(std::size_t, std::uint64_t, std::uint64_t)> callback();
+    /// Draws the last line when a line was drawn; else nothing.
+    void finish();
+
+  private:
+    std::string label_;
+    std::FILE* out_;
+    std::optional<core::ProgressBar> bar_;  // made at the first call (the size known then)
+    std::size_t frames_ = 0;
 };
 
 /// A TUM folder (has rgb.txt) or a `.rawlog` file, chosen by what `path` is. Throws
