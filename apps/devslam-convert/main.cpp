@@ -247,11 +247,19 @@ int convert(int argc, char** argv) {
         if (const int* rc = std::get_if<int>(&parsed)) return *rc;
         const Args& args = std::get<Args>(parsed);
         refuseOverwritingInput(args.input, args.output, args.wo.external_images);
-        devslam::io::OpenProgressBar opening(args.input);
-        devslam::io::ReaderOptions ro = args.ro;
-        ro.on_open = opening.callback();
-        auto reader = devslam::io::openRgbd(args.input, ro);
-        opening.finish();
+        std::unique_ptr<devslam::io::RgbdReader> reader;
+        try {
+            devslam::io::OpenProgressBar opening(args.input);
+            devslam::io::ReaderOptions ro = args.ro;
+            ro.on_open = opening.callback([] { return devslam::core::stopSignal() != 0; });
+            reader = devslam::io::openRgbd(args.input, ro);
+            opening.finish();
+        } catch (const devslam::io::OpeningStopped&) {
+            std::cerr << "devslam-convert: interrupted ("
+                      << devslam::core::signalName(devslam::core::stopSignal())
+                      << ") while opening the input; nothing written\n";
+            return 1;
+        }
         // Each observation of a rawlog carries its own camera: --camera was ignored, and the
         // output kept the rawlog's intrinsics without a word.
         if (args.ro.camera != "auto" && dynamic_cast<devslam::io::RawlogReader*>(reader.get()))

@@ -204,7 +204,7 @@ Input openInput(const Args& a) {
     } else {
         io::OpenProgressBar opening(a.input);
         io::ReaderOptions ro;
-        ro.on_open = opening.callback();
+        ro.on_open = opening.callback([] { return core::stopSignal() != 0; });
         in.reader = io::openRgbd(a.input, ro);
         opening.finish();
     }
@@ -275,7 +275,14 @@ int appMain(int argc, char** argv) {
             filter_source, [&] { return dynamic::makeFilterFromConfig(*cfg, mode_override); });
         const core::FolderClaim claim(a.out_dir);  // (two runs into it at once mixed overlays)
 
-        Input in = openInput(a);
+        Input in;
+        try {
+            in = openInput(a);
+        } catch (const io::OpeningStopped&) {  // (main ends by the signal, the claim let go)
+            std::cerr << "devslam-overlay: interrupted (" << core::signalName(core::stopSignal())
+                      << ") while opening the input; nothing written\n";
+            return 1;
+        }
         core::ProgressBar bar("overlay", in.total);
         std::size_t k = 0, written = 0;
         while (!core::stopSignal()) {
@@ -339,5 +346,8 @@ int appMain(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
-    return core::withStandardOutput("devslam-overlay", appMain(argc, argv));
+    const int rc = appMain(argc, argv);
+    // Stopped by Ctrl-C: end by the signal, so that a shell script running this stops too.
+    if (const int sig = core::stopSignal()) core::exitBySignal(sig);
+    return core::withStandardOutput("devslam-overlay", rc);
 }

@@ -283,12 +283,16 @@ int runOnce(const Args& a) {
             "--replay with mode truth: the renderer's person truth is found by the frames' "
             "stamps, which the replay makes anew; replay another mode");
     std::unique_ptr<io::RgbdReader> reader;
-    {
+    try {
         io::OpenProgressBar opening(a.input, a.quiet ? nullptr : stderr);
         io::ReaderOptions ro = l.reader;
-        ro.on_open = opening.callback();
+        ro.on_open = opening.callback([] { return core::stopSignal() != 0; });
         reader = openInput(a.input, ro, a.replay);
         opening.finish();
+    } catch (const io::OpeningStopped&) {
+        std::cerr << "devslam-run: interrupted (" << core::signalName(core::stopSignal())
+                  << ") while opening the input; nothing written\n";
+        return 1;
     }
     if (const std::string lost = reader->damage(); !lost.empty())
         std::cerr << "devslam-run: WARNING: running on the intact part of the input only: " << lost

@@ -653,6 +653,7 @@ TEST(Rawlog, OpeningTellsItsProgress) {
         bytes_in_order = bytes_in_order && read >= last_read && read <= of;
         last_read = read;
         total = of;
+        return true;
     };
     std::FILE* out = std::tmpfile();
     ASSERT_NE(out, nullptr);
@@ -660,8 +661,7 @@ TEST(Rawlog, OpeningTellsItsProgress) {
         io::OpenProgressBar bar(path, out);
         ro.on_open = [&, inner = ro.on_open, cb = bar.callback()](std::size_t n, std::uint64_t r,
                                                                   std::uint64_t of) {
-            inner(n, r, of);
-            cb(n, r, of);
+            return inner(n, r, of) && cb(n, r, of);
         };
         const auto reader = io::openRgbd(path, ro);
         bar.finish();
@@ -689,7 +689,7 @@ TEST(Rawlog, OpeningTellsItsProgress) {
     std::uint64_t first_read = 0;
     ro.on_open = [&, inner = ro.on_open](std::size_t n, std::uint64_t r, std::uint64_t of) {
         if (frames.empty()) first_read = r;
-        inner(n, r, of);
+        return inner(n, r, of);
     };
     EXPECT_EQ(io::openRgbd(plain, ro)->size(), 6u);
     EXPECT_EQ(frames, (std::vector<std::size_t>{1, 2, 3, 4, 5, 6, 6}));
@@ -701,6 +701,16 @@ TEST(Rawlog, OpeningTellsItsProgress) {
     frames.clear();
     (void)io::openRgbd(kTum, ro);
     EXPECT_TRUE(frames.empty());
+    // Asked to stop (Ctrl-C): the opening ends there, neither as damage nor as a reader.
+    int calls = 0;
+    ro.on_open = [&](std::size_t, std::uint64_t, std::uint64_t) { return ++calls < 3; };
+    expectError<io::OpeningStopped>(
+        [&] { (void)io::openRgbd(path, ro); },
+        "six\\.rawlog: opening stopped after 3 RGB-D observations of it were found");
+    // A bar's callback stops it when told to.
+    io::OpenProgressBar bar(path, nullptr);
+    ro.on_open = bar.callback([] { return true; });
+    EXPECT_THROW((void)io::openRgbd(path, ro), io::OpeningStopped);
 }
 
 TEST(Rawlog, LaterObservationsNameTheFileAndObservation) {

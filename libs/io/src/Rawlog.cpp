@@ -458,11 +458,10 @@ RawlogReader::RawlogReader(std::string path, ReaderOptions opts)
         if (f != nullptr) std::fclose(f);
         return is;
     }();
-    const auto progress = [&](std::uint64_t plain_at) {
-        if (opts_.on_open)
-            opts_.on_open(n_frames_,
-                          std::min(file_bytes, gzip ? control.bytes_read.load() : plain_at),
-                          file_bytes);
+    const auto progress = [&](std::uint64_t at) {
+        if (opts_.on_open && !opts_.on_open(n_frames_, at, file_bytes))
+            throw OpeningStopped(path_ + ": opening stopped after " + std::to_string(n_frames_) +
+                                 " RGB-D observations of it were found");
     };
     std::optional<core::GzipCheck> check;
     const auto checked = [&]() -> const core::GzipCheck& {
@@ -506,15 +505,17 @@ RawlogReader::RawlogReader(std::string path, ReaderOptions opts)
                                          cameraChange(o->cameraParamsIntensity, first_cam));
             }
             ++n_frames_;
-            progress(s.file.getPosition());
+            progress(std::min(file_bytes, gzip ? control.bytes_read.load() : s.file.getPosition()));
         }
         if (const std::string& gz = checked().damage; !gz.empty())
             throw std::runtime_error("truncated or corrupt gzip stream (" + gz + ")");
         // (the frames before are whole: their gzip member's checksum held)
         if (const std::string& after = checked().trailing; !after.empty())
             throw std::runtime_error(after);
-        if (opts_.on_open) opts_.on_open(n_frames_, file_bytes, file_bytes);  // read through
+        progress(file_bytes);  // read through
     } catch (const MixedSensors&) {
+        throw;
+    } catch (const OpeningStopped&) {
         throw;
     } catch (const std::exception& e) {
         damage_ =

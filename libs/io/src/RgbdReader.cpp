@@ -44,13 +44,16 @@ OpenProgressBar::~OpenProgressBar() {
     if (bar_ && bar_->shown()) bar_->finish("(stopped)");
 }
 
-std::function<void(std::size_t, std::uint64_t, std::uint64_t)> OpenProgressBar::callback() {
-    return [this](std::size_t frames, std::uint64_t read, std::uint64_t total) {
+std::function<bool(std::size_t, std::uint64_t, std::uint64_t)> OpenProgressBar::callback(
+    std::function<bool()> stop) {
+    return [this, stop = std::move(stop)](std::size_t frames, std::uint64_t read,
+                                          std::uint64_t total) {
         constexpr double kMB = 1e6;
         if (!bar_) bar_.emplace(label_, static_cast<std::size_t>(total / kMB + 0.5), out_);
         frames_ = frames;
         bar_->update(static_cast<std::size_t>(read / kMB + (read == total ? 0.5 : 0.0)),
                      "MB read, " + std::to_string(frames) + " frames");
+        return !(stop && stop());
     };
 }
 

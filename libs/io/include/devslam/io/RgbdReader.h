@@ -46,8 +46,9 @@ struct ReaderOptions {
     /// Called while a rawlog is read through as it opens (after each RGB-D observation found,
     /// and once more with bytes_read = bytes_total when it is read through and whole; a TUM
     /// folder opens at once and never calls it): the frames found so far, and how far into the
-    /// file's bytes the reading is. For a progress bar (`OpenProgressBar`); not an INI key.
-    std::function<void(std::size_t frames, std::uint64_t bytes_read, std::uint64_t bytes_total)>
+    /// file's bytes the reading is. For a progress bar (`OpenProgressBar`) and Ctrl-C: false
+    /// stops the opening, which throws OpeningStopped. Not an INI key.
+    std::function<bool(std::size_t frames, std::uint64_t bytes_read, std::uint64_t bytes_total)>
         on_open;
 
     void loadFromConfig(const mrpt::config::CConfigFileBase& cfg, const std::string& section);
@@ -67,6 +68,13 @@ class DamagedInput : public std::runtime_error {
 
   private:
     std::size_t intact_;
+};
+
+/// Thrown while an input opens when ReaderOptions::on_open asked to stop (a Ctrl-C during
+/// the minutes a large rawlog may take): nothing of the input was read.
+class OpeningStopped : public std::runtime_error {
+  public:
+    using std::runtime_error::runtime_error;
 };
 
 /// Thrown by next() when no frame after this point can be read (a rawlog cut or written over
@@ -103,7 +111,7 @@ class RgbdReader {
 /// 312 frames". Drawn only once opening has taken ProgressBar's interval, so an input that
 /// opens at once prints nothing.
 ///   io::OpenProgressBar bar(path);
-///   opts.on_open = bar.callback();
+///   opts.on_open = bar.callback([] { return core::stopSignal() != 0; });
 ///   auto reader = io::openRgbd(path, opts);
 ///   bar.finish();
 class OpenProgressBar {
@@ -112,8 +120,10 @@ class OpenProgressBar {
     ~OpenProgressBar();  ///< ends a drawn line (an error printed after it starts its own)
     OpenProgressBar(const OpenProgressBar&) = delete;
     OpenProgressBar& operator=(const OpenProgressBar&) = delete;
-    /// For ReaderOptions::on_open; refers to this bar, which must outlive the opening.
-    [[nodiscard]] std::function<void(std::size_t, std::uint64_t, std::uint64_t)> callback();
+    /// For ReaderOptions::on_open; refers to this bar, which must outlive the opening. The
+    /// opening stops when `stop` (if given) returns true.
+    [[nodiscard]] std::function<bool(std::size_t, std::uint64_t, std::uint64_t)> callback(
+        std::function<bool()> stop = {});
     /// Draws the last line when a line was drawn; else nothing.
     void finish();
 
