@@ -102,6 +102,15 @@ std::vector<core::Frame> intactFrames(const std::string& path, std::size_t n) {
     return frames;
 }
 
+/// Writes the first `n` shipped TUM frames as a rawlog at `path`.
+void writeShippedRawlog(const std::string& path, std::size_t n,
+                        const io::RawlogWriterOptions& wo = {}) {
+    io::TumReader tum(kTum);
+    io::RawlogWriter w(path, wo);
+    for (std::size_t i = 0; i < n; ++i) w.write(tum.read(i));
+    w.close();
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------- TUM folders
@@ -605,13 +614,8 @@ TEST(Rawlog, TruncatedFileReportsWhatWasRead) {
 // file, not a quiet early end that would pass for a shorter sequence.
 TEST(Rawlog, FileCutAfterOpeningIsAnError) {
     TempDir d;
-    io::TumReader tum(kTum);
     const std::string path = d.str("cut.rawlog");
-    {
-        io::RawlogWriter w(path, {});
-        for (std::size_t i = 0; i < 6; ++i) w.write(tum.read(i));
-        w.close();
-    }
+    writeShippedRawlog(path, 6);
     io::RawlogReader r(path);
     ASSERT_EQ(r.size(), 6u);
     fs::resize_file(path, fs::file_size(path) / 2);
@@ -637,13 +641,8 @@ TEST(Rawlog, FileCutAfterOpeningIsAnError) {
 // them; an input that opens at once draws no bar, and a TUM folder never calls it.
 TEST(Rawlog, OpeningTellsItsProgress) {
     TempDir d;
-    io::TumReader tum(kTum);
     const std::string path = d.str("six.rawlog");
-    {
-        io::RawlogWriter w(path, {});
-        for (std::size_t i = 0; i < 6; ++i) w.write(tum.read(i));
-        w.close();
-    }
+    writeShippedRawlog(path, 6);
     std::vector<std::size_t> frames;
     std::uint64_t last_read = 0, total = 0;
     bool bytes_in_order = true;
@@ -717,15 +716,10 @@ TEST(Rawlog, LaterObservationsNameTheFileAndObservation) {
     // The reader decodes only observation 0's images up front; a damaged later one must still
     // be named (file and observation), not surface as a bare MRPT or OpenCV message.
     TempDir d;
-    io::TumReader tum(kTum);
     io::RawlogWriterOptions wo;
     wo.external_images = true;
     const std::string path = d.str("ext.rawlog");
-    {
-        io::RawlogWriter w(path, wo);
-        for (std::size_t i = 0; i < 3; ++i) w.write(tum.read(i));
-        w.close();
-    }
+    writeShippedRawlog(path, 3, wo);
     // A file that is there but does not decode is found when its frame is read, and named: a
     // zero-byte one gave MRPT's banner alone ("==== MRPT exception ====").
     writeText(d.str("ext_Images/frame_1_rgb.png"), "");
