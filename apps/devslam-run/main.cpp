@@ -241,8 +241,11 @@ Loaded loadConfig(const Args& a, const std::vector<std::string>& extra_sets = {}
 }
 
 /// The input reader, wrapped in a ReplayReader when asked.
-std::unique_ptr<io::RgbdReader> openInput(const std::string& input, const io::ReaderOptions& ro,
+std::unique_ptr<io::RgbdReader> openInput(const std::string& input, io::ReaderOptions ro,
                                           int replay) {
+    // A Ctrl-C while a rawlog is read through as it opens stops it there (io::OpeningStopped).
+    if (!ro.on_open)
+        ro.on_open = [](std::size_t, std::uint64_t, std::uint64_t) { return !core::stopSignal(); };
     auto reader = io::openRgbd(input, ro);
     if (replay <= 0) return reader;
     return std::make_unique<run::ReplayReader>(*reader, replay);
@@ -460,7 +463,7 @@ std::string benchModes(const Args& a) {
         ModeRuns runs;
         for (int r = 0; r < a.bench; ++r) {
             auto l = loadConfig(a);
-            auto reader = io::openRgbd(a.input, l.reader);
+            auto reader = openInput(a.input, l.reader, 0);
             const auto rc = runConfig(a, l, mode);
             const auto rep = run::runSequence(*reader, rc, *l.cfg, *l.filter_cfg);
             requireWhole(rep);
@@ -492,7 +495,7 @@ std::string benchAblations(const Args& a) {
     };
     for (const auto& [name, sets] : ablations) {
         auto l = loadConfig(a, sets);
-        auto reader = io::openRgbd(a.input, l.reader);
+        auto reader = openInput(a.input, l.reader, 0);
         const auto rc = runConfig(a, l, "none");
         const auto rep = run::runSequence(*reader, rc, *l.cfg, *l.filter_cfg);
         requireWhole(rep);
@@ -508,7 +511,7 @@ std::string benchAblations(const Args& a) {
 std::string benchLongRun(const Args& a) {
     constexpr int kPasses = 9;
     auto l = loadConfig(a);
-    auto src = io::openRgbd(a.input, l.reader);
+    auto src = openInput(a.input, l.reader, 0);
     run::ReplayReader reader(*src, kPasses);
     auto rc = runConfig(a, l, "dynamic");
     rc.max_frames = 0;       // every replayed frame

@@ -123,10 +123,11 @@ GzipCheck gzipCheck(const std::string& path, GzipCheckControl* control) {
     const auto topUp = [&] {  // keeps what is left of `in` and reads more after it
         std::memmove(in.data(), s.next_in, s.avail_in);
         errno = 0;
-        const std::size_t n = std::fread(in.data() + s.avail_in, 1, in.size() - s.avail_in, f);
-        if (n == 0 && std::ferror(f) != 0 && !read_failed) {
+        std::size_t n = std::fread(in.data() + s.avail_in, 1, in.size() - s.avail_in, f);
+        if (std::ferror(f) != 0) {  // as gzread: what came with the failed read is not used
+            if (!read_failed) read_errno = errno != 0 ? errno : EIO;
             read_failed = true;
-            read_errno = errno != 0 ? errno : EIO;
+            n = 0;
         }
         read += n;
         if (control != nullptr) control->bytes_read.store(read, std::memory_order_relaxed);

@@ -463,9 +463,18 @@ RawlogReader::RawlogReader(std::string path, ReaderOptions opts)
             throw OpeningStopped(path_ + ": opening stopped after " + std::to_string(n_frames_) +
                                  " RGB-D observations of it were found");
     };
+    // The check's verdict, waited for; the wait is a part of the opening too, shown and
+    // stoppable (a scan that broke early, on a camera change, waits for the whole file).
     std::optional<core::GzipCheck> check;
     const auto checked = [&]() -> const core::GzipCheck& {
-        if (!check) check = check_future.get();
+        if (check) return *check;
+        while (check_future.wait_for(std::chrono::milliseconds(100)) == std::future_status::timeout)
+            progress(std::min(file_bytes, control.bytes_read.load()));
+        try {
+            check = check_future.get();
+        } catch (const std::exception& e) {  // (its buffers not had: out of memory)
+            check = core::GzipCheck{std::string("zlib's check failed: ") + e.what(), "", false};
+        }
         return *check;
     };
     try {
@@ -555,6 +564,7 @@ RawlogReader::RawlogReader(std::string path, ReaderOptions opts)
         K_ = K;
     }
     stream_ = std::make_unique<Stream>(path_);
+    opts_.on_open = nullptr;  // (for the opening only: it may refer to a progress bar now gone)
 }
 
 RawlogReader::~RawlogReader() = default;

@@ -41,18 +41,21 @@ OpenProgressBar::OpenProgressBar(const std::string& path, std::FILE* out)
     : label_("opening " + fs::path(path).filename().string()), out_(out) {}
 
 OpenProgressBar::~OpenProgressBar() {
-    if (bar_ && bar_->shown()) bar_->finish("(stopped)");
+    if (bar_ && bar_->shown()) bar_->finish("(not opened)");
 }
 
 std::function<bool(std::size_t, std::uint64_t, std::uint64_t)> OpenProgressBar::callback(
     std::function<bool()> stop) {
     return [this, stop = std::move(stop)](std::size_t frames, std::uint64_t read,
                                           std::uint64_t total) {
-        constexpr double kMB = 1e6;
-        if (!bar_) bar_.emplace(label_, static_cast<std::size_t>(total / kMB + 0.5), out_);
+        // (whole MB, the file's size rounded up: a file under 1 MB is 1, and read through it
+        // is all of it)
+        const auto mb = [](std::uint64_t bytes, bool up) {
+            return static_cast<std::size_t>((bytes + (up ? 999999 : 0)) / 1000000);
+        };
+        if (!bar_) bar_.emplace(label_, mb(total, true), out_);
         frames_ = frames;
-        bar_->update(static_cast<std::size_t>(read / kMB + (read == total ? 0.5 : 0.0)),
-                     "MB read, " + std::to_string(frames) + " frames");
+        bar_->update(mb(read, read == total), "MB read, " + std::to_string(frames) + " frames");
         return !(stop && stop());
     };
 }

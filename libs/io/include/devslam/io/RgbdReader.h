@@ -71,7 +71,7 @@ class DamagedInput : public std::runtime_error {
 };
 
 /// Thrown while an input opens when ReaderOptions::on_open asked to stop (a Ctrl-C during
-/// the minutes a large rawlog may take): nothing of the input was read.
+/// the minutes a large rawlog may take): no reader is made.
 class OpeningStopped : public std::runtime_error {
   public:
     using std::runtime_error::runtime_error;
