@@ -646,21 +646,20 @@ TEST(Rawlog, OpeningTellsItsProgress) {
     std::vector<std::size_t> frames;
     std::uint64_t last_read = 0, total = 0;
     bool bytes_in_order = true;
-    io::ReaderOptions ro;
-    ro.on_open = [&](std::size_t n, std::uint64_t read, std::uint64_t of) {
+    const auto count = [&](std::size_t n, std::uint64_t read, std::uint64_t of) {
         frames.push_back(n);
         bytes_in_order = bytes_in_order && read >= last_read && read <= of;
         last_read = read;
         total = of;
         return true;
     };
+    io::ReaderOptions ro;
     std::FILE* out = std::tmpfile();
     ASSERT_NE(out, nullptr);
     {
         io::OpenProgressBar bar(path, out);
-        ro.on_open = [&, inner = ro.on_open, cb = bar.callback()](std::size_t n, std::uint64_t r,
-                                                                  std::uint64_t of) {
-            return inner(n, r, of) && cb(n, r, of);
+        ro.on_open = [&, cb = bar.callback()](std::size_t n, std::uint64_t r, std::uint64_t of) {
+            return count(n, r, of) && cb(n, r, of);
         };
         const auto reader = io::openRgbd(path, ro);
         bar.finish();
@@ -686,9 +685,9 @@ TEST(Rawlog, OpeningTellsItsProgress) {
     frames.clear();
     last_read = 0;
     std::uint64_t first_read = 0;
-    ro.on_open = [&, inner = ro.on_open](std::size_t n, std::uint64_t r, std::uint64_t of) {
+    ro.on_open = [&](std::size_t n, std::uint64_t r, std::uint64_t of) {
         if (frames.empty()) first_read = r;
-        return inner(n, r, of);
+        return count(n, r, of);
     };
     EXPECT_EQ(io::openRgbd(plain, ro)->size(), 6u);
     EXPECT_EQ(frames, (std::vector<std::size_t>{1, 2, 3, 4, 5, 6, 6}));
