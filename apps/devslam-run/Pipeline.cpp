@@ -173,6 +173,7 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
 
     RunReport rep;
     rep.input = rc.input;
+    rep.truth_file = rc.truth_file;
     rep.input_damage = reader.damage();
     rep.mode = rc.mode;
     rep.mask_source = masks->describe();
@@ -580,6 +581,7 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
 std::string formatSummary(const RunReport& r) {
     std::ostringstream o;
     o << "input      : " << r.input << "\n";
+    if (!r.truth_file.empty()) o << "truth      : " << r.truth_file << " (--groundtruth)\n";
     if (!r.input_damage.empty()) o << "left out   : " << r.input_damage << "\n";
     if (!r.undecodable.empty())
         o << "left out   : " << r.undecodable.size()
@@ -725,16 +727,16 @@ std::string toJson(const RunReport& r) {
         }
         return e;
     };
-    o << "{\n  \"input\": \"" << esc(r.input) << "\",\n  \"input_damage\": \""
-      << esc(r.input_damage) << "\",\n  \"read_error\": \"" << esc(r.read_error)
-      << "\",\n  \"interrupted\": \"" << r.interrupted << "\",\n  \"mode\": \"" << r.mode
-      << "\",\n  \"mask_source\": \"" << esc(r.mask_source) << "\",\n  \"frames\": " << r.frames
+    o << "{\n  \"input\": \"" << esc(r.input) << "\",\n  \"groundtruth_file\": \""
+      << esc(r.truth_file) << "\",\n  \"input_damage\": \"" << esc(r.input_damage)
+      << "\",\n  \"read_error\": \"" << esc(r.read_error) << "\",\n  \"interrupted\": \""
+      << r.interrupted << "\",\n  \"mode\": \"" << r.mode << "\",\n  \"mask_source\": \""
+      << esc(r.mask_source) << "\",\n  \"frames\": " << r.frames
       << ",\n  \"keyframes\": " << r.keyframes
       << ",\n  \"keyframes_culled\": " << r.keyframes_culled
-      << ",\n  \"landmarks\": " << r.landmarks
-      << ",\n  \"local_ba_runs\": " << r.ba_runs << ",\n  \"local_ba_rejected\": " << r.ba_rejected
-      << ",\n  \"loops_closed\": " << r.loops << ",\n  \"lost_frames\": " << r.lost.size()
-      << ",\n  \"lost_frame_indices\": [";
+      << ",\n  \"landmarks\": " << r.landmarks << ",\n  \"local_ba_runs\": " << r.ba_runs
+      << ",\n  \"local_ba_rejected\": " << r.ba_rejected << ",\n  \"loops_closed\": " << r.loops
+      << ",\n  \"lost_frames\": " << r.lost.size() << ",\n  \"lost_frame_indices\": [";
     for (std::size_t i = 0; i < r.lost.size(); ++i) o << (i ? ", " : "") << r.lost[i];
     o << "],\n  \"median_fps\": " << num(r.median_fps, 2)
       << ",\n  \"median_cpu_ms\": " << num(r.median_cpu_ms, 3)

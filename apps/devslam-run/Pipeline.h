@@ -17,6 +17,7 @@ namespace devslam::run {
 
 struct RunConfig {
     std::string input;  ///< TUM folder or .rawlog
+    std::string truth_file;  ///< where the reader's ground truth came from, if not the input
     std::string mode = "dynamic";
     /// Named in front of the "[section] key: ..." errors of the SLAM INI (`cfg`) and of the
     /// filter's (`filter_cfg`): the files, and what was written over them.
@@ -79,6 +80,7 @@ struct LoopReport {
 struct RunReport {
     std::string input, mode, camera, mask_source;
     std::string input_damage;  ///< what of the input was unreadable and left out ("" = none)
+    std::string truth_file;    ///< RunConfig::truth_file
     /// A frame that failed to read during the run, or whose mask or person truth failed
     /// ("" = none): the run stopped there and its outputs hold the frames before it.
     std::string read_error;

@@ -5,6 +5,7 @@
 //   devslam-run --input DIR|FILE.rawlog --mode none|all_persons|dynamic|truth
 //               --config config_ini/slam_tum_fr1.ini --out DIR
 //   devslam-run --bench 5                         # all modes x 5 runs -> docs/RESULTS.md
+#include "GivenTruthReader.h"
 #include "MaskSource.h"
 #include "Pipeline.h"
 #include "ReplayReader.h"
@@ -14,6 +15,7 @@
 #include <devslam/core/Parse.h>
 #include <devslam/core/Results.h>
 #include <devslam/core/Stats.h>
+#include <devslam/io/TrajectoryIO.h>
 
 #include <algorithm>
 #include <filesystem>
@@ -32,6 +34,8 @@ const char* kUsage =
     "usage: devslam-run [--input PATH] [--mode none|all_persons|dynamic|truth] [--config INI]\n"
     "                   [--out DIR] [--max-frames N] [--quiet] [--set SECTION.KEY=VALUE]...\n"
     "                   [--replay N]  (play the input forward/backward N times)\n"
+    "                   [--groundtruth FILE]  (TUM trajectory to score against: a rawlog\n"
+    "                                          holds none; replaces a TUM folder's)\n"
     "                   [--check-config]  (read the INIs as a run would, make the filter,\n"
     "                                      print 'ok' and stop; reads no frame, only\n"
     "                                      the camera of an input that exists)\n"
@@ -64,6 +68,7 @@ struct Args {
     std::string section = "slam";   ///< RESULTS.md section written by --bench
     bool modes_only = false;        ///< --bench without the ablation and the long run
     bool allow_damaged = false;     ///< a damaged input: run on what is intact
+    std::string groundtruth;        ///< --groundtruth: the input's ground truth from this file
     bool check_config = false;      ///< --check-config: the INIs only, no run
     bool out_given = false;         ///< --out was on the command line
     bool results_given = false;     ///< --results was on the command line
@@ -105,7 +110,10 @@ Args parse(int argc, char** argv) {
             a.sets.push_back(value(i));
         else if (k == "--allow-damaged")
             a.allow_damaged = true;
-        else if (k == "--check-config")
+        else if (k == "--groundtruth") {
+            a.groundtruth = value(i);
+            if (a.groundtruth.empty()) throw std::invalid_argument("--groundtruth: no file named");
+        } else if (k == "--check-config")
             a.check_config = true;
         else if (k == "-h" || k == "--help") {
             std::cout << kUsage;
@@ -115,6 +123,9 @@ Args parse(int argc, char** argv) {
     }
     if (a.check_config && a.bench > 0)
         throw std::invalid_argument("--check-config does not go with --bench");
+    if (!a.groundtruth.empty() && a.bench > 0)
+        throw std::invalid_argument(
+            "--groundtruth does not go with --bench (its inputs carry their own)");
     // Found now, not when the run's results are written (after the whole run): a file where
     // the folder or one above it goes, or a folder it cannot be made in. Nothing is created.
     // (--bench writes no run folder: its default --out, relative to where it was started,
@@ -242,11 +253,15 @@ Loaded loadConfig(const Args& a, const std::vector<std::string>& extra_sets = {}
 
 /// The input reader, wrapped in a ReplayReader when asked.
 std::unique_ptr<io::RgbdReader> openInput(const std::string& input, io::ReaderOptions ro,
-                                          int replay) {
+                                          int replay,
+                                          const std::optional<core::Trajectory>& truth = {},
+                                          const std::string& truth_path = {}) {
     // A Ctrl-C while a rawlog is read through as it opens stops it there (io::OpeningStopped).
     if (!ro.on_open)
         ro.on_open = [](std::size_t, std::uint64_t, std::uint64_t) { return !core::stopSignal(); };
-    auto reader = io::openRgbd(input, ro);
+    std::unique_ptr<io::RgbdReader> reader = io::openRgbd(input, ro);
+    if (truth)  // (before the replay, which maps it with the frames)
+        reader = std::make_unique<run::GivenTruthReader>(std::move(reader), *truth, truth_path);
     if (replay <= 0) return reader;
     return std::make_unique<run::ReplayReader>(*reader, replay);
 }
@@ -270,6 +285,7 @@ run::RunConfig runConfig(const Args& a, const Loaded& l, const std::string& mode
 /// frame size of an input that exists (its camera, no frame read) against the filter's.
 int checkOnly(const Args& a) {
     const auto l = loadConfig(a);
+    if (!a.groundtruth.empty()) (void)io::readTumTrajectory(a.groundtruth);
     std::optional<core::CameraIntrinsics> camera;
     if (fs::exists(a.input)) camera = openInput(a.input, l.reader, 0)->intrinsics();
     run::checkConfig(runConfig(a, l, l.mode), *l.cfg, *l.filter_cfg, camera);
@@ -285,12 +301,15 @@ int runOnce(const Args& a) {
         throw std::invalid_argument(
             "--replay with mode truth: the renderer's person truth is found by the frames' "
             "stamps, which the replay makes anew; replay another mode");
+    // Read before the input, which may take seconds to open: a bad file is named at once.
+    std::optional<core::Trajectory> truth;
+    if (!a.groundtruth.empty()) truth = io::readTumTrajectory(a.groundtruth);
     std::unique_ptr<io::RgbdReader> reader;
     try {
         io::OpenProgressBar opening(a.input, a.quiet ? nullptr : stderr);
         io::ReaderOptions ro = l.reader;
         ro.on_open = opening.callback([] { return core::stopSignal() != 0; });
-        reader = openInput(a.input, ro, a.replay);
+        reader = openInput(a.input, ro, a.replay, truth, a.groundtruth);
         opening.finish();
     } catch (const io::OpeningStopped&) {
         std::cerr << "devslam-run: interrupted (" << core::signalName(core::stopSignal())
@@ -302,6 +321,7 @@ int runOnce(const Args& a) {
                   << "\n";
     auto rc = runConfig(a, l, l.mode);
     rc.out_dir = a.out;
+    rc.truth_file = a.groundtruth;
     rc.progress = !a.quiet;
     rc.allow_damaged = a.allow_damaged;
     rc.score_masks = a.replay <= 0;

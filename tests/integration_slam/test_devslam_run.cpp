@@ -733,6 +733,58 @@ TEST(DevslamRun, TruncatedRawlogRunsOnItsIntactPartWhenAsked) {
     fs::remove_all(dir);
 }
 
+// A rawlog holds no ground truth (the TUM rawlogs MRPT publishes come with it beside them):
+// --groundtruth gives it, and the run is scored as the same frames in a TUM folder are. A bad
+// file is named before the input is opened.
+TEST(DevslamRun, ARawlogIsScoredAgainstTheGroundTruthGivenBesideIt) {
+    const fs::path dir = devslam::test::scratchPath("devslam_run_given_truth");
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    const std::string tum = std::string(DEVSLAM_SOURCE_DIR) + "/data/tum/fr1_xyz_first37";
+    const fs::path rawlog = dir / "fr1.rawlog";
+    const std::string convert = std::string(DEVSLAM_BIN_DIR) + "/devslam-convert " + tum + " " +
+                                rawlog.string() + " --max-frames 12 > /dev/null 2>&1";
+    ASSERT_EQ(std::system(convert.c_str()), 0) << convert;
+    const auto ateLine = [](const std::string& out) {
+        const auto at = out.find("ATE        :");
+        return at == std::string::npos ? std::string() : out.substr(at, out.find('\n', at) - at);
+    };
+    auto bare = run("--input " + rawlog.string() + " --mode none --quiet --out ''");
+    ASSERT_EQ(bare.rc, 0) << bare.out;
+    EXPECT_EQ(ateLine(bare.out), "ATE        : no ground truth");
+    const std::string gt = tum + "/groundtruth.txt";
+    // (The rawlog keeps one stamp per frame, not the depth images' own, which the depth-time
+    // compensation uses on the folder: off, the two runs are the same.)
+    const std::string same = " --set mapping.depth_time_compensation=false";
+    auto given = run("--input " + rawlog.string() + " --groundtruth " + gt + same +
+                     " --mode none --quiet --out " + (dir / "given").string());
+    ASSERT_EQ(given.rc, 0) << given.out;
+    EXPECT_NE(given.out.find("truth      : " + gt + " (--groundtruth)"), std::string::npos)
+        << given.out;
+    auto folder =
+        run("--input " + tum + " --max-frames 12" + same + " --mode none --quiet --out ''");
+    ASSERT_EQ(folder.rc, 0) << folder.out;
+    ASSERT_NE(ateLine(folder.out).find("RMSE"), std::string::npos) << folder.out;
+    EXPECT_EQ(ateLine(given.out), ateLine(folder.out));
+    EXPECT_NE(readText(dir / "given" / "run.json").find("\"groundtruth_file\": \"" + gt + "\""),
+              std::string::npos);
+    EXPECT_TRUE(fs::exists(dir / "given" / "trajectory.png"));
+    // A bad file, named with its line, before the input is read; none with --bench.
+    std::ofstream(dir / "bad.txt") << "1305031102.175304 1 2 3\n";
+    auto bad = run("--input /no/such/input --groundtruth " + (dir / "bad.txt").string() +
+                   " --quiet --out ''");
+    EXPECT_EQ(bad.rc, 1);
+    EXPECT_NE(bad.out.find((dir / "bad.txt").string() + " line 1: expected 'timestamp tx ty tz "
+                                                        "qx qy qz qw' (8 values), got 4"),
+              std::string::npos)
+        << bad.out;
+    auto bench = run("--bench 1 --groundtruth " + gt + " --results none");
+    EXPECT_EQ(bench.rc, 1);
+    EXPECT_NE(bench.out.find("--groundtruth does not go with --bench"), std::string::npos)
+        << bench.out;
+    fs::remove_all(dir);
+}
+
 // Ctrl-C stops a run after the frame it is on: it writes its results for the frames done, as
 // at the end of its input, says so, and exits 130 (128 + SIGINT).
 TEST(DevslamRun, CtrlCStopsTheRunAndKeepsTheFramesDone) {
