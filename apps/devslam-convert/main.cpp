@@ -249,11 +249,7 @@ int convert(int argc, char** argv) {
         refuseOverwritingInput(args.input, args.output, args.wo.external_images);
         std::unique_ptr<devslam::io::RgbdReader> reader;
         try {
-            devslam::io::OpenProgressBar opening(args.input);
-            devslam::io::ReaderOptions ro = args.ro;
-            ro.on_open = opening.callback([] { return devslam::core::stopSignal() != 0; });
-            reader = devslam::io::openRgbd(args.input, ro);
-            opening.finish();
+            reader = devslam::io::openRgbdWithProgress(args.input, args.ro);
         } catch (const devslam::io::OpeningStopped&) {
             std::cerr << "devslam-convert: interrupted ("
                       << devslam::core::signalName(devslam::core::stopSignal())

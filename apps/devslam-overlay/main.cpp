@@ -202,11 +202,7 @@ Input openInput(const Args& a) {
             std::make_unique<io::VideoReader>(a.input.substr(6), io::VideoReader::Options{});
         in.fixed_camera = true;
     } else {
-        io::OpenProgressBar opening(a.input);
-        io::ReaderOptions ro;
-        ro.on_open = opening.callback([] { return core::stopSignal() != 0; });
-        in.reader = io::openRgbd(a.input, ro);
-        opening.finish();
+        in.reader = io::openRgbdWithProgress(a.input, {});
     }
     in.total = in.reader->size().value_or(0);
     if (a.frames > 0 && (in.total == 0 || static_cast<std::size_t>(a.frames) < in.total))

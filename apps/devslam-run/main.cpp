@@ -251,15 +251,15 @@ Loaded loadConfig(const Args& a, const std::vector<std::string>& extra_sets = {}
     return l;
 }
 
-/// The input reader, wrapped in a ReplayReader when asked.
-std::unique_ptr<io::RgbdReader> openInput(const std::string& input, io::ReaderOptions ro,
-                                          int replay,
+/// The input reader, wrapped in a ReplayReader when asked. A Ctrl-C while a rawlog is read
+/// through as it opens stops it there (io::OpeningStopped); `progress`: the opening's bar on
+/// stderr.
+std::unique_ptr<io::RgbdReader> openInput(const std::string& input, const io::ReaderOptions& ro,
+                                          int replay, bool progress = false,
                                           const std::optional<core::Trajectory>& truth = {},
                                           const std::string& truth_path = {}) {
-    // A Ctrl-C while a rawlog is read through as it opens stops it there (io::OpeningStopped).
-    if (!ro.on_open)
-        ro.on_open = [](std::size_t, std::uint64_t, std::uint64_t) { return !core::stopSignal(); };
-    std::unique_ptr<io::RgbdReader> reader = io::openRgbd(input, ro);
+    std::unique_ptr<io::RgbdReader> reader =
+        io::openRgbdWithProgress(input, ro, progress ? stderr : nullptr);
     if (truth)  // (before the replay, which maps it with the frames)
         reader = std::make_unique<run::GivenTruthReader>(std::move(reader), *truth, truth_path);
     if (replay <= 0) return reader;
@@ -306,11 +306,7 @@ int runOnce(const Args& a) {
     if (!a.groundtruth.empty()) truth = io::readTumTrajectory(a.groundtruth);
     std::unique_ptr<io::RgbdReader> reader;
     try {
-        io::OpenProgressBar opening(a.input, a.quiet ? nullptr : stderr);
-        io::ReaderOptions ro = l.reader;
-        ro.on_open = opening.callback([] { return core::stopSignal() != 0; });
-        reader = openInput(a.input, ro, a.replay, truth, a.groundtruth);
-        opening.finish();
+        reader = openInput(a.input, l.reader, a.replay, !a.quiet, truth, a.groundtruth);
     } catch (const io::OpeningStopped&) {
         std::cerr << "devslam-run: interrupted (" << core::signalName(core::stopSignal())
                   << ") while opening the input; nothing written\n";

@@ -1,3 +1,4 @@
+#include <devslam/core/Interrupt.h>
 #include <devslam/core/Pose.h>
 #include <devslam/io/Rawlog.h>
 #include <devslam/io/RgbdReader.h>
@@ -709,6 +710,15 @@ TEST(Rawlog, OpeningTellsItsProgress) {
     io::OpenProgressBar bar(path, nullptr);
     ro.on_open = bar.callback([] { return true; });
     EXPECT_THROW((void)io::openRgbd(path, ro), io::OpeningStopped);
+    // As the programs open their input: whole, and stopped by a recorded SIGTERM.
+    EXPECT_EQ(io::openRgbdWithProgress(path, {}, nullptr)->size(), 6u);
+    core::installStopHandler("test_io");
+    core::clearStopSignal();
+    ASSERT_EQ(std::raise(SIGTERM), 0);
+    ASSERT_EQ(core::stopSignal(), SIGTERM);
+    EXPECT_THROW((void)io::openRgbdWithProgress(path, {}, nullptr), io::OpeningStopped);
+    core::clearStopSignal();
+    std::signal(SIGTERM, SIG_DFL);
 }
 
 TEST(Rawlog, LaterObservationsNameTheFileAndObservation) {

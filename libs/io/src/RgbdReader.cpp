@@ -3,6 +3,7 @@
 #include <devslam/io/TumReader.h>
 
 #include <devslam/core/Config.h>
+#include <devslam/core/Interrupt.h>
 
 #include <mrpt/config/CConfigFileBase.h>
 
@@ -93,6 +94,15 @@ std::unique_ptr<RgbdReader> openRgbd(const std::string& path, const ReaderOption
         throw std::runtime_error("the input's name is empty: give a TUM folder or rawlog");
     throw std::runtime_error(path + (fs::exists(st) ? ": neither a TUM folder nor a rawlog file"
                                                     : ": no such TUM folder or rawlog file"));
+}
+
+std::unique_ptr<RgbdReader> openRgbdWithProgress(const std::string& path, ReaderOptions opts,
+                                                 std::FILE* out) {
+    OpenProgressBar opening(path, out);
+    opts.on_open = opening.callback([] { return core::stopSignal() != 0; });
+    auto reader = openRgbd(path, opts);
+    opening.finish();
+    return reader;
 }
 
 }  // namespace devslam::io

@@ -114,6 +114,7 @@ class RgbdReader {
 ///   opts.on_open = bar.callback([] { return core::stopSignal() != 0; });
 ///   auto reader = io::openRgbd(path, opts);
 ///   bar.finish();
+/// (as openRgbdWithProgress, below, does)
 class OpenProgressBar {
   public:
     explicit OpenProgressBar(const std::string& path, std::FILE* out = stderr);
@@ -138,5 +139,12 @@ class OpenProgressBar {
 /// std::runtime_error with the path when it is neither.
 [[nodiscard]] std::unique_ptr<RgbdReader> openRgbd(const std::string& path,
                                                    const ReaderOptions& opts = {});
+
+/// openRgbd as the programs open their input: an OpenProgressBar on `out` (nullptr: none),
+/// and a Ctrl-C or SIGTERM recorded by core::installStopHandler stops the opening
+/// (OpeningStopped). `opts.on_open` is replaced.
+[[nodiscard]] std::unique_ptr<RgbdReader> openRgbdWithProgress(const std::string& path,
+                                                               ReaderOptions opts,
+                                                               std::FILE* out = stderr);
 
 }  // namespace devslam::io
