@@ -170,10 +170,15 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
     const slam::GridMapOptions& grid_opts = parts.grid;
     std::unique_ptr<MaskSource> masks = std::move(parts.masks);
     slam::Slam slam(slam_opts);
+    if (rc.localize_in) {
+        slam::checkOrbMatches(*rc.localize_in, rc.localize_map, slam_opts.orb);
+        slam.localizeIn(rc.localize_in->map);
+    }
 
     RunReport rep;
     rep.input = rc.input;
     rep.truth_file = rc.truth_file;
+    if (rc.localize_in) rep.localize_map = rc.localize_map;
     rep.input_damage = reader.damage();
     rep.mode = rc.mode;
     rep.mask_source = masks->describe();
@@ -310,6 +315,7 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
         fl.ms.backend = msSince(t0);
         fl.state = slam::toString(tr.state);
         if (!tr.pose_valid) fl.lost_reason = tr.reason;
+        if (slam.localizing() && tr.pose_valid && !rep.localized_at) rep.localized_at = n;
         fl.n_inliers = tr.n_inliers;
         fl.keyframe = mr.keyframe_inserted;
         fl.ba_rejected = mr.ba.rejected;
@@ -507,6 +513,9 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
             write(out("loops.txt"), [&] { core::writeFileWhole(out("loops.txt"), lp.str()); });
         }
         write(out("map.ply"), [&] { slam::writePly(out("map.ply"), slam.map()); });
+        // The map to localize in later (--localize); a localizing run writes the map it used.
+        write(out("slam_map.yml"),
+              [&] { slam::saveMap(out("slam_map.yml"), slam.map(), slam_opts.orb); });
         std::optional<core::Trajectory> gt_in_est;
         if (rep.ate && rep.ground_truth) {
             // Ground truth brought into the SLAM frame for the 3D view.
@@ -598,6 +607,11 @@ std::string formatSummary(const RunReport& r) {
       << "frames     : " << r.frames << "   keyframes: " << r.keyframes
       << (r.keyframes_culled ? " (" + std::to_string(r.keyframes_culled) + " culled)" : "")
       << "   landmarks: " << r.landmarks << "   loops closed: " << r.loops << "\n";
+    if (!r.localize_map.empty())
+        o << "localized  : in " << r.localize_map << " (its keyframes and landmarks, unchanged), "
+          << (r.localized_at ? "from frame " + std::to_string(*r.localized_at)
+                             : "NOT: no frame found its pose in the map")
+          << "\n";
     if (const auto e = loopErrors(r.loop_reports); !e.empty()) {
         const auto s = core::summarize(e);
         o << "loops      : measured relative poses vs truth: median " << num(1000 * s.median, 1)
@@ -728,11 +742,13 @@ std::string toJson(const RunReport& r) {
         return e;
     };
     o << "{\n  \"input\": \"" << esc(r.input) << "\",\n  \"groundtruth_file\": \""
-      << esc(r.truth_file) << "\",\n  \"input_damage\": \"" << esc(r.input_damage)
-      << "\",\n  \"read_error\": \"" << esc(r.read_error) << "\",\n  \"interrupted\": \""
-      << r.interrupted << "\",\n  \"mode\": \"" << r.mode << "\",\n  \"mask_source\": \""
-      << esc(r.mask_source) << "\",\n  \"frames\": " << r.frames
-      << ",\n  \"keyframes\": " << r.keyframes
+      << esc(r.truth_file) << "\",\n  \"localize_map\": \"" << esc(r.localize_map)
+      << "\",\n  \"localized_from_frame\": "
+      << (r.localized_at ? std::to_string(*r.localized_at) : std::string("null"))
+      << ",\n  \"input_damage\": \"" << esc(r.input_damage) << "\",\n  \"read_error\": \""
+      << esc(r.read_error) << "\",\n  \"interrupted\": \"" << r.interrupted << "\",\n  \"mode\": \""
+      << r.mode << "\",\n  \"mask_source\": \"" << esc(r.mask_source)
+      << "\",\n  \"frames\": " << r.frames << ",\n  \"keyframes\": " << r.keyframes
       << ",\n  \"keyframes_culled\": " << r.keyframes_culled
       << ",\n  \"landmarks\": " << r.landmarks << ",\n  \"local_ba_runs\": " << r.ba_runs
       << ",\n  \"local_ba_rejected\": " << r.ba_rejected << ",\n  \"loops_closed\": " << r.loops

@@ -5,10 +5,12 @@
 #include <devslam/eval/MaskScore.h>
 #include <devslam/eval/Metrics.h>
 #include <devslam/io/RgbdReader.h>
+#include <devslam/slam/MapFile.h>
 #include <devslam/slam/Slam.h>
 
 #include <mrpt/config/CConfigFileBase.h>
 
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -18,6 +20,10 @@ namespace devslam::run {
 struct RunConfig {
     std::string input;  ///< TUM folder or .rawlog
     std::string truth_file;  ///< where the reader's ground truth came from, if not the input
+    /// --localize: localization only, in this map (slam::Slam::localizeIn), read from
+    /// `localize_map` before the input opened.
+    std::shared_ptr<const slam::MapFile> localize_in;
+    std::string localize_map;
     std::string mode = "dynamic";
     /// Named in front of the "[section] key: ..." errors of the SLAM INI (`cfg`) and of the
     /// filter's (`filter_cfg`): the files, and what was written over them.
@@ -81,6 +87,9 @@ struct RunReport {
     std::string input, mode, camera, mask_source;
     std::string input_damage;  ///< what of the input was unreadable and left out ("" = none)
     std::string truth_file;    ///< RunConfig::truth_file
+    std::string localize_map;  ///< RunConfig::localize_map ("" = a map made by this run)
+    /// Localizing: the first frame that found its pose in the map (none: no frame did).
+    std::optional<std::size_t> localized_at;
     /// A frame that failed to read during the run, or whose mask or person truth failed
     /// ("" = none): the run stopped there and its outputs hold the frames before it.
     std::string read_error;
@@ -127,9 +136,9 @@ struct RunReport {
 
 /// The files a run writes into its --out folder (an earlier run's are removed first).
 inline constexpr const char* kOutputFiles[] = {
-    "run.json",        "run.json.part",    "trajectory.txt", "keyframes.txt",
-    "lost_frames.txt", "loops.txt",        "map.ply",        "map.3Dscene",
-    "map_grid.png",    "map_grid.gridmap", "trajectory.png", "mask_errors.csv"};
+    "run.json",       "run.json.part",   "trajectory.txt", "keyframes.txt",    "lost_frames.txt",
+    "loops.txt",      "map.ply",         "map.3Dscene",    "map_grid.png",     "map_grid.gridmap",
+    "trajectory.png", "mask_errors.csv", "slam_map.yml",   "slam_map.yml.part"};
 
 /// Throws unless each of kOutputFiles in `dir` is a file or not there: found before the run,
 /// not after it (a folder named trajectory.png stopped the run's outputs, the earlier run's

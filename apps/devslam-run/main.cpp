@@ -16,10 +16,12 @@
 #include <devslam/core/Results.h>
 #include <devslam/core/Stats.h>
 #include <devslam/io/TrajectoryIO.h>
+#include <devslam/slam/MapFile.h>
 
 #include <algorithm>
 #include <filesystem>
 #include <iostream>
+#include <memory>
 #include <optional>
 #include <sstream>
 #include <string>
@@ -36,6 +38,9 @@ const char* kUsage =
     "                   [--replay N]  (play the input forward/backward N times)\n"
     "                   [--groundtruth FILE]  (TUM trajectory to score against: a rawlog\n"
     "                                          holds none; replaces a TUM folder's)\n"
+    "                   [--localize MAP]  (localization only, in the slam_map.yml an earlier\n"
+    "                                      run wrote: poses in that map's frame, the map\n"
+    "                                      kept as it is)\n"
     "                   [--check-config]  (read the INIs as a run would, make the filter,\n"
     "                                      print 'ok' and stop; reads no frame, only\n"
     "                                      the camera of an input that exists)\n"
@@ -69,6 +74,7 @@ struct Args {
     bool modes_only = false;        ///< --bench without the ablation and the long run
     bool allow_damaged = false;     ///< a damaged input: run on what is intact
     std::string groundtruth;        ///< --groundtruth: the input's ground truth from this file
+    std::string localize;           ///< --localize: a saved map to localize in
     bool check_config = false;      ///< --check-config: the INIs only, no run
     bool out_given = false;         ///< --out was on the command line
     bool results_given = false;     ///< --results was on the command line
@@ -113,6 +119,9 @@ Args parse(int argc, char** argv) {
         else if (k == "--groundtruth") {
             a.groundtruth = value(i);
             if (a.groundtruth.empty()) throw std::invalid_argument("--groundtruth: no file named");
+        } else if (k == "--localize") {
+            a.localize = value(i);
+            if (a.localize.empty()) throw std::invalid_argument("--localize: no map named");
         } else if (k == "--check-config")
             a.check_config = true;
         else if (k == "-h" || k == "--help") {
@@ -123,6 +132,8 @@ Args parse(int argc, char** argv) {
     }
     if (a.check_config && a.bench > 0)
         throw std::invalid_argument("--check-config does not go with --bench");
+    if (!a.localize.empty() && a.bench > 0)
+        throw std::invalid_argument("--localize does not go with --bench (it makes its maps)");
     if (!a.groundtruth.empty() && a.bench > 0)
         throw std::invalid_argument(
             "--groundtruth does not go with --bench (its inputs carry their own)");
@@ -280,12 +291,22 @@ run::RunConfig runConfig(const Args& a, const Loaded& l, const std::string& mode
     return rc;
 }
 
+/// --localize's map, read and checked against the INI's [orb] (nullptr without --localize):
+/// before the input opens, so that a bad map is named at once.
+std::shared_ptr<const slam::MapFile> loadLocalizeMap(const Args& a, const Loaded& l) {
+    if (a.localize.empty()) return nullptr;
+    auto m = std::make_shared<slam::MapFile>(slam::loadMap(a.localize));
+    slam::checkOrbMatches(*m, a.localize, slam::SlamOptions::fromConfig(*l.cfg).orb);
+    return m;
+}
+
 /// --check-config: every setting of the INIs read and the filter made, as before a run's
 /// first frame (devslam-bench asks this of each SLAM INI before its renders), and the
 /// frame size of an input that exists (its camera, no frame read) against the filter's.
 int checkOnly(const Args& a) {
     const auto l = loadConfig(a);
     if (!a.groundtruth.empty()) (void)io::readTumTrajectory(a.groundtruth);
+    (void)loadLocalizeMap(a, l);
     std::optional<core::CameraIntrinsics> camera;
     if (fs::exists(a.input)) camera = openInput(a.input, l.reader, 0)->intrinsics();
     run::checkConfig(runConfig(a, l, l.mode), *l.cfg, *l.filter_cfg, camera);
@@ -304,6 +325,7 @@ int runOnce(const Args& a) {
     // Read before the input, which may take seconds to open: a bad file is named at once.
     std::optional<core::Trajectory> truth;
     if (!a.groundtruth.empty()) truth = io::readTumTrajectory(a.groundtruth);
+    const auto map = loadLocalizeMap(a, l);
     std::unique_ptr<io::RgbdReader> reader;
     try {
         reader = openInput(a.input, l.reader, a.replay, !a.quiet, truth, a.groundtruth);
@@ -318,6 +340,8 @@ int runOnce(const Args& a) {
     auto rc = runConfig(a, l, l.mode);
     rc.out_dir = a.out;
     rc.truth_file = a.groundtruth;
+    rc.localize_in = map;
+    rc.localize_map = a.localize;
     rc.progress = !a.quiet;
     rc.allow_damaged = a.allow_damaged;
     rc.score_masks = a.replay <= 0;

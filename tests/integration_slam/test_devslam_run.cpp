@@ -1,6 +1,7 @@
 // Smoke tests of the devslam-run app: outputs written and loadable, bad input reported.
 #include <devslam/core/Results.h>
 #include <devslam/io/Rawlog.h>
+#include <devslam/io/TrajectoryIO.h>
 #include <devslam/io/TumReader.h>
 #include <devslam/io/TumWriter.h>
 
@@ -117,8 +118,9 @@ TEST(DevslamRun, WritesEveryOutputAndPrintsTheSummary) {
         EXPECT_NE(r.out.find(key), std::string::npos) << key << "\n" << r.out;
     EXPECT_EQ(lines(out / "trajectory.txt"), 32u);
     EXPECT_GE(lines(out / "keyframes.txt"), 3u);
-    for (const char* f : {"map.ply", "map.3Dscene", "map_grid.png", "map_grid.gridmap",
-                          "trajectory.png", "run.json", "lost_frames.txt", "loops.txt"})
+    for (const char* f :
+         {"map.ply", "map.3Dscene", "map_grid.png", "map_grid.gridmap", "trajectory.png",
+          "run.json", "lost_frames.txt", "loops.txt", "slam_map.yml"})
         EXPECT_TRUE(fs::exists(out / f) && fs::file_size(out / f) > 0) << f;
     mrpt::opengl::COpenGLScene scene;
     EXPECT_TRUE(scene.loadFromFile((out / "map.3Dscene").string()));
@@ -781,6 +783,96 @@ TEST(DevslamRun, ARawlogIsScoredAgainstTheGroundTruthGivenBesideIt) {
     auto bench = run("--bench 1 --groundtruth " + gt + " --results none");
     EXPECT_EQ(bench.rc, 1);
     EXPECT_NE(bench.out.find("--groundtruth does not go with --bench"), std::string::npos)
+        << bench.out;
+    fs::remove_all(dir);
+}
+
+// The map one run saved (slam_map.yml) is localized in by a later one (--localize) that
+// starts elsewhere, here 16 frames into the same recording: its poses are the first run's,
+// in the first run's frame, and the map comes out as it went in. A bad map, or one made with
+// another ORB pyramid, is named before the input opens.
+TEST(DevslamRun, ALaterRunLocalizesInTheMapAnEarlierOneSaved) {
+    const fs::path dir = devslam::test::scratchPath("devslam_run_localize");
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    const std::string tum = std::string(DEVSLAM_SOURCE_DIR) + "/data/tum/fr1_xyz_first37";
+    auto made = run("--mode none --quiet --out " + (dir / "made").string());
+    ASSERT_EQ(made.rc, 0) << made.out;
+    const std::string map = (dir / "made" / "slam_map.yml").string();
+    ASSERT_TRUE(fs::exists(map));
+    // The recording from its 17th frame on.
+    const fs::path later = dir / "later";
+    fs::copy(tum, later, fs::copy_options::recursive);
+    for (const char* list : {"rgb.txt", "depth.txt"}) {
+        std::ifstream in(later / list);
+        std::ostringstream kept;
+        int frame = 0;
+        for (std::string l; std::getline(in, l);)
+            if (l.empty() || l[0] == '#' || frame++ >= 16) kept << l << "\n";
+        in.close();
+        std::ofstream(later / list) << kept.str();
+    }
+    auto loc = run("--input " + later.string() + " --localize " + map +
+                   " --mode none --quiet --out " + (dir / "loc").string());
+    ASSERT_EQ(loc.rc, 0) << loc.out;
+    EXPECT_NE(loc.out.find("localized  : in " + map +
+                           " (its keyframes and landmarks, unchanged), from frame 0"),
+              std::string::npos)
+        << loc.out;
+    EXPECT_NE(loc.out.find("lost frames: 0"), std::string::npos) << loc.out;
+    const auto a = devslam::io::readTumTrajectory((dir / "made" / "trajectory.txt").string());
+    const auto b = devslam::io::readTumTrajectory((dir / "loc" / "trajectory.txt").string());
+    ASSERT_GE(b.size(), 10u);
+    double worst = 0, nearest_origin = 1e9;
+    for (const auto& p : b) {
+        const auto it = std::find_if(a.begin(), a.end(),
+                                     [&](const auto& q) { return std::abs(q.t - p.t) < 1e-6; });
+        ASSERT_NE(it, a.end()) << p.t;
+        worst = std::max(worst, (it->pose.translation() - p.pose.translation()).norm());
+        nearest_origin = std::min(nearest_origin, p.pose.translation().norm());
+    }
+    EXPECT_LT(worst, 0.005);
+    EXPECT_GT(nearest_origin, 0.1) << "a new map's origin would be the first frame's";
+    const std::string js = readText(dir / "loc" / "run.json");
+    EXPECT_NE(js.find("\"localize_map\": \"" + map + "\""), std::string::npos);
+    EXPECT_NE(js.find("\"localized_from_frame\": 0,"), std::string::npos);
+    EXPECT_NE(readText(dir / "made" / "run.json").find("\"localized_from_frame\": null,"),
+              std::string::npos);
+    // The map written by the localizing run: the same keyframes (the run's folder may be the
+    // one the map came from: it is written again, not lost).
+    auto again = run("--input " + later.string() + " --localize " + map +
+                     " --mode none --quiet --out " + (dir / "made").string());
+    ASSERT_EQ(again.rc, 0) << again.out;
+    EXPECT_NE(again.out.find("keyframes: 7"), std::string::npos) << again.out;
+    EXPECT_NE(made.out.find("keyframes: 7"), std::string::npos) << made.out;
+    auto check = run("--check-config --localize " + map);
+    EXPECT_EQ(check.rc, 0) << check.out;
+    // Refused before the input opens: a map that is not there, one cut short, another ORB
+    // pyramid; and with --bench.
+    auto none = run("--input /no/such/input --localize " + (dir / "none.yml").string() +
+                    " --quiet --out ''");
+    EXPECT_EQ(none.rc, 1);
+    EXPECT_NE(none.out.find((dir / "none.yml").string() + ": no such file"), std::string::npos)
+        << none.out;
+    const std::string text = readText(map);
+    std::ofstream(dir / "cut.yml") << text.substr(0, text.size() / 2);
+    auto cut = run("--input /no/such/input --localize " + (dir / "cut.yml").string() +
+                   " --quiet --out ''");
+    EXPECT_EQ(cut.rc, 1);
+    EXPECT_NE(cut.out.find((dir / "cut.yml").string() + ": not a DEV-SLAM map, or cut short"),
+              std::string::npos)
+        << cut.out;
+    auto orb =
+        run("--input /no/such/input --localize " + map + " --set orb.n_levels=8 --quiet --out ''");
+    EXPECT_EQ(orb.rc, 1);
+    EXPECT_NE(orb.out.find(map + ": the map's keypoints come from an ORB pyramid of "
+                                 "scale_factor 1.300000, n_levels 4; this run's [orb] has "
+                                 "1.300000, 8"),
+              std::string::npos)
+        << orb.out;
+    auto bench = run("--bench 1 --localize " + map + " --results none");
+    EXPECT_EQ(bench.rc, 1);
+    EXPECT_NE(bench.out.find("--localize does not go with --bench"), std::string::npos)
         << bench.out;
     fs::remove_all(dir);
 }

@@ -6,6 +6,7 @@
 #include <devslam/slam/LoopDetector.h>
 #include <devslam/slam/Map.h>
 #include <devslam/slam/MapExporter.h>
+#include <devslam/slam/MapFile.h>
 #include <devslam/slam/Matching.h>
 #include <devslam/slam/OrbExtractor.h>
 #include <devslam/slam/PoseGraph.h>
@@ -27,6 +28,8 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <iterator>
 #include <random>
 
 using namespace devslam;
@@ -724,6 +727,215 @@ TEST(MapExporter, AFullDiskIsAnError) {
         EXPECT_EQ(std::string(e.what()), "grid image: cannot write '" + d.str("no/such/grid.png") +
                                              "': No such file or directory");
     }
+}
+
+namespace {
+/// A map with every field set: 4 keyframes (the second removed, so ids have a gap and some
+/// landmarks were created by a keyframe that is gone), random keypoints over 4 octaves,
+/// weights and image points on one keyframe, 40 landmarks seen from 1-3 keyframes.
+Map randomMap(std::uint32_t seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> U(-1, 1);
+    std::uniform_int_distribution<int> byte(0, 255), octave(0, 3);
+    Map map;
+    for (int k = 0; k < 4; ++k) {
+        Keyframe kf;
+        kf.frame_index = static_cast<std::size_t>(10 * k + 3);
+        kf.timestamp = 1305031102.175304 + 0.1 * k;
+        kf.T_wc = makePose(U(rng), U(rng), U(rng), U(rng), U(rng), U(rng));
+        FrameFeatures& f = kf.features;
+        const int n = 30 + k;
+        f.descriptors = cv::Mat(n, 32, CV_8U);
+        for (int i = 0; i < n; ++i) {
+            f.keypoints.emplace_back(
+                static_cast<float>(320 + 300 * U(rng)), static_cast<float>(240 + 200 * U(rng)),
+                static_cast<float>(7 + U(rng)), static_cast<float>(180 + 180 * U(rng)),
+                static_cast<float>(U(rng) * 1e-3), octave(rng));
+            for (int b = 0; b < 32; ++b)
+                f.descriptors.at<unsigned char>(i, b) = static_cast<unsigned char>(byte(rng));
+            f.depth.push_back(i % 7 == 0 ? 0.f : static_cast<float>(2 + U(rng)));
+            f.points_c.emplace_back(U(rng), U(rng), f.depth.back());
+            f.colors.emplace_back(byte(rng), byte(rng), byte(rng));
+        }
+        if (k == 2) {
+            f.weight.assign(static_cast<std::size_t>(n), 0.5f);
+            for (const auto& kp : f.keypoints) f.image_pt.push_back(kp.pt + cv::Point2f(0.5f, 0));
+            f.gate_exponent = -1;
+            f.n_masked = 17;
+            f.masked_fraction = 0.125;
+        }
+        map.addKeyframe(std::move(kf));
+    }
+    for (int l = 0; l < 40; ++l) {
+        const KeyframeId first = l % 4;
+        cv::Mat d(1, 32, CV_8U);
+        for (int b = 0; b < 32; ++b)
+            d.at<unsigned char>(0, b) = static_cast<unsigned char>(byte(rng));
+        const LandmarkId id = map.addLandmark({U(rng), U(rng), 3 + U(rng)}, d,
+                                              {static_cast<unsigned char>(l), 2, 3}, first, l % 30);
+        for (KeyframeId k = first + 1; k < 4 && k < first + 3; ++k)
+            map.addObservation(id, k, (l + 5) % 30);
+        map.landmark(id)->n_visible = 10 + l;
+        map.landmark(id)->n_found = l;
+    }
+    map.removeKeyframe(1);
+    return map;
+}
+}  // namespace
+
+TEST(MapFile, EveryFieldRoundTripsExactly) {
+    const devslam::test::TempDir d("devslam_");
+    const Map map = randomMap(3);
+    OrbExtractor::Options orb;
+    orb.scale_factor = 1.2;
+    orb.n_levels = 8;
+    saveMap(d.str("map.yml"), map, orb);
+    EXPECT_FALSE(std::filesystem::exists(d.str("map.yml.part")));
+    const MapFile m = loadMap(d.str("map.yml"));
+    EXPECT_EQ(m.orb_scale_factor, 1.2);
+    EXPECT_EQ(m.orb_n_levels, 8);
+    EXPECT_NO_THROW(checkOrbMatches(m, "map.yml", orb));
+    EXPECT_THROW(checkOrbMatches(m, "map.yml", OrbExtractor::Options{}), std::invalid_argument);
+    // Keyframes in saved order, renumbered 0, 1, 2 (saved as 0, 2, 3).
+    ASSERT_EQ(m.map.keyframes().size(), map.keyframes().size());
+    std::map<KeyframeId, KeyframeId> id_of;  // saved -> loaded
+    auto loaded = m.map.keyframes().begin();
+    for (const auto& [id, a] : map.keyframes()) {
+        const Keyframe& b = (loaded++)->second;
+        id_of[id] = b.id;
+        EXPECT_EQ(b.frame_index, a.frame_index);
+        EXPECT_EQ(b.timestamp, a.timestamp);
+        EXPECT_EQ(b.T_wc.matrix(), a.T_wc.matrix());
+        const FrameFeatures &fa = a.features, &fb = b.features;
+        ASSERT_EQ(fb.size(), fa.size());
+        for (std::size_t i = 0; i < fa.size(); ++i) {
+            EXPECT_EQ(fb.keypoints[i].pt, fa.keypoints[i].pt);
+            EXPECT_EQ(fb.keypoints[i].size, fa.keypoints[i].size);
+            EXPECT_EQ(fb.keypoints[i].angle, fa.keypoints[i].angle);
+            EXPECT_EQ(fb.keypoints[i].response, fa.keypoints[i].response);
+            EXPECT_EQ(fb.keypoints[i].octave, fa.keypoints[i].octave);
+            EXPECT_EQ(fb.points_c[i], fa.points_c[i]);
+            EXPECT_EQ(fb.colors[i], fa.colors[i]);
+        }
+        EXPECT_EQ(cv::norm(fb.descriptors, fa.descriptors, cv::NORM_INF), 0.0);
+        EXPECT_EQ(fb.depth, fa.depth);
+        EXPECT_EQ(fb.image_pt, fa.image_pt);
+        EXPECT_EQ(fb.weight, fa.weight);
+        EXPECT_EQ(fb.gate_exponent, fa.gate_exponent);
+        EXPECT_EQ(fb.n_masked, fa.n_masked);
+        EXPECT_EQ(fb.masked_fraction, fa.masked_fraction);
+    }
+    EXPECT_EQ(id_of, (std::map<KeyframeId, KeyframeId>{{0, 0}, {2, 1}, {3, 2}}));
+    // Landmarks in id order, each observation moved to the renumbered keyframes.
+    ASSERT_EQ(m.map.landmarks().size(), map.landmarks().size());
+    std::vector<LandmarkId> ids;
+    for (const auto& [id, lm] : map.landmarks()) ids.push_back(id);
+    std::sort(ids.begin(), ids.end());
+    int created_gone = 0;
+    for (std::size_t i = 0; i < ids.size(); ++i) {
+        const Landmark& a = *map.landmark(ids[i]);
+        const Landmark* b = m.map.landmark(static_cast<LandmarkId>(i));
+        ASSERT_NE(b, nullptr);
+        EXPECT_EQ(b->p_w, a.p_w);
+        EXPECT_EQ(cv::norm(b->descriptor, a.descriptor, cv::NORM_INF), 0.0);
+        EXPECT_EQ(b->color, a.color);
+        EXPECT_EQ(b->ref_kf, id_of.at(a.ref_kf));
+        if (a.created_kf == 1) {  // removed before saving
+            EXPECT_EQ(b->created_kf, kNoId);
+            ++created_gone;
+        } else {
+            EXPECT_EQ(b->created_kf, id_of.at(a.created_kf));
+        }
+        EXPECT_EQ(b->n_visible, a.n_visible);
+        EXPECT_EQ(b->n_found, a.n_found);
+        ASSERT_EQ(b->observations.size(), a.observations.size());
+        for (std::size_t j = 0; j < a.observations.size(); ++j) {
+            EXPECT_EQ(b->observations[j].first, id_of.at(a.observations[j].first));
+            EXPECT_EQ(b->observations[j].second, a.observations[j].second);
+            EXPECT_EQ(m.map.keyframe(b->observations[j].first)
+                          .landmark_of_kp[static_cast<std::size_t>(b->observations[j].second)],
+                      b->id);
+        }
+    }
+    EXPECT_GT(created_gone, 0) << "the test should cover a creator that is gone";
+}
+
+TEST(MapFile, BadFilesAreRefusedNamingTheFileAndThePlace) {
+    const devslam::test::TempDir d("devslam_");
+    const OrbExtractor::Options orb;
+    const auto errorOf = [&](const std::string& path) -> std::string {
+        try {
+            (void)loadMap(path);
+        } catch (const std::runtime_error& e) {
+            return e.what();
+        }
+        return "(loaded)";
+    };
+    EXPECT_EQ(errorOf(d.str("none.yml")), d.str("none.yml") + ": no such file");
+    EXPECT_EQ(errorOf(d.str("")), d.str("") + ": not a file");
+    std::ofstream(d.str("text.yml")) << "hello: 1\n";
+    EXPECT_EQ(
+        errorOf(d.str("text.yml")),
+        d.str("text.yml") + ": not a DEV-SLAM map, or cut short (OpenCV: Input file is invalid)");
+    std::ofstream(d.str("other.yml")) << "%YAML:1.0\n---\nhello: 1\n";
+    EXPECT_EQ(errorOf(d.str("other.yml")),
+              d.str("other.yml") + ": not a DEV-SLAM map (no 'format: devslam-map')");
+    std::ofstream(d.str("junk.yml")) << "\x01\x02 {{{ [[ :\n";
+    EXPECT_EQ(errorOf(d.str("junk.yml")).rfind(d.str("junk.yml") + ": not a DEV-SLAM map", 0), 0u)
+        << errorOf(d.str("junk.yml"));
+
+    // A whole map, then cut short at several places: never loaded, always named.
+    saveMap(d.str("map.yml"), randomMap(5), orb);
+    std::string text;
+    {
+        std::ifstream in(d.str("map.yml"), std::ios::binary);
+        text.assign(std::istreambuf_iterator<char>(in), {});
+    }
+    for (const double frac : {0.1, 0.35, 0.5, 0.8, 0.97}) {
+        std::ofstream(d.str("cut.yml"), std::ios::binary)
+            << text.substr(0, static_cast<std::size_t>(frac * static_cast<double>(text.size())));
+        const std::string e = errorOf(d.str("cut.yml"));
+        EXPECT_EQ(e.rfind(d.str("cut.yml") + ": ", 0), 0u) << frac << ": " << e;
+        EXPECT_NE(e.find("cut short"), std::string::npos) << frac << ": " << e;
+        if (std::getenv("MAPFILE_VERBOSE")) std::printf("%.2f: %s\n", frac, e.c_str());
+    }
+    // A later format version.
+    {
+        std::string v2 = text;
+        const auto at = v2.find("version: 1");
+        ASSERT_NE(at, std::string::npos);
+        v2.replace(at, 10, "version: 2");
+        std::ofstream(d.str("v2.yml"), std::ios::binary) << v2;
+        EXPECT_EQ(errorOf(d.str("v2.yml")),
+                  d.str("v2.yml") + ": format version 2, this build reads 1");
+    }
+    // Maps whose content is wrong, each written by saveMap from a map changed behind the
+    // Map's back.
+    const auto broken = [&](const std::function<void(Map&)>& change) {
+        Map m = randomMap(5);
+        change(m);
+        saveMap(d.str("bad.yml"), m, orb);
+        return errorOf(d.str("bad.yml"));
+    };
+    const std::string bad = d.str("bad.yml") + ": ";
+    EXPECT_EQ(broken([](Map& m) { m.keyframes().at(2).T_wc.linear() *= 2; }),
+              bad + "keyframe 1: 'T_wc' is not a rotation and translation");
+    EXPECT_EQ(broken([](Map& m) { m.keyframes().at(3).features.depth.pop_back(); }),
+              bad + "keyframe 2: 'depth' has 32 entries for 33 keypoints");
+    EXPECT_EQ(broken([](Map& m) { m.keyframes().at(0).features.keypoints[4].octave = 4; }),
+              bad + "keyframe 0: a keypoint off the image plane or outside the pyramid");
+    EXPECT_EQ(broken([](Map& m) { m.landmark(0)->observations.emplace_back(0, 999); }),
+              bad + "landmark 0 (id 0): keyframe id 0 has no keypoint 999");
+    EXPECT_EQ(broken([](Map& m) { m.landmark(0)->observations.emplace_back(1, 0); }),
+              bad + "landmark 0 (id 0): keyframe id 1 is not in the map");
+    EXPECT_EQ(broken([](Map& m) {
+                  m.landmark(2)->observations.push_back(m.landmark(0)->observations.front());
+              }),
+              bad + "landmark 2 (id 2): keypoint 0 of keyframe id 0 observes two landmarks");
+    EXPECT_EQ(broken([](Map& m) { m.landmark(3)->observations.clear(); }),
+              bad + "landmark 3 (id 3): no observation");
+    EXPECT_EQ(broken([](Map& m) { m.landmark(0)->p_w.x() = std::nan(""); }),
+              bad + "landmark 0 (id 0): a position that is not finite");
 }
 
 TEST(Map, ObservationsAndRemovalStayConsistent) {

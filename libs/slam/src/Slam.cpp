@@ -9,6 +9,8 @@
 #include <cstdlib>
 #include <filesystem>
 #include <iterator>
+#include <stdexcept>
+#include <utility>
 
 namespace devslam::slam {
 
@@ -180,7 +182,8 @@ TrackResult Slam::track(const core::Frame& frame, const FrameFeatures& features,
     } else {
         rec.T_ref_c = res.T_wc;
     }
-    if (res.pose_valid && opts_.mapping.refine_frames) {
+    // (A loaded map is not adjusted, so nothing is held for refinement.)
+    if (res.pose_valid && opts_.mapping.refine_frames && !localizing_) {
         for (std::size_t i = 0; i < features.size(); ++i) {
             const LandmarkId lm = res.landmark_of_kp[i];
             if (lm == kNoId) continue;
@@ -198,7 +201,7 @@ TrackResult Slam::track(const core::Frame& frame, const FrameFeatures& features,
 MappingResult Slam::mapStep(const core::Frame& frame, FrameFeatures features,
                             const TrackResult& track) {
     MappingResult out;
-    if (!track.pose_valid) return out;
+    if (!track.pose_valid || localizing_) return out;
     ++frames_since_kf_;
     int n_close_tracked = 0, n_close_untracked = 0;
     for (std::size_t i = 0; i < features.size(); ++i) {
@@ -369,7 +372,7 @@ std::size_t Slam::framesHeldForRefinement() const {
 LocalBaResult Slam::finalize(const core::CameraIntrinsics& K) {
     LocalBaResult ba;
     const auto last = map_.lastKeyframes(1);
-    if (last.empty()) return ba;
+    if (last.empty() || localizing_) return ba;
     if (opts_.local_ba.enabled) {
         LocalBaOptions o = opts_.local_ba;
         if (o.final_window > 0) o.window = o.final_window;
@@ -450,6 +453,15 @@ FrameResult Slam::process(const core::Frame& frame, const cv::Mat& mask,
     r.mapping = mapStep(frame, std::move(f), r.track);
     r.backend = backendStep(r.mapping, frame.K);
     return r;
+}
+
+void Slam::localizeIn(Map map) {
+    if (!records_.empty()) throw std::logic_error("Slam::localizeIn: called after the first frame");
+    if (map.keyframes().empty())
+        throw std::invalid_argument("Slam::localizeIn: the map has no keyframe");
+    map_ = std::move(map);
+    localizing_ = true;
+    tracker_.startLocalizing();
 }
 
 core::Trajectory Slam::trajectory() const {

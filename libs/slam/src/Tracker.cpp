@@ -139,6 +139,15 @@ void TrackerOptions::saveToConfig(mrpt::config::CConfigFileBase& c, const std::s
     core::writeKey(c, s, "reloc_max_rate_deg", reloc_max_rate_deg);
 }
 
+void Tracker::startLocalizing() {
+    state_ = TrackingState::Lost;
+    localizing_ = true;
+    localized_ = false;
+    has_velocity_ = false;
+    last_T_wc_ = Eigen::Isometry3d::Identity();
+    last_t_ = 0.0;
+}
+
 void Tracker::initialize(const Eigen::Isometry3d& T_wc, double timestamp) {
     state_ = TrackingState::Ok;
     last_T_wc_ = T_wc;
@@ -228,7 +237,8 @@ std::optional<PoseRefineResult> Tracker::trackWithMap(const FrameFeatures& f, co
 }
 
 bool Tracker::relocPlausible(const Eigen::Isometry3d& T_wc, double timestamp) const {
-    if (opts_.reloc_max_speed <= 0) return true;
+    // No pose to be near before the first one in a loaded map.
+    if (opts_.reloc_max_speed <= 0 || (localizing_ && !localized_)) return true;
     const double lost_s = std::max(0.0, timestamp - last_t_);
     const Eigen::Isometry3d d = last_T_wc_.inverse() * T_wc;
     const double deg = Eigen::AngleAxisd(d.linear()).angle() * 180.0 / M_PI;
@@ -237,18 +247,16 @@ bool Tracker::relocPlausible(const Eigen::Isometry3d& T_wc, double timestamp) co
 }
 
 namespace {
-/// Appends to `kfs`, the map's newest keyframes (Map::lastKeyframes), up to `n` of the older
-/// ones nearest `T_wc` by camera centre (ties by id) among those whose optical axis has a
-/// cosine of at least `min_cos` with its own.
-void addNearestOlder(const Map& map, const Eigen::Isometry3d& T_wc, std::size_t n, double min_cos,
-                     std::vector<KeyframeId>& kfs) {
-    if (n == 0 || kfs.empty()) return;
-    // Keyframes are kept in id order, so the newest are the map's last entries.
-    const KeyframeId oldest_newest = kfs.front();
+/// Appends to `kfs` up to `n` keyframes with ids below `before` (all when kNoId) nearest
+/// `T_wc` by camera centre (ties by id) among those whose optical axis has a cosine of at
+/// least `min_cos` with its own.
+void addNearest(const Map& map, const Eigen::Isometry3d& T_wc, std::size_t n, double min_cos,
+                KeyframeId before, std::vector<KeyframeId>& kfs) {
+    if (n == 0) return;
     const Eigen::Vector3d axis = T_wc.linear().col(2);
     std::vector<std::pair<double, KeyframeId>> near;
     for (const auto& [id, kf] : map.keyframes()) {
-        if (id >= oldest_newest) break;
+        if (before != kNoId && id >= before) break;  // kept in id order
         if (kf.T_wc.linear().col(2).dot(axis) < min_cos) continue;
         near.emplace_back((kf.T_wc.translation() - T_wc.translation()).norm(), id);
     }
@@ -256,52 +264,102 @@ void addNearestOlder(const Map& map, const Eigen::Isometry3d& T_wc, std::size_t 
     std::partial_sort(near.begin(), near.begin() + static_cast<std::ptrdiff_t>(n), near.end());
     for (std::size_t i = 0; i < n; ++i) kfs.push_back(near[i].second);
 }
+
+/// Appends to `kfs`, the map's newest keyframes (Map::lastKeyframes), up to `n` of the older
+/// ones nearest `T_wc` (see addNearest).
+void addNearestOlder(const Map& map, const Eigen::Isometry3d& T_wc, std::size_t n, double min_cos,
+                     std::vector<KeyframeId>& kfs) {
+    if (kfs.empty()) return;
+    addNearest(map, T_wc, n, min_cos, kfs.front(), kfs);
+}
 }  // namespace
 
 std::optional<Eigen::Isometry3d> Tracker::relocalize(const FrameFeatures& f, const Map& map,
                                                      const core::CameraIntrinsics& K,
                                                      double timestamp) const {
     // Candidates: the newest keyframes and the ones nearest to the last pose, facing anywhere.
-    std::vector<KeyframeId> cands = map.lastKeyframes(opts_.reloc_keyframes / 2 + 1);
-    addNearestOlder(map, last_T_wc_, static_cast<std::size_t>(opts_.reloc_keyframes) - cands.size(),
-                    -std::numeric_limits<double>::infinity(), cands);
+    // In a loaded map (localizing) its newest keyframes say nothing of where the camera is,
+    // nor, while lost, does the last pose: every keyframe is matched, and only the
+    // reloc_keyframes with the most matches are verified by PnP (no place recognition ranks
+    // them: the matching costs about 1 ms a keyframe, the verification more).
+    std::vector<KeyframeId> cands;
+    if (localizing_) {
+        for (const auto& [id, kf] : map.keyframes()) cands.push_back(id);
+    } else {
+        cands = map.lastKeyframes(opts_.reloc_keyframes / 2 + 1);
+        addNearestOlder(map, last_T_wc_,
+                        static_cast<std::size_t>(opts_.reloc_keyframes) - cands.size(),
+                        -std::numeric_limits<double>::infinity(), cands);
+    }
+    struct Candidate {
+        const Keyframe* kf = nullptr;
+        std::vector<int> rows;                   ///< its keypoints with a landmark
+        std::vector<std::pair<int, int>> pairs;  ///< (frame keypoint, row)
+    };
+    const auto matchesOf = [&](KeyframeId id) {
+        Candidate c;
+        c.kf = &map.keyframe(id);
+        for (int i = 0; i < static_cast<int>(c.kf->landmark_of_kp.size()); ++i)
+            if (c.kf->landmark_of_kp[i] != kNoId) c.rows.push_back(i);
+        if (static_cast<int>(c.rows.size()) < opts_.reloc_min_inliers) return c;
+        cv::Mat train(static_cast<int>(c.rows.size()), 32, CV_8U);
+        for (std::size_t r = 0; r < c.rows.size(); ++r)
+            c.kf->features.descriptors.row(c.rows[r]).copyTo(train.row(static_cast<int>(r)));
+        for (const auto& [q, t] :
+             matchBruteForce(f.descriptors, train, opts_.reloc_max_hamming, opts_.reloc_ratio))
+            c.pairs.emplace_back(q, t);
+        return c;
+    };
     std::optional<Eigen::Isometry3d> best;
     int best_inliers = 0;
-    for (KeyframeId id : cands) {
-        const Keyframe& kf = map.keyframe(id);
-        std::vector<int> rows;
-        for (int i = 0; i < static_cast<int>(kf.landmark_of_kp.size()); ++i)
-            if (kf.landmark_of_kp[i] != kNoId) rows.push_back(i);
-        if (static_cast<int>(rows.size()) < opts_.reloc_min_inliers) continue;
-        cv::Mat train(static_cast<int>(rows.size()), 32, CV_8U);
-        for (std::size_t r = 0; r < rows.size(); ++r)
-            kf.features.descriptors.row(rows[r]).copyTo(train.row(static_cast<int>(r)));
-        const auto pairs =
-            matchBruteForce(f.descriptors, train, opts_.reloc_max_hamming, opts_.reloc_ratio);
-        if (static_cast<int>(pairs.size()) < opts_.reloc_min_inliers) continue;
+    const auto verify = [&](const Candidate& c) {
+        if (static_cast<int>(c.pairs.size()) < opts_.reloc_min_inliers) return;
         std::vector<PoseObservation> obs;
-        for (const auto& [q, t] : pairs)
-            obs.push_back(observationOf(f, q, map.landmark(kf.landmark_of_kp[rows[t]])->p_w,
+        for (const auto& [q, t] : c.pairs)
+            obs.push_back(observationOf(f, q, map.landmark(c.kf->landmark_of_kp[c.rows[t]])->p_w,
                                         opts_.scale_factor));
         auto pnp_opts = opts_.pnp;
         pnp_opts.iterations = std::max(pnp_opts.iterations, 300);
         pnp_opts.min_inliers = opts_.reloc_min_inliers;
         const auto pnp = solvePnpRansac(obs, K, pnp_opts);
-        if (!pnp) continue;
+        if (!pnp) return;
         const auto refined = refinePose(obs, pnp->T_wc, K, opts_.refine);
         if (refined.n_inliers >= opts_.reloc_min_inliers && refined.n_inliers > best_inliers &&
             relocPlausible(refined.T_wc, timestamp)) {
             best_inliers = refined.n_inliers;
             best = refined.T_wc;
         }
+    };
+    if (!localizing_) {
+        for (KeyframeId id : cands) verify(matchesOf(id));
+        return best;
     }
+    std::vector<Candidate> ranked;
+    for (KeyframeId id : cands) {
+        Candidate c = matchesOf(id);
+        if (static_cast<int>(c.pairs.size()) >= opts_.reloc_min_inliers)
+            ranked.push_back(std::move(c));
+    }
+    std::stable_sort(ranked.begin(), ranked.end(), [](const Candidate& a, const Candidate& b) {
+        return a.pairs.size() > b.pairs.size();
+    });
+    if (ranked.size() > static_cast<std::size_t>(opts_.reloc_keyframes))
+        ranked.resize(static_cast<std::size_t>(opts_.reloc_keyframes));
+    for (const Candidate& c : ranked) verify(c);
     return best;
 }
 
 std::vector<LandmarkId> Tracker::localMap(const Map& map, const Eigen::Isometry3d& T_wc) const {
-    auto kfs = map.lastKeyframes(static_cast<std::size_t>(opts_.local_keyframes));
-    addNearestOlder(map, T_wc, static_cast<std::size_t>(opts_.near_keyframes),
-                    std::cos(opts_.near_max_angle_deg * M_PI / 180.0), kfs);
+    const double min_cos = std::cos(opts_.near_max_angle_deg * M_PI / 180.0);
+    std::vector<KeyframeId> kfs;
+    if (localizing_) {  // a loaded map: the nearest keyframes stand for the newest
+        addNearest(map, T_wc,
+                   static_cast<std::size_t>(opts_.local_keyframes + opts_.near_keyframes), min_cos,
+                   kNoId, kfs);
+        return map.landmarksOf(kfs);
+    }
+    kfs = map.lastKeyframes(static_cast<std::size_t>(opts_.local_keyframes));
+    addNearestOlder(map, T_wc, static_cast<std::size_t>(opts_.near_keyframes), min_cos, kfs);
     return map.landmarksOf(kfs);
 }
 
@@ -368,6 +426,7 @@ TrackResult Tracker::track(const TrackInput& in, Map& map, const core::CameraInt
     has_velocity_ = !was_lost && dt > 0 && dt <= opts_.max_motion_dt;
     last_T_wc_ = ok->T_wc;
     last_t_ = in.timestamp;
+    localized_ = true;
     state_ = (was_lost || !res.reason.empty()) ? TrackingState::Relocalized : TrackingState::Ok;
     res.state = state_;
     if (state_ == TrackingState::Relocalized) state_ = TrackingState::Ok;

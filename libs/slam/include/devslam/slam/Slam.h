@@ -168,6 +168,18 @@ class Slam {
     [[nodiscard]] std::vector<std::size_t> lostFrames() const;
     [[nodiscard]] core::Trajectory keyframeTrajectory() const;
     [[nodiscard]] const Map& map() const { return map_; }
+    /// Localization only, in a map made before (loadMap): before the first frame, takes
+    /// `map` as the map and keeps it as it is. Each frame is tracked against the keyframes
+    /// nearest it; the first frames are lost until one relocalizes against any keyframe of
+    /// the map. No keyframe, landmark, local BA or loop is made (mapStep, backendStep and
+    /// finalize do nothing), so poses are in the map's frame and the map stays valid for the
+    /// next run. Throws std::logic_error after a frame, std::invalid_argument for an empty
+    /// map.
+    void localizeIn(Map map);
+    /// localizeIn was called.
+    [[nodiscard]] bool localizing() const { return localizing_; }
+    /// Localizing and some frame has found its pose in the map.
+    [[nodiscard]] bool localized() const { return tracker_.localized(); }
     [[nodiscard]] int loopsClosed() const { return static_cast<int>(loops_.size()); }
     /// A loop the back end closed, as measured when it was verified.
     struct ClosedLoop {
@@ -230,6 +242,7 @@ class Slam {
     int frames_since_kf_ = 0;
     int tracked_at_last_kf_ = 0;
     bool pending_init_ = false;
+    bool localizing_ = false;  ///< localizeIn
 };
 
 }  // namespace devslam::slam

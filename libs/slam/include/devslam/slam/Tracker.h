@@ -92,6 +92,14 @@ class Tracker {
 
     /// Starts tracking at a pose (the first keyframe's).
     void initialize(const Eigen::Isometry3d& T_wc, double timestamp);
+    /// Starts localizing in a map made before (Slam::localizeIn): lost until a frame
+    /// relocalizes against any of its keyframes (no jump bound for that first pose). From
+    /// then on the local map is the keyframes nearest the camera, not the map's newest, and
+    /// a lost frame is matched against every keyframe, the reloc_keyframes with the most
+    /// matches verified.
+    void startLocalizing();
+    /// Localizing in a loaded map (startLocalizing) and a frame has found its pose there.
+    [[nodiscard]] bool localized() const { return localizing_ && localized_; }
     /// Tracks one frame against `map`; updates the landmarks' visible/found counters.
     [[nodiscard]] TrackResult track(const TrackInput& in, Map& map,
                                     const core::CameraIntrinsics& K);
@@ -136,6 +144,8 @@ class Tracker {
     bool has_velocity_ = false;
     double last_t_ = 0.0;
     double velocity_dt_ = 0.0;
+    bool localizing_ = false;  ///< startLocalizing: the map was loaded, not made here
+    bool localized_ = false;   ///< a frame has been tracked (since startLocalizing)
 };
 
 }  // namespace devslam::slam
