@@ -172,13 +172,16 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
     slam::Slam slam(slam_opts);
     if (rc.localize_in) {
         slam::checkOrbMatches(*rc.localize_in, rc.localize_map, slam_opts.orb);
-        slam.localizeIn(rc.localize_in->map);
+        slam.localizeIn(rc.localize_in->map, rc.extend_map);
     }
 
     RunReport rep;
     rep.input = rc.input;
     rep.truth_file = rc.truth_file;
-    if (rc.localize_in) rep.localize_map = rc.localize_map;
+    if (rc.localize_in) {
+        rep.localize_map = rc.localize_map;
+        rep.extend_map = rc.extend_map;
+    }
     rep.input_damage = reader.damage();
     rep.mode = rc.mode;
     rep.mask_source = masks->describe();
@@ -315,7 +318,7 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
         fl.ms.backend = msSince(t0);
         fl.state = slam::toString(tr.state);
         if (!tr.pose_valid) fl.lost_reason = tr.reason;
-        if (slam.localizing() && tr.pose_valid && !rep.localized_at) rep.localized_at = n;
+        if (rc.localize_in && tr.pose_valid && !rep.localized_at) rep.localized_at = n;
         fl.n_inliers = tr.n_inliers;
         fl.keyframe = mr.keyframe_inserted;
         fl.ba_rejected = mr.ba.rejected;
@@ -608,7 +611,9 @@ std::string formatSummary(const RunReport& r) {
       << (r.keyframes_culled ? " (" + std::to_string(r.keyframes_culled) + " culled)" : "")
       << "   landmarks: " << r.landmarks << "   loops closed: " << r.loops << "\n";
     if (!r.localize_map.empty())
-        o << "localized  : in " << r.localize_map << " (its keyframes and landmarks, unchanged), "
+        o << "localized  : in " << r.localize_map
+          << (r.extend_map ? " (extended: this run mapped on from its first pose in it), "
+                           : " (its keyframes and landmarks, unchanged), ")
           << (r.localized_at ? "from frame " + std::to_string(*r.localized_at)
                              : "NOT: no frame found its pose in the map")
           << "\n";
@@ -743,7 +748,8 @@ std::string toJson(const RunReport& r) {
     };
     o << "{\n  \"input\": \"" << esc(r.input) << "\",\n  \"groundtruth_file\": \""
       << esc(r.truth_file) << "\",\n  \"localize_map\": \"" << esc(r.localize_map)
-      << "\",\n  \"localized_from_frame\": "
+      << "\",\n  \"extend_map\": " << (r.extend_map ? "true" : "false")
+      << ",\n  \"localized_from_frame\": "
       << (r.localized_at ? std::to_string(*r.localized_at) : std::string("null"))
       << ",\n  \"input_damage\": \"" << esc(r.input_damage) << "\",\n  \"read_error\": \""
       << esc(r.read_error) << "\",\n  \"interrupted\": \"" << r.interrupted << "\",\n  \"mode\": \""

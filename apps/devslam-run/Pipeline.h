@@ -24,6 +24,8 @@ struct RunConfig {
     /// `localize_map` before the input opened.
     std::shared_ptr<const slam::MapFile> localize_in;
     std::string localize_map;
+    /// --extend-map: with localize_in, map on from the first pose found in it.
+    bool extend_map = false;
     std::string mode = "dynamic";
     /// Named in front of the "[section] key: ..." errors of the SLAM INI (`cfg`) and of the
     /// filter's (`filter_cfg`): the files, and what was written over them.
@@ -88,6 +90,7 @@ struct RunReport {
     std::string input_damage;  ///< what of the input was unreadable and left out ("" = none)
     std::string truth_file;    ///< RunConfig::truth_file
     std::string localize_map;  ///< RunConfig::localize_map ("" = a map made by this run)
+    bool extend_map = false;   ///< RunConfig::extend_map
     /// Localizing: the first frame that found its pose in the map (none: no frame did).
     std::optional<std::size_t> localized_at;
     /// A frame that failed to read during the run, or whose mask or person truth failed

@@ -41,6 +41,8 @@ const char* kUsage =
     "                   [--localize MAP]  (localization only, in the slam_map.yml an earlier\n"
     "                                      run wrote: poses in that map's frame, the map\n"
     "                                      kept as it is)\n"
+    "                   [--extend-map]  (with --localize: map on from the first pose\n"
+    "                                    found in it, in its frame)\n"
     "                   [--check-config]  (read the INIs as a run would, make the filter,\n"
     "                                      print 'ok' and stop; reads no frame, only\n"
     "                                      the camera of an input that exists)\n"
@@ -75,6 +77,7 @@ struct Args {
     bool allow_damaged = false;     ///< a damaged input: run on what is intact
     std::string groundtruth;        ///< --groundtruth: the input's ground truth from this file
     std::string localize;           ///< --localize: a saved map to localize in
+    bool extend_map = false;        ///< --extend-map: and map on from there
     bool check_config = false;      ///< --check-config: the INIs only, no run
     bool out_given = false;         ///< --out was on the command line
     bool results_given = false;     ///< --results was on the command line
@@ -122,7 +125,9 @@ Args parse(int argc, char** argv) {
         } else if (k == "--localize") {
             a.localize = value(i);
             if (a.localize.empty()) throw std::invalid_argument("--localize: no map named");
-        } else if (k == "--check-config")
+        } else if (k == "--extend-map")
+            a.extend_map = true;
+        else if (k == "--check-config")
             a.check_config = true;
         else if (k == "-h" || k == "--help") {
             std::cout << kUsage;
@@ -132,6 +137,8 @@ Args parse(int argc, char** argv) {
     }
     if (a.check_config && a.bench > 0)
         throw std::invalid_argument("--check-config does not go with --bench");
+    if (a.extend_map && a.localize.empty())
+        throw std::invalid_argument("--extend-map extends the map --localize names; none named");
     if (!a.localize.empty() && a.bench > 0)
         throw std::invalid_argument("--localize does not go with --bench (it makes its maps)");
     if (!a.groundtruth.empty() && a.bench > 0)
@@ -342,6 +349,7 @@ int runOnce(const Args& a) {
     rc.truth_file = a.groundtruth;
     rc.localize_in = map;
     rc.localize_map = a.localize;
+    rc.extend_map = a.extend_map;
     rc.progress = !a.quiet;
     rc.allow_damaged = a.allow_damaged;
     rc.score_masks = a.replay <= 0;

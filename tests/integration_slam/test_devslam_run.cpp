@@ -838,6 +838,27 @@ TEST(DevslamRun, ALaterRunLocalizesInTheMapAnEarlierOneSaved) {
     EXPECT_NE(js.find("\"localized_from_frame\": 0,"), std::string::npos);
     EXPECT_NE(readText(dir / "made" / "run.json").find("\"localized_from_frame\": null,"),
               std::string::npos);
+    // --extend-map: the same start, mapping on from there (keyframes of its own), its poses
+    // still the first run's.
+    auto ext = run("--input " + later.string() + " --localize " + map +
+                   " --extend-map --mode none --quiet --out " + (dir / "ext").string());
+    ASSERT_EQ(ext.rc, 0) << ext.out;
+    EXPECT_NE(ext.out.find("localized  : in " + map +
+                           " (extended: this run mapped on from its first pose in it), from "
+                           "frame 0"),
+              std::string::npos)
+        << ext.out;
+    EXPECT_EQ(ext.out.find("keyframes: 7 "), std::string::npos) << ext.out;
+    const auto e = devslam::io::readTumTrajectory((dir / "ext" / "trajectory.txt").string());
+    ASSERT_EQ(e.size(), b.size());
+    for (std::size_t i = 0; i < e.size(); ++i)
+        EXPECT_LT((e[i].pose.translation() - b[i].pose.translation()).norm(), 0.005) << i;
+    EXPECT_NE(readText(dir / "ext" / "run.json").find("\"extend_map\": true,"), std::string::npos);
+    auto alone = run("--extend-map --quiet --out ''");
+    EXPECT_EQ(alone.rc, 1);
+    EXPECT_NE(alone.out.find("--extend-map extends the map --localize names; none named"),
+              std::string::npos)
+        << alone.out;
     // The map written by the localizing run: the same keyframes (the run's folder may be the
     // one the map came from: it is written again, not lost).
     auto again = run("--input " + later.string() + " --localize " + map +

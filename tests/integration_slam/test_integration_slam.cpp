@@ -137,7 +137,7 @@ TEST(SlamIntegration, ASavedMapIsLocalizedInFromAnotherStart) {
     const std::string path = std::string(tmp ? tmp : "/tmp") + "/devslam_localize_" +
                              std::to_string(::getpid()) + ".yml";
     slam::saveMap(path, mapper->map(), opts.orb);
-    slam::MapFile m = slam::loadMap(path);
+    const slam::MapFile m = slam::loadMap(path);
     std::remove(path.c_str());
     const std::size_t kfs = m.map.keyframes().size(), lms = m.map.landmarks().size();
     EXPECT_EQ(kfs, made.keyframes);
@@ -157,46 +157,61 @@ TEST(SlamIntegration, ASavedMapIsLocalizedInFromAnotherStart) {
         later.push_back(f);
     }
     later.insert(later.end(), seq.frames.begin() + start, seq.frames.end());
-    slam::Slam loc(opts);
-    loc.localizeIn(std::move(m.map));
-    EXPECT_TRUE(loc.localizing());
-    EXPECT_FALSE(loc.localized());
-    double worst_m = 0, worst_deg = 0;
-    for (std::size_t i = 0; i < later.size(); ++i) {
-        core::Frame f = later[i];
-        f.index = i;
-        const auto r = loc.process(f, {});
-        EXPECT_FALSE(r.mapping.keyframe_inserted);
-        if (i < 2) {
-            EXPECT_FALSE(r.track.pose_valid) << i;
-            EXPECT_EQ(r.track.state, slam::TrackingState::Lost) << i;
+    // Localization only, then with the map extended from the first pose found in it.
+    for (const bool extend : {false, true}) {
+        SCOPED_TRACE(extend ? "extended" : "localization only");
+        slam::Slam loc(opts);
+        loc.localizeIn(m.map, extend);
+        EXPECT_TRUE(loc.localizing());
+        EXPECT_FALSE(loc.localized());
+        int inserted = 0;
+        for (std::size_t i = 0; i < later.size(); ++i) {
+            core::Frame f = later[i];
+            f.index = i;
+            const auto r = loc.process(f, {});
+            inserted += r.mapping.keyframe_inserted ? 1 : 0;
+            if (i < 2) {
+                EXPECT_FALSE(r.track.pose_valid) << i;
+                EXPECT_EQ(r.track.state, slam::TrackingState::Lost) << i;
+                continue;
+            }
+            ASSERT_TRUE(r.track.pose_valid) << i << ": " << r.track.reason;
+            EXPECT_EQ(r.track.state,
+                      i == 2 ? slam::TrackingState::Relocalized : slam::TrackingState::Ok)
+                << i;
+        }
+        EXPECT_TRUE(loc.localized());
+        (void)loc.finalize(seq.frames.front().K);  // adjusts nothing without extend
+        const core::Trajectory got = loc.trajectory();
+        ASSERT_EQ(got.size(), later.size());
+        double worst_m = 0, worst_deg = 0;
+        for (std::size_t i = 2; i < later.size(); ++i) {
+            const Eigen::Isometry3d want = core::toIsometry(mapped[start + i - 2].pose);
+            const Eigen::Isometry3d d = want.inverse() * core::toIsometry(got[i].pose);
+            worst_m = std::max(worst_m, d.translation().norm());
+            worst_deg = std::max(worst_deg, Eigen::AngleAxisd(d.linear()).angle() * 180 / M_PI);
+        }
+        std::printf(
+            "%s: largest difference from the mapping run %.4f m, %.3f deg; %d keyframes made\n",
+            extend ? "extended" : "localized", worst_m, worst_deg, inserted);
+        EXPECT_LT(worst_m, 0.005);
+        EXPECT_LT(worst_deg, 0.5);
+        EXPECT_EQ(loc.lostFrames(), (std::vector<std::size_t>{0, 1}));
+        if (extend) {  // keyframes and landmarks of its own
+            EXPECT_GE(inserted, 1);
+            EXPECT_EQ(loc.map().keyframes().size(), kfs + static_cast<std::size_t>(inserted));
+            EXPECT_GT(loc.map().landmarks().size(), lms);
             continue;
         }
-        ASSERT_TRUE(r.track.pose_valid) << i << ": " << r.track.reason;
-        EXPECT_EQ(r.track.state,
-                  i == 2 ? slam::TrackingState::Relocalized : slam::TrackingState::Ok)
-            << i;
-        const Eigen::Isometry3d want = core::toIsometry(mapped[start + i - 2].pose);
-        const Eigen::Isometry3d d = want.inverse() * r.track.T_wc;
-        worst_m = std::max(worst_m, d.translation().norm());
-        worst_deg = std::max(worst_deg, Eigen::AngleAxisd(d.linear()).angle() * 180 / M_PI);
+        // The map is the loaded one, untouched (counters aside).
+        EXPECT_EQ(inserted, 0);
+        EXPECT_EQ(loc.map().keyframes().size(), kfs);
+        EXPECT_EQ(loc.map().landmarks().size(), lms);
+        auto kf = loc.map().keyframes().begin();
+        for (const auto& [id, k] : mapper->map().keyframes())
+            EXPECT_EQ((kf++)->second.T_wc.matrix(), k.T_wc.matrix());
+        EXPECT_THROW(loc.localizeIn(slam::Map{}), std::logic_error);
     }
-    EXPECT_TRUE(loc.localized());
-    (void)loc.finalize(seq.frames.front().K);  // adjusts nothing
-    std::printf(
-        "localized against the saved map: largest difference from the mapping run "
-        "%.4f m, %.3f deg\n",
-        worst_m, worst_deg);
-    EXPECT_LT(worst_m, 0.005);
-    EXPECT_LT(worst_deg, 0.5);
-    EXPECT_EQ(loc.lostFrames(), (std::vector<std::size_t>{0, 1}));
-    // The map is the loaded one, untouched (counters aside).
-    EXPECT_EQ(loc.map().keyframes().size(), kfs);
-    EXPECT_EQ(loc.map().landmarks().size(), lms);
-    auto kf = loc.map().keyframes().begin();
-    for (const auto& [id, k] : mapper->map().keyframes())
-        EXPECT_EQ((kf++)->second.T_wc.matrix(), k.T_wc.matrix());
-    EXPECT_THROW(loc.localizeIn(slam::Map{}), std::logic_error);
     slam::Slam fresh(opts);
     EXPECT_THROW(fresh.localizeIn(slam::Map{}), std::invalid_argument);
 }

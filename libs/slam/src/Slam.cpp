@@ -175,6 +175,7 @@ TrackResult Slam::track(const core::Frame& frame, const FrameFeatures& features,
     const TrackInput in{&features, frame.timestamp, prior};
     res = tracker_.track(in, map_, frame.K);
     rec.valid = res.pose_valid;
+    if (loaded_ && res.pose_valid) found_in_map_ = true;
     const auto last = map_.lastKeyframes(1);
     if (!last.empty()) {
         rec.ref_kf = last.front();
@@ -201,7 +202,7 @@ TrackResult Slam::track(const core::Frame& frame, const FrameFeatures& features,
 MappingResult Slam::mapStep(const core::Frame& frame, FrameFeatures features,
                             const TrackResult& track) {
     MappingResult out;
-    if (!track.pose_valid || localizing_) return out;
+    if (!track.pose_valid || (localizing_ && !extend_)) return out;
     ++frames_since_kf_;
     int n_close_tracked = 0, n_close_untracked = 0;
     for (std::size_t i = 0; i < features.size(); ++i) {
@@ -235,6 +236,10 @@ MappingResult Slam::mapStep(const core::Frame& frame, FrameFeatures features,
     kf.T_wc = track.T_wc;
     kf.features = std::move(features);
     const KeyframeId id = map_.addKeyframe(std::move(kf));
+    if (localizing_) {  // extend_: mapping from here on, as a SLAM run's
+        localizing_ = false;
+        tracker_.finishLocalizing();
+    }
     Keyframe& k = map_.keyframe(id);
     for (std::size_t i = 0; i < k.features.size(); ++i) {
         const LandmarkId lm = track.landmark_of_kp[i];
@@ -455,12 +460,14 @@ FrameResult Slam::process(const core::Frame& frame, const cv::Mat& mask,
     return r;
 }
 
-void Slam::localizeIn(Map map) {
+void Slam::localizeIn(Map map, bool extend) {
     if (!records_.empty()) throw std::logic_error("Slam::localizeIn: called after the first frame");
     if (map.keyframes().empty())
         throw std::invalid_argument("Slam::localizeIn: the map has no keyframe");
     map_ = std::move(map);
     localizing_ = true;
+    loaded_ = true;
+    extend_ = extend;
     tracker_.startLocalizing();
 }
 

@@ -175,11 +175,16 @@ class Slam {
     /// finalize do nothing), so poses are in the map's frame and the map stays valid for the
     /// next run. Throws std::logic_error after a frame, std::invalid_argument for an empty
     /// map.
-    void localizeIn(Map map);
+    ///
+    /// With `extend`, the run maps too once it has found its pose: from the first frame
+    /// tracked in the map it inserts keyframes and landmarks, adjusts and closes loops as a
+    /// SLAM run does, in the map's frame (older keyframes and landmarks move with the local
+    /// BA, loops and the final BA like any others).
+    void localizeIn(Map map, bool extend = false);
     /// localizeIn was called.
-    [[nodiscard]] bool localizing() const { return localizing_; }
-    /// Localizing and some frame has found its pose in the map.
-    [[nodiscard]] bool localized() const { return tracker_.localized(); }
+    [[nodiscard]] bool localizing() const { return loaded_; }
+    /// localizeIn was called and some frame has found its pose in the map.
+    [[nodiscard]] bool localized() const { return found_in_map_; }
     [[nodiscard]] int loopsClosed() const { return static_cast<int>(loops_.size()); }
     /// A loop the back end closed, as measured when it was verified.
     struct ClosedLoop {
@@ -242,7 +247,10 @@ class Slam {
     int frames_since_kf_ = 0;
     int tracked_at_last_kf_ = 0;
     bool pending_init_ = false;
-    bool localizing_ = false;  ///< localizeIn
+    bool localizing_ = false;    ///< localizeIn, and (extend_) no keyframe of its own yet
+    bool extend_ = false;        ///< localizeIn's extend
+    bool loaded_ = false;        ///< localizeIn was called
+    bool found_in_map_ = false;  ///< loaded_, and a frame was tracked
 };
 
 }  // namespace devslam::slam

@@ -98,8 +98,9 @@ class Tracker {
     /// a lost frame is matched against every keyframe, the reloc_keyframes with the most
     /// matches verified.
     void startLocalizing();
-    /// Localizing in a loaded map (startLocalizing) and a frame has found its pose there.
-    [[nodiscard]] bool localized() const { return localizing_ && localized_; }
+    /// Back to a SLAM run's local map and relocalization (Slam::localizeIn's extend, once
+    /// the run has made a keyframe of its own).
+    void finishLocalizing() { localizing_ = false; }
     /// Tracks one frame against `map`; updates the landmarks' visible/found counters.
     [[nodiscard]] TrackResult track(const TrackInput& in, Map& map,
                                     const core::CameraIntrinsics& K);
