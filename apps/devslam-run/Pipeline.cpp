@@ -517,8 +517,12 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
         }
         write(out("map.ply"), [&] { slam::writePly(out("map.ply"), slam.map()); });
         // The map to localize in later (--localize); a localizing run writes the map it used.
-        write(out("slam_map.yml"),
-              [&] { slam::saveMap(out("slam_map.yml"), slam.map(), slam_opts.orb); });
+        // None without a keyframe (nothing could localize in it).
+        if (slam.map().empty())
+            std::cerr << "devslam-run: slam_map.yml not written: the map has no keyframe\n";
+        else
+            write(out("slam_map.yml"),
+                  [&] { slam::saveMap(out("slam_map.yml"), slam.map(), slam_opts.orb); });
         std::optional<core::Trajectory> gt_in_est;
         if (rep.ate && rep.ground_truth) {
             // Ground truth brought into the SLAM frame for the 3D view.

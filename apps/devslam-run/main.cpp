@@ -303,6 +303,8 @@ run::RunConfig runConfig(const Args& a, const Loaded& l, const std::string& mode
 std::shared_ptr<const slam::MapFile> loadLocalizeMap(const Args& a, const Loaded& l) {
     if (a.localize.empty()) return nullptr;
     auto m = std::make_shared<slam::MapFile>(slam::loadMap(a.localize));
+    if (m->map.empty())
+        throw std::invalid_argument(a.localize + ": the map has no keyframe to localize in");
     slam::checkOrbMatches(*m, a.localize, slam::SlamOptions::fromConfig(*l.cfg).orb);
     return m;
 }

@@ -891,6 +891,20 @@ TEST(DevslamRun, ALaterRunLocalizesInTheMapAnEarlierOneSaved) {
                                  "1.300000, 8"),
               std::string::npos)
         << orb.out;
+    // A map without a keyframe (written by hand: devslam-run writes none).
+    std::ofstream(dir / "empty.yml")
+        << "%YAML:1.0\n---\nformat: devslam-map\nversion: 1\norb_scale_factor: 1.3\n"
+           "orb_n_levels: 4\nkeyframes: []\nlandmarks:\n  count: 0\n  id: []\n  p_w: []\n"
+           "  descriptors: []\n  colors: []\n  ref_kf: []\n  created_kf: []\n"
+           "  n_visible: []\n  n_found: []\n  n_observations: []\n  observations: []\n"
+           "end_of_map: 1\n";
+    auto empty = run("--input /no/such/input --localize " + (dir / "empty.yml").string() +
+                     " --quiet --out ''");
+    EXPECT_EQ(empty.rc, 1);
+    EXPECT_NE(
+        empty.out.find((dir / "empty.yml").string() + ": the map has no keyframe to localize in"),
+        std::string::npos)
+        << empty.out;
     auto bench = run("--bench 1 --localize " + map + " --results none");
     EXPECT_EQ(bench.rc, 1);
     EXPECT_NE(bench.out.find("--localize does not go with --bench"), std::string::npos)
@@ -1030,6 +1044,10 @@ TEST(DevslamRun, WithoutAnAteTheRunSaysWhy) {
     EXPECT_NE(lost_js.find("\"reason\": \"not initialized: 0 of "),
               std::string::npos);
     EXPECT_NE(lost_js.find("\"ate_missing\": \"0 of 5 frames tracked"), std::string::npos);
+    // No map to localize in: none written, said so.
+    EXPECT_NE(lost.out.find("slam_map.yml not written: the map has no keyframe"), std::string::npos)
+        << lost.out;
+    EXPECT_FALSE(fs::exists(dir / "lost" / "slam_map.yml"));
     fs::remove_all(dir);
 }
 
