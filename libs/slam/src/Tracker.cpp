@@ -279,9 +279,8 @@ std::optional<Eigen::Isometry3d> Tracker::relocalize(const FrameFeatures& f, con
                                                      double timestamp) const {
     // Candidates: the newest keyframes and the ones nearest to the last pose, facing anywhere.
     // In a loaded map (localizing) its newest keyframes say nothing of where the camera is,
-    // nor, while lost, does the last pose: every keyframe is matched, and only the
-    // reloc_keyframes with the most matches are verified by PnP (no place recognition ranks
-    // them: the matching costs about 1 ms a keyframe, the verification more).
+    // nor, while lost, does the last pose: every keyframe is matched (no place recognition
+    // ranks them), and only the reloc_keyframes with the most matches are verified by PnP.
     std::vector<KeyframeId> cands;
     if (localizing_) {
         for (const auto& [id, kf] : map.keyframes()) cands.push_back(id);
@@ -296,7 +295,7 @@ std::optional<Eigen::Isometry3d> Tracker::relocalize(const FrameFeatures& f, con
         std::vector<int> rows;                   ///< its keypoints with a landmark
         std::vector<std::pair<int, int>> pairs;  ///< (frame keypoint, row)
     };
-    const auto matchesOf = [&](KeyframeId id) {
+    const auto matchesOf = [&](KeyframeId id, const cv::Mat& query) {
         Candidate c;
         c.kf = &map.keyframe(id);
         for (int i = 0; i < static_cast<int>(c.kf->landmark_of_kp.size()); ++i)
@@ -306,7 +305,7 @@ std::optional<Eigen::Isometry3d> Tracker::relocalize(const FrameFeatures& f, con
         for (std::size_t r = 0; r < c.rows.size(); ++r)
             c.kf->features.descriptors.row(c.rows[r]).copyTo(train.row(static_cast<int>(r)));
         for (const auto& [q, t] :
-             matchBruteForce(f.descriptors, train, opts_.reloc_max_hamming, opts_.reloc_ratio))
+             matchBruteForce(query, train, opts_.reloc_max_hamming, opts_.reloc_ratio))
             c.pairs.emplace_back(q, t);
         return c;
     };
@@ -331,21 +330,31 @@ std::optional<Eigen::Isometry3d> Tracker::relocalize(const FrameFeatures& f, con
         }
     };
     if (!localizing_) {
-        for (KeyframeId id : cands) verify(matchesOf(id));
+        for (KeyframeId id : cands) verify(matchesOf(id, f.descriptors));
         return best;
     }
-    std::vector<Candidate> ranked;
-    for (KeyframeId id : cands) {
-        Candidate c = matchesOf(id);
-        if (static_cast<int>(c.pairs.size()) >= opts_.reloc_min_inliers)
-            ranked.push_back(std::move(c));
-    }
-    std::stable_sort(ranked.begin(), ranked.end(), [](const Candidate& a, const Candidate& b) {
-        return a.pairs.size() > b.pairs.size();
+    // The keyframes are ranked by the matches of the frame's strongest quarter of keypoints
+    // (200 at least), which costs a quarter of matching them all; the best are then matched
+    // with every keypoint and verified.
+    const int n_rank =
+        std::min(static_cast<int>(f.size()), std::max(200, static_cast<int>(f.size()) / 4));
+    std::vector<int> order(f.size());
+    for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<int>(i);
+    std::stable_sort(order.begin(), order.end(), [&](int a, int b) {
+        return f.keypoints[static_cast<std::size_t>(a)].response >
+               f.keypoints[static_cast<std::size_t>(b)].response;
     });
+    cv::Mat strongest(n_rank, 32, CV_8U);
+    for (int r = 0; r < n_rank; ++r) f.descriptors.row(order[r]).copyTo(strongest.row(r));
+    std::vector<std::pair<std::size_t, KeyframeId>> ranked;  // (matches, keyframe)
+    for (KeyframeId id : cands)
+        if (const std::size_t n = matchesOf(id, strongest).pairs.size(); n > 0)
+            ranked.emplace_back(n, id);
+    std::stable_sort(ranked.begin(), ranked.end(),
+                     [](const auto& a, const auto& b) { return a.first > b.first; });
     if (ranked.size() > static_cast<std::size_t>(opts_.reloc_keyframes))
         ranked.resize(static_cast<std::size_t>(opts_.reloc_keyframes));
-    for (const Candidate& c : ranked) verify(c);
+    for (const auto& [n, id] : ranked) verify(matchesOf(id, f.descriptors));
     return best;
 }
 
