@@ -564,7 +564,7 @@ Runs runSlam(const Bench& b, const Args& a) {
                     fs::create_directories(dir);
                     std::string cmd = quote(a.bin + "/devslam-run") + " --input " + quote(in.path) +
                                       " --config " + quote(q.slam_config) + " --mode " + m +
-                                      " --out " + quote(dir.string()) + " --quiet";
+                                      " --out " + quote(dir.string()) + " --quiet --no-slam-map";
                     if (b.max_frames) cmd += " --max-frames " + std::to_string(b.max_frames);
                     const std::string again = cmd;  // for a failed run's message
                     cmd += " > " + quote((dir / "log.txt").string()) + " 2>&1";

@@ -170,9 +170,14 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
     const slam::GridMapOptions& grid_opts = parts.grid;
     std::unique_ptr<MaskSource> masks = std::move(parts.masks);
     slam::Slam slam(slam_opts);
+    // The camera slam_map.yml is written with: the input's, or a loaded map's own when it is
+    // only localized in (its keyframes are that camera's).
+    core::CameraIntrinsics map_camera = reader.intrinsics();
     if (rc.localize_in) {
         slam::checkOrbMatches(*rc.localize_in, rc.localize_map, slam_opts.orb);
-        slam.localizeIn(rc.localize_in->map, rc.extend_map);
+        if (rc.extend_map) slam::checkCameraMatches(*rc.localize_in, rc.localize_map, map_camera);
+        map_camera = rc.localize_in->camera;
+        slam.localizeIn(std::move(rc.localize_in->map), rc.extend_map);
     }
 
     RunReport rep;
@@ -465,7 +470,16 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
         // An earlier run's outputs go first: a run that writes fewer (no ATE plot without
         // ground truth, no mask errors without person truth) or is killed while writing
         // leaves none of them beside its own. run.json comes last and says they are whole.
-        for (const char* f : kOutputFiles) fs::remove(fs::path(rep.out_dir) / f);
+        // (Not the map this run was given to localize in, when it is this folder's: it is
+        // replaced whole below, and a write that fails must not lose it.)
+        for (const char* f : kOutputFiles) {
+            const fs::path old = fs::path(rep.out_dir) / f;
+            std::error_code ec;
+            if (!rc.localize_map.empty() && std::string(f) == "slam_map.yml" &&
+                fs::equivalent(old, rc.localize_map, ec))
+                continue;
+            fs::remove(old);
+        }
         auto out = [&](const std::string& name) { return (fs::path(rep.out_dir) / name).string(); };
         // Each output on its own: one that cannot be written (a full disk) is named in
         // output_errors, and the others are still tried; the figures are printed whatever.
@@ -518,11 +532,14 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
         write(out("map.ply"), [&] { slam::writePly(out("map.ply"), slam.map()); });
         // The map to localize in later (--localize); a localizing run writes the map it used.
         // None without a keyframe (nothing could localize in it).
-        if (slam.map().empty())
+        if (!rc.save_map) {
+        } else if (slam.map().empty()) {
             std::cerr << "devslam-run: slam_map.yml not written: the map has no keyframe\n";
-        else
-            write(out("slam_map.yml"),
-                  [&] { slam::saveMap(out("slam_map.yml"), slam.map(), slam_opts.orb); });
+        } else {
+            write(out("slam_map.yml"), [&] {
+                slam::saveMap(out("slam_map.yml"), slam.map(), slam_opts.orb, map_camera);
+            });
+        }
         std::optional<core::Trajectory> gt_in_est;
         if (rep.ate && rep.ground_truth) {
             // Ground truth brought into the SLAM frame for the 3D view.
@@ -614,13 +631,14 @@ std::string formatSummary(const RunReport& r) {
       << "frames     : " << r.frames << "   keyframes: " << r.keyframes
       << (r.keyframes_culled ? " (" + std::to_string(r.keyframes_culled) + " culled)" : "")
       << "   landmarks: " << r.landmarks << "   loops closed: " << r.loops << "\n";
-    if (!r.localize_map.empty())
-        o << "localized  : in " << r.localize_map
-          << (r.extend_map ? " (extended: this run mapped on from its first pose in it), "
-                           : " (its keyframes and landmarks, unchanged), ")
-          << (r.localized_at ? "from frame " + std::to_string(*r.localized_at)
-                             : "NOT: no frame found its pose in the map")
+    if (!r.localize_map.empty() && r.localized_at)
+        o << "localized  : in " << r.localize_map << " from frame " << *r.localized_at
+          << (r.extend_map ? ", and mapped on from there (--extend-map)"
+                           : " (its keyframes and landmarks kept as they were)")
           << "\n";
+    else if (!r.localize_map.empty())
+        o << "localized  : NOT in " << r.localize_map << ": no frame found its pose in the map"
+          << (r.extend_map ? " (--extend-map: nothing mapped)" : "") << "\n";
     if (const auto e = loopErrors(r.loop_reports); !e.empty()) {
         const auto s = core::summarize(e);
         o << "loops      : measured relative poses vs truth: median " << num(1000 * s.median, 1)

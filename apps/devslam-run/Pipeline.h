@@ -21,11 +21,13 @@ struct RunConfig {
     std::string input;  ///< TUM folder or .rawlog
     std::string truth_file;  ///< where the reader's ground truth came from, if not the input
     /// --localize: localization only, in this map (slam::Slam::localizeIn), read from
-    /// `localize_map` before the input opened.
-    std::shared_ptr<const slam::MapFile> localize_in;
+    /// `localize_map` before the input opened. runSequence moves its map into the SLAM (a
+    /// map of 14 MB was held twice).
+    std::shared_ptr<slam::MapFile> localize_in;
     std::string localize_map;
     /// --extend-map: with localize_in, map on from the first pose found in it.
     bool extend_map = false;
+    bool save_map = true;  ///< write slam_map.yml (--no-slam-map: not)
     std::string mode = "dynamic";
     /// Named in front of the "[section] key: ..." errors of the SLAM INI (`cfg`) and of the
     /// filter's (`filter_cfg`): the files, and what was written over them.

@@ -43,6 +43,7 @@ const char* kUsage =
     "                                      kept as it is)\n"
     "                   [--extend-map]  (with --localize: map on from the first pose\n"
     "                                    found in it, in its frame)\n"
+    "                   [--no-slam-map]  (write the other outputs, not slam_map.yml)\n"
     "                   [--check-config]  (read the INIs as a run would, make the filter,\n"
     "                                      print 'ok' and stop; reads no frame, only\n"
     "                                      the camera of an input that exists)\n"
@@ -78,6 +79,7 @@ struct Args {
     std::string groundtruth;        ///< --groundtruth: the input's ground truth from this file
     std::string localize;           ///< --localize: a saved map to localize in
     bool extend_map = false;        ///< --extend-map: and map on from there
+    bool no_slam_map = false;       ///< --no-slam-map: no slam_map.yml
     bool check_config = false;      ///< --check-config: the INIs only, no run
     bool out_given = false;         ///< --out was on the command line
     bool results_given = false;     ///< --results was on the command line
@@ -127,6 +129,8 @@ Args parse(int argc, char** argv) {
             if (a.localize.empty()) throw std::invalid_argument("--localize: no map named");
         } else if (k == "--extend-map")
             a.extend_map = true;
+        else if (k == "--no-slam-map")
+            a.no_slam_map = true;
         else if (k == "--check-config")
             a.check_config = true;
         else if (k == "-h" || k == "--help") {
@@ -300,11 +304,12 @@ run::RunConfig runConfig(const Args& a, const Loaded& l, const std::string& mode
 
 /// --localize's map, read and checked against the INI's [orb] (nullptr without --localize):
 /// before the input opens, so that a bad map is named at once.
-std::shared_ptr<const slam::MapFile> loadLocalizeMap(const Args& a, const Loaded& l) {
+std::shared_ptr<slam::MapFile> loadLocalizeMap(const Args& a, const Loaded& l) {
     if (a.localize.empty()) return nullptr;
     auto m = std::make_shared<slam::MapFile>(slam::loadMap(a.localize));
-    if (m->map.empty())
-        throw std::invalid_argument(a.localize + ": the map has no keyframe to localize in");
+    if (m->map.empty() || m->map.landmarks().empty())
+        throw std::invalid_argument(a.localize + ": the map has no " +
+                                    (m->map.empty() ? "keyframe" : "landmark") + " to localize in");
     slam::checkOrbMatches(*m, a.localize, slam::SlamOptions::fromConfig(*l.cfg).orb);
     return m;
 }
@@ -334,7 +339,7 @@ int runOnce(const Args& a) {
     // Read before the input, which may take seconds to open: a bad file is named at once.
     std::optional<core::Trajectory> truth;
     if (!a.groundtruth.empty()) truth = io::readTumTrajectory(a.groundtruth);
-    const auto map = loadLocalizeMap(a, l);
+    auto map = loadLocalizeMap(a, l);
     std::unique_ptr<io::RgbdReader> reader;
     try {
         reader = openInput(a.input, l.reader, a.replay, !a.quiet, truth, a.groundtruth);
@@ -349,9 +354,10 @@ int runOnce(const Args& a) {
     auto rc = runConfig(a, l, l.mode);
     rc.out_dir = a.out;
     rc.truth_file = a.groundtruth;
-    rc.localize_in = map;
+    rc.localize_in = std::move(map);
     rc.localize_map = a.localize;
     rc.extend_map = a.extend_map;
+    rc.save_map = !a.no_slam_map;
     rc.progress = !a.quiet;
     rc.allow_damaged = a.allow_damaged;
     rc.score_masks = a.replay <= 0;

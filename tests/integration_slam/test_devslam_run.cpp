@@ -816,7 +816,7 @@ TEST(DevslamRun, ALaterRunLocalizesInTheMapAnEarlierOneSaved) {
                    " --mode none --quiet --out " + (dir / "loc").string());
     ASSERT_EQ(loc.rc, 0) << loc.out;
     EXPECT_NE(loc.out.find("localized  : in " + map +
-                           " (its keyframes and landmarks, unchanged), from frame 0"),
+                           " from frame 0 (its keyframes and landmarks kept as they were)"),
               std::string::npos)
         << loc.out;
     EXPECT_NE(loc.out.find("lost frames: 0"), std::string::npos) << loc.out;
@@ -844,8 +844,7 @@ TEST(DevslamRun, ALaterRunLocalizesInTheMapAnEarlierOneSaved) {
                    " --extend-map --mode none --quiet --out " + (dir / "ext").string());
     ASSERT_EQ(ext.rc, 0) << ext.out;
     EXPECT_NE(ext.out.find("localized  : in " + map +
-                           " (extended: this run mapped on from its first pose in it), from "
-                           "frame 0"),
+                           " from frame 0, and mapped on from there (--extend-map)"),
               std::string::npos)
         << ext.out;
     EXPECT_EQ(ext.out.find("keyframes: 7 "), std::string::npos) << ext.out;
@@ -894,7 +893,10 @@ TEST(DevslamRun, ALaterRunLocalizesInTheMapAnEarlierOneSaved) {
     // A map without a keyframe (written by hand: devslam-run writes none).
     std::ofstream(dir / "empty.yml")
         << "%YAML:1.0\n---\nformat: devslam-map\nversion: 1\norb_scale_factor: 1.3\n"
-           "orb_n_levels: 4\nkeyframes: []\nlandmarks:\n  count: 0\n  id: []\n  p_w: []\n"
+           "orb_n_levels: 4\ncamera: {fx: 517.3, fy: 516.5, cx: 318.6, cy: 255.3, width: 640, "
+           "height: 480,\n  dist: !!opencv-matrix {rows: 1, cols: 5, dt: d, data: [0, 0, 0, 0, "
+           "0]}}\n"
+           "keyframes: []\nlandmarks:\n  count: 0\n  id: []\n  p_w: []\n"
            "  descriptors: []\n  colors: []\n  ref_kf: []\n  created_kf: []\n"
            "  n_visible: []\n  n_found: []\n  n_observations: []\n  observations: []\n"
            "end_of_map: 1\n";
@@ -905,6 +907,31 @@ TEST(DevslamRun, ALaterRunLocalizesInTheMapAnEarlierOneSaved) {
         empty.out.find((dir / "empty.yml").string() + ": the map has no keyframe to localize in"),
         std::string::npos)
         << empty.out;
+    // --extend-map with another camera: refused (a BA would move the map's keyframes with
+    // the other camera's pixels); localizing only, the map's 3D points serve any camera.
+    const std::string fr2 = " --set dataset.camera=freiburg2 --mode none --quiet --out ''";
+    auto cam = run("--localize " + map + " --extend-map" + fr2);
+    EXPECT_EQ(cam.rc, 1) << cam.out;
+    EXPECT_NE(cam.out.find(map + ": the map was made with the camera fx=517.3 fy=516.5 cx=318.6 "
+                                 "cy=255.3 640x480"),
+              std::string::npos)
+        << cam.out;
+    EXPECT_EQ(run("--localize " + map + fr2).rc, 0);
+    // A localizing run into the map's own folder whose map write fails keeps the map (it was
+    // removed with the folder's other outputs before they were written).
+    fs::create_directories(dir / "keep");
+    fs::copy_file(map, dir / "keep" / "slam_map.yml");
+    const auto full = devslam::test::runAppWithFileLimit(
+        "devslam-run",
+        "--input " + later.string() + " --localize " + (dir / "keep" / "slam_map.yml").string() +
+            " --mode none --quiet --out " + (dir / "keep").string(),
+        1000000, false);
+    EXPECT_EQ(full.rc, 1) << full.out;
+    EXPECT_NE(full.out.find("cannot write '" + (dir / "keep" / "slam_map.yml").string() +
+                            "': File too large"),
+              std::string::npos)
+        << full.out;
+    EXPECT_EQ(readText(dir / "keep" / "slam_map.yml"), readText(map));
     auto bench = run("--bench 1 --localize " + map + " --results none");
     EXPECT_EQ(bench.rc, 1);
     EXPECT_NE(bench.out.find("--localize does not go with --bench"), std::string::npos)

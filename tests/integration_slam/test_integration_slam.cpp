@@ -136,7 +136,7 @@ TEST(SlamIntegration, ASavedMapIsLocalizedInFromAnotherStart) {
     const char* tmp = std::getenv("TMPDIR");
     const std::string path = std::string(tmp ? tmp : "/tmp") + "/devslam_localize_" +
                              std::to_string(::getpid()) + ".yml";
-    slam::saveMap(path, mapper->map(), opts.orb);
+    slam::saveMap(path, mapper->map(), opts.orb, seq.frames.front().K);
     const slam::MapFile m = slam::loadMap(path);
     std::remove(path.c_str());
     const std::size_t kfs = m.map.keyframes().size(), lms = m.map.landmarks().size();

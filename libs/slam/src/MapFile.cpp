@@ -4,12 +4,17 @@
 #include <opencv2/core/persistence.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <limits>
+#include <map>
 #include <set>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <utility>
 #include <vector>
 
@@ -18,6 +23,7 @@ namespace devslam::slam {
 namespace {
 constexpr const char* kFormat = "devslam-map";
 constexpr int kVersion = 1;
+constexpr int kKeypointCols = 7;  ///< x y size angle response octave class_id
 
 int asInt(std::int64_t v, const char* what) {
     if (v < 0 || v > std::numeric_limits<int>::max())
@@ -26,97 +32,32 @@ int asInt(std::int64_t v, const char* what) {
     return static_cast<int>(v);
 }
 
-/// `fs << key << v`, but an empty list as an empty sequence: OpenCV 4.6's base64 writer
+/// `fs << key << m`, but an empty matrix as an empty sequence: OpenCV 4.6's base64 writer
 /// asserts on an empty array.
-template <typename T>
-void put(cv::FileStorage& fs, const char* key, const T& v) {
+void put(cv::FileStorage& fs, const char* key, const cv::Mat& m) {
     fs << key;
-    if (v.empty())
+    if (m.empty())
         fs << "["
            << "]";
     else
-        fs << v;
+        fs << m;
 }
 
-cv::Mat poseMat(const Eigen::Isometry3d& T) {
-    cv::Mat m(3, 4, CV_64F);
-    for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 4; ++c) m.at<double>(r, c) = T.matrix()(r, c);
+/// One value per row, as a column matrix (every array of the file is a checked matrix).
+template <typename T>
+cv::Mat column(const std::vector<T>& v, int type) {
+    cv::Mat m(static_cast<int>(v.size()), 1, type);
+    for (std::size_t i = 0; i < v.size(); ++i) m.at<T>(static_cast<int>(i), 0) = v[i];
     return m;
 }
 
-/// Reading: every error names the file and, through `where`, the element.
-struct Reader {
-    std::string path;
-
-    [[noreturn]] void fail(const std::string& where, const std::string& what) const {
-        throw std::runtime_error(path + ": " + (where.empty() ? "" : where + ": ") + what);
-    }
-    cv::FileNode need(const cv::FileNode& parent, const char* key, const std::string& where) const {
-        cv::FileNode n = parent[key];
-        if (n.empty() && !n.isSeq() && !n.isMap() && n.type() == cv::FileNode::NONE)
-            fail(where, std::string("no '") + key + "'");
-        return n;
-    }
-    template <typename T>
-    T read(const cv::FileNode& parent, const char* key, const std::string& where) const {
-        const cv::FileNode n = need(parent, key, where);
-        T v{};
-        n >> v;
-        return v;
-    }
-    double readFinite(const cv::FileNode& parent, const char* key, const std::string& where) const {
-        const cv::FileNode n = need(parent, key, where);
-        if (!n.isReal() && !n.isInt()) fail(where, std::string("'") + key + "' is not a number");
-        const double v = n.real();
-        if (!std::isfinite(v)) fail(where, std::string("'") + key + "' is not finite");
-        return v;
-    }
-    int readInt(const cv::FileNode& parent, const char* key, const std::string& where) const {
-        const cv::FileNode n = need(parent, key, where);
-        if (!n.isInt()) fail(where, std::string("'") + key + "' is not an integer");
-        return static_cast<int>(n);
-    }
-    template <typename T>
-    std::vector<T> readVec(const cv::FileNode& parent, const char* key,
-                           const std::string& where) const {
-        const cv::FileNode n = need(parent, key, where);
-        if (!n.isSeq()) fail(where, std::string("'") + key + "' is not a list");
-        std::vector<T> v;
-        n >> v;
-        return v;
-    }
-    cv::Mat readMat(const cv::FileNode& parent, const char* key, const std::string& where, int type,
-                    int cols) const {
-        const cv::FileNode n = need(parent, key, where);
-        cv::Mat m;
-        if (n.isSeq() && n.size() == 0) return cv::Mat(0, cols, type);  // put's empty list
-        n >> m;
-        // An empty matrix is written with no data: zero rows of the right kind.
-        if (m.empty()) return cv::Mat(0, cols, type);
-        if (m.type() != type || m.cols != cols)
-            fail(where, std::string("'") + key + "' is not a " + std::to_string(cols) +
-                            "-column matrix of the expected type");
-        return m;
-    }
-    Eigen::Isometry3d readPose(const cv::FileNode& parent, const char* key,
-                               const std::string& where) const {
-        const cv::Mat m = readMat(parent, key, where, CV_64F, 4);
-        if (m.rows != 3) fail(where, std::string("'") + key + "' is not a 3x4 matrix");
-        Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
-        for (int r = 0; r < 3; ++r)
-            for (int c = 0; c < 4; ++c) {
-                const double v = m.at<double>(r, c);
-                if (!std::isfinite(v)) fail(where, std::string("'") + key + "' is not finite");
-                T.matrix()(r, c) = v;
-            }
-        const Eigen::Matrix3d R = T.linear();
-        if ((R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() > 1e-6 ||
-            R.determinant() < 0)
-            fail(where, std::string("'") + key + "' is not a rotation and translation");
-        return T;
-    }
-};
+/// The rows of a one-column matrix (MatConstIterator divides by zero on an empty one).
+template <typename T>
+std::vector<T> rowsOf(const cv::Mat& m) {
+    std::vector<T> v(static_cast<std::size_t>(m.rows));
+    for (int i = 0; i < m.rows; ++i) v[static_cast<std::size_t>(i)] = m.at<T>(i, 0);
+    return v;
+}
 
 /// OpenCV's words for a file it could not parse: a parse error carries the file and line in
 /// `func` ("map.yml(45): Unexpected end of line"), other errors their condition in `err`.
@@ -130,44 +71,224 @@ std::string describe(const cv::Exception& e) {
     return e.err.empty() ? e.msg : e.err;
 }
 
-template <typename T>
-void requireSize(const Reader& rd, const std::vector<T>& v, std::size_t n, bool may_be_empty,
-                 const char* key, const std::string& where) {
-    if (v.size() == n || (may_be_empty && v.empty())) return;
-    rd.fail(where, std::string("'") + key + "' has " + std::to_string(v.size()) + " entries for " +
-                       std::to_string(n) + " keypoints");
+/// Reading: every error names the file and, through `where`, the element.
+struct Reader {
+    std::string path;
+
+    [[noreturn]] void fail(const std::string& where, const std::string& what) const {
+        throw std::runtime_error(path + ": " + (where.empty() ? "" : where + ": ") + what);
+    }
+    cv::FileNode need(const cv::FileNode& parent, const char* key, const std::string& where) const {
+        cv::FileNode n = parent[key];
+        if (n.type() == cv::FileNode::NONE) fail(where, std::string("no '") + key + "'");
+        return n;
+    }
+    double readFinite(const cv::FileNode& parent, const char* key, const std::string& where) const {
+        const cv::FileNode n = need(parent, key, where);
+        if (!n.isReal() && !n.isInt()) fail(where, std::string("'") + key + "' is not a number");
+        const double v = n.real();
+        if (!std::isfinite(v)) fail(where, std::string("'") + key + "' is not finite");
+        return v;
+    }
+    int readInt(const cv::FileNode& parent, const char* key, const std::string& where) const {
+        const cv::FileNode n = need(parent, key, where);
+        if (!n.isInt()) fail(where, std::string("'") + key + "' is not an integer");
+        return static_cast<int>(n);
+    }
+    /// A matrix of `type` and `cols` columns and, when rows >= 0, that many rows (or none,
+    /// when `may_be_empty`).
+    cv::Mat readMat(const cv::FileNode& parent, const char* key, const std::string& where, int type,
+                    int cols, int rows = -1, bool may_be_empty = false) const {
+        const cv::FileNode n = need(parent, key, where);
+        cv::Mat m;
+        if (n.isSeq() && n.size() == 0) {  // put's empty matrix
+            m = cv::Mat(0, cols, type);
+        } else {
+            if (!n.isMap()) fail(where, std::string("'") + key + "' is not a matrix");
+            n >> m;
+            if (m.type() != type || m.cols != cols || m.dims != 2)
+                fail(where, std::string("'") + key + "' is not a " + std::to_string(cols) +
+                                "-column matrix of the expected type");
+        }
+        if (rows >= 0 && m.rows != rows && !(may_be_empty && m.rows == 0))
+            fail(where, std::string("'") + key + "' has " + std::to_string(m.rows) + " rows for " +
+                            std::to_string(rows));
+        return m;
+    }
+    /// Every element of a floating-point matrix is finite.
+    void requireFinite(const cv::Mat& m, const char* key, const std::string& where) const {
+        if (!cv::checkRange(m))
+            fail(where, std::string("'") + key + "' holds a value that is not finite");
+    }
+    Eigen::Isometry3d readPose(const cv::FileNode& parent, const char* key,
+                               const std::string& where) const {
+        const cv::Mat m = readMat(parent, key, where, CV_64F, 4, 3);
+        requireFinite(m, key, where);
+        Eigen::Isometry3d T = Eigen::Isometry3d::Identity();
+        for (int r = 0; r < 3; ++r)
+            for (int c = 0; c < 4; ++c) T.matrix()(r, c) = m.at<double>(r, c);
+        const Eigen::Matrix3d R = T.linear();
+        if ((R.transpose() * R - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() > 1e-6 ||
+            R.determinant() < 0)
+            fail(where, std::string("'") + key + "' is not a rotation and translation");
+        return T;
+    }
+};
+
+/// Refuses text that OpenCV 4.6's FileStorage parser cannot be given safely (found by
+/// fuzzing): it loops forever on a base64 block whose 24-byte header names no type or has
+/// a stray character before it, and recurses without bound on nested sequences and maps
+/// (a stack overflow at some 30 000 levels). saveMap writes YAML with at most a few levels
+/// and well-formed base64 blocks, so this refuses no map it wrote.
+void precheck(const Reader& rd, const std::string& text) {
+    constexpr const char* kHead = "%YAML:1.0\n";
+    if (text.rfind(kHead, 0) != 0) rd.fail("", "not a DEV-SLAM map (no '%YAML:1.0' first line)");
+    if (text.find('\0') != std::string::npos) rd.fail("", "not a DEV-SLAM map (a NUL byte)");
+    constexpr std::size_t kMaxIndent = 64;
+    constexpr int kMaxDepth = 16;
+    const auto isB64 = [](char c) {
+        return std::isalnum(static_cast<unsigned char>(c)) || c == '+' || c == '/' || c == '=';
+    };
+    const auto b64 = [](char c) -> int {
+        if (c >= 'A' && c <= 'Z') return c - 'A';
+        if (c >= 'a' && c <= 'z') return c - 'a' + 26;
+        if (c >= '0' && c <= '9') return c - '0' + 52;
+        return c == '+' ? 62 : c == '/' ? 63 : 0;
+    };
+    int depth = 0;
+    std::size_t binary_indent = std::string::npos;  // key indentation of an open !!binary block
+    bool header_due = false;
+    std::size_t line_no = 0;
+    for (std::size_t at = 0; at < text.size();) {
+        const std::size_t end = std::min(text.find('\n', at), text.size());
+        const std::string_view line(text.data() + at, end - at);
+        at = end + 1;
+        ++line_no;
+        const std::string where = "line " + std::to_string(line_no);
+        const std::size_t indent = line.find_first_not_of(' ');
+        if (indent == std::string_view::npos) continue;  // blank
+        if (indent > kMaxIndent) rd.fail(where, "indented deeper than a DEV-SLAM map is");
+        if (binary_indent != std::string_view::npos && indent > binary_indent) {
+            const std::string_view data = line.substr(indent);
+            for (const char c : data)
+                if (!isB64(c))
+                    rd.fail(where, "a base64 block holds a character that is not base64");
+            if (header_due) {  // its first 24 bytes: the element type, as "1d" or "3f"
+                header_due = false;
+                if (data.size() < 32) rd.fail(where, "a base64 block without its type header");
+                std::string h;
+                for (std::size_t i = 0; i < 32; i += 4) {
+                    const int v = (b64(data[i]) << 18) | (b64(data[i + 1]) << 12) |
+                                  (b64(data[i + 2]) << 6) | b64(data[i + 3]);
+                    h += static_cast<char>((v >> 16) & 255);
+                    h += static_cast<char>((v >> 8) & 255);
+                    h += static_cast<char>(v & 255);
+                }
+                const std::size_t last = h.find_last_not_of(' ');
+                bool ok = last != std::string::npos;
+                bool typed = false;  // the previous character was a type letter
+                for (std::size_t i = 0; ok && i <= last; ++i) {
+                    const char c = h[i];
+                    if (std::isdigit(static_cast<unsigned char>(c)))
+                        typed = false;
+                    else if (std::string_view("ucwsifdh").find(c) != std::string_view::npos)
+                        typed = true;
+                    else
+                        ok = false;
+                }
+                if (!ok || !typed) rd.fail(where, "a base64 block whose header names no type");
+            }
+            continue;
+        }
+        binary_indent = std::string::npos;
+        bool quoted = false;
+        char quote = 0;
+        for (const char c : line) {
+            if (quoted) {
+                quoted = c != quote;
+            } else if (c == '"' || c == '\'') {
+                quoted = true;
+                quote = c;
+            } else if (c == '[' || c == '{') {
+                if (++depth > kMaxDepth) rd.fail(where, "nested deeper than a DEV-SLAM map is");
+            } else if (c == ']' || c == '}') {
+                --depth;
+            }
+        }
+        const std::string_view trimmed = line.substr(0, line.find_last_not_of(' ') + 1);
+        if (trimmed.size() >= 10 && trimmed.substr(trimmed.size() - 10) == "!!binary |") {
+            binary_indent = indent;
+            header_due = true;
+        }
+    }
+}
+
+/// A float that holds a whole number in [lo, hi].
+bool wholeIn(float v, int lo, int hi) {
+    return std::isfinite(v) && v == std::floor(v) && v >= static_cast<float>(lo) &&
+           v <= static_cast<float>(hi);
 }
 }  // namespace
 
-void saveMap(const std::string& path, const Map& map, const OrbExtractor::Options& orb) {
+void saveMap(const std::string& path, const Map& map, const OrbExtractor::Options& orb,
+             const core::CameraIntrinsics& camera) {
     cv::FileStorage fs(".yml",
                        cv::FileStorage::WRITE | cv::FileStorage::MEMORY | cv::FileStorage::BASE64);
     fs << "format" << kFormat << "version" << kVersion;
     fs << "orb_scale_factor" << orb.scale_factor << "orb_n_levels" << orb.n_levels;
+    fs << "camera"
+       << "{"
+       << "fx" << camera.fx << "fy" << camera.fy << "cx" << camera.cx << "cy" << camera.cy
+       << "width" << camera.width << "height" << camera.height;
+    put(fs, "dist", cv::Mat(1, 5, CV_64F, const_cast<double*>(camera.dist.data())));
+    fs << "}";
     fs << "keyframes"
        << "[";
     for (const auto& [id, kf] : map.keyframes()) {
         const FrameFeatures& f = kf.features;
+        const int n = static_cast<int>(f.size());
         fs << "{";
         fs << "id" << asInt(id, "keyframe id");
         fs << "frame_index" << asInt(static_cast<std::int64_t>(kf.frame_index), "frame index");
-        fs << "timestamp" << kf.timestamp << "T_wc" << poseMat(kf.T_wc);
-        put(fs, "keypoints", f.keypoints);
+        fs << "timestamp" << kf.timestamp;
+        cv::Mat T(3, 4, CV_64F);
+        for (int r = 0; r < 3; ++r)
+            for (int c = 0; c < 4; ++c) T.at<double>(r, c) = kf.T_wc.matrix()(r, c);
+        fs << "T_wc" << T;
+        cv::Mat kp(n, kKeypointCols, CV_32F), pc(n, 3, CV_64F), col(n, 3, CV_8U);
+        for (int i = 0; i < n; ++i) {
+            const auto& k = f.keypoints[static_cast<std::size_t>(i)];
+            const float row[kKeypointCols] = {k.pt.x,
+                                              k.pt.y,
+                                              k.size,
+                                              k.angle,
+                                              k.response,
+                                              static_cast<float>(k.octave),
+                                              static_cast<float>(k.class_id)};
+            std::copy(row, row + kKeypointCols, kp.ptr<float>(i));
+            for (int c = 0; c < 3; ++c) {
+                pc.at<double>(i, c) = f.points_c[static_cast<std::size_t>(i)][c];
+                col.at<unsigned char>(i, c) = f.colors[static_cast<std::size_t>(i)][c];
+            }
+        }
+        cv::Mat image_pt(static_cast<int>(f.image_pt.size()), 2, CV_32F);
+        for (int i = 0; i < image_pt.rows; ++i) {
+            image_pt.at<float>(i, 0) = f.image_pt[static_cast<std::size_t>(i)].x;
+            image_pt.at<float>(i, 1) = f.image_pt[static_cast<std::size_t>(i)].y;
+        }
+        put(fs, "keypoints", kp);
         put(fs, "descriptors", f.descriptors);
-        put(fs, "depth", f.depth);
-        std::vector<cv::Vec3d> pc(f.points_c.size());
-        for (std::size_t i = 0; i < pc.size(); ++i)
-            pc[i] = {f.points_c[i].x(), f.points_c[i].y(), f.points_c[i].z()};
+        put(fs, "depth", column(f.depth, CV_32F));
         put(fs, "points_c", pc);
-        put(fs, "colors", f.colors);
-        put(fs, "image_pt", f.image_pt);
-        put(fs, "weight", f.weight);
+        put(fs, "colors", col);
+        put(fs, "image_pt", image_pt);
+        put(fs, "weight", column(f.weight, CV_32F));
         fs << "gate_exponent" << f.gate_exponent;
         fs << "n_masked" << f.n_masked << "masked_fraction" << f.masked_fraction;
         fs << "}";
     }
     fs << "]";
-    // The landmarks column by column (a node per landmark made the file 3x slower to read).
+    // The landmarks column by column, in id order.
     std::vector<LandmarkId> ids;
     ids.reserve(map.landmarks().size());
     for (const auto& [id, lm] : map.landmarks()) ids.push_back(id);
@@ -197,16 +318,16 @@ void saveMap(const std::string& path, const Map& map, const OrbExtractor::Option
     fs << "landmarks"
        << "{";
     fs << "count" << n;
-    put(fs, "id", lid);
+    put(fs, "id", column(lid, CV_32S));
     put(fs, "p_w", p_w);
     put(fs, "descriptors", desc);
     put(fs, "colors", color);
-    put(fs, "ref_kf", ref_kf);
-    put(fs, "created_kf", created_kf);
-    put(fs, "n_visible", n_visible);
-    put(fs, "n_found", n_found);
-    put(fs, "n_observations", n_obs);
-    put(fs, "observations", obs);
+    put(fs, "ref_kf", column(ref_kf, CV_32S));
+    put(fs, "created_kf", column(created_kf, CV_32S));
+    put(fs, "n_visible", column(n_visible, CV_32S));
+    put(fs, "n_found", column(n_found, CV_32S));
+    put(fs, "n_observations", column(n_obs, CV_32S));
+    put(fs, "observations", column(obs, CV_32S).reshape(1, static_cast<int>(obs.size() / 2)));
     fs << "}";
     // Last, so that a file cut short (which YAML may still parse) is told as one.
     fs << "end_of_map" << 1;
@@ -218,28 +339,62 @@ MapFile loadMap(const std::string& path) {
     std::error_code ec;
     if (!std::filesystem::is_regular_file(path, ec))
         rd.fail("", std::filesystem::exists(path, ec) ? "not a file" : "no such file");
+    // Read here and given to OpenCV as text, not as a path: it would take a name ending in
+    // ".gz" for a gzip file (1 MB of it took 2.4 GB to unpack) and cut a name at a '?'
+    // (reading another file).
+    constexpr std::uintmax_t kMaxBytes = std::uintmax_t{1} << 30;
+    const std::uintmax_t bytes = std::filesystem::file_size(path, ec);
+    if (ec) rd.fail("", "cannot be read (" + ec.message() + ")");
+    if (bytes > kMaxBytes)
+        rd.fail("", std::to_string(bytes) + " bytes: larger than the 1 GiB a map is read up to");
+    std::string text;
+    {
+        std::ifstream in(path, std::ios::binary);
+        text.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+        if (!in && !in.eof()) rd.fail("", "cannot be read");
+    }
+    precheck(rd, text);
     cv::FileStorage fs;
     try {
-        if (!fs.open(path, cv::FileStorage::READ)) rd.fail("", "cannot be read");
+        if (!fs.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY))
+            rd.fail("", "cannot be read");
     } catch (const cv::Exception& e) {
         // A file cut short or not YAML/JSON/XML: OpenCV's parser names the line.
         rd.fail("", "not a DEV-SLAM map, or cut short (OpenCV: " + describe(e) + ")");
     }
     try {
         const cv::FileNode root = fs.root();
-        if (!root.isMap() || root["format"].empty() ||
+        if (!root.isMap() || !root["format"].isString() ||
             static_cast<std::string>(root["format"]) != kFormat)
             rd.fail("", std::string("not a DEV-SLAM map (no 'format: ") + kFormat + "')");
         const int version = rd.readInt(root, "version", "");
         if (version != kVersion)
             rd.fail("", "format version " + std::to_string(version) + ", this build reads " +
                             std::to_string(kVersion));
-        if (root["end_of_map"].empty()) rd.fail("", "cut short (no 'end_of_map' at its end)");
+        if (root["end_of_map"].type() == cv::FileNode::NONE)
+            rd.fail("", "cut short (no 'end_of_map' at its end)");
         MapFile out;
         out.orb_scale_factor = rd.readFinite(root, "orb_scale_factor", "");
         out.orb_n_levels = rd.readInt(root, "orb_n_levels", "");
-        if (out.orb_scale_factor <= 1 || out.orb_n_levels < 1)
-            rd.fail("", "orb_scale_factor must be > 1 and orb_n_levels >= 1");
+        if (out.orb_scale_factor <= 1 || out.orb_n_levels < 1 || out.orb_n_levels > 32)
+            rd.fail("", "orb_scale_factor must be > 1 and orb_n_levels in [1, 32]");
+        {
+            const std::string cw = "camera";
+            const cv::FileNode cn = rd.need(root, "camera", "");
+            if (!cn.isMap()) rd.fail(cw, "not a map of fields");
+            core::CameraIntrinsics& K = out.camera;
+            K.fx = rd.readFinite(cn, "fx", cw);
+            K.fy = rd.readFinite(cn, "fy", cw);
+            K.cx = rd.readFinite(cn, "cx", cw);
+            K.cy = rd.readFinite(cn, "cy", cw);
+            K.width = rd.readInt(cn, "width", cw);
+            K.height = rd.readInt(cn, "height", cw);
+            const cv::Mat d = rd.readMat(cn, "dist", cw, CV_64F, 5, 1);
+            rd.requireFinite(d, "dist", cw);
+            for (int i = 0; i < 5; ++i) K.dist[static_cast<std::size_t>(i)] = d.at<double>(0, i);
+            if (K.fx <= 0 || K.fy <= 0 || K.width <= 0 || K.height <= 0)
+                rd.fail(cw, "fx, fy, width and height must be positive");
+        }
 
         // Keyframes, renumbered in the saved order.
         const cv::FileNode kfs = rd.need(root, "keyframes", "");
@@ -256,33 +411,40 @@ MapFile loadMap(const std::string& path) {
             kf.frame_index = static_cast<std::size_t>(frame_index);
             kf.timestamp = rd.readFinite(kn, "timestamp", where);
             kf.T_wc = rd.readPose(kn, "T_wc", where);
+            const cv::Mat kp = rd.readMat(kn, "keypoints", where, CV_32F, kKeypointCols);
+            const int n = kp.rows;
             FrameFeatures& f = kf.features;
-            f.keypoints = rd.readVec<cv::KeyPoint>(kn, "keypoints", where);
-            const std::size_t n = f.keypoints.size();
-            for (const auto& kp : f.keypoints)
-                if (!std::isfinite(kp.pt.x) || !std::isfinite(kp.pt.y) || kp.octave < 0 ||
-                    kp.octave >= out.orb_n_levels)
-                    rd.fail(where, "a keypoint off the image plane or outside the pyramid");
-            f.descriptors = rd.readMat(kn, "descriptors", where, CV_8U, 32);
-            if (static_cast<std::size_t>(f.descriptors.rows) != n)
-                rd.fail(where, "'descriptors' has " + std::to_string(f.descriptors.rows) +
-                                   " rows for " + std::to_string(n) + " keypoints");
-            f.depth = rd.readVec<float>(kn, "depth", where);
-            requireSize(rd, f.depth, n, false, "depth", where);
-            const auto pc = rd.readVec<cv::Vec3d>(kn, "points_c", where);
-            requireSize(rd, pc, n, false, "points_c", where);
-            f.points_c.resize(n);
-            for (std::size_t i = 0; i < n; ++i) {
-                f.points_c[i] = {pc[i][0], pc[i][1], pc[i][2]};
-                if (!std::isfinite(f.depth[i]) || !f.points_c[i].allFinite())
-                    rd.fail(where, "a depth or point that is not finite");
+            for (int i = 0; i < n; ++i) {
+                const float* r = kp.ptr<float>(i);
+                if (!std::isfinite(r[0]) || !std::isfinite(r[1]) || !std::isfinite(r[2]) ||
+                    r[2] < 0 || !std::isfinite(r[3]) || !std::isfinite(r[4]) ||
+                    !wholeIn(r[5], 0, out.orb_n_levels - 1) || !wholeIn(r[6], -1000000, 1000000))
+                    rd.fail(where, "keypoint " + std::to_string(i) +
+                                       ": a value that is not finite, a negative size, or an "
+                                       "octave outside the pyramid");
+                f.keypoints.emplace_back(r[0], r[1], r[2], r[3], r[4], static_cast<int>(r[5]),
+                                         static_cast<int>(r[6]));
             }
-            f.colors = rd.readVec<cv::Vec3b>(kn, "colors", where);
-            requireSize(rd, f.colors, n, false, "colors", where);
-            f.image_pt = rd.readVec<cv::Point2f>(kn, "image_pt", where);
-            requireSize(rd, f.image_pt, n, true, "image_pt", where);
-            f.weight = rd.readVec<float>(kn, "weight", where);
-            requireSize(rd, f.weight, n, true, "weight", where);
+            f.descriptors = rd.readMat(kn, "descriptors", where, CV_8U, 32, n);
+            const cv::Mat depth = rd.readMat(kn, "depth", where, CV_32F, 1, n);
+            rd.requireFinite(depth, "depth", where);
+            f.depth = rowsOf<float>(depth);
+            const cv::Mat pc = rd.readMat(kn, "points_c", where, CV_64F, 3, n);
+            rd.requireFinite(pc, "points_c", where);
+            const cv::Mat col = rd.readMat(kn, "colors", where, CV_8U, 3, n);
+            for (int i = 0; i < n; ++i) {
+                f.points_c.emplace_back(pc.at<double>(i, 0), pc.at<double>(i, 1),
+                                        pc.at<double>(i, 2));
+                f.colors.emplace_back(col.at<unsigned char>(i, 0), col.at<unsigned char>(i, 1),
+                                      col.at<unsigned char>(i, 2));
+            }
+            const cv::Mat ip = rd.readMat(kn, "image_pt", where, CV_32F, 2, n, true);
+            rd.requireFinite(ip, "image_pt", where);
+            for (int i = 0; i < ip.rows; ++i)
+                f.image_pt.emplace_back(ip.at<float>(i, 0), ip.at<float>(i, 1));
+            const cv::Mat w = rd.readMat(kn, "weight", where, CV_32F, 1, n, true);
+            rd.requireFinite(w, "weight", where);
+            f.weight = rowsOf<float>(w);
             f.gate_exponent = rd.readFinite(kn, "gate_exponent", where);
             f.n_masked = rd.readInt(kn, "n_masked", where);
             f.masked_fraction = rd.readFinite(kn, "masked_fraction", where);
@@ -294,71 +456,64 @@ MapFile loadMap(const std::string& path) {
         const cv::FileNode ln = rd.need(root, "landmarks", "");
         if (!ln.isMap()) rd.fail("", "'landmarks' is not a map of fields");
         const std::string lw = "landmarks";
-        const int count = rd.readInt(ln, "count", lw);
-        if (count < 0) rd.fail(lw, "negative count");
-        const auto n = static_cast<std::size_t>(count);
-        const cv::Mat p_w = rd.readMat(ln, "p_w", lw, CV_64F, 3);
-        const cv::Mat desc = rd.readMat(ln, "descriptors", lw, CV_8U, 32);
-        const cv::Mat color = rd.readMat(ln, "colors", lw, CV_8U, 3);
-        if (static_cast<std::size_t>(p_w.rows) != n || static_cast<std::size_t>(desc.rows) != n ||
-            static_cast<std::size_t>(color.rows) != n)
-            rd.fail(lw, "p_w, descriptors and colors must have 'count' rows");
-        const auto ids = rd.readVec<int>(ln, "id", lw);
-        const auto ref_kf = rd.readVec<int>(ln, "ref_kf", lw);
-        const auto created_kf = rd.readVec<int>(ln, "created_kf", lw);
-        const auto n_visible = rd.readVec<int>(ln, "n_visible", lw);
-        const auto n_found = rd.readVec<int>(ln, "n_found", lw);
-        const auto n_obs = rd.readVec<int>(ln, "n_observations", lw);
-        const auto obs = rd.readVec<int>(ln, "observations", lw);
-        for (const auto* v : {&ids, &ref_kf, &created_kf, &n_visible, &n_found, &n_obs})
-            if (v->size() != n) rd.fail(lw, "every column must have 'count' entries");
+        const int n = rd.readInt(ln, "count", lw);
+        if (n < 0) rd.fail(lw, "negative count");
+        const cv::Mat p_w = rd.readMat(ln, "p_w", lw, CV_64F, 3, n);
+        const cv::Mat desc = rd.readMat(ln, "descriptors", lw, CV_8U, 32, n);
+        const cv::Mat color = rd.readMat(ln, "colors", lw, CV_8U, 3, n);
+        const cv::Mat ids = rd.readMat(ln, "id", lw, CV_32S, 1, n);
+        const cv::Mat ref_kf = rd.readMat(ln, "ref_kf", lw, CV_32S, 1, n);
+        const cv::Mat created_kf = rd.readMat(ln, "created_kf", lw, CV_32S, 1, n);
+        const cv::Mat n_visible = rd.readMat(ln, "n_visible", lw, CV_32S, 1, n);
+        const cv::Mat n_found = rd.readMat(ln, "n_found", lw, CV_32S, 1, n);
+        const cv::Mat n_obs = rd.readMat(ln, "n_observations", lw, CV_32S, 1, n);
+        const cv::Mat obs = rd.readMat(ln, "observations", lw, CV_32S, 2);
         std::set<std::pair<KeyframeId, int>> seen;
-        std::size_t o = 0;
+        int o = 0;
         const auto kfOf = [&](int saved, const std::string& where) -> KeyframeId {
             const auto it = kf_new.find(saved);
             if (it == kf_new.end())
                 rd.fail(where, "keyframe id " + std::to_string(saved) + " is not in the map");
             return it->second;
         };
-        for (std::size_t i = 0; i < n; ++i) {
+        for (int i = 0; i < n; ++i) {
             const std::string where =
-                "landmark " + std::to_string(i) + " (id " + std::to_string(ids[i]) + ")";
-            const int r = static_cast<int>(i);
-            const Eigen::Vector3d p(p_w.at<double>(r, 0), p_w.at<double>(r, 1),
-                                    p_w.at<double>(r, 2));
+                "landmark " + std::to_string(i) + " (id " + std::to_string(ids.at<int>(i, 0)) + ")";
+            const Eigen::Vector3d p(p_w.at<double>(i, 0), p_w.at<double>(i, 1),
+                                    p_w.at<double>(i, 2));
             if (!p.allFinite()) rd.fail(where, "a position that is not finite");
-            if (n_obs[i] < 1) rd.fail(where, "no observation");
-            if (obs.size() < o + 2 * static_cast<std::size_t>(n_obs[i]))
-                rd.fail(where, "'observations' ends before its observations");
+            const int k_obs = n_obs.at<int>(i, 0);
+            if (k_obs < 1) rd.fail(where, "no observation");
+            if (k_obs > obs.rows - o) rd.fail(where, "'observations' ends before its observations");
             LandmarkId lm = kNoId;
-            for (int j = 0; j < n_obs[i]; ++j, o += 2) {
-                const KeyframeId k = kfOf(obs[o], where);
-                const int kp = obs[o + 1];
+            for (int j = 0; j < k_obs; ++j, ++o) {
+                const int saved_kf = obs.at<int>(o, 0), kp = obs.at<int>(o, 1);
+                const KeyframeId k = kfOf(saved_kf, where);
                 if (kp < 0 || kp >= static_cast<int>(out.map.keyframe(k).features.size()))
-                    rd.fail(where, "keyframe id " + std::to_string(obs[o]) + " has no keypoint " +
+                    rd.fail(where, "keyframe id " + std::to_string(saved_kf) + " has no keypoint " +
                                        std::to_string(kp));
                 if (!seen.emplace(k, kp).second)
                     rd.fail(where, "keypoint " + std::to_string(kp) + " of keyframe id " +
-                                       std::to_string(obs[o]) + " observes two landmarks");
+                                       std::to_string(saved_kf) + " observes two landmarks");
                 if (lm == kNoId) {
-                    const cv::Vec3b c(color.at<unsigned char>(r, 0), color.at<unsigned char>(r, 1),
-                                      color.at<unsigned char>(r, 2));
-                    lm = out.map.addLandmark(p, desc.row(r), c, k, kp);
+                    const cv::Vec3b c(color.at<unsigned char>(i, 0), color.at<unsigned char>(i, 1),
+                                      color.at<unsigned char>(i, 2));
+                    lm = out.map.addLandmark(p, desc.row(i), c, k, kp);
                 } else {
                     out.map.addObservation(lm, k, kp);
                 }
             }
             Landmark& l = *out.map.landmark(lm);
             // The anchor must be in the map; the creator may have been culled before saving.
-            l.ref_kf = kfOf(ref_kf[i], where);
-            const auto created = kf_new.find(created_kf[i]);
+            l.ref_kf = kfOf(ref_kf.at<int>(i, 0), where);
+            const auto created = kf_new.find(created_kf.at<int>(i, 0));
             l.created_kf = created == kf_new.end() ? kNoId : created->second;
-            l.n_visible = n_visible[i];
-            l.n_found = n_found[i];
+            l.n_visible = n_visible.at<int>(i, 0);
+            l.n_found = n_found.at<int>(i, 0);
         }
-        if (o != obs.size())
-            rd.fail(lw, "'observations' has " + std::to_string(obs.size() - o) +
-                            " entries past the last landmark's");
+        if (o != obs.rows)
+            rd.fail(lw, "'observations' has " + std::to_string(obs.rows - o) +
+                            " rows past the last landmark's");
         return out;
     } catch (const cv::Exception& e) {
         rd.fail("", "not a DEV-SLAM map, or cut short (OpenCV: " + describe(e) + ")");
@@ -372,6 +527,29 @@ void checkOrbMatches(const MapFile& m, const std::string& path, const OrbExtract
             std::to_string(m.orb_scale_factor) + ", n_levels " + std::to_string(m.orb_n_levels) +
             "; this run's [orb] has " + std::to_string(orb.scale_factor) + ", " +
             std::to_string(orb.n_levels) + " (localize with the INI the map was made with)");
+}
+
+void checkCameraMatches(const MapFile& m, const std::string& path,
+                        const core::CameraIntrinsics& camera) {
+    const core::CameraIntrinsics& a = m.camera;
+    const auto near = [](double x, double y, double tol) { return std::abs(x - y) <= tol; };
+    bool same = a.width == camera.width && a.height == camera.height &&
+                near(a.fx, camera.fx, 1e-6) && near(a.fy, camera.fy, 1e-6) &&
+                near(a.cx, camera.cx, 1e-6) && near(a.cy, camera.cy, 1e-6);
+    for (std::size_t i = 0; i < a.dist.size(); ++i)
+        same = same && near(a.dist[i], camera.dist[i], 1e-9);
+    if (same) return;
+    const auto text = [](const core::CameraIntrinsics& k) {
+        char b[160];
+        std::snprintf(b, sizeof b, "fx=%.1f fy=%.1f cx=%.1f cy=%.1f %dx%d dist=[%g %g %g %g %g]",
+                      k.fx, k.fy, k.cx, k.cy, k.width, k.height, k.dist[0], k.dist[1], k.dist[2],
+                      k.dist[3], k.dist[4]);
+        return std::string(b);
+    };
+    throw std::invalid_argument(path + ": the map was made with the camera " + text(a) +
+                                ", the input's is " + text(camera) +
+                                ": its keyframes cannot be adjusted with another camera's "
+                                "pixels (localize without --extend-map)");
 }
 
 }  // namespace devslam::slam

@@ -99,7 +99,8 @@ class Tracker {
     /// matches verified.
     void startLocalizing();
     /// Back to a SLAM run's local map and relocalization (Slam::localizeIn's extend, once
-    /// the run has made a keyframe of its own).
+    /// the run has made a keyframe of its own), with at least local_keyframes of the older
+    /// keyframes nearest the camera (the loaded map's) beside its newest.
     void finishLocalizing() { localizing_ = false; }
     /// Tracks one frame against `map`; updates the landmarks' visible/found counters.
     [[nodiscard]] TrackResult track(const TrackInput& in, Map& map,
@@ -146,6 +147,7 @@ class Tracker {
     double last_t_ = 0.0;
     double velocity_dt_ = 0.0;
     bool localizing_ = false;  ///< startLocalizing: the map was loaded, not made here
+    bool loaded_map_ = false;  ///< startLocalizing was called (finishLocalizing keeps it)
     bool localized_ = false;   ///< a frame has been tracked (since startLocalizing)
 };
 
