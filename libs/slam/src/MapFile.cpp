@@ -4,6 +4,7 @@
 #include <opencv2/core/persistence.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
 #include <filesystem>
@@ -135,31 +136,102 @@ struct Reader {
     }
 };
 
-/// Refuses text that OpenCV 4.6's FileStorage parser cannot be given safely (found by
-/// fuzzing): it loops forever on a base64 block whose 24-byte header names no type or has
-/// a stray character before it, and recurses without bound on nested sequences and maps
-/// (a stack overflow at some 30 000 levels). saveMap writes YAML with at most a few levels
-/// and well-formed base64 blocks, so this refuses no map it wrote.
+/// Refuses text that is not in the few line forms saveMap writes, before OpenCV 4.6's
+/// FileStorage parser sees it. Two fuzzing rounds found that parser looping forever on a
+/// base64 block whose 24-byte header names no type (reached through many spellings of the
+/// tag), recursing without bound on nested sequences and maps however written (brackets,
+/// "- - -", "a: a: a:", "------"), throwing std::length_error on an empty key, and
+/// allocating whatever a matrix's rows and cols claim before reading its data; a
+/// blacklist of such inputs let new spellings through, so only saveMap's forms pass:
+///   %YAML:1.0 / --- (the first two lines), then, indented by spaces (at most 64):
+///   "-", "[]", "KEY:", "KEY: []", "KEY: !!opencv-matrix", "data: !!binary |" followed by
+///   base64 lines indented deeper, and "KEY: VALUE" with VALUE a number or a word.
 void precheck(const Reader& rd, const std::string& text) {
-    constexpr const char* kHead = "%YAML:1.0\n";
-    if (text.rfind(kHead, 0) != 0) rd.fail("", "not a DEV-SLAM map (no '%YAML:1.0' first line)");
-    if (text.find('\0') != std::string::npos) rd.fail("", "not a DEV-SLAM map (a NUL byte)");
+    constexpr std::string_view kHead = "%YAML:1.0\n---\n";
+    if (text.rfind(kHead, 0) != 0)
+        rd.fail("", "not a DEV-SLAM map (no '%YAML:1.0' and '---' first lines)");
+    // saveMap writes this last, so that a file cut short is told as one.
+    constexpr std::string_view kTail = "\nend_of_map: 1\n";
+    if (text.size() < kTail.size() ||
+        text.compare(text.size() - kTail.size(), kTail.size(), kTail.data(), kTail.size()) != 0)
+        rd.fail("", "cut short (its last line is not 'end_of_map: 1')");
     constexpr std::size_t kMaxIndent = 64;
-    constexpr int kMaxDepth = 16;
-    const auto isB64 = [](char c) {
-        return std::isalnum(static_cast<unsigned char>(c)) || c == '+' || c == '/' || c == '=';
+    const auto isWordStart = [](char c) {
+        return std::isalpha(static_cast<unsigned char>(c)) || c == '_';
+    };
+    const auto isWord = [](char c) {
+        return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-';
+    };
+    const auto isKey = [&](std::string_view k) {
+        if (k.empty() || !isWordStart(k[0])) return false;
+        for (const char c : k)
+            if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_') return false;
+        return true;
+    };
+    // A number as OpenCV writes one ("1.", "-1.5e+00", "640"), or a word ("devslam-map", "d").
+    const auto isScalar = [&](std::string_view v) {
+        if (v.empty()) return false;
+        if (isWordStart(v[0])) {
+            for (const char c : v)
+                if (!isWord(c)) return false;
+            return true;
+        }
+        std::size_t i = 0;
+        if (v[i] == '-' || v[i] == '+') ++i;
+        std::size_t digits = 0;
+        while (i < v.size() && std::isdigit(static_cast<unsigned char>(v[i]))) ++i, ++digits;
+        if (i < v.size() && v[i] == '.') ++i;
+        while (i < v.size() && std::isdigit(static_cast<unsigned char>(v[i]))) ++i, ++digits;
+        if (digits == 0) return false;
+        if (i < v.size() && (v[i] == 'e' || v[i] == 'E')) {
+            ++i;
+            if (i < v.size() && (v[i] == '-' || v[i] == '+')) ++i;
+            std::size_t exp = 0;
+            while (i < v.size() && std::isdigit(static_cast<unsigned char>(v[i]))) ++i, ++exp;
+            if (exp == 0) return false;
+        }
+        return i == v.size();
     };
     const auto b64 = [](char c) -> int {
         if (c >= 'A' && c <= 'Z') return c - 'A';
         if (c >= 'a' && c <= 'z') return c - 'a' + 26;
         if (c >= '0' && c <= '9') return c - '0' + 52;
-        return c == '+' ? 62 : c == '/' ? 63 : 0;
+        if (c == '+') return 62;
+        if (c == '/') return 63;
+        return c == '=' ? 0 : -1;
     };
-    int depth = 0;
-    std::size_t binary_indent = std::string::npos;  // key indentation of an open !!binary block
-    bool header_due = false;
-    std::size_t line_no = 0;
-    for (std::size_t at = 0; at < text.size();) {
+    // The matrix being read ("KEY: !!opencv-matrix", then rows, cols, dt, data).
+    long long rows = -1, cols = -1, elem = -1;
+    // The base64 block being read: its key's indentation, its header, its bytes.
+    std::size_t block_indent = std::string::npos, block_line = 0;
+    std::string header;
+    long long block_bytes = 0;
+    const auto endBlock = [&]() {
+        if (block_indent == std::string::npos) return;
+        const std::string where = "line " + std::to_string(block_line);
+        block_indent = std::string::npos;
+        // The header: the element type, as "1d" or "3f", padded with blanks.
+        const std::size_t last = header.find_last_not_of(' ');
+        bool typed = false, ok = header.size() == 24 && last != std::string::npos;
+        for (std::size_t i = 0; ok && i <= last; ++i) {
+            const char c = header[i];
+            if (std::isdigit(static_cast<unsigned char>(c)))
+                typed = false;
+            else if (std::string_view("ucwsifdh").find(c) != std::string_view::npos)
+                typed = true;
+            else
+                ok = false;
+        }
+        if (!ok || !typed) rd.fail(where, "a base64 block whose header names no type");
+        if (rows < 0 || cols < 0 || elem < 0)
+            rd.fail(where, "a base64 block outside a matrix with rows, cols and dt");
+        if (rows * cols * elem > block_bytes - 24)
+            rd.fail(where,
+                    "a matrix with less data than its rows and cols say: cut short, or "
+                    "not a DEV-SLAM map");
+    };
+    std::size_t line_no = 2;
+    for (std::size_t at = kHead.size(); at < text.size();) {
         const std::size_t end = std::min(text.find('\n', at), text.size());
         const std::string_view line(text.data() + at, end - at);
         at = end + 1;
@@ -168,59 +240,61 @@ void precheck(const Reader& rd, const std::string& text) {
         const std::size_t indent = line.find_first_not_of(' ');
         if (indent == std::string_view::npos) continue;  // blank
         if (indent > kMaxIndent) rd.fail(where, "indented deeper than a DEV-SLAM map is");
-        if (binary_indent != std::string_view::npos && indent > binary_indent) {
-            const std::string_view data = line.substr(indent);
-            for (const char c : data)
-                if (!isB64(c))
+        const std::string_view body = line.substr(indent);
+        if (block_indent != std::string::npos && indent > block_indent) {
+            std::size_t pad = 0;
+            for (const char c : body) {
+                if (b64(c) < 0)
                     rd.fail(where, "a base64 block holds a character that is not base64");
-            if (header_due) {  // its first 24 bytes: the element type, as "1d" or "3f"
-                header_due = false;
-                if (data.size() < 32) rd.fail(where, "a base64 block without its type header");
-                std::string h;
-                for (std::size_t i = 0; i < 32; i += 4) {
-                    const int v = (b64(data[i]) << 18) | (b64(data[i + 1]) << 12) |
-                                  (b64(data[i + 2]) << 6) | b64(data[i + 3]);
-                    h += static_cast<char>((v >> 16) & 255);
-                    h += static_cast<char>((v >> 8) & 255);
-                    h += static_cast<char>(v & 255);
-                }
-                const std::size_t last = h.find_last_not_of(' ');
-                bool ok = last != std::string::npos;
-                bool typed = false;  // the previous character was a type letter
-                for (std::size_t i = 0; ok && i <= last; ++i) {
-                    const char c = h[i];
-                    if (std::isdigit(static_cast<unsigned char>(c)))
-                        typed = false;
-                    else if (std::string_view("ucwsifdh").find(c) != std::string_view::npos)
-                        typed = true;
-                    else
-                        ok = false;
-                }
-                if (!ok || !typed) rd.fail(where, "a base64 block whose header names no type");
+                pad += c == '=' ? 1 : 0;
             }
+            if (body.size() % 4 != 0)
+                rd.fail(where, "a base64 line whose length is no multiple of 4");
+            for (std::size_t i = 0; header.size() < 24 && i + 3 < body.size(); i += 4) {
+                const int v = (b64(body[i]) << 18) | (b64(body[i + 1]) << 12) |
+                              (b64(body[i + 2]) << 6) | b64(body[i + 3]);
+                for (const int shift : {16, 8, 0})
+                    if (header.size() < 24) header += static_cast<char>((v >> shift) & 255);
+            }
+            block_bytes += static_cast<long long>(body.size() / 4 * 3 - pad);
             continue;
         }
-        binary_indent = std::string::npos;
-        bool quoted = false;
-        char quote = 0;
-        for (const char c : line) {
-            if (quoted) {
-                quoted = c != quote;
-            } else if (c == '"' || c == '\'') {
-                quoted = true;
-                quote = c;
-            } else if (c == '[' || c == '{') {
-                if (++depth > kMaxDepth) rd.fail(where, "nested deeper than a DEV-SLAM map is");
-            } else if (c == ']' || c == '}') {
-                --depth;
-            }
-        }
-        const std::string_view trimmed = line.substr(0, line.find_last_not_of(' ') + 1);
-        if (trimmed.size() >= 10 && trimmed.substr(trimmed.size() - 10) == "!!binary |") {
-            binary_indent = indent;
-            header_due = true;
+        endBlock();
+        if (body == "-" || body == "[]") continue;
+        const std::size_t colon = body.find(':');
+        if (colon == std::string_view::npos || !isKey(body.substr(0, colon)))
+            rd.fail(where, "not a line a DEV-SLAM map has");
+        const std::string_view key = body.substr(0, colon), rest = body.substr(colon + 1);
+        if (rest.empty() || rest == " []") continue;
+        if (rest[0] != ' ') rd.fail(where, "not a line a DEV-SLAM map has");
+        const std::string_view value = rest.substr(1);
+        if (value == "!!opencv-matrix") {
+            rows = cols = elem = -1;
+        } else if (value == "!!binary |" && key == "data") {
+            block_indent = indent;
+            block_line = line_no;
+            header.clear();
+            block_bytes = 0;
+        } else if (!isScalar(value)) {
+            rd.fail(where, "not a value a DEV-SLAM map has");
+        } else if (key == "rows" || key == "cols") {
+            if (value.size() > 9 || !std::isdigit(static_cast<unsigned char>(value[0])))
+                rd.fail(where, "'" + std::string(key) + "' is not a count");
+            (key == "rows" ? rows : cols) = std::stoll(std::string(value));
+        } else if (key == "dt") {
+            std::size_t i = 0;
+            long long n = 0;
+            while (i < value.size() && std::isdigit(static_cast<unsigned char>(value[i])) &&
+                   n < 1000)
+                n = n * 10 + (value[i++] - '0');
+            const std::string_view type = value.substr(i);
+            const std::size_t k = std::string_view("ucwsifdh").find(type);
+            if (type.size() != 1 || k == std::string_view::npos)
+                rd.fail(where, "'dt' is not a matrix element type");
+            elem = std::max(1LL, n) * std::array<long long, 8>{1, 1, 2, 2, 4, 4, 8, 2}[k];
         }
     }
+    endBlock();
 }
 
 /// A float that holds a whole number in [lo, hi].
@@ -342,11 +416,13 @@ MapFile loadMap(const std::string& path) {
     // Read here and given to OpenCV as text, not as a path: it would take a name ending in
     // ".gz" for a gzip file (1 MB of it took 2.4 GB to unpack) and cut a name at a '?'
     // (reading another file).
-    constexpr std::uintmax_t kMaxBytes = std::uintmax_t{1} << 30;
+    // (OpenCV's parser takes some 5-12 times a file's size in memory; a 90-keyframe map of a
+    // 750-frame render is 18 MB.)
+    constexpr std::uintmax_t kMaxBytes = std::uintmax_t{512} << 20;
     const std::uintmax_t bytes = std::filesystem::file_size(path, ec);
     if (ec) rd.fail("", "cannot be read (" + ec.message() + ")");
     if (bytes > kMaxBytes)
-        rd.fail("", std::to_string(bytes) + " bytes: larger than the 1 GiB a map is read up to");
+        rd.fail("", std::to_string(bytes) + " bytes: larger than the 512 MiB a map is read up to");
     std::string text;
     {
         std::ifstream in(path, std::ios::binary);
@@ -361,6 +437,8 @@ MapFile loadMap(const std::string& path) {
     } catch (const cv::Exception& e) {
         // A file cut short or not YAML/JSON/XML: OpenCV's parser names the line.
         rd.fail("", "not a DEV-SLAM map, or cut short (OpenCV: " + describe(e) + ")");
+    } catch (const std::exception& e) {  // std::bad_alloc, std::length_error in the parser
+        rd.fail("", std::string("not a DEV-SLAM map, or too large to read (") + e.what() + ")");
     }
     try {
         const cv::FileNode root = fs.root();
@@ -517,6 +595,10 @@ MapFile loadMap(const std::string& path) {
         return out;
     } catch (const cv::Exception& e) {
         rd.fail("", "not a DEV-SLAM map, or cut short (OpenCV: " + describe(e) + ")");
+    } catch (const std::bad_alloc& e) {
+        rd.fail("", std::string("too large to read (") + e.what() + ")");
+    } catch (const std::length_error& e) {
+        rd.fail("", std::string("not a DEV-SLAM map (") + e.what() + ")");
     }
 }
 
