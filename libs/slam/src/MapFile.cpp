@@ -449,8 +449,6 @@ MapFile loadMap(const std::string& path) {
         if (version != kVersion)
             rd.fail("", "format version " + std::to_string(version) + ", this build reads " +
                             std::to_string(kVersion));
-        if (root["end_of_map"].type() == cv::FileNode::NONE)
-            rd.fail("", "cut short (no 'end_of_map' at its end)");
         MapFile out;
         out.orb_scale_factor = rd.readFinite(root, "orb_scale_factor", "");
         out.orb_n_levels = rd.readInt(root, "orb_n_levels", "");
