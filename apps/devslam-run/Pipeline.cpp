@@ -173,8 +173,7 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
     // The camera slam_map.yml is written with: the input's, or a loaded map's own when it is
     // only localized in (its keyframes are that camera's).
     core::CameraIntrinsics map_camera = reader.intrinsics();
-    if (rc.localize_in) {
-        slam::checkOrbMatches(*rc.localize_in, rc.localize_map, slam_opts.orb);
+    if (rc.localize_in) {  // (its ORB pyramid was checked against the INI when it was read)
         if (rc.extend_map) slam::checkCameraMatches(*rc.localize_in, rc.localize_map, map_camera);
         map_camera = rc.localize_in->camera;
         slam.localizeIn(std::move(rc.localize_in->map), rc.extend_map);
@@ -532,14 +531,12 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
         write(out("map.ply"), [&] { slam::writePly(out("map.ply"), slam.map()); });
         // The map to localize in later (--localize); a localizing run writes the map it used.
         // None without a keyframe (nothing could localize in it).
-        if (!rc.save_map) {
-        } else if (slam.map().empty()) {
+        if (rc.save_map && slam.map().empty())
             std::cerr << "devslam-run: slam_map.yml not written: the map has no keyframe\n";
-        } else {
+        else if (rc.save_map)
             write(out("slam_map.yml"), [&] {
                 slam::saveMap(out("slam_map.yml"), slam.map(), slam_opts.orb, map_camera);
             });
-        }
         std::optional<core::Trajectory> gt_in_est;
         if (rep.ate && rep.ground_truth) {
             // Ground truth brought into the SLAM frame for the 3D view.

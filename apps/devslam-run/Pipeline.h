@@ -21,8 +21,8 @@ struct RunConfig {
     std::string input;  ///< TUM folder or .rawlog
     std::string truth_file;  ///< where the reader's ground truth came from, if not the input
     /// --localize: localization only, in this map (slam::Slam::localizeIn), read from
-    /// `localize_map` before the input opened. runSequence moves its map into the SLAM (a
-    /// map of 14 MB was held twice).
+    /// `localize_map` and checked against the INI's [orb] (slam::checkOrbMatches) before the
+    /// input opened. runSequence moves its map into the SLAM (a map of 14 MB was held twice).
     std::shared_ptr<slam::MapFile> localize_in;
     std::string localize_map;
     /// --extend-map: with localize_in, map on from the first pose found in it.

@@ -853,11 +853,14 @@ TEST(DevslamRun, ALaterRunLocalizesInTheMapAnEarlierOneSaved) {
     for (std::size_t i = 0; i < e.size(); ++i)
         EXPECT_LT((e[i].pose.translation() - b[i].pose.translation()).norm(), 0.005) << i;
     EXPECT_NE(readText(dir / "ext" / "run.json").find("\"extend_map\": true,"), std::string::npos);
-    auto alone = run("--extend-map --quiet --out ''");
-    EXPECT_EQ(alone.rc, 1);
-    EXPECT_NE(alone.out.find("--extend-map extends the map --localize names; none named"),
-              std::string::npos)
-        << alone.out;
+    // Each of these fails (status 1) with `message` in its output.
+    const auto refused = [&](const std::string& args, const std::string& message) {
+        const auto r = run(args);
+        EXPECT_EQ(r.rc, 1) << args << "\n" << r.out;
+        EXPECT_NE(r.out.find(message), std::string::npos) << args << "\n" << r.out;
+    };
+    refused("--extend-map --quiet --out ''",
+            "--extend-map extends the map --localize names; none named");
     // The map written by the localizing run: the same keyframes (the run's folder may be the
     // one the map came from: it is written again, not lost).
     auto again = run("--input " + later.string() + " --localize " + map +
@@ -869,28 +872,16 @@ TEST(DevslamRun, ALaterRunLocalizesInTheMapAnEarlierOneSaved) {
     EXPECT_EQ(check.rc, 0) << check.out;
     // Refused before the input opens: a map that is not there, one cut short, another ORB
     // pyramid; and with --bench.
-    auto none = run("--input /no/such/input --localize " + (dir / "none.yml").string() +
-                    " --quiet --out ''");
-    EXPECT_EQ(none.rc, 1);
-    EXPECT_NE(none.out.find((dir / "none.yml").string() + ": no such file"), std::string::npos)
-        << none.out;
+    const std::string nowhere = "--input /no/such/input --quiet --out '' --localize ";
+    refused(nowhere + (dir / "none.yml").string(), (dir / "none.yml").string() + ": no such file");
     const std::string text = readText(map);
     std::ofstream(dir / "cut.yml") << text.substr(0, text.size() / 2);
-    auto cut = run("--input /no/such/input --localize " + (dir / "cut.yml").string() +
-                   " --quiet --out ''");
-    EXPECT_EQ(cut.rc, 1);
-    EXPECT_NE(cut.out.find((dir / "cut.yml").string() +
-                           ": cut short (its last line is not 'end_of_map: 1')"),
-              std::string::npos)
-        << cut.out;
-    auto orb =
-        run("--input /no/such/input --localize " + map + " --set orb.n_levels=8 --quiet --out ''");
-    EXPECT_EQ(orb.rc, 1);
-    EXPECT_NE(orb.out.find(map + ": the map's keypoints come from an ORB pyramid of "
-                                 "scale_factor 1.300000, n_levels 4; this run's [orb] has "
-                                 "1.300000, 8"),
-              std::string::npos)
-        << orb.out;
+    refused(nowhere + (dir / "cut.yml").string(),
+            (dir / "cut.yml").string() + ": cut short (its last line is not 'end_of_map: 1')");
+    refused(nowhere + map + " --set orb.n_levels=8",
+            map +
+                ": the map's keypoints come from an ORB pyramid of scale_factor 1.300000, "
+                "n_levels 4; this run's [orb] has 1.300000, 8");
     // A map without a keyframe (written by hand: devslam-run writes none).
     std::ofstream(dir / "empty.yml")
         << "%YAML:1.0\n---\nformat: devslam-map\nversion: 1\norb_scale_factor: 1.3\n"
@@ -903,22 +894,15 @@ TEST(DevslamRun, ALaterRunLocalizesInTheMapAnEarlierOneSaved) {
            "   descriptors: []\n   colors: []\n   ref_kf: []\n   created_kf: []\n"
            "   n_visible: []\n   n_found: []\n   n_observations: []\n   observations: []\n"
            "end_of_map: 1\n";
-    auto empty = run("--input /no/such/input --localize " + (dir / "empty.yml").string() +
-                     " --quiet --out ''");
-    EXPECT_EQ(empty.rc, 1);
-    EXPECT_NE(
-        empty.out.find((dir / "empty.yml").string() + ": the map has no keyframe to localize in"),
-        std::string::npos)
-        << empty.out;
+    refused(nowhere + (dir / "empty.yml").string(),
+            (dir / "empty.yml").string() + ": the map has no keyframe to localize in");
     // --extend-map with another camera: refused (a BA would move the map's keyframes with
     // the other camera's pixels); localizing only, the map's 3D points serve any camera.
     const std::string fr2 = " --set dataset.camera=freiburg2 --mode none --quiet --out ''";
-    auto cam = run("--localize " + map + " --extend-map" + fr2);
-    EXPECT_EQ(cam.rc, 1) << cam.out;
-    EXPECT_NE(cam.out.find(map + ": the map was made with the camera fx=517.3 fy=516.5 cx=318.6 "
-                                 "cy=255.3 640x480"),
-              std::string::npos)
-        << cam.out;
+    refused("--localize " + map + " --extend-map" + fr2,
+            map +
+                ": the map was made with the camera fx=517.3 fy=516.5 cx=318.6 cy=255.3 "
+                "640x480");
     EXPECT_EQ(run("--localize " + map + fr2).rc, 0);
     // A localizing run into the map's own folder whose map write fails keeps the map (it was
     // removed with the folder's other outputs before they were written).
@@ -935,10 +919,8 @@ TEST(DevslamRun, ALaterRunLocalizesInTheMapAnEarlierOneSaved) {
               std::string::npos)
         << full.out;
     EXPECT_EQ(readText(dir / "keep" / "slam_map.yml"), readText(map));
-    auto bench = run("--bench 1 --localize " + map + " --results none");
-    EXPECT_EQ(bench.rc, 1);
-    EXPECT_NE(bench.out.find("--localize does not go with --bench"), std::string::npos)
-        << bench.out;
+    refused("--bench 1 --localize " + map + " --results none",
+            "--localize does not go with --bench");
     fs::remove_all(dir);
 }
 

@@ -175,7 +175,6 @@ TrackResult Slam::track(const core::Frame& frame, const FrameFeatures& features,
     const TrackInput in{&features, frame.timestamp, prior};
     res = tracker_.track(in, map_, frame.K);
     rec.valid = res.pose_valid;
-    if (loaded_ && res.pose_valid) found_in_map_ = true;
     const auto last = map_.lastKeyframes(1);
     if (!last.empty()) {
         rec.ref_kf = last.front();

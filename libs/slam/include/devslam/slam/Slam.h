@@ -184,7 +184,7 @@ class Slam {
     /// localizeIn was called.
     [[nodiscard]] bool localizing() const { return loaded_; }
     /// localizeIn was called and some frame has found its pose in the map.
-    [[nodiscard]] bool localized() const { return found_in_map_; }
+    [[nodiscard]] bool localized() const { return loaded_ && tracker_.trackedSinceStart(); }
     [[nodiscard]] int loopsClosed() const { return static_cast<int>(loops_.size()); }
     /// A loop the back end closed, as measured when it was verified.
     struct ClosedLoop {
@@ -250,7 +250,6 @@ class Slam {
     bool localizing_ = false;    ///< localizeIn, and (extend_) no keyframe of its own yet
     bool extend_ = false;        ///< localizeIn's extend
     bool loaded_ = false;        ///< localizeIn was called
-    bool found_in_map_ = false;  ///< loaded_, and a frame was tracked
 };
 
 }  // namespace devslam::slam

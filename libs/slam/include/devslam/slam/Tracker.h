@@ -107,6 +107,8 @@ class Tracker {
     /// the run has made a keyframe of its own), with at least local_keyframes of the older
     /// keyframes nearest the camera (the loaded map's) beside its newest.
     void finishLocalizing() { localizing_ = false; }
+    /// A frame has been tracked since startLocalizing (or since the start).
+    [[nodiscard]] bool trackedSinceStart() const { return localized_; }
     /// Tracks one frame against `map`; updates the landmarks' visible/found counters.
     [[nodiscard]] TrackResult track(const TrackInput& in, Map& map,
                                     const core::CameraIntrinsics& K);
