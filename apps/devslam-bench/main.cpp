@@ -605,13 +605,17 @@ Runs runSlam(const Bench& b, const Args& a) {
                         runs.kept_from = std::min(runs.kept_from.value_or(written), written);
                         runs.kept_to = std::max(runs.kept_to.value_or(written), written);
                     }
-                    if (!have) f = rc == 0 ? readRun(json) : RunFigures{};
+                    // kExitNoPose: a whole run that lost every frame; its run.json says so,
+                    // and its figures without a trajectory (no ATE) count as the run's.
+                    const bool whole =
+                        rc == 0 || (WIFEXITED(rc) && WEXITSTATUS(rc) == core::kExitNoPose);
+                    if (!have) f = whole ? readRun(json) : RunFigures{};
                     f.seed = in.seed;
                     f.dir = dir;
                     if (!f.ok) {
                         runs.failed.push_back((dir / "log.txt").string());
                         std::cerr << "  devslam-run failed ("
-                                  << (rc != 0                ? endedBy(rc)
+                                  << (!whole                 ? endedBy(rc)
                                       : f.unreadable.empty() ? std::string("no readable run.json")
                                                              : f.unreadable)
                                   << "):\n"

@@ -409,7 +409,22 @@ int runOnce(const Args& a) {
         std::cerr << "devslam-run: note: "
                   << (std::filesystem::path(a.out) / "stopped_run").string()
                   << " holds an earlier run that stopped early, not this one\n";
-    return rep.output_errors.empty() ? 0 : 1;
+    if (!rep.output_errors.empty()) return 1;
+    // Every frame lost: the run is whole, but a script that went on (devslam-eval, a
+    // navigation run on its map) met an empty trajectory; it said 0 until 2026-12-08.
+    if (rep.lost.size() == rep.frames) {
+        std::cerr << "devslam-run: no frame took a pose: "
+                  << (rep.frames == 0   ? std::string("the input gave no frame")
+                      : rep.frames == 1 ? std::string("the one frame was lost")
+                                        : "all " + std::to_string(rep.frames) + " frames were lost")
+                  << (rep.localize_map.empty() ? std::string()
+                                               : " (not localized in " + rep.localize_map + ")")
+                  << (rep.log.empty() ? std::string()
+                                      : "; the first: " + rep.log.front().lost_reason)
+                  << "; exit status " << core::kExitNoPose << "\n";
+        return core::kExitNoPose;
+    }
+    return 0;
 }
 
 std::string fmt(double v, int p) {

@@ -6,6 +6,8 @@
 #include "Targets.h"
 
 #include <devslam/core/Config.h>
+#include <devslam/io/TumReader.h>
+#include <devslam/io/TumWriter.h>
 
 #include <gtest/gtest.h>
 
@@ -506,6 +508,39 @@ TEST(DevslamBench, ReuseRunsDoesNotKeepAnUnreadableRunJson) {
     EXPECT_EQ(r.rc, 0) << r.out;
     EXPECT_EQ(r.out.find("WARNING"), std::string::npos) << r.out;
     EXPECT_NE(r.out.find("1 of 1 runs were kept"), std::string::npos) << r.out;
+}
+
+// A run that lost every frame (black images: nothing to track) is a whole run without an
+// ATE: devslam-run exits with kExitNoPose, and the bench counts its figures instead of
+// calling it failed.
+TEST(DevslamBench, ARunThatLostEveryFrameIsARunWithoutAnAte) {
+    const std::string root = DEVSLAM_SOURCE_DIR;
+    const devslam::test::TempDir d("devslam_");
+    const fs::path tmp = d.str();
+    {
+        devslam::io::TumReader in(root + "/data/tum/fr1_xyz_first37");
+        devslam::io::TumWriter out((tmp / "black").string(), "three black frames");
+        for (std::size_t i = 0; i < 3; ++i) {
+            auto f = in.read(i);
+            f.bgr.setTo(0);
+            out.write(f);
+        }
+        out.close();
+    }
+    std::ofstream(tmp / "bench.ini")
+        << "[bench]\nmodes = none\nrepeats = 1\n[sequence_black]\npath = "
+        << (tmp / "black").string() << "\nslam_config = " << root
+        << "/config_ini/slam_tum_fr1.ini\n";
+    const auto r = devslam::test::runApp(
+        "devslam-bench", "--config '" + (tmp / "bench.ini").string() + "' --results none --out '" +
+                             (tmp / "out").string() + "'");
+    EXPECT_EQ(r.rc, 0) << r.out;
+    EXPECT_EQ(r.out.find("devslam-run failed"), std::string::npos) << r.out;
+    EXPECT_NE(readFile(tmp / "out/runs/black/none/r0/log.txt")
+                  .find("devslam-run: no frame took a pose: all 3 frames were lost"),
+              std::string::npos);
+    const std::string runs = readFile(tmp / "out/runs.csv");
+    EXPECT_NE(runs.find("black,none,,0,"), std::string::npos) << runs;
 }
 
 TEST(DevslamBench, CompareSetsEachRunBesideTheSameRenderBefore) {

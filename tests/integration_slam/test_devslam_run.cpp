@@ -853,6 +853,29 @@ TEST(DevslamRun, ALaterRunLocalizesInTheMapAnEarlierOneSaved) {
     for (std::size_t i = 0; i < e.size(); ++i)
         EXPECT_LT((e[i].pose.translation() - b[i].pose.translation()).norm(), 0.005) << i;
     EXPECT_NE(readText(dir / "ext" / "run.json").find("\"extend_map\": true,"), std::string::npos);
+    // Frames that find nothing in the map (black): the run is whole and says where it was
+    // not localized, with the status of a run that took no pose.
+    {
+        devslam::io::TumReader in(later.string());
+        devslam::io::TumWriter out((dir / "black").string(), "four black frames");
+        for (std::size_t i = 0; i < 4; ++i) {
+            auto f = in.read(i);
+            f.bgr.setTo(0);
+            out.write(f);
+        }
+        out.close();
+    }
+    auto nowhere_in_map = run("--input " + (dir / "black").string() + " --localize " + map +
+                              " --mode none --quiet --out " + (dir / "unloc").string());
+    EXPECT_EQ(nowhere_in_map.rc, devslam::core::kExitNoPose) << nowhere_in_map.out;
+    EXPECT_NE(nowhere_in_map.out.find("localized  : NOT in " + map), std::string::npos)
+        << nowhere_in_map.out;
+    EXPECT_NE(nowhere_in_map.out.find("devslam-run: no frame took a pose: all 4 frames were lost "
+                                      "(not localized in " +
+                                      map + "); the first: "),
+              std::string::npos)
+        << nowhere_in_map.out;
+    EXPECT_TRUE(fs::exists(dir / "unloc" / "run.json"));
     // Each of these fails (status 1) with `message` in its output.
     const auto refused = [&](const std::string& args, const std::string& message) {
         const auto r = run(args);
@@ -1040,7 +1063,12 @@ TEST(DevslamRun, WithoutAnAteTheRunSaysWhy) {
     // Each lost frame says why, in the summary, lost_frames.txt and run.json.
     const auto lost = run("--mode none --max-frames 5 --set dataset.tum_depth_scale=1e6 --out " +
                           (dir / "lost").string());
-    EXPECT_EQ(lost.rc, 0) << lost.out;
+    // The run is whole, its outputs written, but a script must not go on to score it.
+    EXPECT_EQ(lost.rc, devslam::core::kExitNoPose) << lost.out;
+    EXPECT_NE(lost.out.find("devslam-run: no frame took a pose: all 5 frames were lost; the "
+                            "first: not initialized: 0 of "),
+              std::string::npos)
+        << lost.out;
     EXPECT_NE(lost.out.find("ATE        : not computed (0 of 5 frames tracked (the ATE needs 3))"),
               std::string::npos)
         << lost.out;

@@ -59,6 +59,11 @@ class FolderClaim {
 /// program said 0), saying so on std::cerr as "<program>: cannot write the standard output".
 [[nodiscard]] int withStandardOutput(const char* program, int rc);
 
+/// devslam-run's exit status for a whole run in which no frame took a pose (every frame lost;
+/// a localizing run that never found itself in the map): its outputs are written, as a run's
+/// that tracked, but there is no trajectory to score. 1 stays for errors and stopped runs.
+inline constexpr int kExitNoPose = 2;
+
 /// FNV-1a (64 bit) of a file's bytes as 16 hex digits, "" when it cannot be read: tells
 /// whether a file's content changed (not a cryptographic hash).
 [[nodiscard]] std::string fileHash(const std::string& path);
