@@ -73,6 +73,7 @@ case "${1:-}" in
       --config config_ini/slam_synthetic.ini --input out/synth/walking_xyz_300   # section slam-synthetic
     "$B/devslam-bench"                                          # section bench (Tables 1-3)
     "$B/devslam-nav-bench"                                      # section nav
-    "$BUILD_DIR/benchmarks/bench_nav" ;;                        # Google Benchmark: A*, VFH+ step
+    "$BUILD_DIR/benchmarks/bench_nav"                           # Google Benchmark: A*, VFH+ step
+    "$BUILD_DIR/benchmarks/bench_place" ;;                      # Google Benchmark: place index
   *) sed -n '2,9p' "$0"; exit 2 ;;
 esac

@@ -173,10 +173,19 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
     // The camera slam_map.yml is written with: the input's, or a loaded map's own when it is
     // only localized in (its keyframes are that camera's).
     core::CameraIntrinsics map_camera = reader.intrinsics();
+    double place_index_ms = 0;
+    int place_words = 0;
+    std::size_t place_keyframes = 0;
     if (rc.localize_in) {  // (its ORB pyramid was checked against the INI when it was read)
         if (rc.extend_map) slam::checkCameraMatches(*rc.localize_in, rc.localize_map, map_camera);
         map_camera = rc.localize_in->camera;
+        const auto t0 = Clock::now();
         slam.localizeIn(std::move(rc.localize_in->map), rc.extend_map);
+        if (const slam::PlaceIndex* place = slam.placeIndex()) {
+            place_index_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+            place_words = place->words();
+            place_keyframes = place->keyframes();
+        }
     }
 
     RunReport rep;
@@ -185,6 +194,9 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
     if (rc.localize_in) {
         rep.localize_map = rc.localize_map;
         rep.extend_map = rc.extend_map;
+        rep.place_words = place_words;
+        rep.place_keyframes = place_keyframes;
+        rep.place_index_ms = place_index_ms;
     }
     rep.input_damage = reader.damage();
     rep.mode = rc.mode;
@@ -636,6 +648,10 @@ std::string formatSummary(const RunReport& r) {
     else if (!r.localize_map.empty())
         o << "localized  : NOT in " << r.localize_map << ": no frame found its pose in the map"
           << (r.extend_map ? " (--extend-map: nothing mapped)" : "") << "\n";
+    if (r.place_words > 0)
+        o << "place index: " << r.place_words << " words over " << r.place_keyframes
+          << " keyframes, trained on the map in " << num(r.place_index_ms, 0)
+          << " ms ([tracker] place_recognition)\n";
     if (const auto e = loopErrors(r.loop_reports); !e.empty()) {
         const auto s = core::summarize(e);
         o << "loops      : measured relative poses vs truth: median " << num(1000 * s.median, 1)
@@ -770,6 +786,11 @@ std::string toJson(const RunReport& r) {
       << "\",\n  \"extend_map\": " << (r.extend_map ? "true" : "false")
       << ",\n  \"localized_from_frame\": "
       << (r.localized_at ? std::to_string(*r.localized_at) : std::string("null"))
+      << ",\n  \"place_index\": "
+      << (r.place_words > 0 ? "{\"words\": " + std::to_string(r.place_words) +
+                                  ", \"keyframes\": " + std::to_string(r.place_keyframes) +
+                                  ", \"build_ms\": " + num(r.place_index_ms, 1) + "}"
+                            : std::string("null"))
       << ",\n  \"input_damage\": \"" << esc(r.input_damage) << "\",\n  \"read_error\": \""
       << esc(r.read_error) << "\",\n  \"interrupted\": \"" << r.interrupted << "\",\n  \"mode\": \""
       << r.mode << "\",\n  \"mask_source\": \"" << esc(r.mask_source)

@@ -95,6 +95,11 @@ struct RunReport {
     bool extend_map = false;   ///< RunConfig::extend_map
     /// Localizing: the first frame that found its pose in the map (none: no frame did).
     std::optional<std::size_t> localized_at;
+    /// Localizing with [tracker] place_recognition: the words of the vocabulary trained on
+    /// the map, over how many keyframes, and the time it took with indexing them (0: none).
+    int place_words = 0;
+    std::size_t place_keyframes = 0;
+    double place_index_ms = 0;
     /// A frame that failed to read during the run, or whose mask or person truth failed
     /// ("" = none): the run stopped there and its outputs hold the frames before it.
     std::string read_error;

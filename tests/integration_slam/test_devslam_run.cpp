@@ -820,6 +820,7 @@ TEST(DevslamRun, ALaterRunLocalizesInTheMapAnEarlierOneSaved) {
               std::string::npos)
         << loc.out;
     EXPECT_NE(loc.out.find("lost frames: 0"), std::string::npos) << loc.out;
+    EXPECT_NE(loc.out.find(" keyframes, trained on the map in "), std::string::npos) << loc.out;
     const auto a = devslam::io::readTumTrajectory((dir / "made" / "trajectory.txt").string());
     const auto b = devslam::io::readTumTrajectory((dir / "loc" / "trajectory.txt").string());
     ASSERT_GE(b.size(), 10u);
@@ -836,6 +837,9 @@ TEST(DevslamRun, ALaterRunLocalizesInTheMapAnEarlierOneSaved) {
     const std::string js = readText(dir / "loc" / "run.json");
     EXPECT_NE(js.find("\"localize_map\": \"" + map + "\""), std::string::npos);
     EXPECT_NE(js.find("\"localized_from_frame\": 0,"), std::string::npos);
+    EXPECT_NE(js.find("\"place_index\": {\"words\": "), std::string::npos) << js;
+    EXPECT_NE(readText(dir / "made" / "run.json").find("\"place_index\": null,"),
+              std::string::npos);
     EXPECT_NE(readText(dir / "made" / "run.json").find("\"localized_from_frame\": null,"),
               std::string::npos);
     // --extend-map: the same start, mapping on from there (keyframes of its own), its poses

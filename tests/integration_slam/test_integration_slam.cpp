@@ -157,11 +157,20 @@ TEST(SlamIntegration, ASavedMapIsLocalizedInFromAnotherStart) {
         later.push_back(f);
     }
     later.insert(later.end(), seq.frames.begin() + start, seq.frames.end());
-    // Localization only, then with the map extended from the first pose found in it.
-    for (const bool extend : {false, true}) {
-        SCOPED_TRACE(extend ? "extended" : "localization only");
-        slam::Slam loc(opts);
+    // Localization only, then with the map extended from the first pose found in it; and
+    // localization only with the keyframes ranked by matches instead of the place index.
+    const std::pair<bool, bool> cases[] = {{false, true}, {true, true}, {false, false}};
+    for (const auto& [extend, place] : cases) {
+        SCOPED_TRACE(std::string(extend ? "extended" : "localization only") +
+                     (place ? "" : ", place_recognition = false"));
+        auto o = opts;
+        o.tracker.place_recognition = place;
+        slam::Slam loc(o);
         loc.localizeIn(m.map, extend);
+        ASSERT_EQ(loc.placeIndex() != nullptr, place);
+        if (place) {
+            EXPECT_EQ(loc.placeIndex()->keyframes(), kfs);
+        }
         EXPECT_TRUE(loc.localizing());
         EXPECT_FALSE(loc.localized());
         int inserted = 0;

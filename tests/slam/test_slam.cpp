@@ -9,6 +9,7 @@
 #include <devslam/slam/MapFile.h>
 #include <devslam/slam/Matching.h>
 #include <devslam/slam/OrbExtractor.h>
+#include <devslam/slam/PlaceIndex.h>
 #include <devslam/slam/PoseGraph.h>
 #include <devslam/slam/PoseSolver.h>
 #include <devslam/slam/Slam.h>
@@ -1332,4 +1333,98 @@ TEST(Config, SaveLoadRoundTrip) {
 TEST(Config, EveryKeyRoundTrips) {
     test::expectEveryKeyRoundTrips(
         [](const test::Ini& in, test::Ini& out) { SlamOptions::fromConfig(in).saveToConfig(out); });
+}
+
+namespace {
+/// A map of `n_places` keyframes, each with its own 400 random descriptors (a place's look),
+/// every keypoint a landmark; keyframe ids are 0 .. n_places - 1.
+Map placesMap(int n_places, std::mt19937& rng) {
+    std::uniform_int_distribution<int> byte(0, 255);
+    Map map;
+    for (int k = 0; k < n_places; ++k) {
+        Keyframe kf;
+        kf.T_wc = makePose(k, 0, 0, 0, 0, 0);
+        kf.features.descriptors.create(400, 32, CV_8U);
+        for (int i = 0; i < 400; ++i) {
+            for (int b = 0; b < 32; ++b)
+                kf.features.descriptors.at<uchar>(i, b) = static_cast<uchar>(byte(rng));
+            kf.features.keypoints.emplace_back(cv::Point2f(1.f * i, 1.f), 7.f);
+            kf.features.depth.push_back(1.f);
+            kf.features.points_c.emplace_back(0, 0, 1);
+            kf.features.colors.emplace_back();
+        }
+        const cv::Mat d = kf.features.descriptors.clone();
+        const KeyframeId id = map.addKeyframe(std::move(kf));
+        for (int i = 0; i < 400; ++i)
+            (void)map.addLandmark(Eigen::Vector3d(k, 0, 1), d.row(i), {}, id, i);
+    }
+    return map;
+}
+}  // namespace
+
+// A frame that shows half of a place's keypoints again, each descriptor with 8 of its 256
+// bits flipped (a new view's noise), among as many keypoints of nowhere: the place index puts
+// that keyframe first, for each of 40 places.
+TEST(PlaceIndex, AFrameOfAPlaceFindsThatPlacesKeyframeFirst) {
+    std::mt19937 rng(11);
+    const Map map = placesMap(40, rng);
+    const PlaceIndex index(map, PlaceIndexOptions{});
+    EXPECT_EQ(index.keyframes(), 40u);
+    EXPECT_GT(index.words(), 1000);
+    EXPECT_LE(index.words(), 10000);  // branching^levels
+    std::uniform_int_distribution<int> byte(0, 255), bit(0, 255);
+    for (KeyframeId k = 0; k < 40; ++k) {
+        const cv::Mat& place = map.keyframe(k).features.descriptors;
+        cv::Mat frame(400, 32, CV_8U);
+        for (int i = 0; i < 400; ++i) {
+            if (i % 2 == 0) {
+                place.row(i).copyTo(frame.row(i));
+                for (int f = 0; f < 8; ++f) {
+                    const int b = bit(rng);
+                    frame.at<uchar>(i, b / 8) ^= static_cast<uchar>(1u << (b % 8));
+                }
+            } else {
+                for (int b = 0; b < 32; ++b) frame.at<uchar>(i, b) = static_cast<uchar>(byte(rng));
+            }
+        }
+        const auto found = index.query(frame, 3);
+        ASSERT_FALSE(found.empty()) << k;
+        EXPECT_EQ(found[0].second, k);
+        EXPECT_GT(found[0].first, 0.1) << k;
+        EXPECT_LE(found[0].first, 1.0 + 1e-6) << k;
+        if (found.size() > 1) {
+            EXPECT_GT(found[0].first, 3 * found[1].first) << k;
+        }
+    }
+    // A keyframe's own descriptors score it 1 (its whole histogram).
+    const auto self = index.query(map.keyframe(7).features.descriptors, 1);
+    ASSERT_EQ(self.size(), 1u);
+    EXPECT_EQ(self[0].second, 7);
+    EXPECT_NEAR(self[0].first, 1.0, 1e-5);
+}
+
+// The vocabulary is the same wherever it is trained from the same map (its seeding draws
+// from a fixed seed), so a run's candidates do not change from one run to the next.
+TEST(PlaceIndex, IsDeterministicAndEmptyWhereTheMapHasNoLandmark) {
+    std::mt19937 rng_a(3), rng_b(3);
+    const Map a = placesMap(12, rng_a), b = placesMap(12, rng_b);
+    const PlaceIndex ia(a, PlaceIndexOptions{}), ib(b, PlaceIndexOptions{});
+    EXPECT_EQ(ia.words(), ib.words());
+    const cv::Mat& q = a.keyframe(5).features.descriptors;
+    EXPECT_EQ(ia.query(q, 12), ib.query(q, 12));
+    // A map whose keyframes have no landmark: nothing to find, nothing thrown.
+    Map bare;
+    Keyframe kf;
+    kf.features.descriptors = q.clone();
+    kf.features.keypoints.resize(400);
+    kf.features.depth.assign(400, 1.f);
+    kf.features.points_c.assign(400, Eigen::Vector3d(0, 0, 1));
+    kf.features.colors.resize(400);
+    bare.addKeyframe(std::move(kf));
+    const PlaceIndex none(bare, PlaceIndexOptions{});
+    EXPECT_EQ(none.words(), 0);
+    EXPECT_TRUE(none.query(q, 5).empty());
+    PlaceIndexOptions bad;
+    bad.branching = 1;
+    EXPECT_THROW(BinaryVocabulary(q, bad), std::invalid_argument);
 }

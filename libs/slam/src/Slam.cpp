@@ -467,7 +467,7 @@ void Slam::localizeIn(Map map, bool extend) {
     localizing_ = true;
     loaded_ = true;
     extend_ = extend;
-    tracker_.startLocalizing();
+    tracker_.startLocalizing(map_);
 }
 
 core::Trajectory Slam::trajectory() const {

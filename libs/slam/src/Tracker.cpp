@@ -37,7 +37,7 @@ void TrackerOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, cons
                                   "reloc_min_inliers",  "reloc_max_hamming",
                                   "reloc_ratio",        "reloc_max_jump",
                                   "reloc_max_speed",    "reloc_max_jump_deg",
-                                  "reloc_max_rate_deg"});
+                                  "reloc_max_rate_deg", "place_recognition"});
     projection.radius = core::readDouble(c, s, "search_radius", projection.radius);
     fine_radius = core::readDouble(c, s, "fine_radius", fine_radius);
     wide_radius_factor = core::readDouble(c, s, "wide_radius_factor", wide_radius_factor);
@@ -58,6 +58,7 @@ void TrackerOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, cons
     localize_keyframes = core::readInt(c, s, "localize_keyframes", localize_keyframes);
     max_motion_dt = core::readDouble(c, s, "max_motion_dt", max_motion_dt);
     reloc_keyframes = core::readInt(c, s, "reloc_keyframes", reloc_keyframes);
+    place_recognition = core::readBool(c, s, "place_recognition", place_recognition);
     reloc_min_inliers = core::readInt(c, s, "reloc_min_inliers", reloc_min_inliers);
     reloc_max_hamming = core::readInt(c, s, "reloc_max_hamming", reloc_max_hamming);
     reloc_ratio = core::readDouble(c, s, "reloc_ratio", reloc_ratio);
@@ -135,6 +136,7 @@ void TrackerOptions::saveToConfig(mrpt::config::CConfigFileBase& c, const std::s
     core::writeKey(c, s, "near_max_angle_deg", near_max_angle_deg);
     core::writeKey(c, s, "max_motion_dt", max_motion_dt);
     core::writeKey(c, s, "reloc_keyframes", reloc_keyframes);
+    core::writeKey(c, s, "place_recognition", place_recognition);
     core::writeKey(c, s, "reloc_min_inliers", reloc_min_inliers);
     core::writeKey(c, s, "reloc_max_hamming", reloc_max_hamming);
     core::writeKey(c, s, "reloc_ratio", reloc_ratio);
@@ -144,7 +146,10 @@ void TrackerOptions::saveToConfig(mrpt::config::CConfigFileBase& c, const std::s
     core::writeKey(c, s, "reloc_max_rate_deg", reloc_max_rate_deg);
 }
 
-void Tracker::startLocalizing() {
+void Tracker::startLocalizing(const Map& map) {
+    place_.reset();
+    if (opts_.place_recognition)
+        place_ = std::make_shared<const PlaceIndex>(map, PlaceIndexOptions{});
     state_ = TrackingState::Lost;
     localizing_ = true;
     loaded_map_ = true;
@@ -285,8 +290,9 @@ std::optional<Eigen::Isometry3d> Tracker::relocalize(const FrameFeatures& f, con
                                                      double timestamp) const {
     // Candidates: the newest keyframes and the ones nearest to the last pose, facing anywhere.
     // In a loaded map (localizing) its newest keyframes say nothing of where the camera is,
-    // nor, while lost, does the last pose: every keyframe is matched (no place recognition
-    // ranks them), and only the reloc_keyframes with the most matches are verified by PnP.
+    // nor, while lost, does the last pose: the place index's most alike keyframes are
+    // verified by PnP (or, without it, every keyframe is matched and the reloc_keyframes with
+    // the most matches verified).
     std::vector<KeyframeId> cands;
     if (localizing_) {
         for (const auto& [id, kf] : map.keyframes()) cands.push_back(id);
@@ -339,9 +345,16 @@ std::optional<Eigen::Isometry3d> Tracker::relocalize(const FrameFeatures& f, con
         for (KeyframeId id : cands) verify(matchesOf(id, f.descriptors));
         return best;
     }
-    // The keyframes are ranked by the matches of the frame's strongest quarter of keypoints
-    // (200 at least), which costs a quarter of matching them all; the best are then matched
-    // with every keypoint and verified.
+    // The candidates are the keyframes whose words are most like the frame's; without the
+    // place index, the keyframes are ranked by the matches of the frame's strongest quarter
+    // of keypoints (200 at least), which costs a quarter of matching them all. The best are
+    // then matched with every keypoint and verified.
+    if (place_) {
+        for (const auto& [score, id] :
+             place_->query(f.descriptors, static_cast<std::size_t>(opts_.reloc_keyframes)))
+            if (map.keyframes().count(id)) verify(matchesOf(id, f.descriptors));
+        return best;
+    }
     const int n_rank =
         std::min(static_cast<int>(f.size()), std::max(200, static_cast<int>(f.size()) / 4));
     std::vector<int> order(f.size());

@@ -185,6 +185,8 @@ class Slam {
     [[nodiscard]] bool localizing() const { return loaded_; }
     /// localizeIn was called and some frame has found its pose in the map.
     [[nodiscard]] bool localized() const { return loaded_ && tracker_.trackedSinceStart(); }
+    /// The place index localizeIn trained on the map ([tracker] place_recognition), or null.
+    [[nodiscard]] const PlaceIndex* placeIndex() const { return tracker_.placeIndex(); }
     [[nodiscard]] int loopsClosed() const { return static_cast<int>(loops_.size()); }
     /// A loop the back end closed, as measured when it was verified.
     struct ClosedLoop {
