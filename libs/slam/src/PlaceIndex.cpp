@@ -14,6 +14,17 @@ namespace {
 double uniform01(std::mt19937_64& rng) {
     return static_cast<double>(rng() >> 11) * 0x1.0p-53;
 }
+
+/// kSpread[v]: byte j is bit 7 - j of v (the descriptor's bits, most significant first).
+constexpr std::array<std::uint64_t, 256> makeSpread() {
+    std::array<std::uint64_t, 256> t{};
+    for (int v = 0; v < 256; ++v)
+        for (int j = 0; j < 8; ++j)
+            t[static_cast<std::size_t>(v)] |= static_cast<std::uint64_t>((v >> (7 - j)) & 1)
+                                              << (8 * j);
+    return t;
+}
+constexpr auto kSpread = makeSpread();
 }  // namespace
 
 BinaryVocabulary::BinaryVocabulary(const cv::Mat& descriptors, const PlaceIndexOptions& opts) {
@@ -90,14 +101,28 @@ void BinaryVocabulary::split(std::vector<const uchar*>& rows, int node, int leve
             of[i] = best;
         }
         if (!changed) break;
+        // Bit counts per cluster, 8 at a time: byte j of lanes[c][B] counts bit 7 - j of byte
+        // B, so a row adds 32 words, not 256 bits (the counting was most of the training);
+        // flushed before a byte lane can overflow.
         std::vector<std::array<int, 256>> ones(k);
-        std::vector<int> size(k, 0);
+        std::vector<std::array<std::uint64_t, 32>> lanes(k);
+        std::vector<int> size(k, 0), pending(k, 0);
         for (auto& o1 : ones) o1.fill(0);
+        for (auto& l : lanes) l.fill(0);
+        const auto flush = [&](std::size_t c) {
+            for (int B = 0; B < 32; ++B)
+                for (int j = 0; j < 8; ++j)
+                    ones[c][8 * B + j] += static_cast<int>((lanes[c][B] >> (8 * j)) & 0xff);
+            lanes[c].fill(0);
+            pending[c] = 0;
+        };
         for (std::size_t i = 0; i < n; ++i) {
-            auto& c = ones[static_cast<std::size_t>(of[i])];
-            ++size[static_cast<std::size_t>(of[i])];
-            for (int b = 0; b < 256; ++b) c[b] += (rows[i][b / 8] >> (7 - b % 8)) & 1;
+            const auto c = static_cast<std::size_t>(of[i]);
+            ++size[c];
+            for (int B = 0; B < 32; ++B) lanes[c][B] += kSpread[rows[i][B]];
+            if (++pending[c] == 255) flush(c);
         }
+        for (std::size_t c = 0; c < k; ++c) flush(c);
         for (std::size_t c = 0; c < k; ++c) {
             if (size[c] == 0) continue;  // kept; dropped below if still empty
             centres[c].fill(0);
