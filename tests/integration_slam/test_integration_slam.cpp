@@ -454,3 +454,67 @@ TEST(SlamIntegration, FramesHeldForRefinementStayBoundedWithoutLocalBa) {
         }
     }
 }
+
+// A map of one keyframe has no word that tells keyframes apart, so its place index finds
+// nothing; the tracker then verifies every keyframe (fewer than reloc_keyframes) and the
+// frames after it are localized in it. (With the index alone none was, found in review.)
+TEST(SlamIntegration, AMapOfOneKeyframeIsLocalizedInWithPlaceRecognition) {
+    const auto& seq = realSequence();
+    const auto opts = options();
+    ASSERT_TRUE(opts.tracker.place_recognition);
+    slam::Slam* mapper = nullptr;
+    const std::vector<core::Frame> first(seq.frames.begin(), seq.frames.begin() + 1);
+    (void)runSlam(first, opts, {}, &mapper);
+    ASSERT_EQ(mapper->map().keyframes().size(), 1u);
+    const slam::Map one = mapper->map();
+    slam::Slam loc(opts);
+    loc.localizeIn(one);
+    ASSERT_NE(loc.placeIndex(), nullptr);
+    EXPECT_TRUE(
+        loc.placeIndex()->query(one.keyframes().begin()->second.features.descriptors, 5).empty());
+    for (std::size_t i = 1; i <= 5; ++i) {
+        core::Frame f = seq.frames[i];
+        f.index = i - 1;
+        const auto r = loc.process(f, {});
+        EXPECT_TRUE(r.track.pose_valid) << i << ": " << r.track.reason;
+    }
+}
+
+// The free-space test while localizing: the shipped frames in their own map, the first three
+// as they are, then with every depth 1.5 times what it was, so that at the poses found on
+// their pictures the depth sees through the map's landmarks: the first such frame, tracked
+// on from the last, is lost saying why, and no later one relocalizes. Without the test
+// (localize_max_see_through = 1) that frame keeps its pose.
+TEST(SlamIntegration, APoseWhoseDepthSeesThroughTheMapIsRefusedWhileLocalizing) {
+    const auto& seq = realSequence();
+    const auto opts = options();
+    ASSERT_LT(opts.tracker.localize_max_see_through, 1.0);
+    slam::Slam* mapper = nullptr;
+    (void)runSlam(seq.frames, opts, {}, &mapper);
+    const slam::Map map = mapper->map();
+    for (const double test : {opts.tracker.localize_max_see_through, 1.0}) {
+        SCOPED_TRACE(test);
+        auto o = opts;
+        o.tracker.localize_max_see_through = test;
+        slam::Slam loc(o);
+        loc.localizeIn(map);
+        std::vector<bool> tracked;
+        std::vector<std::string> why;
+        for (std::size_t i = 0; i < 10; ++i) {
+            core::Frame f = seq.frames[i];
+            f.index = i;
+            if (i >= 3) f.depth = f.depth * 1.5;
+            const auto r = loc.process(f, {});
+            tracked.push_back(r.track.pose_valid);
+            why.push_back(r.track.reason);
+        }
+        for (std::size_t i = 0; i < 3; ++i) EXPECT_TRUE(tracked[i]) << i << ": " << why[i];
+        if (test < 1) {
+            EXPECT_NE(why[3].find("the depth sees through "), std::string::npos) << why[3];
+            EXPECT_NE(why[3].find(" map landmarks at the pose found"), std::string::npos);
+            for (std::size_t i = 3; i < 10; ++i) EXPECT_FALSE(tracked[i]) << i;
+        } else {  // (the depth that is wrong everywhere loses the track a few frames on)
+            EXPECT_TRUE(tracked[3]) << why[3];
+        }
+    }
+}

@@ -1428,3 +1428,46 @@ TEST(PlaceIndex, IsDeterministicAndEmptyWhereTheMapHasNoLandmark) {
     bad.branching = 1;
     EXPECT_THROW(BinaryVocabulary(q, bad), std::invalid_argument);
 }
+
+// The free-space test of a relocalized pose: landmarks on a wall 2 m ahead, and the depth
+// image of a wall at 2 m (none seen through), at 3 m (all seen through: the camera is not
+// where the pose puts it), or with a person at 1 m in front of half of them (hidden, not
+// seen through); pixels without depth check nothing.
+TEST(Tracker, TheFreeSpaceTestCountsLandmarksTheDepthSeesThrough) {
+    const auto K = fr1NoDist();
+    Map map;
+    Keyframe kf;
+    kf.features.keypoints.resize(100);
+    kf.features.descriptors = cv::Mat::zeros(100, 32, CV_8U);
+    kf.features.depth.assign(100, 2.f);
+    kf.features.points_c.assign(100, Eigen::Vector3d(0, 0, 2));
+    kf.features.colors.resize(100);
+    const KeyframeId k = map.addKeyframe(std::move(kf));
+    std::vector<LandmarkId> lms;
+    const cv::Mat d = cv::Mat::zeros(1, 32, CV_8U);
+    for (int i = 0; i < 100; ++i) {
+        const double x = -0.8 + 0.016 * i, y = (i % 10 - 5) * 0.1;
+        lms.push_back(map.addLandmark(Eigen::Vector3d(x, y, 2.0), d, {}, k, i));
+    }
+    const Eigen::Isometry3d I = Eigen::Isometry3d::Identity();
+    cv::Mat depth(480, 640, CV_32FC1, cv::Scalar(2.02f));
+    auto r = freeSpaceTest(map, lms, I, depth, K);
+    EXPECT_EQ(r.checked, 100);
+    EXPECT_EQ(r.seen_through, 0);
+    depth.setTo(3.0f);
+    r = freeSpaceTest(map, lms, I, depth, K);
+    EXPECT_EQ(r.checked, 100);
+    EXPECT_EQ(r.seen_through, 100);
+    depth(cv::Rect(0, 0, 320, 480)).setTo(1.0f);  // a person on the left half
+    r = freeSpaceTest(map, lms, I, depth, K);
+    EXPECT_EQ(r.checked, 100);
+    EXPECT_GT(r.seen_through, 30);
+    EXPECT_LT(r.seen_through, 70);
+    depth.setTo(0.0f);
+    r = freeSpaceTest(map, lms, I, depth, K);
+    EXPECT_EQ(r.checked, 0);
+    // Behind the camera: not checked.
+    r = freeSpaceTest(map, lms, I * Eigen::Translation3d(0, 0, 5),
+                      cv::Mat(480, 640, CV_32FC1, cv::Scalar(3.0f)), K);
+    EXPECT_EQ(r.checked, 0);
+}

@@ -88,7 +88,9 @@ void BinaryVocabulary::split(std::vector<const uchar*>& rows, int node, int leve
     for (std::size_t c = 0; c < k; ++c) std::copy(seeds[c], seeds[c] + 32, centres[c].begin());
     // k-medians: each row to its nearest centre, each centre the bitwise majority of its rows.
     std::vector<int> of(n, -1);
-    for (int it = 0; it < o.iterations; ++it) {
+    // At most `iterations` centre updates, each followed by an assignment: the children are
+    // split by the assignment to the centres they get.
+    for (int it = 0;; ++it) {
         bool changed = false;
         for (std::size_t i = 0; i < n; ++i) {
             int best = 0, best_d = 257;
@@ -100,7 +102,7 @@ void BinaryVocabulary::split(std::vector<const uchar*>& rows, int node, int leve
             changed |= of[i] != best;
             of[i] = best;
         }
-        if (!changed) break;
+        if (!changed || it == o.iterations) break;
         // Bit counts per cluster, 8 at a time: byte j of lanes[c][B] counts bit 7 - j of byte
         // B, so a row adds 32 words, not 256 bits (the counting was most of the training);
         // flushed before a byte lane can overflow.
@@ -241,6 +243,8 @@ std::vector<std::pair<int, float>> PlaceIndex::histogram(const cv::Mat& descript
 
 std::vector<std::pair<double, KeyframeId>> PlaceIndex::query(const cv::Mat& descriptors,
                                                              std::size_t n) const {
+    if (!descriptors.empty() && (descriptors.type() != CV_8U || descriptors.cols != 32))
+        throw std::invalid_argument("PlaceIndex::query: descriptors must be CV_8U, 32 columns");
     std::vector<int> rows(static_cast<std::size_t>(descriptors.rows));
     for (int i = 0; i < descriptors.rows; ++i) rows[static_cast<std::size_t>(i)] = i;
     std::vector<double> score(kf_ids_.size(), 0.0);

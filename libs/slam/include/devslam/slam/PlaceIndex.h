@@ -66,8 +66,10 @@ class PlaceIndex {
     /// Trains the vocabulary on `map`'s keyframes and indexes them (a map with no keypoint
     /// that has a landmark gives an index that finds nothing).
     PlaceIndex(const Map& map, const PlaceIndexOptions& opts);
-    /// The keyframes sharing words with the frame's `descriptors`, by score (best first; ties
-    /// by id), at most `n`.
+    /// The keyframes sharing words with the frame's `descriptors` (CV_8U, 32 columns, else
+    /// std::invalid_argument), by score (best first; ties by id), at most `n`. Only words
+    /// some keyframes have and others not count (idf > 0): a map of one keyframe, or of
+    /// keyframes with the same words, gives none (the tracker then ranks by matches).
     [[nodiscard]] std::vector<std::pair<double, KeyframeId>> query(const cv::Mat& descriptors,
                                                                    std::size_t n) const;
     [[nodiscard]] int words() const { return voc_.words(); }

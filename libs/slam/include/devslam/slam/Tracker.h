@@ -56,6 +56,13 @@ struct TrackerOptions {
     /// false: every keyframe is matched with the frame's strongest keypoints and ranked by
     /// matches (about 2 ms a keyframe).
     bool place_recognition = true;
+    /// Localizing in a loaded map: a pose, relocalized or tracked, is refused (the frame
+    /// lost) when the frame's depth image sees through more than this fraction of the map's
+    /// landmarks that it measures depth at (freeSpaceTest over the local map at that pose, at
+    /// least 20 landmarks checked); 1: no test. A place whose pictures are found elsewhere in
+    /// the map (a room with the same photos cropped otherwise) relocalized 0.3-1.3 m off
+    /// without it, and was tracked on there.
+    double localize_max_see_through = 0.07;
     int reloc_min_inliers = 25;   ///< PnP inliers needed to relocalize
     int reloc_max_hamming = 64;   ///< brute-force matching threshold
     double reloc_ratio = 0.8;     ///< brute-force ratio test
@@ -84,7 +91,29 @@ struct TrackInput {
     /// while the tracker is lost (the last tracked pose is then frames old; relocalisation
     /// needs no prior).
     std::optional<Eigen::Isometry3d> T_prev_cur_prior;
+    /// The frame's depth image (CV_32FC1 [m], 0 = none, in the image's own, distorted,
+    /// pixels), for the free-space test of a pose relocalized in a loaded map; null: none.
+    const cv::Mat* depth = nullptr;
 };
+
+/// What the depth image says of a camera pose: of the landmarks that project into the
+/// image, those where it measures depth nearby, and those it sees through.
+struct FreeSpaceResult {
+    int checked = 0;       ///< projected, with a measured depth within the window
+    int seen_through = 0;  ///< every depth measured there is farther than the landmark
+};
+
+/// Free-space test of a camera pose `T_wc` (Tracker::relocalize while localizing): each of
+/// `landmarks` in front of the camera is projected into `depth` (with K's distortion);
+/// where a pixel within `window_px` of it measures depth, the landmark is checked, and it is
+/// seen through when the nearest of those depths is farther than the landmark by more than
+/// `margin_m + margin_rel * depth`. Something nearer (a person, a chair) may hide a landmark;
+/// a camera that sees through a landmark's place is not where the pose puts it.
+[[nodiscard]] FreeSpaceResult freeSpaceTest(const Map& map,
+                                            const std::vector<LandmarkId>& landmarks,
+                                            const Eigen::Isometry3d& T_wc, const cv::Mat& depth,
+                                            const core::CameraIntrinsics& K, int window_px = 1,
+                                            double margin_m = 0.05, double margin_rel = 0.05);
 
 struct TrackResult {
     TrackingState state = TrackingState::NotInitialized;
@@ -115,10 +144,14 @@ class Tracker {
     /// Back to a SLAM run's local map and relocalization (Slam::localizeIn's extend, once
     /// the run has made a keyframe of its own), with at least local_keyframes of the older
     /// keyframes nearest the camera (the loaded map's) beside its newest.
-    void finishLocalizing() { localizing_ = false; }
+    void finishLocalizing() {
+        localizing_ = false;
+        place_.reset();
+    }
     /// A frame has been tracked since startLocalizing (or since the start).
     [[nodiscard]] bool trackedSinceStart() const { return localized_; }
-    /// The loaded map's place index; null when not localizing or place_recognition is off.
+    /// The loaded map's place index; null when not localizing (or no longer: finishLocalizing)
+    /// or place_recognition is off.
     [[nodiscard]] const PlaceIndex* placeIndex() const { return place_.get(); }
     /// Tracks one frame against `map`; updates the landmarks' visible/found counters.
     [[nodiscard]] TrackResult track(const TrackInput& in, Map& map,
@@ -149,9 +182,10 @@ class Tracker {
                                                  TrackResult& res,
                                                  std::vector<LandmarkId>& in_view) const;
     /// `timestamp`: of the frame, for the jump bound.
+    /// `depth`: the frame's depth image for the free-space test (localizing), or null.
     std::optional<Eigen::Isometry3d> relocalize(const FrameFeatures& f, const Map& map,
-                                                const core::CameraIntrinsics& K,
-                                                double timestamp) const;
+                                                const core::CameraIntrinsics& K, double timestamp,
+                                                const cv::Mat* depth) const;
 
     /// The landmarks of the local map for a camera at `T_wc` (local_keyframes newest,
     /// near_keyframes nearest).
