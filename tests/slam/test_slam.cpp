@@ -1458,6 +1458,13 @@ TEST(Tracker, TheFreeSpaceTestCountsLandmarksTheDepthSeesThrough) {
     r = freeSpaceTest(map, lms, I, depth, K);
     EXPECT_EQ(r.checked, 100);
     EXPECT_EQ(r.seen_through, 100);
+    // ... unless [orb] depth_factor scales the image's depths to the landmarks' (3 m x 2/3).
+    r = freeSpaceTest(map, lms, I, depth, K, 2.0 / 3.0);
+    EXPECT_EQ(r.checked, 100);
+    EXPECT_EQ(r.seen_through, 0);
+    // A depth image of another size than the camera's checks nothing.
+    EXPECT_EQ(freeSpaceTest(map, lms, I, cv::Mat(240, 320, CV_32FC1, cv::Scalar(3.0f)), K).checked,
+              0);
     depth(cv::Rect(0, 0, 320, 480)).setTo(1.0f);  // a person on the left half
     r = freeSpaceTest(map, lms, I, depth, K);
     EXPECT_EQ(r.checked, 100);

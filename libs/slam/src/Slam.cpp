@@ -172,7 +172,7 @@ TrackResult Slam::track(const core::Frame& frame, const FrameFeatures& features,
         records_.push_back(rec);
         return res;
     }
-    const TrackInput in{&features, frame.timestamp, prior, &frame.depth};
+    const TrackInput in{&features, frame.timestamp, prior, &frame.depth, opts_.orb.depth_factor};
     res = tracker_.track(in, map_, frame.K);
     rec.valid = res.pose_valid;
     const auto last = map_.lastKeyframes(1);

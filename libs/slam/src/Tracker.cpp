@@ -177,6 +177,7 @@ void Tracker::startLocalizing(const Map& map) {
     localizing_ = true;
     loaded_map_ = true;
     localized_ = false;
+    unanchored_ = false;
     has_velocity_ = false;
     last_T_wc_ = Eigen::Isometry3d::Identity();
     last_t_ = 0.0;
@@ -272,7 +273,7 @@ std::optional<PoseRefineResult> Tracker::trackWithMap(const FrameFeatures& f, co
 
 bool Tracker::relocPlausible(const Eigen::Isometry3d& T_wc, double timestamp) const {
     // No pose to be near before the first one in a loaded map.
-    if (opts_.reloc_max_speed <= 0 || (localizing_ && !localized_)) return true;
+    if (opts_.reloc_max_speed <= 0 || (localizing_ && (!localized_ || unanchored_))) return true;
     const double lost_s = std::max(0.0, timestamp - last_t_);
     const Eigen::Isometry3d d = last_T_wc_.inverse() * T_wc;
     const double deg = Eigen::AngleAxisd(d.linear()).angle() * 180.0 / M_PI;
@@ -310,16 +311,24 @@ void addNearestOlder(const Map& map, const Eigen::Isometry3d& T_wc, std::size_t 
 
 FreeSpaceResult freeSpaceTest(const Map& map, const std::vector<LandmarkId>& landmarks,
                               const Eigen::Isometry3d& T_wc, const cv::Mat& depth,
-                              const core::CameraIntrinsics& K, int window_px, double margin_m,
-                              double margin_rel) {
+                              const core::CameraIntrinsics& K, double depth_factor, int window_px,
+                              double margin_m, double margin_rel) {
     FreeSpaceResult r;
-    if (depth.empty() || depth.type() != CV_32FC1) return r;
+    // (a depth image of another size than the camera's is no depth, as for OrbExtractor)
+    if (depth.empty() || depth.type() != CV_32FC1 || depth.cols != K.width ||
+        depth.rows != K.height)
+        return r;
     const Eigen::Isometry3d T_cw = T_wc.inverse();
     std::vector<cv::Point3f> pc;
     for (const LandmarkId id : landmarks)
         if (const Landmark* lm = map.landmark(id)) {
             const Eigen::Vector3d p = T_cw * lm->p_w;
-            if (p.z() > 0.1)
+            if (p.z() <= 0.1) continue;
+            // In the image by the pinhole (10 % beside it allowed): a point far off the axis
+            // would fold back into it through a barrel distortion's polynomial.
+            const double u = K.fx * p.x() / p.z() + K.cx, v = K.fy * p.y() / p.z() + K.cy;
+            if (u > -0.1 * K.width && u < 1.1 * K.width && v > -0.1 * K.height &&
+                v < 1.1 * K.height)
                 pc.emplace_back(static_cast<float>(p.x()), static_cast<float>(p.y()),
                                 static_cast<float>(p.z()));
         }
@@ -342,6 +351,7 @@ FreeSpaceResult freeSpaceTest(const Map& map, const std::vector<LandmarkId>& lan
                 if (row[x] > 0 && (nearest == 0 || row[x] < nearest)) nearest = row[x];
         }
         if (nearest == 0) continue;
+        nearest = static_cast<float>(nearest * depth_factor);  // the landmarks' scale
         ++r.checked;
         const double z = pc[i].z;
         if (nearest > z + margin_m + margin_rel * z) ++r.seen_through;
@@ -351,7 +361,8 @@ FreeSpaceResult freeSpaceTest(const Map& map, const std::vector<LandmarkId>& lan
 
 std::optional<Eigen::Isometry3d> Tracker::relocalize(const FrameFeatures& f, const Map& map,
                                                      const core::CameraIntrinsics& K,
-                                                     double timestamp, const cv::Mat* depth) const {
+                                                     double timestamp, const cv::Mat* depth,
+                                                     double depth_factor) const {
     // Candidates: the newest keyframes and the ones nearest to the last pose, facing anywhere.
     // In a loaded map (localizing) its newest keyframes say nothing of where the camera is,
     // nor, while lost, does the last pose: the place index's most alike keyframes are
@@ -405,8 +416,8 @@ std::optional<Eigen::Isometry3d> Tracker::relocalize(const FrameFeatures& f, con
         // In a loaded map, a pose found on pictures that are elsewhere in the map too sees
         // through the map's landmarks around it.
         if (localizing_ && depth && opts_.localize_max_see_through < 1) {
-            const auto fs =
-                freeSpaceTest(map, localMap(map, refined.T_wc), refined.T_wc, *depth, K);
+            const auto fs = freeSpaceTest(map, localMap(map, refined.T_wc), refined.T_wc, *depth, K,
+                                          depth_factor);
             if (fs.checked >= 20 && fs.seen_through > opts_.localize_max_see_through * fs.checked)
                 return;
         }
@@ -510,7 +521,7 @@ TrackResult Tracker::track(const TrackInput& in, Map& map, const core::CameraInt
     if (!ok && f.size() > 0) {
         // Relocalize against keyframes, then track the local map from that pose.
         TrackResult reloc_res;
-        if (const auto T = relocalize(f, map, K, in.timestamp, in.depth)) {
+        if (const auto T = relocalize(f, map, K, in.timestamp, in.depth, in.depth_factor)) {
             auto near = localMap(map, *T);
             std::vector<LandmarkId> reloc_in_view;
             ok = trackWithMap(f, map, K, *T, near, reloc_res, reloc_in_view);
@@ -544,8 +555,9 @@ TrackResult Tracker::track(const TrackInput& in, Map& map, const core::CameraInt
     // seed 15 in seed 14's map: 0.02-0.45 of the landmarks against at most 0.012 on the true
     // track): lost, and relocalized (or not) from the next frame.
     if (localizing_ && in.depth && opts_.localize_max_see_through < 1) {
-        const auto fs = freeSpaceTest(map, *used_local, ok->T_wc, *in.depth, K);
+        const auto fs = freeSpaceTest(map, *used_local, ok->T_wc, *in.depth, K, in.depth_factor);
         if (fs.checked >= 20 && fs.seen_through > opts_.localize_max_see_through * fs.checked) {
+            unanchored_ = true;
             state_ = TrackingState::Lost;
             has_velocity_ = false;
             res = TrackResult{};
@@ -569,6 +581,7 @@ TrackResult Tracker::track(const TrackInput& in, Map& map, const core::CameraInt
     last_T_wc_ = ok->T_wc;
     last_t_ = in.timestamp;
     localized_ = true;
+    unanchored_ = false;
     state_ = (was_lost || !res.reason.empty()) ? TrackingState::Relocalized : TrackingState::Ok;
     res.state = state_;
     if (state_ == TrackingState::Relocalized) state_ = TrackingState::Ok;

@@ -92,8 +92,11 @@ struct TrackInput {
     /// needs no prior).
     std::optional<Eigen::Isometry3d> T_prev_cur_prior;
     /// The frame's depth image (CV_32FC1 [m], 0 = none, in the image's own, distorted,
-    /// pixels), for the free-space test of a pose relocalized in a loaded map; null: none.
+    /// pixels), for the free-space test of the poses found while localizing in a loaded map
+    /// (relocalized and tracked); null: none.
     const cv::Mat* depth = nullptr;
+    /// [orb] depth_factor: the landmarks' depths are the image's times this.
+    double depth_factor = 1.0;
 };
 
 /// What the depth image says of a camera pose: of the landmarks that project into the
@@ -103,8 +106,10 @@ struct FreeSpaceResult {
     int seen_through = 0;  ///< every depth measured there is farther than the landmark
 };
 
-/// Free-space test of a camera pose `T_wc` (Tracker::relocalize while localizing): each of
-/// `landmarks` in front of the camera is projected into `depth` (with K's distortion);
+/// Free-space test of a camera pose `T_wc` (Tracker, while localizing: each relocalized and
+/// tracked pose): each of `landmarks` in front of the camera and in its view is projected
+/// into `depth` (with K's distortion; a depth of another size than K's checks nothing), whose
+/// values are multiplied by `depth_factor` ([orb] depth_factor, the landmarks' scale);
 /// where a pixel within `window_px` of it measures depth, the landmark is checked, and it is
 /// seen through when the nearest of those depths is farther than the landmark by more than
 /// `margin_m + margin_rel * depth`. Something nearer (a person, a chair) may hide a landmark;
@@ -112,7 +117,8 @@ struct FreeSpaceResult {
 [[nodiscard]] FreeSpaceResult freeSpaceTest(const Map& map,
                                             const std::vector<LandmarkId>& landmarks,
                                             const Eigen::Isometry3d& T_wc, const cv::Mat& depth,
-                                            const core::CameraIntrinsics& K, int window_px = 1,
+                                            const core::CameraIntrinsics& K,
+                                            double depth_factor = 1.0, int window_px = 1,
                                             double margin_m = 0.05, double margin_rel = 0.05);
 
 struct TrackResult {
@@ -185,7 +191,7 @@ class Tracker {
     /// `depth`: the frame's depth image for the free-space test (localizing), or null.
     std::optional<Eigen::Isometry3d> relocalize(const FrameFeatures& f, const Map& map,
                                                 const core::CameraIntrinsics& K, double timestamp,
-                                                const cv::Mat* depth) const;
+                                                const cv::Mat* depth, double depth_factor) const;
 
     /// The landmarks of the local map for a camera at `T_wc` (local_keyframes newest,
     /// near_keyframes nearest).
@@ -201,6 +207,9 @@ class Tracker {
     bool localizing_ = false;  ///< startLocalizing: the map was loaded, not made here
     bool loaded_map_ = false;  ///< startLocalizing was called (finishLocalizing keeps it)
     bool localized_ = false;   ///< a frame has been tracked (since startLocalizing)
+    /// The free-space test refused the last pose kept: the next relocalization has no jump
+    /// bound (the last pose was the wrong one), as before the first.
+    bool unanchored_ = false;
     /// The loaded map's place index (startLocalizing with place_recognition); shared, so that
     /// the tracker stays copyable.
     std::shared_ptr<const PlaceIndex> place_;
