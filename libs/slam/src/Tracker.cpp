@@ -415,16 +415,17 @@ std::optional<Eigen::Isometry3d> Tracker::relocalize(const FrameFeatures& f, con
             return;
         // In a loaded map, a pose found on pictures that are elsewhere in the map too sees
         // through the map's landmarks around it.
-        if (localizing_ && depth && opts_.localize_max_see_through < 1) {
-            const auto fs = freeSpaceTest(map, localMap(map, refined.T_wc), refined.T_wc, *depth, K,
-                                          depth_factor);
-            if (fs.checked >= 20 && fs.seen_through > opts_.localize_max_see_through * fs.checked)
-                return;
-        }
+        if (testsFreeSpace(depth) &&
+            seenThrough(freeSpaceTest(map, localMap(map, refined.T_wc), refined.T_wc, *depth, K,
+                                      depth_factor)))
+            return;
         best_inliers = refined.n_inliers;
         best = refined.T_wc;
     };
-    if (!localizing_) {
+    // A map of reloc_keyframes keyframes or fewer, localizing with the place index: all of
+    // them.
+    const auto n_cands = static_cast<std::size_t>(opts_.reloc_keyframes);
+    if (!localizing_ || (place_ && cands.size() <= n_cands)) {
         for (KeyframeId id : cands) verify(matchesOf(id, f.descriptors));
         return best;
     }
@@ -432,14 +433,8 @@ std::optional<Eigen::Isometry3d> Tracker::relocalize(const FrameFeatures& f, con
     // place index, the keyframes are ranked by the matches of the frame's strongest quarter
     // of keypoints (200 at least), which costs a quarter of matching them all. The best are
     // then matched with every keypoint and verified.
-    // A map of reloc_keyframes keyframes or fewer: all of them. The index finds fewer than
-    // that where most words are in every keyframe (a map of one keyframe has no word that
-    // tells keyframes apart): ranked by matches instead.
-    const auto n_cands = static_cast<std::size_t>(opts_.reloc_keyframes);
-    if (place_ && cands.size() <= n_cands) {
-        for (KeyframeId id : cands) verify(matchesOf(id, f.descriptors));
-        return best;
-    }
+    // The index finds fewer than reloc_keyframes where most words are in every keyframe (a
+    // map of one keyframe has no word that tells keyframes apart): ranked by matches instead.
     if (place_) {
         if (const auto found = place_->query(f.descriptors, n_cands); found.size() == n_cands) {
             for (const auto& [score, id] : found)
@@ -539,6 +534,20 @@ TrackResult Tracker::track(const TrackInput& in, Map& map, const core::CameraInt
         }
         if (!ok && res.reason.empty()) res.reason = "relocalization failed";
     }
+    // In a loaded map, a pose tracked on from a wrong relocalization keeps finding the
+    // pictures it was found on, but the depth sees through the map around it (walking_xyz
+    // seed 15 in seed 14's map: 0.02-0.45 of the landmarks against at most 0.012 on the true
+    // track): lost, and relocalized (or not) from the next frame.
+    if (ok && testsFreeSpace(in.depth)) {
+        const auto fs = freeSpaceTest(map, *used_local, ok->T_wc, *in.depth, K, in.depth_factor);
+        if (seenThrough(fs)) {
+            unanchored_ = true;
+            ok.reset();
+            res = TrackResult{};
+            res.reason = "the depth sees through " + std::to_string(fs.seen_through) + " of " +
+                         std::to_string(fs.checked) + " map landmarks at the pose found";
+        }
+    }
     if (f.size() == 0) res.reason = "no features";
     if (!ok) {
         state_ = TrackingState::Lost;
@@ -549,25 +558,6 @@ TrackResult Tracker::track(const TrackInput& in, Map& map, const core::CameraInt
         res.landmark_of_kp.assign(f.size(), kNoId);
         // Keep last_T_wc_: the next frame predicts from the last good pose.
         return res;
-    }
-    // In a loaded map, a pose tracked on from a wrong relocalization keeps finding the
-    // pictures it was found on, but the depth sees through the map around it (walking_xyz
-    // seed 15 in seed 14's map: 0.02-0.45 of the landmarks against at most 0.012 on the true
-    // track): lost, and relocalized (or not) from the next frame.
-    if (localizing_ && in.depth && opts_.localize_max_see_through < 1) {
-        const auto fs = freeSpaceTest(map, *used_local, ok->T_wc, *in.depth, K, in.depth_factor);
-        if (fs.checked >= 20 && fs.seen_through > opts_.localize_max_see_through * fs.checked) {
-            unanchored_ = true;
-            state_ = TrackingState::Lost;
-            has_velocity_ = false;
-            res = TrackResult{};
-            res.state = state_;
-            res.T_wc = pred;
-            res.landmark_of_kp.assign(f.size(), kNoId);
-            res.reason = "the depth sees through " + std::to_string(fs.seen_through) + " of " +
-                         std::to_string(fs.checked) + " map landmarks at the pose found";
-            return res;
-        }
     }
     // The culling counters, for the pose kept only: a relocalization the jump bound refused
     // (a false match on repeated texture, say) counts no landmark as seen or found.

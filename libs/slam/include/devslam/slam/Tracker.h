@@ -193,6 +193,17 @@ class Tracker {
                                                 const core::CameraIntrinsics& K, double timestamp,
                                                 const cv::Mat* depth, double depth_factor) const;
 
+    /// Whether poses are put to the free-space test: localizing, with a depth image, and
+    /// localize_max_see_through below 1.
+    [[nodiscard]] bool testsFreeSpace(const cv::Mat* depth) const {
+        return localizing_ && depth && opts_.localize_max_see_through < 1;
+    }
+    /// Whether a free-space test refuses its pose: more than localize_max_see_through of at
+    /// least 20 checked landmarks seen through.
+    [[nodiscard]] bool seenThrough(const FreeSpaceResult& fs) const {
+        return fs.checked >= 20 && fs.seen_through > opts_.localize_max_see_through * fs.checked;
+    }
+
     /// The landmarks of the local map for a camera at `T_wc` (local_keyframes newest,
     /// near_keyframes nearest).
     std::vector<LandmarkId> localMap(const Map& map, const Eigen::Isometry3d& T_wc) const;
