@@ -74,6 +74,7 @@ case "${1:-}" in
     "$B/devslam-bench"                                          # section bench (Tables 1-3)
     "$B/devslam-nav-bench"                                      # section nav
     "$BUILD_DIR/benchmarks/bench_nav"                           # Google Benchmark: A*, VFH+ step
-    "$BUILD_DIR/benchmarks/bench_place" ;;                      # Google Benchmark: place index
+    "$BUILD_DIR/benchmarks/bench_place"                         # Google Benchmark: place index
+    "$BUILD_DIR/benchmarks/bench_pose" ;;                       # Google Benchmark: inlier bound
   *) sed -n '2,9p' "$0"; exit 2 ;;
 esac

@@ -261,6 +261,201 @@ TEST(PoseSolver, GateExponentDecidesWhatAWeightDoesToTheOutlierTest) {
     }
 }
 
+namespace {
+
+/// Observations at refinePose's final chi2 test at pose T_wc (its classification).
+int inliersAt(const std::vector<PoseObservation>& obs, const Eigen::Isometry3d& T_wc,
+              const core::CameraIntrinsics& K, const PoseRefineOptions& o) {
+    int n = 0;
+    Eigen::Vector3d r;
+    Eigen::Matrix<double, 3, 6> Jp;
+    Eigen::Matrix3d Jl;
+    int rows = 0;
+    for (const auto& ob : obs)
+        if (observationJacobians(T_wc.inverse(), ob.p_w, ob.uv, ob.depth, K, o.bf, r, Jp, Jl, rows))
+            n += r.squaredNorm() * ob.inv_sigma2 <= (rows == 3 ? o.chi2_stereo : o.chi2_mono);
+    return n;
+}
+
+}  // namespace
+
+// inlierReach: residuals on the gate's sphere, in the directions that move the point most
+// (along the ray, with the pixel error too), never put it farther than the reach, and
+// some come close to it.
+TEST(PoseSolver, InlierReachBoundsHowFarAnInliersPointIsFromTheMeasuredOne) {
+    const auto K = fr1NoDist();
+    const PoseRefineOptions o;
+    for (const double d : {0.6, 2.0, 4.0, 7.0})
+        for (const int octave : {0, 3, 7})
+            for (const auto& [u, v] : {std::pair{5.0, 5.0}, {320.0, 240.0}, {630.0, 470.0}}) {
+                PoseObservation ob;
+                ob.uv = {u, v};
+                ob.depth = d;
+                const double sigma = std::pow(1.2, octave);
+                ob.inv_sigma2 = 1 / (sigma * sigma);
+                const double reach = inlierReach(ob, K, o);
+                const double rho = std::sqrt(o.chi2_stereo) * sigma;
+                if (1 / d <= std::sqrt(2.0) * rho / o.bf) {
+                    EXPECT_TRUE(std::isinf(reach)) << d << " " << octave;
+                    continue;
+                }
+                ASSERT_TRUE(std::isfinite(reach));
+                const Eigen::Vector3d p_meas = core::backproject(u, v, d, K);
+                double farthest = 0;
+                for (int a = 0; a < 64; ++a)
+                    for (int b = 0; b <= 32; ++b) {  // r = rho (ru, rv, rur) on the sphere
+                        const double th = M_PI * b / 32, ph = 2 * M_PI * a / 64;
+                        const double ru = rho * std::sin(th) * std::cos(ph),
+                                     rv = rho * std::sin(th) * std::sin(ph),
+                                     rur = rho * std::cos(th);
+                        // predicted u' = u + ru, u_r' = u_r + rur: bf/z' = bf/d + ru - rur
+                        const double bf_z = o.bf / d + ru - rur;
+                        if (bf_z <= 0) continue;
+                        const double z = o.bf / bf_z;
+                        const Eigen::Vector3d p = core::backproject(u + ru, v + rv, z, K);
+                        farthest = std::max(farthest, (p - p_meas).norm());
+                    }
+                EXPECT_LE(farthest, reach) << d << " " << octave << " " << u;
+                EXPECT_GE(farthest, 0.8 * reach) << d << " " << octave << " " << u;
+            }
+    PoseObservation none;
+    none.uv = {100, 100};
+    EXPECT_TRUE(std::isinf(inlierReach(none, K, o)));  // no depth
+}
+
+// At the largest depth whose reach is finite, z_max is huge and the chi2 test's rounding
+// takes any farther z' (bf/z' below 1e-13 px): the reach must still hold (a review found
+// 7.7e299 m accepted against a reach of 7.2e16 m before the gate was widened for rounding).
+TEST(PoseSolver, InlierReachHoldsWhereTheGateAlmostTakesAnyDepth) {
+    const auto K = fr1NoDist();
+    const PoseRefineOptions o;
+    const double rho = std::sqrt(o.chi2_stereo);
+    PoseObservation ob;
+    ob.uv = {K.cx, K.cy};
+    ob.depth = o.bf / (std::sqrt(2.0) * rho);  // the gate takes any depth here
+    ASSERT_TRUE(std::isinf(inlierReach(ob, K, o)));
+    int steps = 0;
+    while (std::isinf(inlierReach(ob, K, o)) && steps++ < 100000000)
+        ob.depth = std::nextafter(ob.depth, 0.0);
+    const double reach = inlierReach(ob, K, o);
+    ASSERT_TRUE(std::isfinite(reach));
+    // The predicted point of the residual (-rho, 0, +rho) / sqrt(2), ever farther along z.
+    const double u = ob.uv.x() - rho / std::sqrt(2.0);
+    const Eigen::Vector3d p_meas = core::backproject(ob.uv.x(), ob.uv.y(), ob.depth, K);
+    Eigen::Vector3d r;
+    Eigen::Matrix<double, 3, 6> Jp;
+    Eigen::Matrix3d Jl;
+    int rows = 0;
+    for (double z = 1; z < 1e300; z *= 1.5) {
+        const Eigen::Vector3d p((u - K.cx) * z / K.fx, 0, z);
+        if (observationJacobians(Eigen::Isometry3d::Identity(), p, ob.uv, ob.depth, K, o.bf, r, Jp,
+                                 Jl, rows) &&
+            r.squaredNorm() <= o.chi2_stereo)
+            ASSERT_LE((p - p_meas).norm(), reach) << "z' " << z << " depth " << ob.depth;
+    }
+}
+
+// The bound lets relocalization and loop checks skip a PnP-RANSAC: it must never be below
+// the inliers of any pose. The worst case for it: every residual just inside the gate, in
+// every direction, at every pyramid level, near and far.
+TEST(PoseSolver, InlierBoundIsNeverBelowTheInliersOfAPose) {
+    const auto K = fr1NoDist();
+    const PoseRefineOptions o;
+    const Eigen::Isometry3d T_true = makePose(0.4, -0.2, 0.1, 0.1, -0.2, 0.3);
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> U(0.0, 1.0);
+    std::normal_distribution<double> N(0.0, 1.0);
+    std::vector<PoseObservation> obs;
+    while (obs.size() < 80) {
+        const int octave = static_cast<int>(U(rng) * 8);
+        const double sigma = std::pow(1.2, octave);
+        const double z = 0.5 + U(rng) * 5.0;
+        const Eigen::Vector3d pc = core::backproject(20 + U(rng) * 600, 20 + U(rng) * 440, z, K);
+        // A residual of length 0.999 times the gate, in a random direction.
+        Eigen::Vector3d r(N(rng), N(rng), N(rng));
+        r *= 0.999 * std::sqrt(o.chi2_stereo) * sigma / r.norm();
+        const double u = K.fx * pc.x() / z + K.cx, v = K.fy * pc.y() / z + K.cy;
+        const double bf_d = o.bf / z - r.x() + r.z();  // measured bf/depth
+        if (bf_d <= 0) continue;
+        PoseObservation ob;
+        ob.p_w = T_true * pc;
+        ob.uv = Eigen::Vector2d(u - r.x(), v - r.y());
+        ob.depth = o.bf / bf_d;
+        ob.inv_sigma2 = 1.0 / (sigma * sigma);
+        obs.push_back(ob);
+    }
+    ASSERT_EQ(inliersAt(obs, T_true, K, o), 80);  // all of them, just inside the gate
+    EXPECT_GE(inlierBound(obs, K, o), 80);
+    // Fewer inliers at other poses, the bound as before; a subset has a bound >= its own.
+    for (int k = 0; k < 40; ++k) {
+        const Eigen::Isometry3d T = T_true * makePose(0.05 * N(rng), 0.05 * N(rng), 0.05 * N(rng),
+                                                      0.03 * N(rng), 0.03 * N(rng), 0.03 * N(rng));
+        EXPECT_GE(inlierBound(obs, K, o), inliersAt(obs, T, K, o));
+        std::vector<PoseObservation> some;
+        for (const auto& ob : obs)
+            if (U(rng) < 0.5) some.push_back(ob);
+        EXPECT_GE(inlierBound(some, K, o), inliersAt(some, T_true, K, o));
+    }
+    // refinePose from PnP on real-looking data: the bound holds for its count too.
+    const auto noisy = syntheticObservations(T_true, K, 120, 1.0, 0.3, 5);
+    const auto pnp = solvePnpRansac(noisy, K, {});
+    ASSERT_TRUE(pnp.has_value());
+    const auto ref = refinePose(noisy, pnp->T_wc, K, o);
+    EXPECT_GE(inlierBound(noisy, K, o), ref.n_inliers);
+    EXPECT_GE(ref.n_inliers, 70);
+    // The early answer is the bound's: found by a greedy clique (k small) or by the bound.
+    for (const auto* set : std::initializer_list<const std::vector<PoseObservation>*>{&obs, &noisy})
+        for (const int k : {1, 25, 70, 79, 80, 81, 100, 119, 120, 121}) {
+            EXPECT_EQ(inlierBoundReaches(*set, k, K, o), inlierBound(*set, K, o) >= k)
+                << set->size() << " " << k;
+        }
+}
+
+// What the bound is for: a lost frame matched to a keyframe of another place has about 30
+// matches no pose explains; no PnP-RANSAC is needed to know that 25 of them cannot agree.
+TEST(PoseSolver, InlierBoundTellsThatNoPoseExplainsUnrelatedMatches) {
+    const auto K = fr1NoDist();
+    const PoseRefineOptions o;
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> U(0.0, 1.0);
+    std::vector<PoseObservation> obs;
+    for (int i = 0; i < 30; ++i) {
+        PoseObservation ob;
+        ob.p_w = Eigen::Vector3d(U(rng) * 5, U(rng) * 5, U(rng) * 2.5);  // somewhere in a room
+        ob.uv = Eigen::Vector2d(U(rng) * 640, U(rng) * 480);
+        ob.depth = 0.8 + U(rng) * 3.0;
+        obs.push_back(ob);
+    }
+    const int bound = inlierBound(obs, K, o);
+    EXPECT_LT(bound, 25);
+    EXPECT_FALSE(solvePnpRansac(obs, K, {300, 4.0, 0.99, 25}).has_value());
+    // An observation without depth, or one whose gate takes any depth (25 m at level 0:
+    // 1/25 < sqrt(2 * 7.815) / 40), may be an inlier of any pose: each adds one.
+    auto more = obs;
+    more.push_back(obs[0]);
+    more.back().depth = 0;
+    more.push_back(obs[1]);
+    more.back().depth = 25;
+    EXPECT_EQ(inlierBound(more, K, o), bound + 2);
+    for (int k = 0; k <= 33; ++k) {
+        EXPECT_EQ(inlierBoundReaches(obs, k, K, o), bound >= k) << k;
+        EXPECT_EQ(inlierBoundReaches(more, k, K, o), bound + 2 >= k) << k;
+    }
+    EXPECT_EQ(inlierBound({}, K, o), 0);
+    // Matches a rigid motion explains: all of them.
+    auto good = syntheticObservations(makePose(1, 2, 0.5, 0.2, 0.1, -0.3), K, 30, 0.5, 0, 9);
+    EXPECT_GE(inlierBound(good, K, o), 30);
+    // With 10 matches to points 100 m away, 10 m apart (consistent with none), the bound is
+    // the 30 and the early answer says so, with a greedy clique of all 30 to find.
+    for (int i = 0; i < 10; ++i) {
+        good.push_back(good[static_cast<std::size_t>(i)]);
+        good.back().p_w = Eigen::Vector3d(100 + 10 * i, 0, 0);
+    }
+    EXPECT_EQ(inlierBound(good, K, o), 30);
+    EXPECT_TRUE(inlierBoundReaches(good, 30, K, o));
+    EXPECT_FALSE(inlierBoundReaches(good, 31, K, o));
+}
+
 // observationOf: what tracking, relocalisation, loop checks and the frame records give the
 // pose solver for a keypoint: its pixel, depth, the tests' information and the weight.
 TEST(PoseSolver, ObservationOfAKeypointCarriesItsInformationAndWeight) {

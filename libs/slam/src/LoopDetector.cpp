@@ -113,6 +113,7 @@ std::optional<LoopConstraint> detectLoop(const Map& map, KeyframeId current,
         for (const auto& [q, t] : pairs)
             obs.push_back(
                 observationOf(cur.features, q, old.features.points_c[rows[t]], opts.scale_factor));
+        if (!inlierBoundReaches(obs, opts.min_inliers, K, refine)) continue;  // none could pass
         PnpRansacOptions pnp;
         pnp.iterations = 300;
         pnp.min_inliers = opts.min_inliers;

@@ -3,7 +3,9 @@
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core/eigen.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace devslam::slam {
 
@@ -160,4 +162,119 @@ PoseRefineResult refinePose(const std::vector<PoseObservation>& obs,
     return res;
 }
 
+double inlierReach(const PoseObservation& o, const core::CameraIntrinsics& K,
+                   const PoseRefineOptions& opts) {
+    constexpr double kInf = std::numeric_limits<double>::infinity();
+    const double d = o.depth;
+    if (!(d > 0) || !(o.inv_sigma2 > 0)) return kInf;
+    // The gate [px], a little wider for rounding: where 1/d is barely above the gate in 1/z,
+    // z_max is huge and the chi2 test's own rounding (bf/z' below 1e-13 px) takes any z'.
+    const double rho = std::sqrt(opts.chi2_stereo / o.inv_sigma2) * (1 + 1e-9) + 1e-9;
+    // |r_u| + |r_ur| <= sqrt(2) rho bounds |bf/z' - bf/d|, z' the moved point's depth.
+    const double dinv = std::sqrt(2.0) * rho / opts.bf;
+    if (1.0 / d - dinv <= 0) return kInf;
+    const double z_max = 1.0 / (1.0 / d - dinv);
+    const double dz = z_max - d;  // 1/z is convex: the far side is the wider one
+    // x' - x = ((u' - cx) z' - (u - cx) d) / fx with |u' - u| <= rho; y alike.
+    const double ex = (rho * z_max + std::abs(o.uv.x() - K.cx) * dz) / K.fx;
+    const double ey = (rho * z_max + std::abs(o.uv.y() - K.cy) * dz) / K.fy;
+    // A little slack for rounding (the observations come from floats).
+    return std::sqrt(ex * ex + ey * ey + dz * dz) * (1 + 1e-6) + 1e-6;
+}
+
+namespace {
+
+/// inlierBound's observations with a bounded gate: the world point, the point the keypoint
+/// and its depth measure, and how far from it the moved world point of an inlier can be.
+struct Measured {
+    const Eigen::Vector3d* p_w;
+    Eigen::Vector3d p_c;
+    double e;
+};
+
+/// The observations with a bounded gate, and the count of the others.
+std::vector<Measured> measured(const std::vector<PoseObservation>& obs,
+                               const core::CameraIntrinsics& K, const PoseRefineOptions& opts,
+                               int& unconstrained) {
+    std::vector<Measured> m;
+    m.reserve(obs.size());
+    unconstrained = 0;
+    for (const auto& o : obs) {
+        const double e = inlierReach(o, K, opts);
+        if (!std::isfinite(e)) {
+            ++unconstrained;
+            continue;
+        }
+        m.push_back(
+            {&o.p_w,
+             {(o.uv.x() - K.cx) * o.depth / K.fx, (o.uv.y() - K.cy) * o.depth / K.fy, o.depth},
+             e});
+    }
+    return m;
+}
+
+/// Whether i and j can both be inliers of one pose (which preserves their distance).
+bool consistent(const Measured& i, const Measured& j) {
+    return std::abs((*i.p_w - *j.p_w).norm() - (i.p_c - j.p_c).norm()) <= i.e + j.e;
+}
+
+/// The degeneracy of m's consistency graph plus one: at least its largest clique.
+int cliqueBound(const std::vector<Measured>& m) {
+    const std::size_t n = m.size();
+    if (n == 0) return 0;
+    std::vector<std::vector<std::size_t>> adj(n);
+    for (std::size_t i = 0; i < n; ++i)
+        for (std::size_t j = i + 1; j < n; ++j)
+            if (consistent(m[i], m[j])) {
+                adj[i].push_back(j);
+                adj[j].push_back(i);
+            }
+    // Remove a vertex of least degree until none is left; the vertices of a clique of k
+    // keep degree >= k - 1 until the first of them is removed.
+    std::vector<std::size_t> degree(n);
+    for (std::size_t i = 0; i < n; ++i) degree[i] = adj[i].size();
+    std::vector<char> removed(n, 0);
+    std::size_t degeneracy = 0;
+    for (std::size_t step = 0; step < n; ++step) {
+        std::size_t v = n;
+        for (std::size_t i = 0; i < n; ++i)
+            if (!removed[i] && (v == n || degree[i] < degree[v])) v = i;
+        degeneracy = std::max(degeneracy, degree[v]);
+        removed[v] = 1;
+        for (const std::size_t w : adj[v])
+            if (!removed[w]) --degree[w];
+    }
+    return static_cast<int>(degeneracy) + 1;
+}
+
+}  // namespace
+
+int inlierBound(const std::vector<PoseObservation>& obs, const core::CameraIntrinsics& K,
+                const PoseRefineOptions& opts) {
+    int unconstrained = 0;
+    const auto m = measured(obs, K, opts, unconstrained);
+    return unconstrained + cliqueBound(m);
+}
+
+bool inlierBoundReaches(const std::vector<PoseObservation>& obs, int k,
+                        const core::CameraIntrinsics& K, const PoseRefineOptions& opts) {
+    if (static_cast<int>(obs.size()) < k) return false;
+    int unconstrained = 0;
+    const auto m = measured(obs, K, opts, unconstrained);
+    const int need = k - unconstrained;
+    if (need <= 0) return true;
+    // Correspondences of the true place are nearly all consistent: a greedy clique of `need`
+    // (grown from each of the first few observations, an outlier among them) proves the
+    // bound reaches k in O(n k), where the bound itself is O(n^2) (0.6 ms for 300).
+    std::vector<std::size_t> clique;
+    for (std::size_t s = 0; s < std::min<std::size_t>(m.size(), 4); ++s) {
+        clique.assign(1, s);
+        for (std::size_t i = 0; i < m.size() && static_cast<int>(clique.size()) < need; ++i)
+            if (i != s && std::all_of(clique.begin(), clique.end(),
+                                      [&](std::size_t c) { return consistent(m[i], m[c]); }))
+                clique.push_back(i);
+        if (static_cast<int>(clique.size()) >= need) return true;
+    }
+    return cliqueBound(m) >= need;
+}
 }  // namespace devslam::slam

@@ -404,6 +404,9 @@ std::optional<Eigen::Isometry3d> Tracker::relocalize(const FrameFeatures& f, con
         for (const auto& [q, t] : c.pairs)
             obs.push_back(observationOf(f, q, map.landmark(c.kf->landmark_of_kp[c.rows[t]])->p_w,
                                         opts_.scale_factor));
+        // No pose could have reloc_min_inliers of these: the RANSAC would run all its
+        // iterations to fail (a frame that is nowhere in the map).
+        if (!inlierBoundReaches(obs, opts_.reloc_min_inliers, K, opts_.refine)) return;
         auto pnp_opts = opts_.pnp;
         pnp_opts.iterations = std::max(pnp_opts.iterations, 300);
         pnp_opts.min_inliers = opts_.reloc_min_inliers;
