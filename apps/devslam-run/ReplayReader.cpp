@@ -3,12 +3,31 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <string>
 
 namespace devslam::run {
 
-ReplayReader::ReplayReader(io::RgbdReader& source, int passes) : K_(source.intrinsics()) {
+ReplayReader::ReplayReader(io::RgbdReader& source, int passes, bool allow_damaged)
+    : K_(source.intrinsics()) {
     if (passes < 1) throw std::invalid_argument("replay: passes must be >= 1");
-    while (auto f = source.next()) frames_.push_back(std::move(*f));
+    std::vector<std::string> undecodable;
+    while (true) {
+        std::optional<core::Frame> f;
+        try {
+            f = source.next();
+        } catch (const io::InputBroken&) {
+            throw;
+        } catch (const std::exception& e) {
+            if (!allow_damaged)
+                throw std::runtime_error(std::string(e.what()) +
+                                         " (--replay reads every frame before the first is "
+                                         "run; --allow-damaged leaves such frames out)");
+            undecodable.emplace_back(e.what());
+            continue;
+        }
+        if (!f) break;
+        frames_.push_back(std::move(*f));
+    }
     if (frames_.size() < 2)
         throw std::invalid_argument("--replay: " + source.describe() + " has " +
                                     std::to_string(frames_.size()) +
@@ -40,6 +59,10 @@ ReplayReader::ReplayReader(io::RgbdReader& source, int passes) : K_(source.intri
         gt_ = g;
     }
     damage_ = source.damage();
+    if (!undecodable.empty())
+        damage_ += (damage_.empty() ? "" : "; ") + std::to_string(undecodable.size()) +
+                   " frame(s) that do not decode left out of the replay, the first: " +
+                   undecodable.front();
     what_ = source.describe() + " replayed " + std::to_string(passes) + " passes (" +
             std::to_string(order_.size()) + " frames)";
 }

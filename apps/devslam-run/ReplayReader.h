@@ -12,8 +12,11 @@ namespace devslam::run {
 
 class ReplayReader final : public io::RgbdReader {
   public:
-    /// Reads all of `source`; throws std::invalid_argument for passes < 1 or < 2 frames.
-    ReplayReader(io::RgbdReader& source, int passes);
+    /// Reads all of `source`; throws std::invalid_argument for passes < 1 or < 2 frames. A
+    /// frame that does not decode is left out with `allow_damaged` (damage() says so), else
+    /// its error is thrown before any frame is run (with the hint of --allow-damaged);
+    /// io::InputBroken (nothing after it can be read) is thrown as it is.
+    ReplayReader(io::RgbdReader& source, int passes, bool allow_damaged = false);
     [[nodiscard]] std::optional<core::Frame> next() override;
     [[nodiscard]] std::optional<std::size_t> size() const override { return order_.size(); }
     [[nodiscard]] std::optional<core::Trajectory> groundTruth() const override { return gt_; }

@@ -285,7 +285,7 @@ std::unique_ptr<io::RgbdReader> openInput(const std::string& input, const io::Re
     if (truth)  // (before the replay, which maps it with the frames)
         reader = std::make_unique<run::GivenTruthReader>(std::move(reader), *truth, truth_path);
     if (replay <= 0) return reader;
-    return std::make_unique<run::ReplayReader>(*reader, replay);
+    return std::make_unique<run::ReplayReader>(*reader, replay, ro.allow_damaged);
 }
 
 /// A run of `mode` with the loaded INIs and the command line's input and frame limit,
@@ -583,7 +583,7 @@ std::string benchLongRun(const Args& a) {
     constexpr int kPasses = 9;
     auto l = loadConfig(a);
     auto src = openInput(a.input, l.reader, 0);
-    run::ReplayReader reader(*src, kPasses);
+    run::ReplayReader reader(*src, kPasses, l.reader.allow_damaged);
     auto rc = runConfig(a, l, "dynamic");
     rc.max_frames = 0;       // every replayed frame
     rc.score_masks = false;  // replayed: timestamps are not the truth's

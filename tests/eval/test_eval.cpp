@@ -491,6 +491,18 @@ TEST(Report, RefusesOverflowNonFiniteJsonAndOutputsThatAreInputs) {
         EXPECT_EQ(full.out,
                   "devslam-eval: cannot write the standard output (No space left on device)\n");
     }
+    // A file-size limit under the plot, SIGXFSZ left at its default (it killed the program:
+    // no error, no figures, a cut p.png.part left): the figures, the error, no cut file.
+    const auto cut = devslam::test::runAppWithFileLimit(
+        "devslam-eval", g + " " + e + " --plot " + d.str("p.png"), 2000, false);
+    EXPECT_EQ(cut.rc, 1) << cut.out;
+    EXPECT_NE(cut.out.find("ATE translation"), std::string::npos) << cut.out;
+    EXPECT_NE(
+        cut.out.find("devslam-eval: plot: cannot write '" + d.str("p.png") + "': File too large"),
+        std::string::npos)
+        << cut.out;
+    EXPECT_FALSE(std::filesystem::exists(d.str("p.png")));
+    EXPECT_FALSE(std::filesystem::exists(d.str("p.png.part")));
 }
 
 TEST(MaskScore, CountsWalkersStaticPeopleAndArea) {

@@ -1156,6 +1156,27 @@ TEST(DevslamRun, AnUndecodableFrameMidRunKeepsTheFramesBeforeIt) {
     const auto all = run("--input " + (dir / "seq").string() +
                          " --mode dynamic --quiet --allow-damaged --out " + (dir / "all").string());
     EXPECT_EQ(all.rc, 0) << all.out;
+    // --replay reads every frame first: the error comes before any frame is run, with the
+    // hint; with --allow-damaged the replay leaves that frame out and says so (it lost the
+    // whole run and ignored the flag before).
+    const auto replay = run("--input " + (dir / "seq").string() +
+                            " --mode none --quiet --replay 2 --out " + (dir / "replay").string());
+    EXPECT_EQ(replay.rc, 1) << replay.out;
+    EXPECT_NE(replay.out.find(image + ": cannot decode colour image (--replay reads every frame "
+                                      "before the first is run; --allow-damaged leaves such "
+                                      "frames out)"),
+              std::string::npos)
+        << replay.out;
+    const auto replay_all =
+        run("--input " + (dir / "seq").string() + " --mode none --quiet --replay 2 " +
+            "--allow-damaged --out " + (dir / "replay").string());
+    EXPECT_EQ(replay_all.rc, 0) << replay_all.out;
+    EXPECT_NE(replay_all.out.find("1 frame(s) that do not decode left out of the replay, the "
+                                  "first: " +
+                                  (dir / "seq" / image).string()),
+              std::string::npos)
+        << replay_all.out;
+    EXPECT_EQ(lines(dir / "replay" / "trajectory.txt"), 13u);  // 7 forward, 6 back
     // A run that stops early where a whole run's outputs are goes beside them: the whole run
     // of 7 frames was replaced by the 5 frames of the stopped one.
     const auto stopped = run("--input " + (dir / "seq").string() +

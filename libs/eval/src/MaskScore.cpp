@@ -133,11 +133,11 @@ PersonTruth::FrameTruth PersonTruth::frame(double timestamp, cv::Size expected) 
     if (f.labels.empty() || f.labels.type() != CV_8UC1)
         throw MissingTruth("cannot read person labels '" + label_path +
                            "' (expected an 8-bit one-channel PNG)" + why);
-    if (!expected.empty() && f.labels.size() != expected)
-        throw std::runtime_error(
-            "person labels '" + label_path + "' are " + std::to_string(f.labels.cols) + "x" +
-            std::to_string(f.labels.rows) + ", the frame is " + std::to_string(expected.width) +
-            "x" + std::to_string(expected.height));
+    if (!expected.empty() && f.labels.size() != expected)  // unusable, as a missing one
+        throw MissingTruth("person labels '" + label_path + "' are " +
+                           std::to_string(f.labels.cols) + "x" + std::to_string(f.labels.rows) +
+                           ", the frame is " + std::to_string(expected.width) + "x" +
+                           std::to_string(expected.height));
     // Every labelled id is a person of this frame's rows (devslam-synth lists every person in
     // every frame): another render's labels, or a hand-edited persons.txt, were scored against
     // the wrong people without a word. Unusable truth, as a missing label image: the run ends
