@@ -1,5 +1,6 @@
 // devslam-eval: ATE and RPE of an estimated trajectory against ground truth, computed as
 // the TUM RGB-D benchmark tools do (evaluate_ate.py, evaluate_rpe.py --fixed_delta).
+#include <devslam/core/Interrupt.h>
 #include <devslam/core/Parse.h>
 #include <devslam/core/Results.h>
 #include <devslam/eval/Metrics.h>
@@ -152,6 +153,7 @@ static int appMain(int argc, char** argv) {
 }
 
 int main(int argc, char** argv) {
+    devslam::core::ignoreFileSizeSignal();  // a write past ulimit -f is reported, not a kill
     // The figures go to the standard output: one that cannot be written (a full disk behind
     // '>') lost them while the program said 0.
     return devslam::core::withStandardOutput("devslam-eval", appMain(argc, argv));

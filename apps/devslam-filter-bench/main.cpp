@@ -5,6 +5,7 @@
 //   devslam-filter-bench                      # defaults below, writes docs/RESULTS.md
 //   devslam-filter-bench --threads 1 --frames 30 --results FILE|none
 #include <devslam/core/Config.h>
+#include <devslam/core/Interrupt.h>
 #include <devslam/core/Parse.h>
 #include <devslam/core/Progress.h>
 #include <devslam/core/Results.h>
@@ -601,5 +602,6 @@ int appMain(int argc, char** argv) {
 }  // namespace
 
 int main(int argc, char** argv) {
+    core::ignoreFileSizeSignal();  // a write past ulimit -f is reported, not a kill
     return core::withStandardOutput("devslam-filter-bench", appMain(argc, argv));
 }

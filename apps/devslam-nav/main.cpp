@@ -318,6 +318,8 @@ static int appMain(int argc, char** argv) {
 }
 
 int main(int argc, char** argv) {
+    // Before any file is written (--map's plan too): a write past ulimit -f is reported.
+    devslam::core::ignoreFileSizeSignal();
     // The figures go to the standard output: one that cannot be written (a full disk behind
     // '>') lost them while the program said 0.
     return devslam::core::withStandardOutput("devslam-nav", appMain(argc, argv));

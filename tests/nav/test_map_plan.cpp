@@ -130,6 +130,17 @@ TEST(MapPlan, DevslamNavPlansOnAMapFile) {
     EXPECT_NE(out.find("result=path length="), std::string::npos) << out;
     EXPECT_NE(out.find("waypoint 4.50 0.00"), std::string::npos) << out;
     EXPECT_TRUE(fs::exists(d.str("p.png")));
+    // A file-size limit under the picture, SIGXFSZ at its default (it killed the program,
+    // leaving a cut q.png.part): the path, the error, no cut file.
+    const auto cut = devslam::test::runAppWithFileLimit(
+        "devslam-nav", "--map " + file + " --to 4.5,0 --png " + d.str("q.png"), 1000, false);
+    EXPECT_EQ(cut.rc, 2) << cut.out;
+    EXPECT_NE(cut.out.find("waypoint 4.50 0.00"), std::string::npos) << cut.out;
+    EXPECT_NE(cut.out.find("cannot write '" + d.str("q.png") + "': File too large"),
+              std::string::npos)
+        << cut.out;
+    EXPECT_FALSE(fs::exists(d.str("q.png")));
+    EXPECT_FALSE(fs::exists(d.str("q.png.part")));
     EXPECT_EQ(run("--map " + file + " --from 0,0 --to 2,0", out), 2) << out;
     EXPECT_NE(out.find("goal (2, 0) is inside an obstacle"), std::string::npos) << out;
     EXPECT_NE(out.find("devslam-nav: " + file + ", --from 0,0 --to 2,0: global planner: "),

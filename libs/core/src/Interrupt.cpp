@@ -49,11 +49,15 @@ extern "C" void onStopSignal(int sig) {
 }
 }  // namespace
 
-void installStopHandler(const char* program) {
+void ignoreFileSizeSignal() {
     // Past a file-size limit (ulimit -f) a write fails with EFBIG, which every writer reports,
     // keeping the other outputs; SIGXFSZ's default action killed the program first, losing
     // the summary (devslam-run left a cut map.ply.part and printed nothing).
     std::signal(SIGXFSZ, SIG_IGN);
+}
+
+void installStopHandler(const char* program) {
+    ignoreFileSizeSignal();
     g_program = program;
     g_program_len = std::strlen(program);
     struct sigaction sa {};

@@ -22,6 +22,9 @@ namespace devslam::core {
 /// Also ignores SIGXFSZ: past a file-size limit a write fails (EFBIG) and is reported like a
 /// full disk, instead of the process being killed (the programs runCommand starts inherit it).
 void installStopHandler(const char* program);
+/// Only the SIGXFSZ part of installStopHandler, for programs without a stop handler (their
+/// Ctrl-C ends them at once): past a file-size limit their writes fail and are reported.
+void ignoreFileSizeSignal();
 /// 0 while no stop was asked for, else the first signal's number.
 [[nodiscard]] int stopSignal();
 /// "SIGINT", "SIGTERM", or "signal N".
