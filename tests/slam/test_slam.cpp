@@ -350,8 +350,9 @@ TEST(PoseSolver, InlierReachHoldsWhereTheGateAlmostTakesAnyDepth) {
         const Eigen::Vector3d p((u - K.cx) * z / K.fx, 0, z);
         if (observationJacobians(Eigen::Isometry3d::Identity(), p, ob.uv, ob.depth, K, o.bf, r, Jp,
                                  Jl, rows) &&
-            r.squaredNorm() <= o.chi2_stereo)
+            r.squaredNorm() <= o.chi2_stereo) {
             ASSERT_LE((p - p_meas).norm(), reach) << "z' " << z << " depth " << ob.depth;
+        }
     }
 }
 
@@ -1011,6 +1012,18 @@ TEST(MapFile, EveryFieldRoundTripsExactly) {
                                               0),
                   0u)
             << e.what();
+    }
+    // Cameras whose summaries read the same: what differs is named in full.
+    other = cam;
+    other.fx += 0.006;
+    try {
+        checkCameraMatches(m, "map.yml", other);
+        ADD_FAILURE() << "another camera passed";
+    } catch (const std::invalid_argument& e) {
+        char want[96];
+        std::snprintf(want, sizeof want, "(fx %.10g in the map, %.10g in the input)", cam.fx,
+                      other.fx);
+        EXPECT_NE(std::string(e.what()).find(want), std::string::npos) << e.what();
     }
     // Keyframes in saved order, renumbered 0, 1, 2 (saved as 0, 2, 3).
     ASSERT_EQ(m.map.keyframes().size(), map.keyframes().size());

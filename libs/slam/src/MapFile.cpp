@@ -626,9 +626,26 @@ void checkCameraMatches(const MapFile& m, const std::string& path,
                       k.dist[3], k.dist[4]);
         return std::string(b);
     };
+    // What differs, in full: the summaries round to 0.1 px and may read the same.
+    std::string differs;
+    const auto add = [&](const std::string& name, double x, double y) {
+        if (x == y) return;
+        char b[128];
+        std::snprintf(b, sizeof b, "%s%s %.10g in the map, %.10g in the input",
+                      differs.empty() ? "" : "; ", name.c_str(), x, y);
+        differs += b;
+    };
+    add("width", a.width, camera.width);
+    add("height", a.height, camera.height);
+    add("fx", a.fx, camera.fx);
+    add("fy", a.fy, camera.fy);
+    add("cx", a.cx, camera.cx);
+    add("cy", a.cy, camera.cy);
+    for (std::size_t i = 0; i < a.dist.size(); ++i)
+        add("dist[" + std::to_string(i) + "]", a.dist[i], camera.dist[i]);
     throw std::invalid_argument(path + ": the map was made with the camera " + text(a) +
-                                ", the input's is " + text(camera) +
-                                ": its keyframes cannot be adjusted with another camera's "
+                                ", the input's is " + text(camera) + " (" + differs +
+                                "): its keyframes cannot be adjusted with another camera's "
                                 "pixels (localize without --extend-map)");
 }
 
