@@ -260,7 +260,19 @@ int run(int argc, char** argv) {
               << "  frames with a visible moving person " << sum.frames_with_moving_person
               << ", with a visible static person " << sum.frames_with_static_person << "\n"
               << "  render median " << sum.render_ms_median << " ms/frame\n"
+              << "  depth on " << std::lround(100 * sum.depth_fraction_median)
+              << " % of the pixels (median over frames)\n"
               << "  preview " << prev << (rawlog.empty() ? "" : ", rawlog " + rawlog) << "\n";
+    // The render is written as asked; a sensor that measures nothing is said loudly (a
+    // sigma_a of 1e300 or a max_range short of the room rendered depth of zeros, exit 0).
+    if (sum.frames_without_depth > 0)
+        std::cerr << "devslam-synth: WARNING: " << sum.frames_without_depth << " of "
+                  << sum.n_frames
+                  << " frames have no depth value at all with this [depth_noise] (min_range "
+                  << sc.depth_noise.min_range << ", max_range " << sc.depth_noise.max_range
+                  << " m, sigma_a " << sc.depth_noise.sigma_a << ", sigma_b "
+                  << sc.depth_noise.sigma_b << ", disparity_step " << sc.depth_noise.disparity_step
+                  << ", dropout " << sc.depth_noise.dropout << "): no RGB-D SLAM can run on them\n";
     return 0;
 }
 

@@ -268,6 +268,18 @@ TEST(RenderSequence, GroundTruthMatchesPosesUsed) {
     o.max_frames = 6;
     const auto sum = writeSequence(sc, o);
     EXPECT_EQ(sum.n_frames, 6u);
+    EXPECT_EQ(sum.frames_without_depth, 0u);
+    EXPECT_GT(sum.depth_fraction_median, 0.8);
+    // A sensor that measures nothing (a noise of 1e300 m leaves every value out of range) is
+    // counted, for devslam-synth's warning: it wrote depth of zeros and said nothing.
+    Scenario deaf = sc;
+    deaf.depth_noise.sigma_a = 1e300;
+    WriteOptions od;
+    od.out_dir = tmp.str("deaf");
+    od.max_frames = 2;
+    const auto none = writeSequence(deaf, od);
+    EXPECT_EQ(none.frames_without_depth, 2u);
+    EXPECT_EQ(none.depth_fraction_median, 0.0);
     // The rawlog holds the same frames as the TUM folder.
     auto tum = io::openRgbd(o.out_dir, {});
     io::RawlogReader rawlog(o.rawlog_path);

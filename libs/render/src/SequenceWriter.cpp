@@ -8,6 +8,7 @@
 #include <devslam/render/SequenceWriter.h>
 
 #include <mrpt/config/CConfigFileMemory.h>
+#include <opencv2/core.hpp>
 
 #include <chrono>
 #include <cstdio>
@@ -212,7 +213,7 @@ WriteSummary writeSequence(const Scenario& sc, const WriteOptions& o,
 
     core::Trajectory gt;
     WriteSummary sum;
-    std::vector<double> ms;
+    std::vector<double> ms, depth_fraction;
     std::size_t i = 0;
     for (; i < n; ++i) {
         // Not before the first frame: the earlier render's files are gone already, and a
@@ -240,6 +241,10 @@ WriteSummary writeSequence(const Scenario& sc, const WriteOptions& o,
         }
         sum.frames_with_moving_person += moving_visible;
         sum.frames_with_static_person += static_visible;
+        const int with_depth = cv::countNonZero(rf.frame.depth > 0);
+        depth_fraction.push_back(static_cast<double>(with_depth) /
+                                 static_cast<double>(rf.frame.depth.total()));
+        if (with_depth == 0 && cv::countNonZero(rf.clean_depth > 0) > 0) ++sum.frames_without_depth;
         if (o.write_labels) {
             const std::string lp =
                 (fs::path(o.out_dir) / "labels" / (std::string(stamp) + ".png")).string();
@@ -269,6 +274,7 @@ WriteSummary writeSequence(const Scenario& sc, const WriteOptions& o,
 
     sum.n_frames = i;
     sum.render_ms_median = core::median(ms);
+    sum.depth_fraction_median = depth_fraction.empty() ? 0.0 : core::median(depth_fraction);
     if (sum.stopped) return sum;  // not this render's frame count: no render.txt
     const std::string sig_path = signaturePath(o).string();
     std::ofstream sf(sig_path, std::ios::binary);

@@ -39,6 +39,10 @@ struct WriteSummary {
     std::size_t frames_with_static_person =
         0;                          ///< frames where a sitting/standing person is visible
     double render_ms_median = 0.0;  ///< GL render + read-back per frame [ms]
+    /// Frames whose depth image (after [depth_noise]) has no value at all, though the scene
+    /// was in view: a noise model or range that leaves the render useless for RGB-D.
+    std::size_t frames_without_depth = 0;
+    double depth_fraction_median = 0.0;  ///< of each frame's pixels, those with a depth
     bool stopped = false;           ///< WriteOptions::stop ended it before the last frame
 };
 
