@@ -26,6 +26,7 @@
 #include <limits>
 #include <random>
 #include <thread>
+#include <tuple>
 #include <typeinfo>
 
 #include <fcntl.h>
@@ -1078,6 +1079,77 @@ TEST(Association, NearestPairsNeverReused) {
     // Unsorted input, offset applied to b.
     EXPECT_EQ(associate({2.0, 1.0}, {0.5, 1.5}, 0.02, 0.5), (std::vector<P>{{1, 0}, {0, 1}}));
     EXPECT_TRUE(associate({1.0}, {}, 0.02).empty());
+}
+
+namespace {
+
+/// associate.py itself: every candidate pair, sorted by (|diff|, i, j), taken greedily. What
+/// core::associate did until it ran out of memory on dense stamps; the reference it must equal.
+std::vector<std::pair<std::size_t, std::size_t>> associateAllPairs(const std::vector<double>& a,
+                                                                   const std::vector<double>& b,
+                                                                   double max_dt, double offset) {
+    std::vector<std::tuple<double, std::size_t, std::size_t>> cand;
+    for (std::size_t i = 0; i < a.size(); ++i)
+        for (std::size_t j = 0; j < b.size(); ++j)
+            if (const double d = std::abs(a[i] - (b[j] + offset)); d < max_dt)
+                cand.emplace_back(d, i, j);
+    std::sort(cand.begin(), cand.end());
+    std::vector<char> used_a(a.size(), 0), used_b(b.size(), 0);
+    std::vector<std::pair<std::size_t, std::size_t>> out;
+    for (const auto& [d, i, j] : cand) {
+        if (used_a[i] || used_b[j]) continue;
+        used_a[i] = used_b[j] = 1;
+        out.emplace_back(i, j);
+    }
+    std::sort(out.begin(), out.end(), [&](auto x, auto y) { return a[x.first] < a[y.first]; });
+    return out;
+}
+
+}  // namespace
+
+// The same pairs as every candidate sorted, over stamps made to tie: equal stamps, stamps on
+// a coarse grid (equal differences), unsorted, with offsets, denser and sparser than max_dt.
+TEST(Association, EqualsTheAllPairsAlgorithmOnTiesAndDenseStamps) {
+    std::mt19937 rng(5);
+    std::uniform_int_distribution<int> grid(0, 40);
+    std::uniform_real_distribution<double> U(0.0, 1.0);
+    for (int trial = 0; trial < 3000; ++trial) {
+        const std::size_t na = 1 + rng() % 30, nb = rng() % 30;
+        const double step = trial % 3 == 0 ? 0.01 : (trial % 3 == 1 ? 0.0037 : 0.05);
+        std::vector<double> a(na), b(nb);
+        for (auto& t : a) t = trial % 2 ? 100 + grid(rng) * step : 100 + U(rng) * 0.4;
+        for (auto& t : b) t = trial % 2 ? 100 + grid(rng) * step : 100 + U(rng) * 0.4;
+        const double max_dt = std::vector<double>{0.02, 0.0371, 0.5}[trial % 3];
+        const double offset = trial % 5 == 0 ? 0.01 : 0.0;
+        ASSERT_EQ(associate(a, b, max_dt, offset), associateAllPairs(a, b, max_dt, offset))
+            << "trial " << trial;
+    }
+}
+
+// 20 000 stamps 1 us apart, all within max_dt of each other: 4e8 candidates for the
+// all-pairs way (6 GB, then std::bad_alloc); here one per stamp. (Every difference is
+// 5e-7 s up to rounding, which decides the greedy order: 3000 of them as the reference does.)
+TEST(Association, DenseStampsNeedNoMemoryPerCandidate) {
+    const auto dense = [](std::size_t n, std::vector<double>& a, std::vector<double>& b) {
+        a.resize(n);
+        b.resize(n);
+        for (std::size_t k = 0; k < n; ++k) {
+            a[k] = 1000 + 1e-6 * static_cast<double>(k);
+            b[k] = a[k] + 5e-7;
+        }
+    };
+    std::vector<double> a, b;
+    dense(3000, a, b);
+    EXPECT_EQ(associate(a, b, 0.02), associateAllPairs(a, b, 0.02, 0.0));
+    dense(20000, a, b);
+    const auto pairs = associate(a, b, 0.02);
+    ASSERT_EQ(pairs.size(), a.size());
+    std::vector<char> seen(b.size(), 0);
+    for (const auto& [i, j] : pairs) {
+        EXPECT_LT(std::abs(a[i] - b[j]), 0.02);
+        EXPECT_FALSE(seen[j]);
+        seen[j] = 1;
+    }
 }
 
 TEST(GzFile, InnermostMessageSkipsEmptyMessages) {
