@@ -623,6 +623,26 @@ TEST(MaskScore, PersonTruthOfAFolder) {
     }
     EXPECT_THROW((void)eval::PersonTruth::open(dir.string()), std::runtime_error);
     EXPECT_THROW((void)eval::PersonTruth::hasWalkers(dir.string()), std::runtime_error);
+    // A person twice in a frame (it was scored twice), an id no 8-bit label holds, a negative
+    // size, a tenth value: refused, naming the line.
+    const std::string good = "1.000000 1 p moving 0 0 10 10 100\n";
+    for (const auto& [text, says] : std::vector<std::pair<std::string, std::string>>{
+             {good + "2.000000 1 p moving 0 0 10 10 100\n" + good,
+              "line 3: person 1 of frame 1.000000 again (line 1)"},
+             {"1.000000 256 p moving 0 0 10 10 100\n", "line 1: person id 256"},
+             {"1.000000 0 p moving 0 0 10 10 100\n", "line 1: person id 0"},
+             {"1.000000 1 p moving 0 0 -10 10 100\n", "line 1: a negative box size"},
+             {"1.000000 1 p moving 0 0 10 10 100 7\n", "line 1: '7' after the 9 values"}}) {
+        std::ofstream(dir / "persons.txt") << text;
+        try {
+            (void)eval::PersonTruth::open(dir.string());
+            ADD_FAILURE() << "accepted: " << text;
+        } catch (const std::runtime_error& e) {
+            EXPECT_NE(std::string(e.what()).find((dir / "persons.txt").string() + " " + says),
+                      std::string::npos)
+                << e.what();
+        }
+    }
     fs::remove_all(dir);
 }
 

@@ -20,6 +20,7 @@ std::map<std::string, std::vector<PersonEntry>> readPersons(const std::string& p
     std::ifstream in(path);
     if (!in) throw std::runtime_error("cannot open '" + path + "'");
     std::map<std::string, std::vector<PersonEntry>> out;
+    std::map<std::string, int> first_line;  // "stamp id" -> its line
     std::string line;
     for (int n = 1; std::getline(in, line); ++n) {
         if (line.empty() || line[0] == '#') continue;
@@ -32,6 +33,20 @@ std::map<std::string, std::vector<PersonEntry>> readPersons(const std::string& p
             throw std::runtime_error(
                 path + " line " + std::to_string(n) +
                 ": expected 'timestamp id name moving|static x y w h visible_pixels'");
+        const auto where = path + " line " + std::to_string(n) + ": ";
+        if (std::string extra; ss >> extra)
+            throw std::runtime_error(where + "'" + extra + "' after the 9 values");
+        // Label images are 8-bit, 0 the background: another id labels no pixel.
+        if (p.id < 1 || p.id > 255)
+            throw std::runtime_error(where + "person id " + std::to_string(p.id) +
+                                     " (the labels are 8-bit: 1..255)");
+        if (w < 0 || h < 0 || p.visible_pixels < 0)
+            throw std::runtime_error(where + "a negative box size or visible_pixels");
+        // A person listed twice in a frame was scored twice (a duplicated line: 6 -> 7
+        // person-frames, without a word).
+        if (const auto [it, fresh] = first_line.emplace(t + " " + std::to_string(p.id), n); !fresh)
+            throw std::runtime_error(where + "person " + std::to_string(p.id) + " of frame " + t +
+                                     " again (line " + std::to_string(it->second) + ")");
         p.moving = state == "moving";
         out[t].push_back(p);
     }
