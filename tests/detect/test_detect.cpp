@@ -265,6 +265,12 @@ TEST(DetectYolo, CorruptWeightsGiveAClearError) {
     // 30 kB short: under 1 % of the file, which the size check used to allow.
     const std::string short_by_30k = (dir / "short.weights").string();
     std::ofstream(short_by_30k, std::ios::binary).write(bytes.data(), bytes.size() - 30000);
+    // One float short (its value was left uninitialised: the check allowed 1 kB) or one
+    // float too many.
+    const std::string short_by_4 = (dir / "short4.weights").string();
+    std::ofstream(short_by_4, std::ios::binary).write(bytes.data(), bytes.size() - 4);
+    const std::string long_by_4 = (dir / "long4.weights").string();
+    std::ofstream(long_by_4, std::ios::binary).write(bytes.data(), bytes.size()) << "0000";
     const std::string folder = (dir / "folder.weights").string();
     fs::create_directories(folder);
     // The right size, but every weight 0 or NaN after the 20-byte header: these loaded, and
@@ -282,6 +288,8 @@ TEST(DetectYolo, CorruptWeightsGiveAClearError) {
          std::vector<std::pair<std::string, std::string>>{{half, ""},
                                                           {tiny, ""},
                                                           {short_by_30k, ""},
+                                                          {short_by_4, "bytes but cfg"},
+                                                          {long_by_4, "bytes but cfg"},
                                                           {folder, ""},
                                                           {zero, "the same objectness"},
                                                           {nan_w, "non-finite outputs"}}) {
@@ -296,6 +304,18 @@ TEST(DetectYolo, CorruptWeightsGiveAClearError) {
         }
     }
     fs::remove_all(dir);
+    // Every shipped model passes the exact size check.
+    for (const std::string m :
+         {"yolo-fastest-1.1", "yolo-fastest-1.1-xl", "yolo-fastest-1.1_body"}) {
+        detect::YoloDetector::Options o;
+        o.model = kRoot + "/models/yolo-fastest-1.1/" + m + ".cfg";
+        o.weights = kRoot + "/models/yolo-fastest-1.1/" + m + ".weights";
+        if (m == "yolo-fastest-1.1_body") {
+            o.names = kRoot + "/models/yolo-fastest-1.1/body.names";
+            o.classes = {"body"};
+        }
+        EXPECT_NO_THROW(detect::YoloDetector det(o)) << m;
+    }
 }
 
 TEST(DetectYolo, BadOptionsAreRejected) {

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -289,21 +290,26 @@ YoloDetector::YoloDetector(const Options& opts) : opts_(opts) {
             checkDarknetCfg(model);
             net_ = read([&] { return cv::dnn::readNetFromDarknet(model, weights); });
             // cv::dnn reads a truncated weights file without complaint (missing values
-            // stay uninitialised): compare the file size with the parameters the cfg needs.
+            // stay uninitialised): the file must hold exactly the header and a float32 for
+            // every parameter of the cfg but the YOLO layers' anchors (OpenCV keeps them as
+            // blobs of its "Region" layers; they come from the cfg). The header is 3 int32
+            // (major, minor, revision) and the images seen, an int64 from version 0.2 on.
             std::size_t n_params = 0;
-            for (const auto& layer : net_.getLayerNames())
-                for (const auto& blob : net_.getLayer(net_.getLayerId(layer))->blobs)
-                    n_params += blob.total();
-            const double expected = 4.0 * static_cast<double>(n_params);  // float32
-            const auto actual = static_cast<double>(fs::file_size(weights));
-            // The file holds a 20-byte header and every float of the cfg but the YOLO layers'
-            // anchors, which OpenCV keeps as blobs too: 28 bytes fewer for the shipped models
-            // (two YOLO layers), 52 for three. A file cut by more than 1 kB is refused.
-            if (std::abs(actual - expected) > 1024)
+            for (const auto& layer : net_.getLayerNames()) {
+                const auto l = net_.getLayer(net_.getLayerId(layer));
+                if (l->type == "Region") continue;
+                for (const auto& blob : l->blobs) n_params += blob.total();
+            }
+            std::int32_t version[3] = {0, 0, 0};
+            std::ifstream(weights, std::ios::binary)
+                .read(reinterpret_cast<char*>(version), sizeof version);
+            const std::uintmax_t header = (version[0] * 10 + version[1] >= 2) ? 20 : 16;
+            const std::uintmax_t expected = header + 4 * static_cast<std::uintmax_t>(n_params);
+            const auto actual = fs::file_size(weights);
+            if (actual != expected)
                 throw std::runtime_error("yolo weights '" + weights + "' has " +
-                                         std::to_string(fs::file_size(weights)) +
-                                         " bytes but cfg '" + model + "' needs about " +
-                                         std::to_string(static_cast<long long>(expected)) +
+                                         std::to_string(actual) + " bytes but cfg '" + model +
+                                         "' needs " + std::to_string(expected) +
                                          " (truncated file, or weights of another model?)");
         }
     } catch (const cv::Exception& e) {
