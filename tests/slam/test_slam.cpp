@@ -1105,6 +1105,11 @@ TEST(MapFile, BadFilesAreRefusedNamingTheFileAndThePlace) {
     std::ofstream(d.str("text.yml")) << "hello: 1\n";
     EXPECT_EQ(errorOf(d.str("text.yml")),
               d.str("text.yml") + ": not a DEV-SLAM map (no '%YAML:1.0' and '---' first lines)");
+    std::ofstream(d.str("crlf.yml")) << "%YAML:1.0\r\n---\r\nend_of_map: 1\r\n";
+    EXPECT_EQ(errorOf(d.str("crlf.yml")),
+              d.str("crlf.yml") +
+                  ": has Windows line endings (CRLF), which saveMap never writes: convert them "
+                  "back (dos2unix) or use the map as it was saved");
     std::ofstream(d.str("empty.yml")).close();
     EXPECT_EQ(errorOf(d.str("empty.yml")),
               d.str("empty.yml") + ": not a DEV-SLAM map (no '%YAML:1.0' and '---' first lines)");

@@ -148,6 +148,10 @@ struct Reader {
 ///   base64 lines indented deeper, and "KEY: VALUE" with VALUE a number or a word.
 void precheck(const Reader& rd, const std::string& text) {
     constexpr std::string_view kHead = "%YAML:1.0\n---\n";
+    if (text.rfind("%YAML:1.0\r\n", 0) == 0)  // (it said there were no such lines)
+        rd.fail("",
+                "has Windows line endings (CRLF), which saveMap never writes: convert "
+                "them back (dos2unix) or use the map as it was saved");
     if (text.rfind(kHead, 0) != 0)
         rd.fail("", "not a DEV-SLAM map (no '%YAML:1.0' and '---' first lines)");
     // saveMap writes this last, so that a file cut short is told as one.
