@@ -230,6 +230,16 @@ std::optional<std::size_t> overlayIndex(const std::string& name) {
     return k;
 }
 
+/// "; overlays there of later frames are an earlier run's" when `dir` holds any of frame k
+/// on, else nothing (a fresh folder has no earlier run to warn of).
+std::string earlierOverlaysNote(const std::string& dir, std::size_t k) {
+    std::error_code ec;
+    for (const auto& e : fs::directory_iterator(dir, ec))
+        if (const auto index = overlayIndex(e.path().filename().string()); index && *index >= k)
+            return "; overlays there of later frames are an earlier run's";
+    return "";
+}
+
 /// Frame k's overlay as DIR/overlayName(k); `written` overlays came before it.
 void writeOverlay(const std::string& out_dir, std::size_t k, const core::Frame& f,
                   const dynamic::FilterOutput& out, std::size_t written) {
@@ -295,10 +305,10 @@ int appMain(int argc, char** argv) {
                 } catch (const std::exception& e) {
                     // A frame that does not decode: the overlays written so far replaced an
                     // earlier run's, whose later ones stay; said as an interrupt says it.
-                    throw std::runtime_error(
-                        std::string(e.what()) + "; stopped after " + std::to_string(k) +
-                        " frames: wrote " + std::to_string(written) + " overlays to " + a.out_dir +
-                        "; overlays there of later frames are an earlier run's");
+                    throw std::runtime_error(std::string(e.what()) + "; stopped after " +
+                                             std::to_string(k) + " frames: wrote " +
+                                             std::to_string(written) + " overlays to " + a.out_dir +
+                                             earlierOverlaysNote(a.out_dir, k));
                 }
                 if (!f) break;
                 if (in.fixed_camera && a.use_prior) prior = Eigen::Isometry3d::Identity();
@@ -316,7 +326,7 @@ int appMain(int argc, char** argv) {
         if (sig) {
             std::cerr << "devslam-overlay: interrupted (" << core::signalName(sig) << ") after "
                       << k << " frames: wrote " << written << " overlays to " << a.out_dir
-                      << "; overlays there of later frames are an earlier run's\n";
+                      << earlierOverlaysNote(a.out_dir, k) << "\n";
             core::exitBySignal(sig);
         }
         std::vector<fs::path> stale;

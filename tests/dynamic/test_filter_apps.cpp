@@ -139,6 +139,12 @@ TEST(DevslamOverlay, AnUndecodableFrameSaysWhichOverlaysAreThisRuns) {
               std::string::npos)
         << r.out;
     EXPECT_EQ(pngsIn(d.str("o")), 3);  // the earlier run's later overlays are not removed
+    // Into a fresh folder there is no earlier run to speak of (it was said all the same).
+    r = runApp("devslam-overlay", "--input " + in + " --mode none --out " + d.str("fresh"));
+    EXPECT_EQ(r.rc, 1) << r.out;
+    EXPECT_NE(r.out.find("; stopped after 1 frames: wrote 1 overlays to " + d.str("fresh") + "\n"),
+              std::string::npos)
+        << r.out;
 }
 
 // Ctrl-C: the overlay being written is finished, the run stops there, says how far it got and
