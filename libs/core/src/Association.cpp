@@ -60,30 +60,24 @@ std::vector<std::pair<std::size_t, std::size_t>> associate(const std::vector<dou
     Remaining left(b.size());
 
     using Cand = std::tuple<double, std::size_t, std::size_t>;  // (|diff|, i, j)
-    // a[i]'s best pair among the remaining b: on each side, the nearest and every next one
-    // at the same |diff| (equal stamps, or rounding), the smallest index among them.
+    // a[i]'s best pair among the remaining b: walking away from a[i] on each side, |diff|
+    // only grows, so each walk stops at the first stamp farther than the best so far (every
+    // next one at the same |diff|, equal stamps or rounding, is weighed by its index).
     const auto best = [&](std::size_t i) -> std::optional<Cand> {
         std::optional<Cand> c;
-        const auto consider = [&](std::size_t k) {  // false: farther than the best on that side
+        const auto consider = [&](std::size_t k) {  // false: no stamp past k can be better
             const double d = std::abs(a[i] - sorted_b[k]);
-            if (!(d < max_dt)) return false;
-            const Cand x{d, i, order_b[k]};
-            if (c && std::get<0>(*c) < d) return false;
-            if (!c || x < *c) c = x;
+            if (!(d < max_dt) || (c && std::get<0>(*c) < d)) return false;
+            if (const Cand x{d, i, order_b[k]}; !c || x < *c) c = x;
             return true;
         };
         const std::size_t split = static_cast<std::size_t>(
             std::lower_bound(sorted_b.begin(), sorted_b.end(), a[i]) - sorted_b.begin());
-        std::optional<Cand> right;
         for (std::size_t k = left.atOrAfter(split); k < b.size(); k = left.atOrAfter(k + 1))
             if (!consider(k)) break;
-        right = c;
-        c.reset();
         for (std::size_t k = left.before(split); k > 0; k = left.before(k - 1))
             if (!consider(k - 1)) break;
-        if (!right) return c;
-        if (!c) return right;
-        return std::min(*c, *right);
+        return c;
     };
     std::priority_queue<Cand, std::vector<Cand>, std::greater<>> heap;
     for (std::size_t i = 0; i < a.size(); ++i)
