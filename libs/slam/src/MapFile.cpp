@@ -616,13 +616,25 @@ void checkOrbMatches(const MapFile& m, const std::string& path, const OrbExtract
 void checkCameraMatches(const MapFile& m, const std::string& path,
                         const core::CameraIntrinsics& camera) {
     const core::CameraIntrinsics& a = m.camera;
-    const auto near = [](double x, double y, double tol) { return std::abs(x - y) <= tol; };
-    bool same = a.width == camera.width && a.height == camera.height &&
-                near(a.fx, camera.fx, 1e-6) && near(a.fy, camera.fy, 1e-6) &&
-                near(a.cx, camera.cx, 1e-6) && near(a.cy, camera.cy, 1e-6);
+    // What differs beyond its tolerance, in full (the summaries below round to 0.1 px and
+    // may read the same); nothing: the same camera.
+    std::string differs;
+    const auto check = [&](const std::string& name, double x, double y, double tol) {
+        if (std::abs(x - y) <= tol) return;
+        char b[128];
+        std::snprintf(b, sizeof b, "%s%s %.10g in the map, %.10g in the input",
+                      differs.empty() ? "" : "; ", name.c_str(), x, y);
+        differs += b;
+    };
+    check("width", a.width, camera.width, 0);
+    check("height", a.height, camera.height, 0);
+    check("fx", a.fx, camera.fx, 1e-6);
+    check("fy", a.fy, camera.fy, 1e-6);
+    check("cx", a.cx, camera.cx, 1e-6);
+    check("cy", a.cy, camera.cy, 1e-6);
     for (std::size_t i = 0; i < a.dist.size(); ++i)
-        same = same && near(a.dist[i], camera.dist[i], 1e-9);
-    if (same) return;
+        check("dist[" + std::to_string(i) + "]", a.dist[i], camera.dist[i], 1e-9);
+    if (differs.empty()) return;
     const auto text = [](const core::CameraIntrinsics& k) {
         char b[160];
         std::snprintf(b, sizeof b, "fx=%.1f fy=%.1f cx=%.1f cy=%.1f %dx%d dist=[%g %g %g %g %g]",
@@ -630,23 +642,6 @@ void checkCameraMatches(const MapFile& m, const std::string& path,
                       k.dist[3], k.dist[4]);
         return std::string(b);
     };
-    // What differs, in full: the summaries round to 0.1 px and may read the same.
-    std::string differs;
-    const auto add = [&](const std::string& name, double x, double y) {
-        if (x == y) return;
-        char b[128];
-        std::snprintf(b, sizeof b, "%s%s %.10g in the map, %.10g in the input",
-                      differs.empty() ? "" : "; ", name.c_str(), x, y);
-        differs += b;
-    };
-    add("width", a.width, camera.width);
-    add("height", a.height, camera.height);
-    add("fx", a.fx, camera.fx);
-    add("fy", a.fy, camera.fy);
-    add("cx", a.cx, camera.cx);
-    add("cy", a.cy, camera.cy);
-    for (std::size_t i = 0; i < a.dist.size(); ++i)
-        add("dist[" + std::to_string(i) + "]", a.dist[i], camera.dist[i]);
     throw std::invalid_argument(path + ": the map was made with the camera " + text(a) +
                                 ", the input's is " + text(camera) + " (" + differs +
                                 "): its keyframes cannot be adjusted with another camera's "
