@@ -225,17 +225,8 @@ RunReport runSequence(io::RgbdReader& reader, const RunConfig& rc,
     auto within = [&](std::size_t i) { return rc.max_frames == 0 || i < rc.max_frames; };
     // The next frame; one that does not decode is left out with allow_damaged (the readers
     // pass it), else its error ends the run there. Nothing after a broken stream can be read.
-    const auto readNext = [&]() -> std::optional<core::Frame> {
-        while (true) {
-            try {
-                return reader.next();
-            } catch (const io::InputBroken&) {
-                throw;
-            } catch (const std::exception& e) {
-                if (!rc.allow_damaged) throw;
-                rep.undecodable.push_back(e.what());
-            }
-        }
+    const auto readNext = [&] {
+        return io::nextDecodable(reader, rc.allow_damaged, rep.undecodable);
     };
     std::optional<core::Frame> cur = readNext();
     if (cur) cur->index = 0;

@@ -14,16 +14,13 @@ ReplayReader::ReplayReader(io::RgbdReader& source, int passes, bool allow_damage
     while (true) {
         std::optional<core::Frame> f;
         try {
-            f = source.next();
+            f = io::nextDecodable(source, allow_damaged, undecodable);
         } catch (const io::InputBroken&) {
             throw;
-        } catch (const std::exception& e) {
-            if (!allow_damaged)
-                throw std::runtime_error(std::string(e.what()) +
-                                         " (--replay reads every frame before the first is "
-                                         "run; --allow-damaged leaves such frames out)");
-            undecodable.emplace_back(e.what());
-            continue;
+        } catch (const std::exception& e) {  // a frame that does not decode, without allow_damaged
+            throw std::runtime_error(std::string(e.what()) +
+                                     " (--replay reads every frame before the first is run; "
+                                     "--allow-damaged leaves such frames out)");
         }
         if (!f) break;
         frames_.push_back(std::move(*f));

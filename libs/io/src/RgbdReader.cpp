@@ -16,6 +16,20 @@ namespace fs = std::filesystem;
 
 namespace devslam::io {
 
+std::optional<core::Frame> nextDecodable(RgbdReader& reader, bool allow_damaged,
+                                         std::vector<std::string>& undecodable) {
+    while (true) {
+        try {
+            return reader.next();
+        } catch (const InputBroken&) {
+            throw;
+        } catch (const std::exception& e) {
+            if (!allow_damaged) throw;
+            undecodable.emplace_back(e.what());
+        }
+    }
+}
+
 void ReaderOptions::loadFromConfig(const mrpt::config::CConfigFileBase& c, const std::string& s) {
     core::requireKnownKeys(c, s, {"camera", "max_dt", "tum_depth_scale", "sensor_label"});
     camera = c.read_string(s, "camera", camera);

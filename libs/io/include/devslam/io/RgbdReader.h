@@ -20,6 +20,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace mrpt::config {
 class CConfigFileBase;
@@ -105,6 +106,13 @@ class RgbdReader {
     /// `ReaderOptions::allow_damaged`.
     [[nodiscard]] virtual std::string damage() const { return {}; }
 };
+
+/// The next frame of `reader` that decodes, or std::nullopt at the end. A frame whose next()
+/// throws (damaged: the reader passes it) is left out with `allow_damaged`, its message
+/// added to `undecodable`, else its error is thrown; InputBroken (nothing after it can be
+/// read) is thrown as it is.
+[[nodiscard]] std::optional<core::Frame> nextDecodable(RgbdReader& reader, bool allow_damaged,
+                                                       std::vector<std::string>& undecodable);
 
 /// A progress bar for an input that takes a while to open (a rawlog is read through to count
 /// its frames and check it: 6 s for 700 MB): "opening seq.rawlog [#####....] 350/705 MB ...
