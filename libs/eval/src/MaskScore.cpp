@@ -28,12 +28,11 @@ std::map<std::string, std::vector<PersonEntry>> readPersons(const std::string& p
         std::string t, state;
         PersonEntry p;
         int x = 0, y = 0, w = 0, h = 0;
+        const auto where = path + " line " + std::to_string(n) + ": ";
         if (!(ss >> t >> p.id >> p.name >> state >> x >> y >> w >> h >> p.visible_pixels) ||
             (state != "moving" && state != "static"))
             throw std::runtime_error(
-                path + " line " + std::to_string(n) +
-                ": expected 'timestamp id name moving|static x y w h visible_pixels'");
-        const auto where = path + " line " + std::to_string(n) + ": ";
+                where + "expected 'timestamp id name moving|static x y w h visible_pixels'");
         if (std::string extra; ss >> extra)
             throw std::runtime_error(where + "'" + extra + "' after the 9 values");
         // Label images are 8-bit, 0 the background: another id labels no pixel.
